@@ -1,0 +1,110 @@
+#include "bindings.hpp"
+#include "petsc4py_interop.hpp"
+#include "core/error.hpp"
+#include "mesh/mesh.hpp"
+#include "mesh/traversal.hpp"
+
+#include <pybind11/stl.h>
+
+namespace snede::bindings {
+namespace {
+
+using DoubleArray = py::array_t<double, py::array::c_style | py::array::forcecast>;
+using IndexArray = py::array_t<std::int64_t, py::array::c_style | py::array::forcecast>;
+
+std::vector<VertexId> to_vertex_ids(const IndexArray& a) {
+  std::vector<VertexId> ids(a.size());
+  for (py::ssize_t i = 0; i < a.size(); ++i) {
+    const std::int64_t v = a.data()[i];
+    if (v < 0 || v > std::numeric_limits<VertexId>::max())
+      throw std::invalid_argument("vertex id " + std::to_string(v) + " is out of range");
+    ids[i] = static_cast<VertexId>(v);
+  }
+  return ids;
+}
+
+Mesh make_mesh(const DoubleArray& points, const IndexArray& cells) {
+  if (points.ndim() != 2 || cells.ndim() != 2) throw std::invalid_argument("points and cells must be 2-D arrays");
+  const int dim = static_cast<int>(points.shape(1));
+  if (cells.shape(1) != dim + 1)
+    throw std::invalid_argument("cells must have " + std::to_string(dim + 1) + " columns for " + std::to_string(dim) +
+                                "-D points, got " + std::to_string(cells.shape(1)));
+  std::vector<double> p(points.data(), points.data() + points.size());
+  return Mesh(dim, std::move(p), std::span<const std::int64_t>(cells.data(), cells.size()));
+}
+
+py::dict quality_arrays(const Mesh& mesh) {
+  const auto q = mesh.quality();
+  py::array_t<double> volume(q.size()), aspect(q.size()), min_dihedral(q.size()), max_dihedral(q.size());
+  for (std::size_t i = 0; i < q.size(); ++i) {
+    volume.mutable_at(i) = q[i].volume;
+    aspect.mutable_at(i) = q[i].aspect_ratio;
+    min_dihedral.mutable_at(i) = q[i].min_dihedral;
+    max_dihedral.mutable_at(i) = q[i].max_dihedral;
+  }
+  py::dict out;
+  out["volume"] = volume;
+  out["aspect_ratio"] = aspect;
+  out["min_dihedral"] = min_dihedral;
+  out["max_dihedral"] = max_dihedral;
+  return out;
+}
+
+// The points as a sequential PETSc Vec of block size dim, handed to petsc4py.
+py::object points_vec(const Mesh& mesh) {
+  Vec v = nullptr;
+  SNEDE_PETSC(VecCreateSeq(PETSC_COMM_SELF, static_cast<PetscInt>(mesh.points().size()), &v));
+  SNEDE_PETSC(VecSetBlockSize(v, mesh.dim()));
+  PetscScalar* data = nullptr;
+  SNEDE_PETSC(VecGetArray(v, &data));
+  std::copy(mesh.points().begin(), mesh.points().end(), data);
+  SNEDE_PETSC(VecRestoreArray(v, &data));
+  py::object wrapped = to_petsc4py(v);
+  SNEDE_PETSC(VecDestroy(&v));
+  return wrapped;
+}
+
+std::vector<ElementId> star_of(const Mesh& mesh, VertexId v) { return vertex_star(mesh.connectivity(), v); }
+
+py::tuple components_of(const Mesh& mesh) {
+  auto [label, n] = connected_components(mesh.connectivity());
+  std::vector<int> live;
+  for (ElementId e : mesh.cell_ids()) live.push_back(label[e]);
+  return py::make_tuple(n, py::array_t<int>(live.size(), live.data()));
+}
+
+py::array_t<VertexId> dissect_mesh(Mesh& mesh, const IndexArray& faces) {
+  std::vector<VertexId> split;
+  for (const SplitVertex& s : mesh.dissect(to_vertex_ids(faces))) {
+    split.push_back(s.original);
+    split.push_back(s.copy);
+  }
+  return to_array(split, 2);
+}
+
+}  // namespace
+
+void bind_mesh(py::module_& m) {
+  py::register_exception<InvalidMesh>(m, "InvalidMesh", PyExc_ValueError);
+  py::class_<Mesh>(m, "Mesh")
+      .def(py::init(&make_mesh), py::arg("points"), py::arg("cells"))
+      .def_property_readonly("dim", &Mesh::dim)
+      .def_property_readonly("n_points", &Mesh::n_points)
+      .def_property_readonly("n_cells", &Mesh::n_cells)
+      .def_property_readonly("n_reoriented", &Mesh::n_reoriented)
+      .def_property_readonly("points", [](const Mesh& mesh) { return to_array(mesh.points(), mesh.dim()); })
+      .def_property_readonly("cells", [](const Mesh& mesh) { return to_array(mesh.cells(), mesh.dim() + 1); })
+      .def_property_readonly("cell_ids", &Mesh::cell_ids)
+      .def("boundary_faces", [](const Mesh& mesh) { return to_array(mesh.boundary_faces(), mesh.dim()); })
+      .def("quality", &quality_arrays)
+      .def("validate", &Mesh::validate)
+      .def("points_vec", &points_vec)
+      .def("star", &star_of, py::arg("vertex"))
+      .def("connected_components", &components_of)
+      .def("dissect", &dissect_mesh, py::arg("faces"))
+      .def("memory_bytes", [](const Mesh& mesh) {
+        return mesh.connectivity().memory_bytes() + mesh.points().capacity() * sizeof(double);
+      });
+}
+
+}  // namespace snede::bindings

@@ -1,0 +1,25 @@
+// One binding function per engine folder; module.cpp only calls them.
+#pragma once
+
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+
+#include <vector>
+
+namespace snede::bindings {
+
+namespace py = pybind11;
+
+void bind_core(py::module_& m);
+void bind_mesh(py::module_& m);
+
+// A (rows, columns) numpy array holding a copy of `values`.
+template <class T>
+py::array_t<T> to_array(const std::vector<T>& values, py::ssize_t columns) {
+  const py::ssize_t rows = columns ? static_cast<py::ssize_t>(values.size()) / columns : 0;
+  py::array_t<T> out({rows, columns});
+  std::copy(values.begin(), values.end(), out.mutable_data());
+  return out;
+}
+
+}  // namespace snede::bindings

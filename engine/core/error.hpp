@@ -1,0 +1,29 @@
+// Error handling: PETSc error codes become C++ exceptions (and, through the bindings,
+// Python exceptions) so that no PETSc failure aborts the process.
+#pragma once
+
+#include <petscsys.h>
+
+#include <stdexcept>
+#include <string>
+
+namespace snede {
+
+// A PETSc call returned a non-zero error code; what() carries PETSc's own message.
+class PetscError : public std::runtime_error {
+ public:
+  PetscError(PetscErrorCode code, const std::string& message)
+      : std::runtime_error(message), code_(code) {}
+  PetscErrorCode code() const noexcept { return code_; }
+
+ private:
+  PetscErrorCode code_;
+};
+
+// Throws PetscError with PETSc's text for `code` if it is non-zero; `call` names the call.
+void check_petsc(PetscErrorCode code, const char* call, const char* file, int line);
+
+}  // namespace snede
+
+// Wrap every PETSc call made by the engine: SNEDE_PETSC(VecCreate(comm, &v));
+#define SNEDE_PETSC(...) ::snede::check_petsc((__VA_ARGS__), #__VA_ARGS__, __FILE__, __LINE__)

@@ -1,0 +1,15 @@
+#include "core/options.hpp"
+
+#include "core/error.hpp"
+
+namespace snede {
+
+std::optional<double> option_real(const std::string& name) {
+  PetscReal value = 0;
+  PetscBool set = PETSC_FALSE;
+  SNEDE_PETSC(PetscOptionsGetReal(nullptr, nullptr, name.c_str(), &value, &set));
+  if (!set) return std::nullopt;
+  return static_cast<double>(value);
+}
+
+}  // namespace snede

@@ -1,0 +1,365 @@
+#include "mesh/connectivity.hpp"
+
+#include <algorithm>
+#include <stdexcept>
+#include <string>
+#include <unordered_set>
+
+namespace snede {
+namespace {
+
+std::string element_text(ElementId e) { return "element " + std::to_string(e); }
+
+}  // namespace
+
+Connectivity::Connectivity(int dim) : dim_(dim) {
+  if (dim < 1 || dim > max_dimension)
+    throw std::invalid_argument("Connectivity: dimension must be 1.." + std::to_string(max_dimension) +
+                                ", got " + std::to_string(dim));
+}
+
+Connectivity Connectivity::from_cells(int dim, std::span<const VertexId> cells) {
+  Connectivity c(dim);
+  const int n_vertices_per_cell = dim + 1;
+  if (cells.size() % n_vertices_per_cell != 0)
+    throw std::invalid_argument("Connectivity::from_cells: cell array length is not a multiple of " +
+                                std::to_string(n_vertices_per_cell));
+  const std::size_t n_cells = cells.size() / n_vertices_per_cell;
+  c.elements_.resize(n_cells);
+  c.faces_.resize(n_cells * n_vertices_per_cell);
+  c.n_elements_ = n_cells;
+
+  struct FaceKey {
+    std::array<VertexId, max_dimension> vertices;
+    FaceId face;
+  };
+  std::vector<FaceKey> keys(c.faces_.size());
+  for (std::size_t e = 0; e < n_cells; ++e) {
+    Element& element = c.elements_[e];
+    element.simplex = Simplex(1, cells.subspan(e * n_vertices_per_cell, n_vertices_per_cell));
+    for (int j = 0; j < n_vertices_per_cell; ++j) {
+      const FaceId f = static_cast<FaceId>(e * n_vertices_per_cell + j);
+      Face& face = c.faces_[f];
+      face.simplex = element.simplex.subn(j);
+      face.element = static_cast<ElementId>(e);
+      element.faces[j] = f;
+      FaceKey& key = keys[f];
+      key.vertices.fill(no_id);
+      for (int k = 0; k < dim; ++k) key.vertices[k] = face.simplex.vertex(k);
+      key.face = f;
+    }
+  }
+  std::sort(keys.begin(), keys.end(),
+            [](const FaceKey& a, const FaceKey& b) { return a.vertices < b.vertices; });
+
+  for (std::size_t i = 0; i < keys.size();) {
+    std::size_t end = i + 1;
+    while (end < keys.size() && keys[end].vertices == keys[i].vertices) ++end;
+    const FaceId a = keys[i].face;
+    if (end - i == 1) {
+      c.boundary_.emplace(c.faces_[a].simplex, a);
+    } else {
+      const FaceId b = keys[i + 1].face;
+      const ElementId ea = c.faces_[a].element, eb = c.faces_[b].element;
+      if (end - i > 2)
+        throw std::invalid_argument("Connectivity::from_cells: face " + c.faces_[a].simplex.to_string() +
+                                    " is shared by " + std::to_string(end - i) + " cells (" +
+                                    std::to_string(ea) + ", " + std::to_string(eb) +
+                                    ", ...): not a manifold mesh");
+      if (c.elements_[ea].simplex.same_vertices(c.elements_[eb].simplex))
+        throw std::invalid_argument("Connectivity::from_cells: cells " + std::to_string(ea) + " and " +
+                                    std::to_string(eb) + " have the same vertices");
+      if (c.faces_[a].simplex.sign() == c.faces_[b].simplex.sign())
+        throw std::invalid_argument("Connectivity::from_cells: cells " + std::to_string(ea) + " and " +
+                                    std::to_string(eb) + " lie on the same side of their common face " +
+                                    c.faces_[a].simplex.to_string() + " (they overlap)");
+      c.link(a, b);
+    }
+    i = end;
+  }
+  return c;
+}
+
+bool Connectivity::already_kept(const Simplex& sigma, const BoundaryMap& old_faces,
+                                const std::unordered_set<ElementId>& old_set) const {
+  if (boundary_.count(sigma)) return true;
+  // An interior face σ of a kept element is the mate of -σ; seen from -σ if that is an old face.
+  const auto minus = old_faces.find(sigma.mate());
+  if (minus == old_faces.end()) return false;
+  const FaceId mate = faces_[minus->second].mate;
+  return mate != no_id && !old_set.count(faces_[mate].element);
+}
+
+bool Connectivity::is_element(ElementId e) const {
+  return e >= 0 && e < element_capacity() && !elements_[e].simplex.empty();
+}
+
+bool Connectivity::is_face(FaceId f) const {
+  return f >= 0 && f < face_capacity() && faces_[f].element != no_id;
+}
+
+FaceId Connectivity::opposite_face(ElementId e, VertexId v) const {
+  const int j = elements_[e].simplex.index(v);
+  return j < 0 ? no_id : elements_[e].faces[j];
+}
+
+VertexId Connectivity::opposite_vertex(ElementId e, FaceId f) const {
+  const Element& element = elements_[e];
+  for (int j = 0; j <= dim_; ++j)
+    if (element.faces[j] == f) return element.simplex.vertex(j);
+  return no_id;
+}
+
+ElementId Connectivity::neighbor(ElementId e, int j) const {
+  const FaceId mate = faces_[elements_[e].faces[j]].mate;
+  return mate == no_id ? no_id : faces_[mate].element;
+}
+
+std::vector<ElementId> Connectivity::element_ids() const {
+  std::vector<ElementId> ids;
+  ids.reserve(n_elements_);
+  for (ElementId e = 0; e < element_capacity(); ++e)
+    if (!elements_[e].simplex.empty()) ids.push_back(e);
+  return ids;
+}
+
+ElementId Connectivity::allocate_element(const Simplex& simplex) {
+  ElementId e;
+  if (!free_elements_.empty()) {
+    e = free_elements_.back();
+    free_elements_.pop_back();
+  } else {
+    e = element_capacity();
+    elements_.emplace_back();
+  }
+  elements_[e].simplex = simplex;
+  ++n_elements_;
+  return e;
+}
+
+FaceId Connectivity::allocate_face(const Simplex& simplex) {
+  FaceId f;
+  if (!free_faces_.empty()) {
+    f = free_faces_.back();
+    free_faces_.pop_back();
+  } else {
+    f = face_capacity();
+    faces_.emplace_back();
+  }
+  faces_[f] = Face{simplex, no_id, no_id};
+  return f;
+}
+
+void Connectivity::release_element(ElementId e) {
+  elements_[e] = Element{};
+  free_elements_.push_back(e);
+  --n_elements_;
+}
+
+void Connectivity::release_face(FaceId f) {
+  faces_[f] = Face{};
+  free_faces_.push_back(f);
+}
+
+void Connectivity::link(FaceId a, FaceId b) {
+  faces_[a].mate = b;
+  faces_[b].mate = a;
+}
+
+std::vector<ElementId> Connectivity::replace_elements(std::span<const ElementId> old_elements,
+                                                      std::span<const Simplex> new_simplexes) {
+  // Checks first, so that a rejected call changes nothing.
+  std::unordered_set<ElementId> old_set;
+  BoundaryMap old_faces;  // simplex -> Face of an old element
+  for (ElementId e : old_elements) {
+    if (!is_element(e)) throw std::invalid_argument("replace_elements: " + element_text(e) + " does not exist");
+    if (!old_set.insert(e).second)
+      throw std::invalid_argument("replace_elements: " + element_text(e) + " is listed twice");
+    for (int j = 0; j <= dim_; ++j) old_faces.emplace(faces_[elements_[e].faces[j]].simplex, elements_[e].faces[j]);
+  }
+  BoundaryMap new_faces;  // simplex -> Face (reused or created); filled with no_id for now
+  for (const Simplex& tau : new_simplexes) {
+    if (tau.dimension() != dim_)
+      throw std::invalid_argument("replace_elements: simplex " + tau.to_string() + " has dimension " +
+                                  std::to_string(tau.dimension()) + ", the mesh has " + std::to_string(dim_));
+    for (int j = 0; j <= dim_; ++j) {
+      const Simplex sigma = tau.subn(j);
+      if (!new_faces.emplace(sigma, no_id).second)
+        throw std::invalid_argument("replace_elements: face " + sigma.to_string() +
+                                    " would belong to two new elements (7.4)");
+      if (!old_faces.count(sigma) && already_kept(sigma, old_faces, old_set))
+        throw std::invalid_argument("replace_elements: face " + sigma.to_string() +
+                                    " already belongs to an element that stays (7.4)");
+    }
+  }
+
+  ConnectivityChange change;
+  // Discard old faces that do not occur again; their surviving mates become orphans that
+  // join the boundary unless a new face pairs with them.
+  std::vector<FaceId> orphans;
+  for (const auto& [sigma, f] : old_faces) {
+    if (new_faces.count(sigma)) continue;
+    const FaceId mate = faces_[f].mate;
+    if (mate != no_id) {
+      const bool mate_discarded = old_faces.count(faces_[mate].simplex) && !new_faces.count(faces_[mate].simplex);
+      if (!mate_discarded) {
+        faces_[mate].mate = no_id;
+        orphans.push_back(mate);
+      }
+    } else {
+      boundary_.erase(sigma);
+      change.boundary_removed.push_back(sigma);
+    }
+    release_face(f);
+  }
+  for (ElementId e : old_elements) {
+    change.removed_elements.emplace_back(e, elements_[e].simplex);
+    release_element(e);
+  }
+
+  std::vector<FaceId> created;
+  std::vector<ElementId> added;
+  added.reserve(new_simplexes.size());
+  for (const Simplex& tau : new_simplexes) {
+    const ElementId e = allocate_element(tau);
+    added.push_back(e);
+    for (int j = 0; j <= dim_; ++j) {
+      const Simplex sigma = tau.subn(j);
+      FaceId f;
+      if (auto old = old_faces.find(sigma); old != old_faces.end()) {
+        f = old->second;  // reused: pointers to this face stay valid (§7.3)
+      } else {
+        f = allocate_face(sigma);
+        created.push_back(f);
+      }
+      faces_[f].element = e;
+      elements_[e].faces[j] = f;
+      new_faces[sigma] = f;
+    }
+  }
+  // Pair created faces: first among the new faces (matched pairs never touch the boundary
+  // map), then with the boundary; what stays unmatched joins the boundary.
+  for (FaceId f : created) {
+    if (faces_[f].mate != no_id) continue;
+    const Simplex minus = faces_[f].simplex.mate();
+    if (auto partner = new_faces.find(minus); partner != new_faces.end()) {
+      const FaceId g = partner->second;
+      if (faces_[g].mate == no_id && boundary_.erase(minus)) change.boundary_removed.push_back(minus);
+      link(f, g);
+    } else if (auto b = boundary_.find(minus); b != boundary_.end()) {
+      link(f, b->second);
+      change.boundary_removed.push_back(minus);
+      boundary_.erase(b);
+    } else {
+      boundary_.emplace(faces_[f].simplex, f);
+      change.boundary_added.push_back(f);
+    }
+  }
+  for (FaceId g : orphans) {
+    if (faces_[g].mate != no_id) continue;
+    boundary_.emplace(faces_[g].simplex, g);
+    change.boundary_added.push_back(g);
+  }
+  change.added_elements = added;
+  notify(change);
+  return added;
+}
+
+void Connectivity::change_elements(std::span<const ElementSubstitution> substitutions) {
+  std::unordered_set<ElementId> changed_set;
+  std::vector<Simplex> new_simplexes;
+  new_simplexes.reserve(substitutions.size());
+  for (const ElementSubstitution& s : substitutions) {
+    if (!is_element(s.element))
+      throw std::invalid_argument("change_elements: " + element_text(s.element) + " does not exist");
+    if (!changed_set.insert(s.element).second)
+      throw std::invalid_argument("change_elements: " + element_text(s.element) + " is listed twice");
+    try {
+      new_simplexes.push_back(elements_[s.element].simplex.mapped(s));
+    } catch (const std::invalid_argument&) {
+      throw std::invalid_argument("change_elements: the substitution is not injective on " +
+                                  element_text(s.element) + " " + elements_[s.element].simplex.to_string());
+    }
+  }
+
+  ConnectivityChange change;
+  // Unlink every face of a changed element; a mate outside the change becomes an orphan.
+  std::vector<FaceId> affected, orphans;
+  for (const ElementSubstitution& s : substitutions) {
+    for (int j = 0; j <= dim_; ++j) {
+      const FaceId f = elements_[s.element].faces[j];
+      affected.push_back(f);
+      const FaceId mate = faces_[f].mate;
+      if (mate == no_id) {
+        boundary_.erase(faces_[f].simplex);
+        change.boundary_removed.push_back(faces_[f].simplex);
+      } else if (!changed_set.count(faces_[mate].element)) {
+        faces_[mate].mate = no_id;
+        orphans.push_back(mate);
+      }
+      faces_[f].mate = no_id;
+    }
+  }
+  // Rename: the face opposite vertex v becomes the face opposite π(v), so (7.1) holds again.
+  for (std::size_t i = 0; i < substitutions.size(); ++i) {
+    const ElementSubstitution& s = substitutions[i];
+    Element& element = elements_[s.element];
+    const Simplex& tau_new = new_simplexes[i];
+    std::array<FaceId, max_dimension + 1> faces{no_id, no_id, no_id, no_id};
+    for (int j = 0; j <= dim_; ++j) {
+      const int j_new = tau_new.index(s(element.simplex.vertex(j)));
+      faces[j_new] = element.faces[j];
+      faces_[element.faces[j]].simplex = tau_new.subn(j_new);
+    }
+    change.changed_elements.emplace_back(s.element, element.simplex);
+    element.simplex = tau_new;
+    element.faces = faces;
+  }
+  // Re-pair: affected faces and orphans with each other first, then with the boundary.
+  BoundaryMap local;
+  for (FaceId f : affected) local.emplace(faces_[f].simplex, f);
+  for (FaceId g : orphans) local.emplace(faces_[g].simplex, g);
+  for (FaceId f : affected) {
+    if (faces_[f].mate != no_id) continue;
+    const Simplex minus = faces_[f].simplex.mate();
+    if (auto partner = local.find(minus); partner != local.end() && faces_[partner->second].mate == no_id) {
+      link(f, partner->second);
+    } else if (auto b = boundary_.find(minus); b != boundary_.end()) {
+      link(f, b->second);
+      change.boundary_removed.push_back(minus);
+      boundary_.erase(b);
+    } else {
+      boundary_.emplace(faces_[f].simplex, f);
+      change.boundary_added.push_back(f);
+    }
+  }
+  for (FaceId g : orphans) {
+    if (faces_[g].mate != no_id) continue;
+    boundary_.emplace(faces_[g].simplex, g);
+    change.boundary_added.push_back(g);
+  }
+  notify(change);
+}
+
+void Connectivity::add_watcher(ConnectivityWatcher* watcher) {
+  watchers_.push_back(watcher);
+  watcher->init(*this);
+}
+
+void Connectivity::remove_watcher(ConnectivityWatcher* watcher) {
+  watchers_.erase(std::remove(watchers_.begin(), watchers_.end(), watcher), watchers_.end());
+}
+
+void Connectivity::notify(const ConnectivityChange& change) {
+  for (ConnectivityWatcher* watcher : watchers_) watcher->on_change(*this, change);
+}
+
+std::size_t Connectivity::memory_bytes() const {
+  // unordered_map: one node (key, value, next pointer, cached hash) per entry plus buckets.
+  const std::size_t boundary_node = sizeof(Simplex) + sizeof(FaceId) + 2 * sizeof(void*);
+  return elements_.capacity() * sizeof(Element) + faces_.capacity() * sizeof(Face) +
+         (free_elements_.capacity() + free_faces_.capacity()) * sizeof(std::int32_t) +
+         boundary_.size() * boundary_node + boundary_.bucket_count() * sizeof(void*);
+}
+
+}  // namespace snede

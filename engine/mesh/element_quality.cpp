@@ -1,0 +1,116 @@
+#include "mesh/element_quality.hpp"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <stdexcept>
+
+namespace snede {
+namespace {
+
+template <int D>
+using Corners = Eigen::Matrix<double, D + 1, D, Eigen::RowMajor>;
+
+template <int D>
+Eigen::Map<const Corners<D>> corners_of(std::span<const double> corners) {
+  if (corners.size() != static_cast<std::size_t>((D + 1) * D))
+    throw std::invalid_argument("element_quality: expected " + std::to_string((D + 1) * D) + " coordinates");
+  return Eigen::Map<const Corners<D>>(corners.data());
+}
+
+template <int D>
+double signed_volume_of(const Corners<D>& x) {
+  Eigen::Matrix<double, D, D> edges;
+  for (int i = 0; i < D; ++i) edges.row(i) = x.row(i + 1) - x.row(0);
+  return edges.determinant() / (D == 2 ? 2.0 : 6.0);
+}
+
+template <int D>
+double longest_edge_of(const Corners<D>& x) {
+  double longest = 0;
+  for (int i = 0; i <= D; ++i)
+    for (int j = i + 1; j <= D; ++j) longest = std::max(longest, (x.row(i) - x.row(j)).norm());
+  return longest;
+}
+
+// Measure of the facet opposite corner i: length of an edge in 2D, area of a triangle in 3D.
+template <int D>
+double facet_measure(const Corners<D>& x, int i) {
+  int other[D];
+  for (int j = 0, k = 0; j <= D; ++j)
+    if (j != i) other[k++] = j;
+  if constexpr (D == 2) {
+    return (x.row(other[0]) - x.row(other[1])).norm();
+  } else {
+    const Eigen::Vector3d a = x.row(other[1]) - x.row(other[0]);
+    const Eigen::Vector3d b = x.row(other[2]) - x.row(other[0]);
+    return 0.5 * a.cross(b).norm();
+  }
+}
+
+template <int D>
+ElementQuality quality_of(const Corners<D>& x) {
+  ElementQuality q;
+  q.volume = signed_volume_of<D>(x);
+  double min_height = std::numeric_limits<double>::infinity();
+  for (int i = 0; i <= D; ++i) min_height = std::min(min_height, D * std::abs(q.volume) / facet_measure<D>(x, i));
+  q.aspect_ratio = min_height / longest_edge_of<D>(x);
+  q.min_dihedral = std::numbers::pi;
+  q.max_dihedral = 0;
+  if constexpr (D == 2) {
+    for (int i = 0; i < 3; ++i) {
+      const Eigen::Vector2d a = x.row((i + 1) % 3) - x.row(i), b = x.row((i + 2) % 3) - x.row(i);
+      const double angle = std::atan2(std::abs(a.x() * b.y() - a.y() * b.x()), a.dot(b));
+      q.min_dihedral = std::min(q.min_dihedral, angle);
+      q.max_dihedral = std::max(q.max_dihedral, angle);
+    }
+  } else {
+    // Dihedral angle at edge (i, j): angle between the two faces containing it, measured
+    // from the components of the other two corners orthogonal to the edge.
+    for (int i = 0; i < 4; ++i)
+      for (int j = i + 1; j < 4; ++j) {
+        int k = 0;
+        while (k == i || k == j) ++k;
+        int l = 6 - i - j - k;
+        const Eigen::Vector3d edge = (x.row(j) - x.row(i)).normalized();
+        Eigen::Vector3d u = x.row(k) - x.row(i), w = x.row(l) - x.row(i);
+        u -= u.dot(edge) * edge;
+        w -= w.dot(edge) * edge;
+        const double angle = std::atan2(u.cross(w).norm(), u.dot(w));
+        q.min_dihedral = std::min(q.min_dihedral, angle);
+        q.max_dihedral = std::max(q.max_dihedral, angle);
+      }
+  }
+  return q;
+}
+
+template <class F>
+auto dispatch(int dim, std::span<const double> corners, F&& f) {
+  if (dim == 2) return f(Corners<2>(corners_of<2>(corners)));
+  if (dim == 3) return f(Corners<3>(corners_of<3>(corners)));
+  throw std::invalid_argument("element_quality: dimension must be 2 or 3, got " + std::to_string(dim));
+}
+
+}  // namespace
+
+double signed_volume(int dim, std::span<const double> corners) {
+  return dispatch(dim, corners, [](const auto& x) {
+    return signed_volume_of<std::decay_t<decltype(x)>::ColsAtCompileTime>(x);
+  });
+}
+
+double longest_edge(int dim, std::span<const double> corners) {
+  return dispatch(dim, corners, [](const auto& x) {
+    return longest_edge_of<std::decay_t<decltype(x)>::ColsAtCompileTime>(x);
+  });
+}
+
+ElementQuality element_quality(int dim, std::span<const double> corners) {
+  return dispatch(dim, corners, [](const auto& x) {
+    return quality_of<std::decay_t<decltype(x)>::ColsAtCompileTime>(x);
+  });
+}
+
+}  // namespace snede

@@ -1,0 +1,21 @@
+// Geometric measures of one simplex: signed volume (area in 2D), aspect ratio (minimum
+// height over maximum edge, §3.2.3) and the extreme dihedral angles (interior angles in 2D).
+#pragma once
+
+#include <span>
+
+namespace snede {
+
+struct ElementQuality {
+  double volume = 0;        // positive for a positively oriented element
+  double aspect_ratio = 0;  // min height / max edge: 0.816 for the regular tetrahedron, 0.866 for the regular triangle
+  double min_dihedral = 0;  // radians
+  double max_dihedral = 0;  // radians
+};
+
+// `corners`: (dim + 1, dim) coordinates, row-major; dim is 2 or 3.
+double signed_volume(int dim, std::span<const double> corners);
+double longest_edge(int dim, std::span<const double> corners);
+ElementQuality element_quality(int dim, std::span<const double> corners);
+
+}  // namespace snede

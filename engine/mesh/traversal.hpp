@@ -1,0 +1,32 @@
+// Walking the connectivity: around a (d-2)-simplex (§7.2 cycle-around), stars of vertices
+// and of any simplex, boundary faces, connected components.
+#pragma once
+
+#include <vector>
+
+#include "mesh/connectivity.hpp"
+
+namespace snede {
+
+// §7.2 cycle-around: the elements containing σ = entry.simplex.subn(j), in the order met
+// when walking from face to mate around σ. Where the walk reaches the boundary it also walks
+// the other way from entry's mate, so the result is the whole ring around σ (in order along
+// the ring, starting at one boundary end when σ is on the boundary).
+std::vector<ElementId> cycle_around(const Connectivity& c, FaceId entry, int j);
+
+// All elements containing every vertex of `s`, found by walking across faces that contain
+// `s`, starting from `start` (which must contain s). For a vertex this is its star.
+std::vector<ElementId> elements_around(const Connectivity& c, const Simplex& s, ElementId start);
+
+// The star of vertex v (§7.3), starting the walk at an element containing v. Without a start
+// element the elements are scanned for one first (O(n)). Empty if no element contains v.
+std::vector<ElementId> vertex_star(const Connectivity& c, VertexId v, ElementId start = no_id);
+
+// Face ids of the boundary faces, sorted by their simplex (deterministic order).
+std::vector<FaceId> boundary_faces(const Connectivity& c);
+
+// Component label per element id (no_id for free slots), components being classes of
+// elements joined through faces; second member is the number of components.
+std::pair<std::vector<int>, int> connected_components(const Connectivity& c);
+
+}  // namespace snede

@@ -1,0 +1,182 @@
+"""The user-facing simplicial mesh: triangles in 2D, tetrahedra in 3D (thesis §7)."""
+from __future__ import annotations
+
+from pathlib import Path
+from typing import NamedTuple
+
+import numpy as np
+
+from snede import _snede
+
+
+class MeshQuality(NamedTuple):
+    """Per-cell measures, each an array of shape (n_cells,), in the row order of ``Mesh.cells``."""
+
+    volume: np.ndarray  #: volume (area in 2D), positive
+    aspect_ratio: np.ndarray  #: minimum height / maximum edge (§3.2.3); 0.816 regular tet, 0.866 regular triangle
+    min_dihedral: np.ndarray  #: smallest dihedral angle, radians (smallest interior angle in 2D)
+    max_dihedral: np.ndarray  #: largest dihedral angle, radians (largest interior angle in 2D)
+
+
+def _as_points(points) -> np.ndarray:
+    array = np.asarray(points)
+    if array.dtype.kind not in "fiu":
+        raise ValueError(f"points must be real numbers (float64), got dtype {array.dtype}")
+    if array.ndim != 2 or array.shape[1] not in (2, 3):
+        raise ValueError(f"points must have shape (n_points, 2) or (n_points, 3), got {array.shape}")
+    if array.shape[0] == 0:
+        raise ValueError("points is empty: a mesh needs at least one cell")
+    return np.ascontiguousarray(array, dtype=np.float64)
+
+
+def _as_cells(cells, dim: int) -> np.ndarray:
+    array = np.asarray(cells)
+    if array.dtype.kind not in "iu":
+        raise ValueError(f"cells must be integer vertex indices, got dtype {array.dtype}")
+    if array.ndim != 2 or array.shape[1] != dim + 1:
+        raise ValueError(
+            f"cells must have shape (n_cells, {dim + 1}) for {dim}-D points, got {array.shape}"
+        )
+    if array.shape[0] == 0:
+        raise ValueError("cells is empty: a mesh needs at least one cell")
+    if array.dtype.kind == "u" and array.max() > np.iinfo(np.int64).max:
+        raise ValueError("cells holds vertex indices beyond int64")
+    return np.ascontiguousarray(array, dtype=np.int64)
+
+
+class Mesh:
+    """A simplicial mesh with the connectivity of thesis §7.
+
+    ``Mesh(points, cells)``: ``points`` is ``(n_points, dim)`` with dim 2 or 3 (float64),
+    ``cells`` is ``(n_cells, dim + 1)`` integer vertex indices. Bad input raises
+    ``ValueError`` naming the problem and the offending index: wrong shapes or dtypes,
+    out-of-range or repeated vertex indices in a cell, non-finite coordinates, zero-volume
+    cells, a face shared by more than two cells, two cells overlapping across a face.
+
+    Cells with negative orientation (negative signed volume) are re-oriented by swapping
+    their first two vertices, so every cell of ``mesh.cells`` has positive volume;
+    ``mesh.n_reoriented`` says how many were turned.
+    """
+
+    def __init__(self, points, cells):
+        points = _as_points(points)
+        cells = _as_cells(cells, points.shape[1])
+        self._impl = _snede.Mesh(points, cells)
+
+    @classmethod
+    def _wrap(cls, impl) -> "Mesh":
+        mesh = cls.__new__(cls)
+        mesh._impl = impl
+        return mesh
+
+    # -- properties --------------------------------------------------------------------
+    @property
+    def dim(self) -> int:
+        return self._impl.dim
+
+    @property
+    def n_points(self) -> int:
+        return self._impl.n_points
+
+    @property
+    def n_cells(self) -> int:
+        return self._impl.n_cells
+
+    @property
+    def n_reoriented(self) -> int:
+        """How many input cells were re-oriented to positive volume."""
+        return self._impl.n_reoriented
+
+    @property
+    def points(self) -> np.ndarray:
+        """(n_points, dim) coordinates (a copy)."""
+        return self._impl.points
+
+    @property
+    def cells(self) -> np.ndarray:
+        """(n_cells, dim + 1) vertex indices, each row positively oriented (a copy)."""
+        return self._impl.cells
+
+    @property
+    def cell_ids(self) -> np.ndarray:
+        """(n_cells,) element id of each row of ``cells`` (ids stay stable across mesh changes)."""
+        return np.asarray(self._impl.cell_ids, dtype=np.int64)
+
+    # -- queries -----------------------------------------------------------------------
+    def boundary_faces(self) -> np.ndarray:
+        """(n_faces, dim) vertex indices of the boundary faces (edges in 2D), oriented with the
+        outward normal in 3D and counter-clockwise around the body in 2D."""
+        return self._impl.boundary_faces()
+
+    def quality(self) -> MeshQuality:
+        """Per-cell volume, aspect ratio and extreme dihedral angles, see MeshQuality."""
+        return MeshQuality(**self._impl.quality())
+
+    def validate(self) -> None:
+        """Check the connectivity invariants (7.1)–(7.5) and positive orientation of every
+        cell; raise ``snede.InvalidMesh`` (a ValueError) describing the first violation."""
+        self._impl.validate()
+
+    def star(self, vertex: int) -> np.ndarray:
+        """Element ids of the cells containing ``vertex`` (O(n) to find the first one)."""
+        return np.asarray(self._impl.star(int(vertex)), dtype=np.int64)
+
+    def connected_components(self) -> tuple[int, np.ndarray]:
+        """(number of components, (n_cells,) component label per row of ``cells``)."""
+        return self._impl.connected_components()
+
+    def points_vec(self):
+        """The coordinates as a sequential ``petsc4py.PETSc.Vec`` of block size ``dim``."""
+        return self._impl.points_vec()
+
+    def memory_bytes(self) -> int:
+        """Bytes held by the coordinates and the connectivity (capacity, not just size)."""
+        return self._impl.memory_bytes()
+
+    # -- changes -----------------------------------------------------------------------
+    def dissect(self, faces) -> np.ndarray:
+        """Cut along interior faces (§7.3), given as ``(n, dim)`` vertex indices (either
+        orientation). Vertices whose star the cut splits are duplicated (same coordinates).
+        Returns ``(n_new, 2)`` pairs ``(original, copy)``."""
+        faces = np.asarray(faces)
+        if faces.dtype.kind not in "iu" or faces.ndim != 2 or faces.shape[1] != self.dim:
+            raise ValueError(f"faces must be (n, {self.dim}) integer vertex indices, got {faces.shape} {faces.dtype}")
+        return self._impl.dissect(np.ascontiguousarray(faces, dtype=np.int64))
+
+    # -- files -------------------------------------------------------------------------
+    @classmethod
+    def read(cls, path) -> "Mesh":
+        """Read a mesh with meshio (gmsh .msh, VTK/VTU, XDMF, and every format meshio reads).
+        Tetrahedra are taken if present, else triangles (whose z must be 0)."""
+        import meshio
+
+        data = meshio.read(str(path))
+        blocks = {block.type: block.data for block in data.cells}
+        if "tetra" in blocks:
+            cells = np.concatenate([b.data for b in data.cells if b.type == "tetra"])
+            points = data.points
+        elif "triangle" in blocks:
+            cells = np.concatenate([b.data for b in data.cells if b.type == "triangle"])
+            points = data.points
+            if points.shape[1] == 3:
+                if np.any(points[:, 2] != 0):
+                    raise ValueError(f"{path}: triangles with non-zero z (a surface in 3D) are not supported")
+                points = points[:, :2]
+        else:
+            raise ValueError(f"{path}: no tetrahedra or triangles (cell types: {sorted(blocks)})")
+        return cls(points, cells)
+
+    def write(self, path) -> None:
+        """Write with meshio; the format follows the file extension (.msh, .vtu, .xdmf, ...)."""
+        import meshio
+
+        points = self.points
+        if self.dim == 2:
+            points = np.column_stack([points, np.zeros(len(points))])
+        kind = "tetra" if self.dim == 3 else "triangle"
+        Path(path).parent.mkdir(parents=True, exist_ok=True)
+        meshio.Mesh(points, [(kind, self.cells)]).write(str(path))
+
+    def __repr__(self) -> str:
+        kind = "tetrahedra" if self.dim == 3 else "triangles"
+        return f"<snede.Mesh {self.n_cells} {kind}, {self.n_points} points>"

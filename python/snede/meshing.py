@@ -1,0 +1,110 @@
+"""Mesh generators: structured boxes and rectangles, unstructured cylinders (gmsh)."""
+from __future__ import annotations
+
+import itertools
+
+import numpy as np
+
+from snede.mesh import Mesh
+
+
+def _grid_points(size, divisions) -> np.ndarray:
+    axes = [np.linspace(0.0, s, n + 1) for s, n in zip(size, divisions)]
+    return np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, len(size))
+
+
+def _check(size, divisions, dim: int):
+    size = tuple(float(s) for s in size)
+    divisions = tuple(int(n) for n in divisions)
+    if len(size) != dim or len(divisions) != dim:
+        raise ValueError(f"size and divisions must have {dim} entries, got {size} and {divisions}")
+    if not all(np.isfinite(s) and s > 0 for s in size):
+        raise ValueError(f"size must be positive and finite, got {size}")
+    if not all(n >= 1 for n in divisions):
+        raise ValueError(f"divisions must be at least 1, got {divisions}")
+    return size, divisions
+
+
+def box(size=(1.0, 1.0, 1.0), divisions=(10, 10, 10)) -> Mesh:
+    """Structured tetrahedra on [0, size]: each of the nx·ny·nz cubes split into six
+    tetrahedra around its main diagonal (the Kuhn split, which conforming bisection needs).
+    Gives 6·nx·ny·nz cells and (nx+1)(ny+1)(nz+1) points."""
+    size, divisions = _check(size, divisions, 3)
+    nx, ny, nz = divisions
+    points = _grid_points(size, divisions)
+
+    def vertex(i, j, k):
+        return (i * (ny + 1) + j) * (nz + 1) + k
+
+    i, j, k = (a.ravel() for a in np.meshgrid(np.arange(nx), np.arange(ny), np.arange(nz), indexing="ij"))
+    cells = []
+    # Kuhn split: one tetrahedron per path 000 -> 111 along the axes in the order of a permutation.
+    for permutation in itertools.permutations(range(3)):
+        corner = np.zeros(3, dtype=np.int64)
+        path = [vertex(i, j, k)]
+        for axis in permutation:
+            corner[axis] += 1
+            path.append(vertex(i + corner[0], j + corner[1], k + corner[2]))
+        odd = np.linalg.det(np.eye(3)[list(permutation)]) < 0
+        if odd:  # keep every cell positively oriented
+            path[2], path[3] = path[3], path[2]
+        cells.append(np.stack(path, axis=1))
+    return Mesh(points, np.concatenate(cells))
+
+
+def rectangle(size=(1.0, 1.0), divisions=(10, 10)) -> Mesh:
+    """Structured right triangles on [0, size]: each square split along its diagonal from
+    (x, y) to (x + hx, y + hy). Gives 2·nx·ny cells and (nx+1)(ny+1) points."""
+    size, divisions = _check(size, divisions, 2)
+    nx, ny = divisions
+    points = _grid_points(size, divisions)
+    i, j = (a.ravel() for a in np.meshgrid(np.arange(nx), np.arange(ny), indexing="ij"))
+
+    def vertex(i, j):
+        return i * (ny + 1) + j
+
+    lower = np.stack([vertex(i, j), vertex(i + 1, j), vertex(i + 1, j + 1)], axis=1)
+    upper = np.stack([vertex(i, j), vertex(i + 1, j + 1), vertex(i, j + 1)], axis=1)
+    return Mesh(points, np.concatenate([lower, upper]))
+
+
+def cylinder(length=0.1, radius=0.03, h=0.01, seed: int | None = None) -> Mesh:
+    """Unstructured tetrahedra of the cylinder 0 ≤ x ≤ length, y² + z² ≤ radius², meshed by
+    gmsh (Delaunay, then optimised) with target edge length ``h``. Deterministic for given
+    arguments (gmsh's random factor is fixed by ``seed`` when given)."""
+    import gmsh
+
+    for name, value in (("length", length), ("radius", radius), ("h", h)):
+        if not (np.isfinite(value) and value > 0):
+            raise ValueError(f"{name} must be positive and finite, got {value}")
+    initialized_here = not gmsh.isInitialized()
+    if initialized_here:
+        gmsh.initialize(["gmsh", "-noenv"], readConfigFiles=False)
+    try:
+        gmsh.option.setNumber("General.Terminal", 0)
+        gmsh.model.add("snede-cylinder")
+        gmsh.model.occ.addCylinder(0, 0, 0, length, 0, 0, radius)
+        gmsh.model.occ.synchronize()
+        gmsh.option.setNumber("Mesh.MeshSizeMin", h)
+        gmsh.option.setNumber("Mesh.MeshSizeMax", h)
+        gmsh.option.setNumber("Mesh.Algorithm3D", 1)  # Delaunay
+        gmsh.option.setNumber("Mesh.Optimize", 1)
+        if seed is not None:
+            gmsh.option.setNumber("Mesh.RandomSeed", seed)
+        gmsh.model.mesh.generate(3)
+        node_tags, coords, _ = gmsh.model.mesh.getNodes()
+        element_types, _, element_nodes = gmsh.model.mesh.getElements(3)
+        gmsh.model.remove()
+    finally:
+        if initialized_here:
+            gmsh.finalize()
+    points = coords.reshape(-1, 3)
+    index_of_tag = np.zeros(int(node_tags.max()) + 1, dtype=np.int64)
+    index_of_tag[node_tags.astype(np.int64)] = np.arange(len(node_tags))
+    tetra = [nodes for kind, nodes in zip(element_types, element_nodes) if kind == 4]
+    if not tetra:
+        raise RuntimeError("gmsh produced no tetrahedra")
+    cells = index_of_tag[np.concatenate(tetra).astype(np.int64)].reshape(-1, 4)
+    # gmsh lists nodes that are not in any tetrahedron (geometry points); keep only used ones.
+    used, cells = np.unique(cells, return_inverse=True)
+    return Mesh(points[used], cells.reshape(-1, 4))

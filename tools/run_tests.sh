@@ -1,0 +1,24 @@
+#!/usr/bin/env bash
+# make test: C++ tests through ctest, then Python tests through pytest. Prints both summaries
+# and exits non-zero if either failed.
+set -uo pipefail
+cd "$(dirname "$0")/.."
+export PATH="$PWD/.venv/bin:$PATH"
+export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_rmaps_base_oversubscribe=1
+
+cpp_status=0
+{ cmake -S . -B build/cpp -G Ninja -DSNEDE_BUILD_TESTS=ON -DSNEDE_BUILD_PYTHON=OFF >/dev/null &&
+  cmake --build build/cpp; } || cpp_status=$?
+if [ $cpp_status -eq 0 ]; then
+  ctest --test-dir build/cpp --output-on-failure -j2 | tee build/ctest.log | tail -n 25
+  cpp_status=${PIPESTATUS[0]}
+fi
+
+.venv/bin/python -m pytest -q tests/python 2>&1 | tee build/pytest.log
+py_status=${PIPESTATUS[0]}
+
+echo
+echo "== summary =="
+echo "ctest:  $(grep -E 'tests passed|tests failed' build/ctest.log 2>/dev/null || echo "did not run (build failed, status $cpp_status)")"
+echo "pytest: $(tail -n 1 build/pytest.log)"
+[ $cpp_status -eq 0 ] && [ $py_status -eq 0 ]
