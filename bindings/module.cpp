@@ -8,4 +8,5 @@ PYBIND11_MODULE(_snede, m) {
   snede::bindings::import_petsc4py_api();
   snede::bindings::bind_core(m);
   snede::bindings::bind_mesh(m);
+  snede::bindings::bind_fem(m);
 }

@@ -20,5 +20,5 @@ py_status=${PIPESTATUS[0]}
 echo
 echo "== summary =="
 echo "ctest:  $(grep -E 'tests passed|tests failed' build/ctest.log 2>/dev/null || echo "did not run (build failed, status $cpp_status)")"
-echo "pytest: $(tail -n 1 build/pytest.log)"
+echo "pytest: $(grep -v "^\s*$" build/pytest.log | tail -n 1)"
 [ $cpp_status -eq 0 ] && [ $py_status -eq 0 ]

@@ -3,9 +3,22 @@
 Importing snede initialises PETSc once, through petsc4py (see ``snede._petsc``).
 """
 from snede._petsc import PETSc  # noqa: F401  (initialises PETSc before the engine loads)
-from snede._snede import InvalidMesh, PetscError  # noqa: F401
+from snede._snede import (  # noqa: F401
+    DomainError,
+    InvalidMesh,
+    LinearElastic,
+    NeoHookean,
+    PetscError,
+    StVenantKirchhoff,
+    VerondaWestmann,
+)
 from snede.mesh import Mesh, MeshQuality  # noqa: F401
+from snede.body import Body  # noqa: F401
 from snede import meshing  # noqa: F401
 
-__all__ = ["Mesh", "MeshQuality", "InvalidMesh", "PetscError", "PETSc", "meshing"]
+__all__ = [
+    "Mesh", "MeshQuality", "Body", "meshing",
+    "LinearElastic", "StVenantKirchhoff", "NeoHookean", "VerondaWestmann",
+    "InvalidMesh", "PetscError", "DomainError", "PETSc",
+]
 __version__ = "0.1.0"

@@ -1,0 +1,109 @@
+#include "bindings.hpp"
+#include "fem/elastic_body.hpp"
+
+#include <pybind11/stl.h>
+
+namespace snede::bindings {
+namespace {
+
+using DoubleArray = py::array_t<double, py::array::c_style | py::array::forcecast>;
+
+std::span<const double> view(const DoubleArray& a) { return {a.data(), static_cast<std::size_t>(a.size())}; }
+
+// Runs an evaluation that fills a (n_points, dim) array, raising DomainError on overflow.
+template <class Evaluate>
+py::array_t<double> nodal_result(const ElasticBody& body, Evaluate&& evaluate) {
+  std::vector<double> out(body.n_dofs());
+  EvaluationReport report;
+  evaluate(std::span<double>(out), report);
+  throw_if_domain_error(report);
+  return to_array(out, body.dim());
+}
+
+double energy_of(const ElasticBody& body, const DoubleArray& u) {
+  EvaluationReport report;
+  const double value = body.energy(view(u), report);
+  throw_if_domain_error(report);
+  return value;
+}
+
+py::array_t<double> forces_of(const ElasticBody& body, const DoubleArray& u) {
+  return nodal_result(body, [&](std::span<double> f, EvaluationReport& r) { body.internal_forces(view(u), f, r); });
+}
+
+py::array_t<double> tangent_of(const ElasticBody& body, const DoubleArray& u, const DoubleArray& d) {
+  return nodal_result(body, [&](std::span<double> out, EvaluationReport& r) { body.tangent_apply(view(u), view(d), out, r); });
+}
+
+py::array_t<double> stress_of(const ElasticBody& body, const DoubleArray& u) {
+  const std::vector<double> s = body.element_stress(view(u));
+  py::array_t<double> out({static_cast<py::ssize_t>(s.size() / (body.dim() * body.dim())),
+                           static_cast<py::ssize_t>(body.dim()), static_cast<py::ssize_t>(body.dim())});
+  std::copy(s.begin(), s.end(), out.mutable_data());
+  return out;
+}
+
+py::array_t<double> stiffness_of(const ElasticBody& body, ElementId e, const DoubleArray& u) {
+  return to_array(body.element_stiffness(e, view(u)), (body.dim() + 1) * body.dim());
+}
+
+// std::variant's caster needs default-constructible alternatives; materials have none.
+Material material_from(const py::handle& object) {
+  if (py::isinstance<LinearElastic>(object)) return object.cast<LinearElastic>();
+  if (py::isinstance<StVenantKirchhoff>(object)) return object.cast<StVenantKirchhoff>();
+  if (py::isinstance<NeoHookean>(object)) return object.cast<NeoHookean>();
+  if (py::isinstance<VerondaWestmann>(object)) return object.cast<VerondaWestmann>();
+  throw py::type_error("material must be LinearElastic, StVenantKirchhoff, NeoHookean or VerondaWestmann, got " +
+                       py::str(py::type::of(object)).cast<std::string>());
+}
+
+std::unique_ptr<ElasticBody> make_body(Mesh& mesh, const py::handle& material, double density, double thickness) {
+  return std::make_unique<ElasticBody>(mesh, material_from(material), density, thickness);
+}
+
+py::dict flops_of(const ElasticBody& body) {
+  const KernelFlops f = body.flops_per_element();
+  py::dict out;
+  out["energy"] = f.energy;
+  out["force"] = f.force;
+  out["tangent"] = f.tangent;
+  out["functions"] = f.functions;
+  return out;
+}
+
+}  // namespace
+
+void bind_fem(py::module_& m) {
+  py::register_exception<DomainError>(m, "DomainError", PyExc_ArithmeticError);
+  py::class_<LinearElastic>(m, "LinearElastic")
+      .def(py::init<double, double>(), py::arg("E"), py::arg("nu"))
+      .def_property_readonly("lame", [](const LinearElastic& s) { return py::make_tuple(s.lame.lambda, s.lame.mu); });
+  py::class_<StVenantKirchhoff>(m, "StVenantKirchhoff")
+      .def(py::init<double, double>(), py::arg("E"), py::arg("nu"))
+      .def_property_readonly("lame", [](const StVenantKirchhoff& s) { return py::make_tuple(s.lame.lambda, s.lame.mu); });
+  py::class_<NeoHookean>(m, "NeoHookean")
+      .def(py::init<double, double>(), py::arg("E"), py::arg("nu"))
+      .def_property_readonly("lame", [](const NeoHookean& s) { return py::make_tuple(s.lame.lambda, s.lame.mu); });
+  py::class_<VerondaWestmann>(m, "VerondaWestmann")
+      .def(py::init<double, double, double>(), py::arg("E"), py::arg("nu"), py::arg("gamma"))
+      .def_property_readonly("lame", [](const VerondaWestmann& s) { return py::make_tuple(s.lame.lambda, s.lame.mu); })
+      .def_readonly("gamma", &VerondaWestmann::gamma);
+
+  py::class_<ElasticBody>(m, "ElasticBody")
+      .def(py::init(&make_body), py::arg("mesh"), py::arg("material"), py::arg("density"),
+           py::arg("thickness"), py::keep_alive<1, 2>())
+      .def_property_readonly("dim", &ElasticBody::dim)
+      .def_property_readonly("density", &ElasticBody::density)
+      .def_property_readonly("thickness", &ElasticBody::thickness)
+      .def("energy", &energy_of, py::arg("u"))
+      .def("internal_forces", &forces_of, py::arg("u"))
+      .def("tangent_apply", &tangent_of, py::arg("u"), py::arg("d"))
+      .def("inverted_elements", [](const ElasticBody& b, const DoubleArray& u) { return b.inverted_elements(view(u)); })
+      .def("element_stress", &stress_of, py::arg("u"))
+      .def("element_stiffness", &stiffness_of, py::arg("element"), py::arg("u"))
+      .def("lumped_mass", &ElasticBody::lumped_mass)
+      .def("gravity_forces", [](const ElasticBody& b, const DoubleArray& g) { return to_array(b.gravity_forces(view(g)), b.dim()); })
+      .def("flops_per_element", &flops_of);
+}
+
+}  // namespace snede::bindings

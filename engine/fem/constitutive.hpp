@@ -1,0 +1,80 @@
+// The first Piola-Kirchhoff view of a material for a D-dimensional element: energy density
+// W(F), P(F) and dP(F)[dF]. Materials written in C (hyperelastic, §4.3) go through
+// P = F S and dP = dF S + F (∂S/∂C : (dFᵀF + FᵀdF)) (4.4); LinearElastic is written in F.
+//
+// Plane stress (2D, §6.3.1): the in-plane C₂ = FᵀF is extended to C = diag(C₂, c) with c
+// chosen so that S₃₃ = 0 (each material's plane_stress_c33: closed form for St. Venant-
+// Kirchhoff and neo-Hookean, a scalar Newton solve for Veronda-Westmann). Because
+// ∂W/∂c = S₃₃/2 = 0 there, W₂(C₂) = W(C) has S₂ = the in-plane block of S. Its
+// derivative needs dc: differentiating S₃₃ = 0 gives
+// dc = −(∂S/∂C : diag(H₂, 0))₃₃ / (∂S/∂C : e₃⊗e₃)₃₃.
+#pragma once
+
+#include <concepts>
+
+#include "fem/tensor.hpp"
+
+namespace snede {
+
+template <class M>
+concept WrittenInC = requires(const M& m, const Mat<double, 3>& C) {
+  { m.stress(C) };
+};
+
+template <class T, int D, class M>
+Mat<T, 3> right_cauchy_green_3d(const M& m, const Mat<T, D>& F) {
+  if constexpr (D == 3) {
+    return F.transpose() * F;
+  } else {
+    Mat<T, 3> C = Mat<T, 3>::Zero();
+    const Mat<T, 2> C2 = F.transpose() * F;
+    C.template topLeftCorner<2, 2>() = C2;
+    C(2, 2) = m.plane_stress_c33(C2);
+    return C;
+  }
+}
+
+template <class T, int D, class M>
+T energy_density(const M& m, const Mat<T, D>& F) {
+  if constexpr (WrittenInC<M>)
+    return m.energy(right_cauchy_green_3d<T, D>(m, F));
+  else
+    return m.template energy<T, D>(F);
+}
+
+template <class T, int D, class M>
+Mat<T, D> second_piola(const M& m, const Mat<T, D>& F) {
+  if constexpr (WrittenInC<M>)
+    return m.stress(right_cauchy_green_3d<T, D>(m, F)).template topLeftCorner<D, D>();
+  else
+    return m.template second_piola<T, D>(F);
+}
+
+template <class T, int D, class M>
+Mat<T, D> first_piola(const M& m, const Mat<T, D>& F) {
+  if constexpr (WrittenInC<M>)
+    return F * second_piola<T, D>(m, F);
+  else
+    return m.template first_piola<T, D>(F);
+}
+
+template <class T, int D, class M>
+Mat<T, D> first_piola_derivative(const M& m, const Mat<T, D>& F, const Mat<T, D>& dF) {
+  if constexpr (WrittenInC<M>) {
+    const Mat<T, 3> C = right_cauchy_green_3d<T, D>(m, F);
+    Mat<T, 3> H = Mat<T, 3>::Zero();
+    H.template topLeftCorner<D, D>() = dF.transpose() * F + F.transpose() * dF;
+    if constexpr (D == 2) {
+      Mat<T, 3> e33 = Mat<T, 3>::Zero();
+      e33(2, 2) = T(1);
+      H(2, 2) = -m.stress_derivative(C, H)(2, 2) / m.stress_derivative(C, e33)(2, 2);
+    }
+    const Mat<T, D> S = m.stress(C).template topLeftCorner<D, D>();
+    const Mat<T, D> dS = m.stress_derivative(C, H).template topLeftCorner<D, D>();
+    return dF * S + F * dS;
+  } else {
+    return m.template first_piola_derivative<T, D>(F, dF);
+  }
+}
+
+}  // namespace snede

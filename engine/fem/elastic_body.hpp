@@ -1,0 +1,92 @@
+// Matrix-free evaluation over a whole mesh (§2.3, §4.3): total energy, internal forces,
+// tangent action, lumped mass and gravity, for one material. It is a connectivity watcher:
+// per-element reference data (Z⁻¹, |τ|) is recomputed only for elements a change reports.
+//
+// Conventions: displacement and force arrays are (n_points, dim) row-major; internal forces
+// are −∂Π_int/∂u; the tangent action is ∂²Π_int/∂u² · d.
+#pragma once
+
+#include <array>
+#include <span>
+#include <stdexcept>
+#include <vector>
+
+#include "fem/element_kernel.hpp"
+#include "fem/material.hpp"
+#include "mesh/mesh.hpp"
+
+namespace snede {
+
+// Which elements could not be evaluated honestly in the last call.
+struct EvaluationReport {
+  std::vector<ElementId> inverted;       // det F ≤ 0
+  std::vector<ElementId> domain_errors;  // non-finite result (exponential overflow)
+};
+
+// An evaluation overflowed (Veronda-Westmann's exponential); the message lists elements.
+class DomainError : public std::domain_error {
+  using std::domain_error::domain_error;
+};
+// Throws DomainError naming the elements if report.domain_errors is not empty.
+void throw_if_domain_error(const EvaluationReport& report);
+
+// Flops per element per kernel, counted by running the kernels on Counted scalars.
+struct KernelFlops {
+  std::int64_t energy = 0, force = 0, tangent = 0;
+  std::int64_t functions = 0;  // sqrt/exp/log calls in the force kernel (not in the counts)
+};
+
+class ElasticBody : public ConnectivityWatcher {
+ public:
+  // thickness: required (> 0) for 2D meshes (plane stress), must be 0 for 3D.
+  ElasticBody(Mesh& mesh, Material material, double density, double thickness);
+  ~ElasticBody() override;
+  ElasticBody(const ElasticBody&) = delete;
+  ElasticBody& operator=(const ElasticBody&) = delete;
+
+  const Mesh& mesh() const { return mesh_; }
+  const Material& material() const { return material_; }
+  double density() const { return density_; }
+  double thickness() const { return thickness_; }
+  int dim() const { return mesh_.dim(); }
+  std::size_t n_dofs() const { return static_cast<std::size_t>(mesh_.n_points()) * dim(); }
+
+  // Π_int(u). +∞ if an element is inverted under a material that forbids inversion.
+  double energy(std::span<const double> u, EvaluationReport& report) const;
+  // f = −∂Π_int/∂u; inverted elements of a material that forbids inversion contribute nothing.
+  void internal_forces(std::span<const double> u, std::span<double> f, EvaluationReport& report) const;
+  // out = K(u) d, K = ∂²Π_int/∂u²; inverted elements as for the forces.
+  void tangent_apply(std::span<const double> u, std::span<const double> d, std::span<double> out,
+                     EvaluationReport& report) const;
+  // Ids of the elements with det F ≤ 0 at u.
+  std::vector<ElementId> inverted_elements(std::span<const double> u) const;
+  // Second Piola-Kirchhoff stress per live element (σ for LinearElastic): (n_cells, dim, dim).
+  std::vector<double> element_stress(std::span<const double> u) const;
+  // Stiffness matrix of element e at u: ((dim+1)·dim)², rows and columns ordered by the
+  // element's oriented vertices, then by component. For comparison and preconditioning only.
+  std::vector<double> element_stiffness(ElementId e, std::span<const double> u) const;
+  // Lumped mass per vertex: a share 1/(dim+1) of each incident element's mass (§2.5).
+  std::vector<double> lumped_mass() const;
+  // Consistent gravity load for linear elements: ρ|τ|g/(dim+1) per vertex and element.
+  std::vector<double> gravity_forces(std::span<const double> g) const;
+  KernelFlops flops_per_element() const { return flops_; }
+
+  void init(const Connectivity& connectivity) override;
+  void on_change(const Connectivity& connectivity, const ConnectivityChange& change) override;
+
+ private:
+  template <int D>
+  const std::vector<ElementReference<D>>& references() const;
+  void compute_reference(ElementId e);
+  void check_size(const char* what, std::span<const double> a) const;
+
+  Mesh& mesh_;
+  Material material_;
+  double density_;
+  double thickness_;
+  std::vector<ElementReference<2>> references_2d_;
+  std::vector<ElementReference<3>> references_3d_;
+  KernelFlops flops_;
+};
+
+}  // namespace snede

@@ -1,0 +1,101 @@
+"""An elastic body: a mesh, a material and a density, evaluated matrix-free (§2.3, §4.3).
+
+Sign convention: ``internal_forces(u)`` is −∂Π_int/∂u (the force the material exerts on the
+nodes); ``tangent_apply(u, d)`` is ∂²Π_int/∂u² · d. Arrays are ``(n_points, dim)``.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from snede import _snede
+from snede.mesh import Mesh
+
+
+class Body:
+    """``Body(mesh, material, density=1000.0, thickness=None)``.
+
+    ``material`` is one of ``snede.LinearElastic(E, nu)``, ``snede.StVenantKirchhoff(E, nu)``,
+    ``snede.NeoHookean(E, nu)``, ``snede.VerondaWestmann(E, nu, gamma)``. A 2D mesh is a
+    plane-stress sheet and needs ``thickness`` (metres); a 3D mesh must not have one.
+
+    Inverted elements (det F ≤ 0): neo-Hookean and Veronda-Westmann give energy +inf and
+    leave those elements out of forces and tangent actions; St. Venant-Kirchhoff and linear
+    evaluate them as usual. ``inverted_elements(u)`` lists them either way. An exponential
+    overflow (Veronda-Westmann at large strain) raises ``snede.DomainError``.
+    """
+
+    def __init__(self, mesh: Mesh, material, density: float = 1000.0, thickness: float | None = None):
+        if not isinstance(mesh, Mesh):
+            raise TypeError(f"mesh must be a snede.Mesh, got {type(mesh).__name__}")
+        if mesh.dim == 2 and thickness is None:
+            raise ValueError("a 2D mesh is a plane-stress sheet: give its thickness (e.g. thickness=0.01)")
+        if mesh.dim == 3 and thickness is not None:
+            raise ValueError(f"thickness is only for 2D (plane-stress) meshes; this mesh is 3D (got thickness={thickness})")
+        self.mesh = mesh
+        self.material = material
+        self._impl = _snede.ElasticBody(mesh._impl, material, float(density), float(thickness or 0.0))
+
+    @property
+    def dim(self) -> int:
+        return self.mesh.dim
+
+    @property
+    def density(self) -> float:
+        return self._impl.density
+
+    @property
+    def thickness(self) -> float | None:
+        return self._impl.thickness if self.dim == 2 else None
+
+    def _field(self, name: str, value) -> np.ndarray:
+        array = np.asarray(value, dtype=np.float64)
+        expected = (self.mesh.n_points, self.dim)
+        if array.shape != expected:
+            raise ValueError(f"{name} must have shape {expected} (n_points, dim), got {array.shape}")
+        return np.ascontiguousarray(array)
+
+    def energy(self, u) -> float:
+        """Internal elastic energy Π_int(u) (joules); +inf if an element is inverted under a
+        material that forbids inversion."""
+        return self._impl.energy(self._field("u", u))
+
+    def internal_forces(self, u) -> np.ndarray:
+        """−∂Π_int/∂u at u, shape (n_points, dim)."""
+        return self._impl.internal_forces(self._field("u", u))
+
+    def tangent_apply(self, u, d) -> np.ndarray:
+        """K(u)·d with K = ∂²Π_int/∂u², without forming K; shape (n_points, dim)."""
+        return self._impl.tangent_apply(self._field("u", u), self._field("d", d))
+
+    def inverted_elements(self, u) -> np.ndarray:
+        """Row indices (into ``mesh.cells``) of the cells with det F ≤ 0 at u."""
+        ids = np.asarray(self._impl.inverted_elements(self._field("u", u)), dtype=np.int64)
+        return np.searchsorted(self.mesh.cell_ids, ids)
+
+    def element_stress(self, u) -> np.ndarray:
+        """Second Piola-Kirchhoff stress per cell (σ for LinearElastic): (n_cells, dim, dim)."""
+        return self._impl.element_stress(self._field("u", u))
+
+    def element_stiffness(self, row: int, u) -> np.ndarray:
+        """Stiffness matrix of cell ``row`` at u: ((dim+1)·dim)², ordered by the cell's
+        vertices (``mesh.cells[row]``) then components. For checks and preconditioners."""
+        return self._impl.element_stiffness(int(self.mesh.cell_ids[row]), self._field("u", u))
+
+    def lumped_mass(self) -> np.ndarray:
+        """Mass per vertex (kg): 1/(dim+1) of each incident cell's mass (§2.5); (n_points,)."""
+        return np.asarray(self._impl.lumped_mass())
+
+    def gravity_forces(self, g=(0.0, 0.0, -9.81)) -> np.ndarray:
+        """Nodal gravity load ρ|τ|g/(dim+1) per cell and vertex; (n_points, dim)."""
+        g = np.asarray(g, dtype=np.float64)
+        if g.shape != (self.dim,):
+            raise ValueError(f"g must have {self.dim} components, got shape {g.shape}")
+        return self._impl.gravity_forces(g)
+
+    def flops_per_element(self) -> dict:
+        """Flops per element of the energy, force and tangent-action kernels, counted by
+        running them on a counting scalar type (Table 4.3's measure)."""
+        return self._impl.flops_per_element()
+
+    def __repr__(self) -> str:
+        return f"<snede.Body {type(self.material).__name__} on {self.mesh!r}>"
