@@ -15,6 +15,7 @@ meshes: setup
 
 benchmark: setup
 	@.venv/bin/python benchmarks/connectivity_build.py
+	@.venv/bin/python benchmarks/fem_throughput.py
 
 clean:
 	rm -rf build
