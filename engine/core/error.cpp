@@ -14,7 +14,7 @@ void check_petsc(PetscErrorCode code, const char* call, const char* file, int li
   if (generic) message << " (" << generic << ")";
   if (specific && specific[0]) message << ": " << specific;
   message << " [in " << call << " at " << file << ":" << line << "]";
-  throw PetscError(code, message.str());
+  throw PetscException(code, message.str());
 }
 
 }  // namespace snede

@@ -10,9 +10,9 @@
 namespace snede {
 
 // A PETSc call returned a non-zero error code; what() carries PETSc's own message.
-class PetscError : public std::runtime_error {
+class PetscException : public std::runtime_error {
  public:
-  PetscError(PetscErrorCode code, const std::string& message)
+  PetscException(PetscErrorCode code, const std::string& message)
       : std::runtime_error(message), code_(code) {}
   PetscErrorCode code() const noexcept { return code_; }
 
@@ -20,7 +20,7 @@ class PetscError : public std::runtime_error {
   PetscErrorCode code_;
 };
 
-// Throws PetscError with PETSc's text for `code` if it is non-zero; `call` names the call.
+// Throws PetscException with PETSc's text for `code` if it is non-zero; `call` names the call.
 void check_petsc(PetscErrorCode code, const char* call, const char* file, int line);
 
 }  // namespace snede

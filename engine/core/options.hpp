@@ -7,7 +7,7 @@
 namespace snede {
 
 // The real value of option `name` (with its leading '-'), or nullopt if it is not set.
-// A value that is not a number raises PetscError carrying PETSc's message.
+// A value that is not a number raises PetscException carrying PETSc's message.
 std::optional<double> option_real(const std::string& name);
 
 }  // namespace snede

@@ -17,17 +17,17 @@
 namespace snede {
 
 template <class M>
-concept WrittenInC = requires(const M& m, const Mat<double, 3>& C) {
+concept WrittenInC = requires(const M& m, const Tensor<double, 3>& C) {
   { m.stress(C) };
 };
 
 template <class T, int D, class M>
-Mat<T, 3> right_cauchy_green_3d(const M& m, const Mat<T, D>& F) {
+Tensor<T, 3> right_cauchy_green_3d(const M& m, const Tensor<T, D>& F) {
   if constexpr (D == 3) {
     return F.transpose() * F;
   } else {
-    Mat<T, 3> C = Mat<T, 3>::Zero();
-    const Mat<T, 2> C2 = F.transpose() * F;
+    Tensor<T, 3> C = Tensor<T, 3>::Zero();
+    const Tensor<T, 2> C2 = F.transpose() * F;
     C.template topLeftCorner<2, 2>() = C2;
     C(2, 2) = m.plane_stress_c33(C2);
     return C;
@@ -35,7 +35,7 @@ Mat<T, 3> right_cauchy_green_3d(const M& m, const Mat<T, D>& F) {
 }
 
 template <class T, int D, class M>
-T energy_density(const M& m, const Mat<T, D>& F) {
+T energy_density(const M& m, const Tensor<T, D>& F) {
   if constexpr (WrittenInC<M>)
     return m.energy(right_cauchy_green_3d<T, D>(m, F));
   else
@@ -43,7 +43,7 @@ T energy_density(const M& m, const Mat<T, D>& F) {
 }
 
 template <class T, int D, class M>
-Mat<T, D> second_piola(const M& m, const Mat<T, D>& F) {
+Tensor<T, D> second_piola(const M& m, const Tensor<T, D>& F) {
   if constexpr (WrittenInC<M>)
     return m.stress(right_cauchy_green_3d<T, D>(m, F)).template topLeftCorner<D, D>();
   else
@@ -51,7 +51,7 @@ Mat<T, D> second_piola(const M& m, const Mat<T, D>& F) {
 }
 
 template <class T, int D, class M>
-Mat<T, D> first_piola(const M& m, const Mat<T, D>& F) {
+Tensor<T, D> first_piola(const M& m, const Tensor<T, D>& F) {
   if constexpr (WrittenInC<M>)
     return F * second_piola<T, D>(m, F);
   else
@@ -59,18 +59,18 @@ Mat<T, D> first_piola(const M& m, const Mat<T, D>& F) {
 }
 
 template <class T, int D, class M>
-Mat<T, D> first_piola_derivative(const M& m, const Mat<T, D>& F, const Mat<T, D>& dF) {
+Tensor<T, D> first_piola_derivative(const M& m, const Tensor<T, D>& F, const Tensor<T, D>& dF) {
   if constexpr (WrittenInC<M>) {
-    const Mat<T, 3> C = right_cauchy_green_3d<T, D>(m, F);
-    Mat<T, 3> H = Mat<T, 3>::Zero();
+    const Tensor<T, 3> C = right_cauchy_green_3d<T, D>(m, F);
+    Tensor<T, 3> H = Tensor<T, 3>::Zero();
     H.template topLeftCorner<D, D>() = dF.transpose() * F + F.transpose() * dF;
     if constexpr (D == 2) {
-      Mat<T, 3> e33 = Mat<T, 3>::Zero();
+      Tensor<T, 3> e33 = Tensor<T, 3>::Zero();
       e33(2, 2) = T(1);
       H(2, 2) = -m.stress_derivative(C, H)(2, 2) / m.stress_derivative(C, e33)(2, 2);
     }
-    const Mat<T, D> S = m.stress(C).template topLeftCorner<D, D>();
-    const Mat<T, D> dS = m.stress_derivative(C, H).template topLeftCorner<D, D>();
+    const Tensor<T, D> S = m.stress(C).template topLeftCorner<D, D>();
+    const Tensor<T, D> dS = m.stress_derivative(C, H).template topLeftCorner<D, D>();
     return dF * S + F * dS;
   } else {
     return m.template first_piola_derivative<T, D>(F, dF);

@@ -15,8 +15,8 @@ namespace {
 using Vertices = std::array<VertexId, max_dimension + 1>;
 
 template <int D>
-Mat<double, D> gather_differences(std::span<const double> u, const Vertices& v) {
-  Mat<double, D> U;
+Tensor<double, D> gather_differences(std::span<const double> u, const Vertices& v) {
+  Tensor<double, D> U;
   for (int j = 1; j <= D; ++j)
     for (int k = 0; k < D; ++k)
       U(k, j - 1) = u[static_cast<std::size_t>(v[j]) * D + k] - u[static_cast<std::size_t>(v[0]) * D + k];
@@ -25,7 +25,7 @@ Mat<double, D> gather_differences(std::span<const double> u, const Vertices& v) 
 
 // Adds columns to nodes 1..D and minus their sum to node 0.
 template <int D>
-void scatter_columns(std::span<double> out, const Vertices& v, const Mat<double, D>& G) {
+void scatter_columns(std::span<double> out, const Vertices& v, const Tensor<double, D>& G) {
   for (int j = 1; j <= D; ++j)
     for (int k = 0; k < D; ++k) {
       out[static_cast<std::size_t>(v[j]) * D + k] += G(k, j - 1);
@@ -50,9 +50,9 @@ decltype(auto) with_material(const Material& material, Function&& function) {
 template <int D, class M>
 KernelFlops count_flops(const M& m) {
   ElementReference<D> ref;
-  ref.Z_inv = Mat<double, D>::Identity();
+  ref.Z_inv = Tensor<double, D>::Identity();
   ref.measure = 1;
-  Mat<Counted, D> U, dU;
+  Tensor<Counted, D> U, dU;
   for (int i = 0; i < D; ++i)
     for (int j = 0; j < D; ++j) {
       U(i, j) = Counted(0.01 * (i + 2 * j + 1));
@@ -123,7 +123,7 @@ void ElasticBody::compute_reference(ElementId e) {
   auto fill = [&](auto& refs, auto dimension) {
     constexpr int D = decltype(dimension)::value;
     if (refs.size() <= static_cast<std::size_t>(e)) refs.resize(mesh_.connectivity().element_capacity());
-    Mat<double, D> Z;
+    Tensor<double, D> Z;
     for (int j = 1; j <= D; ++j)
       for (int k = 0; k < D; ++k) Z(k, j - 1) = x[j * D + k] - x[k];
     refs[e].Z_inv = Z.inverse();
@@ -161,7 +161,7 @@ double ElasticBody::energy(std::span<const double> u, EvaluationReport& report) 
       double total = 0;
       std::size_t n = 0;
       for_each_element<D>(mesh_.connectivity(), references<D>(), [&](ElementId e, const Vertices& v, const auto& ref) {
-        const Mat<double, D> U = gather_differences<D>(u, v);
+        const Tensor<double, D> U = gather_differences<D>(u, v);
         if (deformation_gradient<double, D>(ref, U).determinant() <= 0) {
           report.inverted.push_back(e);
           if (forbids_inversion(m)) {
@@ -193,12 +193,12 @@ void ElasticBody::internal_forces(std::span<const double> u, std::span<double> f
       constexpr int D = decltype(dimension)::value;
       std::size_t n = 0;
       for_each_element<D>(mesh_.connectivity(), references<D>(), [&](ElementId e, const Vertices& v, const auto& ref) {
-        const Mat<double, D> U = gather_differences<D>(u, v);
+        const Tensor<double, D> U = gather_differences<D>(u, v);
         if (deformation_gradient<double, D>(ref, U).determinant() <= 0) {
           report.inverted.push_back(e);
           if (forbids_inversion(m)) return;
         }
-        const Mat<double, D> G = element_force_columns<double, D>(m, ref, U);
+        const Tensor<double, D> G = element_force_columns<double, D>(m, ref, U);
         ++n;
         if (!G.allFinite()) {
           report.domain_errors.push_back(e);
@@ -223,12 +223,12 @@ void ElasticBody::tangent_apply(std::span<const double> u, std::span<const doubl
       constexpr int D = decltype(dimension)::value;
       std::size_t n = 0;
       for_each_element<D>(mesh_.connectivity(), references<D>(), [&](ElementId e, const Vertices& v, const auto& ref) {
-        const Mat<double, D> U = gather_differences<D>(u, v);
+        const Tensor<double, D> U = gather_differences<D>(u, v);
         if (deformation_gradient<double, D>(ref, U).determinant() <= 0) {
           report.inverted.push_back(e);
           if (forbids_inversion(m)) return;
         }
-        const Mat<double, D> G = element_tangent_columns<double, D>(m, ref, U, gather_differences<D>(d, v));
+        const Tensor<double, D> G = element_tangent_columns<double, D>(m, ref, U, gather_differences<D>(d, v));
         ++n;
         if (!G.allFinite()) {
           report.domain_errors.push_back(e);
@@ -262,7 +262,7 @@ std::vector<double> ElasticBody::element_stress(std::span<const double> u) const
     auto loop = [&](auto dimension) {
       constexpr int D = decltype(dimension)::value;
       for_each_element<D>(mesh_.connectivity(), references<D>(), [&](ElementId, const Vertices& v, const auto& ref) {
-        const Mat<double, D> S = second_piola<double, D>(m, deformation_gradient<double, D>(ref, gather_differences<D>(u, v)));
+        const Tensor<double, D> S = second_piola<double, D>(m, deformation_gradient<double, D>(ref, gather_differences<D>(u, v)));
         for (int i = 0; i < D; ++i)
           for (int j = 0; j < D; ++j) stress.push_back(S(i, j));
       });
@@ -282,16 +282,16 @@ std::vector<double> ElasticBody::element_stiffness(ElementId e, std::span<const 
     auto columns = [&](auto dimension) {
       constexpr int D = decltype(dimension)::value;
       const auto& ref = references<D>()[e];
-      const Mat<double, D> U = gather_differences<D>(u, v);
+      const Tensor<double, D> U = gather_differences<D>(u, v);
       for (int column = 0; column < n; ++column) {
         // unit direction on (node column / D, component column % D), as local differences
-        Mat<double, D> dU = Mat<double, D>::Zero();
+        Tensor<double, D> dU = Tensor<double, D>::Zero();
         const int node = column / D, component = column % D;
         if (node == 0)
           dU.row(component).setConstant(-1.0);
         else
           dU(component, node - 1) = 1.0;
-        const Mat<double, D> G = element_tangent_columns<double, D>(m, ref, U, dU);
+        const Tensor<double, D> G = element_tangent_columns<double, D>(m, ref, U, dU);
         for (int j = 1; j <= D; ++j)
           for (int k = 0; k < D; ++k) {
             K[static_cast<std::size_t>(j * D + k) * n + column] = G(k, j - 1);

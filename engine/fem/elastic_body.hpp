@@ -45,6 +45,7 @@ class ElasticBody : public ConnectivityWatcher {
   ElasticBody& operator=(const ElasticBody&) = delete;
 
   const Mesh& mesh() const { return mesh_; }
+  Mesh& mesh() { return mesh_; }
   const Material& material() const { return material_; }
   double density() const { return density_; }
   double thickness() const { return thickness_; }

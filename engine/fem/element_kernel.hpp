@@ -12,33 +12,33 @@ namespace snede {
 
 template <int D>
 struct ElementReference {
-  Mat<double, D> Z_inv;
+  Tensor<double, D> Z_inv;
   double measure = 0;  // volume (3D) or area × thickness (2D); 0 for a free slot
 };
 
 template <class T, int D>
-Mat<T, D> deformation_gradient(const ElementReference<D>& ref, const Mat<T, D>& U) {
+Tensor<T, D> deformation_gradient(const ElementReference<D>& ref, const Tensor<T, D>& U) {
   return identity<T, D>() + U * ref.Z_inv.template cast<T>();
 }
 
 template <class T, int D, class M>
-T element_energy(const M& m, const ElementReference<D>& ref, const Mat<T, D>& U) {
+T element_energy(const M& m, const ElementReference<D>& ref, const Tensor<T, D>& U) {
   return T(ref.measure) * energy_density<T, D>(m, deformation_gradient<T, D>(ref, U));
 }
 
 // Forces on nodes 1..D as columns (node 0: minus the sum of the columns); −∂(energy)/∂u.
 template <class T, int D, class M>
-Mat<T, D> element_force_columns(const M& m, const ElementReference<D>& ref, const Mat<T, D>& U) {
-  const Mat<T, D> P = first_piola<T, D>(m, deformation_gradient<T, D>(ref, U));
+Tensor<T, D> element_force_columns(const M& m, const ElementReference<D>& ref, const Tensor<T, D>& U) {
+  const Tensor<T, D> P = first_piola<T, D>(m, deformation_gradient<T, D>(ref, U));
   return T(-ref.measure) * P * ref.Z_inv.transpose().template cast<T>();
 }
 
 // Tangent action on nodes 1..D as columns (node 0: minus the sum); ∂²(energy)/∂u² · d.
 template <class T, int D, class M>
-Mat<T, D> element_tangent_columns(const M& m, const ElementReference<D>& ref, const Mat<T, D>& U,
-                                  const Mat<T, D>& dU) {
-  const Mat<T, D> Z_inv = ref.Z_inv.template cast<T>();
-  const Mat<T, D> dP = first_piola_derivative<T, D>(m, deformation_gradient<T, D>(ref, U), Mat<T, D>(dU * Z_inv));
+Tensor<T, D> element_tangent_columns(const M& m, const ElementReference<D>& ref, const Tensor<T, D>& U,
+                                  const Tensor<T, D>& dU) {
+  const Tensor<T, D> Z_inv = ref.Z_inv.template cast<T>();
+  const Tensor<T, D> dP = first_piola_derivative<T, D>(m, deformation_gradient<T, D>(ref, U), Tensor<T, D>(dU * Z_inv));
   return T(ref.measure) * dP * Z_inv.transpose();
 }
 

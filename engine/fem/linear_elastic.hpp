@@ -21,32 +21,32 @@ struct LinearElastic {
     return D == 3 ? lame.lambda : 2 * lame.lambda * lame.mu / (lame.lambda + 2 * lame.mu);
   }
   template <class T, int D>
-  T energy(const Mat<T, D>& F) const {
-    const Mat<T, D> eps = strain<T, D>(F);
+  T energy(const Tensor<T, D>& F) const {
+    const Tensor<T, D> eps = strain<T, D>(F);
     const T trace = eps.trace();
     return T(lame.mu) * double_dot<T, D>(eps, eps) + T(0.5 * effective_lambda<D>()) * trace * trace;
   }
   template <class T, int D>
-  Mat<T, D> first_piola(const Mat<T, D>& F) const {
+  Tensor<T, D> first_piola(const Tensor<T, D>& F) const {
     return stress_of<T, D>(strain<T, D>(F));
   }
   template <class T, int D>
-  Mat<T, D> first_piola_derivative(const Mat<T, D>&, const Mat<T, D>& dF) const {
+  Tensor<T, D> first_piola_derivative(const Tensor<T, D>&, const Tensor<T, D>& dF) const {
     return stress_of<T, D>(T(0.5) * (dF + dF.transpose()));
   }
   // The stress reported per element: σ (the linear theory does not tell S from σ).
   template <class T, int D>
-  Mat<T, D> second_piola(const Mat<T, D>& F) const {
+  Tensor<T, D> second_piola(const Tensor<T, D>& F) const {
     return first_piola<T, D>(F);
   }
 
  private:
   template <class T, int D>
-  static Mat<T, D> strain(const Mat<T, D>& F) {
+  static Tensor<T, D> strain(const Tensor<T, D>& F) {
     return T(0.5) * (F + F.transpose()) - identity<T, D>();
   }
   template <class T, int D>
-  Mat<T, D> stress_of(const Mat<T, D>& eps) const {
+  Tensor<T, D> stress_of(const Tensor<T, D>& eps) const {
     return T(2 * lame.mu) * eps + T(effective_lambda<D>()) * eps.trace() * identity<T, D>();
   }
 };

@@ -18,7 +18,7 @@ struct NeoHookean {
   NeoHookean(double young, double poisson) : lame(lame_from_young_poisson(young, poisson)) {}
 
   template <class T>
-  T energy(const Mat<T, 3>& C) const {
+  T energy(const Tensor<T, 3>& C) const {
     using std::log;
     using std::sqrt;
     const T i3 = C.determinant();
@@ -26,24 +26,24 @@ struct NeoHookean {
     return T(0.5) * (T(lame.mu) * (C.trace() - T(3)) - T(lame.mu) * log(i3) + T(lame.lambda) * (J - T(1)) * (J - T(1)));
   }
   template <class T>
-  Mat<T, 3> stress(const Mat<T, 3>& C) const {
+  Tensor<T, 3> stress(const Tensor<T, 3>& C) const {
     using std::sqrt;
     const T J = sqrt(C.determinant());
     return T(lame.mu) * identity<T, 3>() + (T(lame.lambda) * (J - T(1)) * J - T(lame.mu)) * inverse<T, 3>(C);
   }
   template <class T>
-  Mat<T, 3> stress_derivative(const Mat<T, 3>& C, const Mat<T, 3>& H) const {
+  Tensor<T, 3> stress_derivative(const Tensor<T, 3>& C, const Tensor<T, 3>& H) const {
     using std::sqrt;
     const T J = sqrt(C.determinant());
-    const Mat<T, 3> C_inv = inverse<T, 3>(C);
-    const Mat<T, 3> C_inv_H_C_inv = C_inv * H * C_inv;
+    const Tensor<T, 3> C_inv = inverse<T, 3>(C);
+    const Tensor<T, 3> C_inv_H_C_inv = C_inv * H * C_inv;
     return -(T(lame.lambda) * (J - T(1)) * J - T(lame.mu)) * C_inv_H_C_inv +
            T(0.5 * lame.lambda) * (T(2) * J - T(1)) * J * double_dot<T, 3>(C_inv, H) * C_inv;
   }
   // Plane stress: with C = diag(C₂, c), d = det C₂ and s = √c, S₃₃ = 0 reads
   // (μ + λ d) s² − λ √d s − μ = 0, whose positive root is taken (closed form).
   template <class T>
-  T plane_stress_c33(const Mat<T, 2>& C2) const {
+  T plane_stress_c33(const Tensor<T, 2>& C2) const {
     using std::sqrt;
     const T d = C2.determinant();
     const T a = T(lame.mu) + T(lame.lambda) * d;

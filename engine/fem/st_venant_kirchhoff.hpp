@@ -15,23 +15,23 @@ struct StVenantKirchhoff {
   StVenantKirchhoff(double young, double poisson) : lame(lame_from_young_poisson(young, poisson)) {}
 
   template <class T>
-  T energy(const Mat<T, 3>& C) const {
-    const Mat<T, 3> C_minus_I = C - identity<T, 3>();
+  T energy(const Tensor<T, 3>& C) const {
+    const Tensor<T, 3> C_minus_I = C - identity<T, 3>();
     const T t = C.trace() - T(3);
     return T(0.25 * lame.mu) * double_dot<T, 3>(C_minus_I, C_minus_I) + T(0.125 * lame.lambda) * t * t;
   }
   template <class T>
-  Mat<T, 3> stress(const Mat<T, 3>& C) const {
+  Tensor<T, 3> stress(const Tensor<T, 3>& C) const {
     return T(lame.mu) * (C - identity<T, 3>()) + T(0.5 * lame.lambda) * (C.trace() - T(3)) * identity<T, 3>();
   }
   template <class T>
-  Mat<T, 3> stress_derivative(const Mat<T, 3>&, const Mat<T, 3>& H) const {
+  Tensor<T, 3> stress_derivative(const Tensor<T, 3>&, const Tensor<T, 3>& H) const {
     return T(lame.mu) * H + T(0.5 * lame.lambda) * H.trace() * identity<T, 3>();
   }
   // Plane stress: S₃₃ = μ (c − 1) + λ/2 (tr C₂ + c − 3) = 0 is linear in c = C₃₃, so
   // c = 1 − λ/2 (tr C₂ − 2) / (μ + λ/2) (closed form).
   template <class T>
-  T plane_stress_c33(const Mat<T, 2>& C2) const {
+  T plane_stress_c33(const Tensor<T, 2>& C2) const {
     return T(1) - T(0.5 * lame.lambda / (lame.mu + 0.5 * lame.lambda)) * (C2.trace() - T(2));
   }
 };

@@ -7,21 +7,21 @@
 namespace snede {
 
 template <class T, int D>
-using Mat = Eigen::Matrix<T, D, D>;
+using Tensor = Eigen::Matrix<T, D, D>;
 
 template <class T, int D>
-T double_dot(const Mat<T, D>& a, const Mat<T, D>& b) {
+T double_dot(const Tensor<T, D>& a, const Tensor<T, D>& b) {
   return (a.array() * b.array()).sum();
 }
 
 template <class T, int D>
-Mat<T, D> identity() {
-  return Mat<T, D>::Identity();
+Tensor<T, D> identity() {
+  return Tensor<T, D>::Identity();
 }
 
 // Inverse of a symmetric positive definite 3×3 (or 2×2) matrix by cofactors.
 template <class T, int D>
-Mat<T, D> inverse(const Mat<T, D>& a) {
+Tensor<T, D> inverse(const Tensor<T, D>& a) {
   return a.inverse();
 }
 

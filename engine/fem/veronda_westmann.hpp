@@ -28,7 +28,7 @@ struct VerondaWestmann {
   }
 
   template <class T>
-  T energy(const Mat<T, 3>& C) const {
+  T energy(const Tensor<T, 3>& C) const {
     using std::exp;
     using std::log;
     const T i1 = C.trace();
@@ -38,7 +38,7 @@ struct VerondaWestmann {
                      T(0.5 * lame.lambda) * (i3 - T(1) - log(i3)));
   }
   template <class T>
-  Mat<T, 3> stress(const Mat<T, 3>& C) const {
+  Tensor<T, 3> stress(const Tensor<T, 3>& C) const {
     using std::exp;
     const T i1 = C.trace();
     const T i3 = C.determinant();
@@ -46,10 +46,10 @@ struct VerondaWestmann {
            T(0.5 * lame.lambda) * (i3 - T(1)) * inverse<T, 3>(C);
   }
   template <class T>
-  Mat<T, 3> stress_derivative(const Mat<T, 3>& C, const Mat<T, 3>& H) const {
+  Tensor<T, 3> stress_derivative(const Tensor<T, 3>& C, const Tensor<T, 3>& H) const {
     using std::exp;
     const T i3 = C.determinant();
-    const Mat<T, 3> C_inv = inverse<T, 3>(C);
+    const Tensor<T, 3> C_inv = inverse<T, 3>(C);
     const T e = exp(T(gamma) * (C.trace() - T(3)));
     return T(lame.mu) * (T(2 * gamma) * e - T(1)) * H.trace() * identity<T, 3>() + T(lame.mu) * H +
            T(0.5 * lame.lambda) * (i3 * double_dot<T, 3>(C_inv, H) * C_inv - (i3 - T(1)) * (C_inv * H * C_inv));
@@ -59,7 +59,7 @@ struct VerondaWestmann {
   // at c → 0 to +∞: one root, found per element by Newton's method safeguarded by
   // bisection (no closed form: the exponential).
   template <class T>
-  T plane_stress_c33(const Mat<T, 2>& C2) const {
+  T plane_stress_c33(const Tensor<T, 2>& C2) const {
     using std::exp;
     const T t = C2.trace(), d = C2.determinant();
     auto residual = [&](T c) { return T(2 * lame.mu) * exp(T(gamma) * (t + c - T(3))) - T(lame.mu) * t + T(0.5 * lame.lambda) * (d - T(1) / c); };

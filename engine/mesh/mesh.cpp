@@ -74,6 +74,7 @@ Mesh::Mesh(int dim, std::vector<double> points, std::span<const std::int64_t> ce
       throw std::invalid_argument(message.str());
     }
   connectivity_ = Connectivity::from_cells(dim, checked_oriented_cells(dim, points_, cells, n_reoriented_));
+  n_initial_points_ = n_points();
 }
 
 std::vector<VertexId> Mesh::cells() const {
@@ -134,10 +135,32 @@ std::vector<FaceId> Mesh::find_faces(const std::vector<VertexId>& face_vertices)
 std::vector<SplitVertex> Mesh::dissect(const std::vector<VertexId>& face_vertices) {
   const std::vector<FaceId> faces = find_faces(face_vertices);
   return snede::dissect(connectivity_, faces, [this](VertexId original) {
-    const VertexId copy = n_points();
-    for (int k = 0; k < dim_; ++k) points_.push_back(points_[static_cast<std::size_t>(original) * dim_ + k]);
-    return copy;
+    VertexParents copy_of;
+    copy_of.vertex[0] = original;
+    copy_of.weight[0] = 1.0;
+    copy_of.count = 1;
+    return add_vertex(copy_of);
   });
+}
+
+VertexId Mesh::add_vertex(const VertexParents& parents) {
+  if (parents.count < 1 || parents.count > 2) throw std::invalid_argument("add_vertex: needs one or two parents");
+  const VertexId v = n_points();
+  for (int k = 0; k < dim_; ++k) {
+    double x = 0;
+    for (int i = 0; i < parents.count; ++i) {
+      if (parents.vertex[i] < 0 || parents.vertex[i] >= v)
+        throw std::invalid_argument("add_vertex: parent " + std::to_string(parents.vertex[i]) + " does not exist");
+      x += parents.weight[i] * points_[static_cast<std::size_t>(parents.vertex[i]) * dim_ + k];
+    }
+    points_.push_back(x);
+  }
+  added_parents_.push_back(parents);
+  return v;
+}
+
+VertexParents Mesh::parents(VertexId v) const {
+  return v < n_initial_points_ ? VertexParents{} : added_parents_.at(v - n_initial_points_);
 }
 
 void Mesh::validate() const {

@@ -2,6 +2,7 @@
 // the coordinate array (§7.4: vertex v's coordinates are at dim·v … dim·v + dim − 1).
 #pragma once
 
+#include <array>
 #include <stdexcept>
 #include <vector>
 
@@ -14,6 +15,15 @@ namespace snede {
 // validate() found a broken invariant; the message names it.
 class InvalidMesh : public std::runtime_error {
   using std::runtime_error::runtime_error;
+};
+
+// Where a vertex added after construction came from: its coordinates (and, in a model, its
+// displacement) are the weighted sum of its parents' (a copy: one parent, weight 1; an edge
+// midpoint: two parents, weights ½).
+struct VertexParents {
+  std::array<VertexId, 2> vertex{no_id, no_id};
+  std::array<double, 2> weight{0, 0};
+  int count = 0;
 };
 
 class Mesh {
@@ -50,6 +60,11 @@ class Mesh {
   // of the originals' coordinates.
   std::vector<SplitVertex> dissect(const std::vector<VertexId>& face_vertices);
 
+  // Adds a vertex at the weighted sum of its parents' coordinates and records the parents.
+  VertexId add_vertex(const VertexParents& parents);
+  // The parents of v; count = 0 for a vertex given at construction.
+  VertexParents parents(VertexId v) const;
+
   // Checks (7.1)–(7.5), vertex ids against the coordinate array, and positive volume of
   // every element. Throws InvalidMesh with the first violation.
   void validate() const;
@@ -59,6 +74,8 @@ class Mesh {
   std::vector<double> points_;
   Connectivity connectivity_;
   std::size_t n_reoriented_ = 0;
+  VertexId n_initial_points_ = 0;
+  std::vector<VertexParents> added_parents_;  // for vertices n_initial_points_, ...
 };
 
 }  // namespace snede

@@ -13,7 +13,7 @@ TEST(PetscErrors, BecomeExceptionsCarryingPetscsMessage) {
   try {
     SNEDE_PETSC(VecDot(x, y, &dot));
     ADD_FAILURE() << "vectors of different sizes must be rejected";
-  } catch (const snede::PetscError& e) {
+  } catch (const snede::PetscException& e) {
     EXPECT_NE(e.code(), 0);
     EXPECT_NE(std::string(e.what()).find("VecDot"), std::string::npos) << e.what();
   }
@@ -29,7 +29,7 @@ TEST(PetscErrors, OptionValuesAreParsedByPetsc) {
   try {
     snede::option_real("-snede_test_value");
     FAIL() << "a non-numeric value must be rejected";
-  } catch (const snede::PetscError& e) {
+  } catch (const snede::PetscException& e) {
     EXPECT_NE(std::string(e.what()).find("no numeric value"), std::string::npos) << e.what();
   }
 }

@@ -15,20 +15,20 @@ void expect_plane_stress(const M& m) {
   std::mt19937 rng(11);
   std::uniform_real_distribution<double> jitter(-0.3, 0.3);
   for (int trial = 0; trial < 200; ++trial) {
-    Mat<double, 2> F;
+    Tensor<double, 2> F;
     F << 1 + jitter(rng), jitter(rng), jitter(rng), 1 + jitter(rng);
     if (F.determinant() <= 0.1) continue;
-    const Mat<double, 2> C2 = F.transpose() * F;
+    const Tensor<double, 2> C2 = F.transpose() * F;
     const double c33 = m.plane_stress_c33(C2);
     ASSERT_GT(c33, 0) << M::name;
-    Mat<double, 3> C = Mat<double, 3>::Zero();
+    Tensor<double, 3> C = Tensor<double, 3>::Zero();
     C.topLeftCorner<2, 2>() = C2;
     C(2, 2) = c33;
-    const Mat<double, 3> S = m.stress(C);
+    const Tensor<double, 3> S = m.stress(C);
     EXPECT_NEAR(S(2, 2), 0.0, 1e-12 * S.norm() + 1e-12 * m.lame.mu) << M::name << " trial " << trial;
   }
   // the reference state is plane and stress free: C₃₃ = 1
-  EXPECT_NEAR(m.plane_stress_c33(Mat<double, 2>(Mat<double, 2>::Identity())), 1.0, 1e-14) << M::name;
+  EXPECT_NEAR(m.plane_stress_c33(Tensor<double, 2>(Tensor<double, 2>::Identity())), 1.0, 1e-14) << M::name;
 }
 
 }  // namespace

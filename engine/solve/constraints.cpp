@@ -1,0 +1,125 @@
+#include "solve/constraints.hpp"
+
+#include <cmath>
+#include <stdexcept>
+
+namespace snede {
+
+void Constraints::check_vertex(VertexId v) const {
+  if (v < 0 || v >= n_points())
+    throw std::invalid_argument("vertex " + std::to_string(v) + " does not exist (there are " +
+                                std::to_string(n_points()) + " points)");
+}
+
+void Constraints::fix(std::span<const VertexId> vertices, std::span<const double> values) {
+  if (!values.empty() && values.size() != vertices.size() * dim_)
+    throw std::invalid_argument("fix: values must be (n_vertices, " + std::to_string(dim_) + ")");
+  for (std::size_t i = 0; i < vertices.size(); ++i) {
+    check_vertex(vertices[i]);
+    VertexConstraint& c = vertices_[vertices[i]];
+    c = VertexConstraint{ConstraintKind::fixed, {0, 0, 0}, {0, 0, 0}};
+    for (int k = 0; k < dim_ && !values.empty(); ++k) {
+      if (!std::isfinite(values[i * dim_ + k]))
+        throw std::invalid_argument("fix: non-finite value for vertex " + std::to_string(vertices[i]));
+      c.anchor[k] = values[i * dim_ + k];
+    }
+  }
+}
+
+void Constraints::slide(std::span<const VertexId> vertices, std::span<const double> direction,
+                        std::span<const double> u) {
+  if (direction.size() != static_cast<std::size_t>(dim_))
+    throw std::invalid_argument("slide: direction must have " + std::to_string(dim_) + " components");
+  double norm = 0;
+  for (double x : direction) norm += x * x;
+  norm = std::sqrt(norm);
+  if (!(norm > 0 && std::isfinite(norm))) throw std::invalid_argument("slide: direction must be non-zero and finite");
+  for (VertexId v : vertices) {
+    check_vertex(v);
+    VertexConstraint& c = vertices_[v];
+    c = VertexConstraint{ConstraintKind::slide, {0, 0, 0}, {0, 0, 0}};
+    for (int k = 0; k < dim_; ++k) {
+      c.direction[k] = direction[k] / norm;
+      c.anchor[k] = u[static_cast<std::size_t>(v) * dim_ + k];
+    }
+  }
+}
+
+void Constraints::release(std::span<const VertexId> vertices) {
+  for (VertexId v : vertices) {
+    check_vertex(v);
+    vertices_[v] = VertexConstraint{};
+  }
+}
+
+std::size_t Constraints::n_constrained() const {
+  std::size_t n = 0;
+  for (const auto& c : vertices_) n += c.kind != ConstraintKind::free;
+  return n;
+}
+
+std::size_t Constraints::n_constrained_components() const {
+  std::size_t n = 0;
+  for (const auto& c : vertices_)
+    n += c.kind == ConstraintKind::fixed ? dim_ : c.kind == ConstraintKind::slide ? dim_ - 1 : 0;
+  return n;
+}
+
+void Constraints::project(std::span<double> v) const {
+  for (std::size_t i = 0; i < vertices_.size(); ++i) {
+    const VertexConstraint& c = vertices_[i];
+    double* x = v.data() + i * dim_;
+    if (c.kind == ConstraintKind::fixed) {
+      for (int k = 0; k < dim_; ++k) x[k] = 0;
+    } else if (c.kind == ConstraintKind::slide) {
+      double along = 0;
+      for (int k = 0; k < dim_; ++k) along += x[k] * c.direction[k];
+      for (int k = 0; k < dim_; ++k) x[k] = along * c.direction[k];
+    }
+  }
+}
+
+void Constraints::project_complement(std::span<double> v) const {
+  for (std::size_t i = 0; i < vertices_.size(); ++i) {
+    const VertexConstraint& c = vertices_[i];
+    double* x = v.data() + i * dim_;
+    if (c.kind == ConstraintKind::free) {
+      for (int k = 0; k < dim_; ++k) x[k] = 0;
+    } else if (c.kind == ConstraintKind::slide) {
+      double along = 0;
+      for (int k = 0; k < dim_; ++k) along += x[k] * c.direction[k];
+      for (int k = 0; k < dim_; ++k) x[k] -= along * c.direction[k];
+    }
+  }
+}
+
+void Constraints::enforce(std::span<double> u) const {
+  for (std::size_t i = 0; i < vertices_.size(); ++i) {
+    const VertexConstraint& c = vertices_[i];
+    double* x = u.data() + i * dim_;
+    if (c.kind == ConstraintKind::fixed) {
+      for (int k = 0; k < dim_; ++k) x[k] = c.anchor[k];
+    } else if (c.kind == ConstraintKind::slide) {
+      double along = 0;
+      for (int k = 0; k < dim_; ++k) along += (x[k] - c.anchor[k]) * c.direction[k];
+      for (int k = 0; k < dim_; ++k) x[k] = c.anchor[k] + along * c.direction[k];
+    }
+  }
+}
+
+void Constraints::inherit(VertexId v, const VertexParents& parents) {
+  if (v >= n_points()) resize(v + 1);
+  VertexConstraint inherited;
+  if (parents.count == 1) {
+    inherited = vertices_[parents.vertex[0]];
+  } else if (parents.count == 2 && vertices_[parents.vertex[0]].kind == ConstraintKind::fixed &&
+             vertices_[parents.vertex[1]].kind == ConstraintKind::fixed) {
+    inherited.kind = ConstraintKind::fixed;
+    for (int k = 0; k < dim_; ++k)
+      inherited.anchor[k] = parents.weight[0] * vertices_[parents.vertex[0]].anchor[k] +
+                            parents.weight[1] * vertices_[parents.vertex[1]].anchor[k];
+  }
+  vertices_[v] = inherited;
+}
+
+}  // namespace snede

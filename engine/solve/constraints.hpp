@@ -1,0 +1,56 @@
+// Vertex constraints as projections (§3.1, §6.6): a fixed vertex keeps a prescribed
+// displacement; a sliding vertex moves along a line through where it was when the
+// constraint was set. P is the orthogonal projection onto the allowed motions (0 for fixed,
+// t tᵀ for sliding along t, I for free); the constraint reads (I − P)(u − anchor) = 0.
+#pragma once
+
+#include <array>
+#include <span>
+#include <vector>
+
+#include "mesh/mesh.hpp"
+
+namespace snede {
+
+enum class ConstraintKind : std::uint8_t { free, fixed, slide };
+
+struct VertexConstraint {
+  ConstraintKind kind = ConstraintKind::free;
+  std::array<double, 3> anchor{0, 0, 0};     // displacement that (I − P) must keep
+  std::array<double, 3> direction{0, 0, 0};  // unit line direction (slide)
+};
+
+class Constraints {
+ public:
+  explicit Constraints(int dim) : dim_(dim) {}
+  int dim() const { return dim_; }
+  void resize(VertexId n_points) { vertices_.resize(n_points); }
+  VertexId n_points() const { return static_cast<VertexId>(vertices_.size()); }
+  const VertexConstraint& operator[](VertexId v) const { return vertices_[v]; }
+
+  // values: dim numbers per vertex, or empty for zero displacement.
+  void fix(std::span<const VertexId> vertices, std::span<const double> values);
+  // Slide along `direction` (dim numbers, normalised here) through the current displacement.
+  void slide(std::span<const VertexId> vertices, std::span<const double> direction, std::span<const double> u);
+  void release(std::span<const VertexId> vertices);
+  std::size_t n_constrained() const;
+  // Number of independent constrained displacement components.
+  std::size_t n_constrained_components() const;
+
+  // v ← P v
+  void project(std::span<double> v) const;
+  // v ← (I − P) v
+  void project_complement(std::span<double> v) const;
+  // u ← P u + (I − P) anchor: the nearest displacement that satisfies the constraints.
+  void enforce(std::span<double> u) const;
+  // A new vertex inherits its parents' constraint when they agree (one parent: its
+  // constraint; two fixed parents: fixed at the interpolated anchor); otherwise free.
+  void inherit(VertexId v, const VertexParents& parents);
+
+ private:
+  void check_vertex(VertexId v) const;
+  int dim_;
+  std::vector<VertexConstraint> vertices_;
+};
+
+}  // namespace snede
