@@ -13,6 +13,7 @@ namespace py = pybind11;
 void bind_core(py::module_& m);
 void bind_mesh(py::module_& m);
 void bind_fem(py::module_& m);
+void bind_solve(py::module_& m);
 
 // A (rows, columns) numpy array holding a copy of `values`.
 template <class T>

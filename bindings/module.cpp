@@ -9,4 +9,5 @@ PYBIND11_MODULE(_snede, m) {
   snede::bindings::bind_core(m);
   snede::bindings::bind_mesh(m);
   snede::bindings::bind_fem(m);
+  snede::bindings::bind_solve(m);
 }

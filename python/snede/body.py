@@ -34,6 +34,7 @@ class Body:
         self.mesh = mesh
         self.material = material
         self._impl = _snede.ElasticBody(mesh._impl, material, float(density), float(thickness or 0.0))
+        self._model = _snede.Model(self._impl)
 
     @property
     def dim(self) -> int:
@@ -91,6 +92,69 @@ class Body:
         if g.shape != (self.dim,):
             raise ValueError(f"g must have {self.dim} components, got shape {g.shape}")
         return self._impl.gravity_forces(g)
+
+    # -- constraints, loads and state (the model, §3.1, §6.6) ----------------------------
+    def _vertices(self, vertices) -> np.ndarray:
+        array = np.atleast_1d(np.asarray(vertices))
+        if array.dtype == bool:
+            if array.shape != (self.mesh.n_points,):
+                raise ValueError(f"a boolean vertex mask must have shape ({self.mesh.n_points},), got {array.shape}")
+            array = np.flatnonzero(array)
+        if array.dtype.kind not in "iu" or array.ndim != 1:
+            raise ValueError(f"vertices must be a 1-D array of vertex indices or a boolean mask, got {array.dtype} {array.shape}")
+        bad = array[(array < 0) | (array >= self.mesh.n_points)]
+        if len(bad):
+            raise ValueError(f"vertex {bad[0]} does not exist (the mesh has {self.mesh.n_points} points)")
+        return np.ascontiguousarray(array, dtype=np.int64)
+
+    def fix(self, vertices, value=None) -> None:
+        """Fix vertices (indices or a boolean mask) at displacement ``value``: None for zero,
+        one (dim,) vector for all, or (n_vertices, dim). The state is moved onto it."""
+        vertices = self._vertices(vertices)
+        if value is None:
+            values = np.zeros((len(vertices), self.dim))
+        else:
+            values = np.broadcast_to(np.asarray(value, dtype=np.float64), (len(vertices), self.dim))
+        self._model.fix(vertices, np.ascontiguousarray(values))
+
+    def slide(self, vertices, direction) -> None:
+        """Let vertices move only along ``direction`` (a line through where they are now)."""
+        self._model.slide(self._vertices(vertices), np.asarray(direction, dtype=np.float64))
+
+    def release(self, vertices) -> None:
+        """Remove the constraints of these vertices."""
+        self._model.release(self._vertices(vertices))
+
+    def add_gravity(self, g=(0.0, 0.0, -9.81)) -> None:
+        """Gravity (m/s²) acting on the element masses; replaces a previous gravity."""
+        g = np.asarray(g, dtype=np.float64)
+        if g.shape != (self.dim,):
+            raise ValueError(f"g must have {self.dim} components, got shape {g.shape}")
+        self._model.set_gravity(g)
+
+    def add_nodal_force(self, vertices, force) -> None:
+        """Add a force (newtons): one (dim,) vector on every listed vertex, or (n_vertices, dim)."""
+        self._model.add_nodal_force(self._vertices(vertices), np.asarray(force, dtype=np.float64))
+
+    def clear_loads(self) -> None:
+        self._model.clear_loads()
+
+    def external_forces(self) -> np.ndarray:
+        """Gravity plus nodal forces, (n_points, dim)."""
+        return self._model.external_forces()
+
+    def reaction_forces(self) -> np.ndarray:
+        """Forces the supports exert on the body at the current state, (I − P)∇Π(u)."""
+        return self._model.reaction_forces()
+
+    @property
+    def displacement(self) -> np.ndarray:
+        """The state u, (n_points, dim) (a copy; assign to set it)."""
+        return self._model.displacement
+
+    @displacement.setter
+    def displacement(self, u) -> None:
+        self._model.displacement = self._field("displacement", u)
 
     def flops_per_element(self) -> dict:
         """Flops per element of the energy, force and tangent-action kernels, counted by

@@ -1,0 +1,84 @@
+#include "bindings.hpp"
+#include "core/error.hpp"
+#include "petsc4py_interop.hpp"
+#include "solve/model.hpp"
+#include "solve/solve_result.hpp"
+
+#include <pybind11/stl.h>
+
+namespace snede::bindings {
+namespace {
+
+using DoubleArray = py::array_t<double, py::array::c_style | py::array::forcecast>;
+using IndexArray = py::array_t<std::int64_t, py::array::c_style | py::array::forcecast>;
+
+std::vector<VertexId> vertex_ids(const IndexArray& a) {
+  std::vector<VertexId> ids(a.data(), a.data() + a.size());
+  return ids;
+}
+
+std::span<const double> view(const DoubleArray& a) { return {a.data(), static_cast<std::size_t>(a.size())}; }
+
+py::array_t<double> vec_to_array(Vec v, int dim) {
+  const PetscScalar* data = nullptr;
+  PetscInt n = 0;
+  SNEDE_PETSC(VecGetLocalSize(v, &n));
+  SNEDE_PETSC(VecGetArrayRead(v, &data));
+  std::vector<double> values(data, data + n);
+  SNEDE_PETSC(VecRestoreArrayRead(v, &data));
+  return to_array(values, dim);
+}
+
+void array_to_vec(const DoubleArray& a, Vec v) {
+  PetscInt n = 0;
+  SNEDE_PETSC(VecGetLocalSize(v, &n));
+  if (a.size() != n) throw std::invalid_argument("expected " + std::to_string(n) + " values, got " + std::to_string(a.size()));
+  PetscScalar* data = nullptr;
+  SNEDE_PETSC(VecGetArray(v, &data));
+  std::copy(a.data(), a.data() + n, data);
+  SNEDE_PETSC(VecRestoreArray(v, &data));
+}
+
+py::array_t<double> reactions_of(Model& model) {
+  Vec R = nullptr;
+  SNEDE_PETSC(VecDuplicate(model.displacement(), &R));
+  model.reaction_forces(model.displacement(), R);
+  py::array_t<double> out = vec_to_array(R, model.dim());
+  SNEDE_PETSC(VecDestroy(&R));
+  return out;
+}
+
+}  // namespace
+
+void bind_solve(py::module_& m) {
+  py::class_<SolveResult>(m, "EngineSolveResult")
+      .def_readonly("converged", &SolveResult::converged)
+      .def_readonly("reason", &SolveResult::reason)
+      .def_readonly("iterations", &SolveResult::iterations)
+      .def_readonly("linear_iterations", &SolveResult::linear_iterations)
+      .def_readonly("residual_norm", &SolveResult::residual_norm)
+      .def_readonly("initial_residual_norm", &SolveResult::initial_residual_norm)
+      .def_readonly("tolerance", &SolveResult::tolerance)
+      .def_readonly("energy", &SolveResult::energy)
+      .def_readonly("seconds", &SolveResult::seconds)
+      .def_readonly("flops", &SolveResult::flops)
+      .def_readonly("residual_history", &SolveResult::residual_history);
+  py::class_<Model>(m, "Model")
+      .def(py::init<ElasticBody&>(), py::arg("body"), py::keep_alive<1, 2>())
+      .def("fix", [](Model& s, const IndexArray& v, const DoubleArray& values) { s.fix(vertex_ids(v), view(values)); })
+      .def("slide", [](Model& s, const IndexArray& v, const DoubleArray& t) { s.slide(vertex_ids(v), view(t)); })
+      .def("release", [](Model& s, const IndexArray& v) { s.constraints().release(vertex_ids(v)); })
+      .def("set_gravity", [](Model& s, const DoubleArray& g) { s.set_gravity(view(g)); })
+      .def("add_nodal_force", [](Model& s, const IndexArray& v, const DoubleArray& f) { s.add_nodal_force(vertex_ids(v), view(f)); })
+      .def("clear_loads", &Model::clear_loads)
+      .def("external_forces", [](Model& s) { return to_array(s.external_forces(), s.dim()); })
+      .def("reaction_forces", &reactions_of)
+      .def_property_readonly("n_constrained", [](const Model& s) { return s.constraints().n_constrained(); })
+      .def_property_readonly("generation", &Model::generation)
+      .def_property("displacement", [](const Model& s) { return vec_to_array(s.displacement(), s.dim()); },
+                    [](Model& s, const DoubleArray& u) { array_to_vec(u, s.displacement()); })
+      .def_property_readonly("displacement_vec", [](const Model& s) { return to_petsc4py(s.displacement()); })
+      .def_property_readonly("tangent_mat", [](const Model& s) { return to_petsc4py(s.tangent()); });
+}
+
+}  // namespace snede::bindings
