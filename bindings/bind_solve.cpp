@@ -3,6 +3,7 @@
 #include "petsc4py_interop.hpp"
 #include "solve/model.hpp"
 #include "solve/solve_result.hpp"
+#include "solve/static_solver.hpp"
 
 #include <pybind11/stl.h>
 
@@ -48,6 +49,24 @@ py::array_t<double> reactions_of(Model& model) {
   return out;
 }
 
+std::unique_ptr<StaticSolver> make_static_solver(Model& model, const std::string& method, double rtol,
+                                                 const std::string& criterion, double round_tolerance,
+                                                 int max_iterations, const std::string& prefix) {
+  StaticOptions options;
+  if (method == "cg") options.method = StaticMethod::linear_cg;
+  else if (method == "ncg") options.method = StaticMethod::nonlinear_cg;
+  else if (method == "newton") options.method = StaticMethod::newton;
+  else throw std::invalid_argument("method must be 'cg', 'ncg' or 'newton', got '" + method + "'");
+  if (criterion == "6.9") options.stopping.criterion = StoppingCriterion::with_reactions;
+  else if (criterion == "6.8") options.stopping.criterion = StoppingCriterion::load_relative;
+  else throw std::invalid_argument("criterion must be '6.8' or '6.9', got '" + criterion + "'");
+  options.stopping.rtol = rtol;
+  options.stopping.round_tolerance = round_tolerance;
+  options.max_iterations = max_iterations;
+  options.options_prefix = prefix;
+  return std::make_unique<StaticSolver>(model, options);
+}
+
 }  // namespace
 
 void bind_solve(py::module_& m) {
@@ -79,6 +98,15 @@ void bind_solve(py::module_& m) {
                     [](Model& s, const DoubleArray& u) { array_to_vec(u, s.displacement()); })
       .def_property_readonly("displacement_vec", [](const Model& s) { return to_petsc4py(s.displacement()); })
       .def_property_readonly("tangent_mat", [](const Model& s) { return to_petsc4py(s.tangent()); });
+
+  py::class_<StaticSolver>(m, "StaticSolver")
+      .def(py::init(&make_static_solver), py::arg("model"), py::arg("method"), py::arg("rtol"), py::arg("criterion"),
+           py::arg("round_tolerance"), py::arg("max_iterations"), py::arg("options_prefix"), py::keep_alive<1, 2>())
+      .def("solve", &StaticSolver::solve)
+      .def_property_readonly("ksp", [](const StaticSolver& s) { return to_petsc4py(s.ksp()); })
+      .def_property_readonly("snes", [](const StaticSolver& s) {
+        return s.snes() ? to_petsc4py(s.snes()) : py::object(py::none());
+      });
 }
 
 }  // namespace snede::bindings

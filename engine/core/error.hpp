@@ -23,6 +23,19 @@ class PetscException : public std::runtime_error {
 // Throws PetscException with PETSc's text for `code` if it is non-zero; `call` names the call.
 void check_petsc(PetscErrorCode code, const char* call, const char* file, int line);
 
+// Runs `body` inside a callback that PETSc calls (MatMult of a shell, SNES function, ...):
+// a C++ exception becomes a PETSc error carrying its message, so it travels back through
+// PETSc to the caller instead of unwinding through C frames.
+template <class Body>
+PetscErrorCode petsc_callback(const char* name, Body&& body) noexcept {
+  try {
+    body();
+    return 0;
+  } catch (const std::exception& e) {
+    return PetscError(PETSC_COMM_SELF, __LINE__, name, __FILE__, PETSC_ERR_LIB, PETSC_ERROR_INITIAL, "%s", e.what());
+  }
+}
+
 }  // namespace snede
 
 // Wrap every PETSc call made by the engine: SNEDE_PETSC(VecCreate(comm, &v));

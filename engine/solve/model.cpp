@@ -224,15 +224,11 @@ void Model::tangent_mult(Vec d, Vec out) {
 }
 
 PetscErrorCode Model::tangent_mult_callback(Mat A, Vec d, Vec out) {
-  PetscFunctionBeginUser;
-  void* context = nullptr;
-  PetscCall(MatShellGetContext(A, &context));
-  try {
+  return petsc_callback("snede tangent shell MatMult", [&] {
+    void* context = nullptr;
+    SNEDE_PETSC(MatShellGetContext(A, &context));
     static_cast<Model*>(context)->tangent_mult(d, out);
-  } catch (const std::exception& e) {
-    SETERRQ(PETSC_COMM_SELF, PETSC_ERR_LIB, "%s", e.what());
-  }
-  PetscFunctionReturn(0);
+  });
 }
 
 std::vector<double> Model::carried_over(std::span<const double> old_values, VertexId n_old_points) const {

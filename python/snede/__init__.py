@@ -14,10 +14,12 @@ from snede._snede import (  # noqa: F401
 )
 from snede.mesh import Mesh, MeshQuality  # noqa: F401
 from snede.body import Body  # noqa: F401
+from snede.result import SolveResult  # noqa: F401
+from snede.static import StaticSolver  # noqa: F401
 from snede import meshing  # noqa: F401
 
 __all__ = [
-    "Mesh", "MeshQuality", "Body", "meshing",
+    "Mesh", "MeshQuality", "Body", "meshing", "StaticSolver", "SolveResult",
     "LinearElastic", "StVenantKirchhoff", "NeoHookean", "VerondaWestmann",
     "InvalidMesh", "PetscError", "DomainError", "PETSc",
 ]

@@ -1,0 +1,285 @@
+#include "solve/static_solver.hpp"
+
+#include <petsctime.h>
+
+#include <cmath>
+#include <limits>
+
+#include "core/error.hpp"
+
+namespace snede {
+namespace {
+
+bool is_linear(const Material& material) { return std::holds_alternative<LinearElastic>(material); }
+
+bool forbids_inversion(const Material& material) {
+  return std::visit([](const auto& m) { return std::decay_t<decltype(m)>::forbids_inversion; }, material);
+}
+
+std::string without_prefix(const char* name) {
+  const std::string text = name ? name : "UNKNOWN";
+  return text;
+}
+
+double norm_of(Vec v) {
+  PetscReal n = 0;
+  SNEDE_PETSC(VecNorm(v, NORM_2, &n));
+  return n;
+}
+
+double wall_seconds() {
+  PetscLogDouble t = 0;
+  SNEDE_PETSC(PetscTime(&t));
+  return t;
+}
+
+}  // namespace
+
+StaticSolver::StaticSolver(Model& model, StaticOptions options) : model_(model), options_(std::move(options)) {
+  if (options_.stopping.rtol <= 0 || !std::isfinite(options_.stopping.rtol))
+    throw std::invalid_argument("rtol must be positive, got " + std::to_string(options_.stopping.rtol));
+  if (options_.method == StaticMethod::linear_cg && !is_linear(model.body().material()))
+    throw std::invalid_argument(
+        "method 'cg' (linear CG) solves the linear problem and needs LinearElastic; use 'ncg' or 'newton' for "
+        "nonlinear materials");
+  register_line_searches();
+  create_objects();
+}
+
+StaticSolver::~StaticSolver() {
+  KSPDestroy(&ksp_);
+  SNESDestroy(&snes_);
+  VecDestroy(&residual_);
+}
+
+KSP StaticSolver::ksp() const {
+  if (ksp_) return ksp_;
+  KSP inner = nullptr;
+  SNESGetKSP(snes_, &inner);
+  return inner;
+}
+
+void StaticSolver::create_objects() {
+  generation_ = model_.generation();
+  SNEDE_PETSC(VecDuplicate(model_.displacement(), &residual_));
+  const char* prefix = options_.options_prefix.c_str();
+  if (options_.method == StaticMethod::linear_cg) {
+    SNEDE_PETSC(KSPCreate(PETSC_COMM_SELF, &ksp_));
+    SNEDE_PETSC(KSPSetOptionsPrefix(ksp_, prefix));
+    SNEDE_PETSC(KSPSetType(ksp_, KSPCG));
+    PC pc = nullptr;
+    SNEDE_PETSC(KSPGetPC(ksp_, &pc));
+    SNEDE_PETSC(PCSetType(pc, PCNONE));  // matrix-free: no diagonal is formed
+    SNEDE_PETSC(KSPSetOperators(ksp_, model_.tangent(), model_.tangent()));
+    SNEDE_PETSC(KSPSetTolerances(ksp_, 0.0, 0.0, PETSC_DEFAULT, options_.max_iterations));
+    SNEDE_PETSC(KSPSetConvergenceTest(ksp_, ksp_converged_callback, this, nullptr));
+    SNEDE_PETSC(KSPSetFromOptions(ksp_));
+    return;
+  }
+  SNEDE_PETSC(SNESCreate(PETSC_COMM_SELF, &snes_));
+  SNEDE_PETSC(SNESSetOptionsPrefix(snes_, prefix));
+  SNEDE_PETSC(SNESSetApplicationContext(snes_, this));
+  SNEDE_PETSC(SNESSetFunction(snes_, residual_, residual_callback, this));
+  SNEDE_PETSC(SNESSetObjective(snes_, objective_callback, this));
+  SNEDE_PETSC(SNESSetTolerances(snes_, 0.0, 0.0, 0.0, options_.max_iterations, -1));
+  SNEDE_PETSC(SNESSetConvergenceTest(snes_, snes_converged_callback, this, nullptr));
+  if (options_.method == StaticMethod::nonlinear_cg) {
+    SNEDE_PETSC(SNESSetType(snes_, SNESNCG));
+    SNEDE_PETSC(SNESNCGSetType(snes_, SNES_NCG_PRP));
+  } else {
+    SNEDE_PETSC(SNESSetType(snes_, SNESNEWTONLS));
+    SNEDE_PETSC(SNESSetJacobian(snes_, model_.tangent(), model_.tangent(), jacobian_callback, this));
+    KSP inner = nullptr;
+    SNEDE_PETSC(SNESGetKSP(snes_, &inner));
+    SNEDE_PETSC(KSPSetType(inner, KSPCG));
+    PC pc = nullptr;
+    SNEDE_PETSC(KSPGetPC(inner, &pc));
+    SNEDE_PETSC(PCSetType(pc, PCNONE));
+    // Truncated Newton (§2.4.3): the inner CG stops early, tightening as the outer converges.
+    SNEDE_PETSC(SNESKSPSetUseEW(snes_, PETSC_TRUE));
+  }
+  SNEDE_PETSC(SNESSetFromOptions(snes_));
+}
+
+void StaticSolver::reissue_sizes_if_mesh_changed() {
+  if (generation_ == model_.generation()) return;
+  // The mesh changed size (a cut or a refinement): new vectors and a new shell, same
+  // solver objects (so a user's handle and options survive).
+  generation_ = model_.generation();
+  SNEDE_PETSC(VecDestroy(&residual_));
+  SNEDE_PETSC(VecDuplicate(model_.displacement(), &residual_));
+  if (ksp_) {
+    SNEDE_PETSC(KSPReset(ksp_));
+    SNEDE_PETSC(KSPSetOperators(ksp_, model_.tangent(), model_.tangent()));
+  } else {
+    SNEDE_PETSC(SNESReset(snes_));
+    SNEDE_PETSC(SNESSetFunction(snes_, residual_, residual_callback, this));
+    if (options_.method == StaticMethod::newton)
+      SNEDE_PETSC(SNESSetJacobian(snes_, model_.tangent(), model_.tangent(), jacobian_callback, this));
+  }
+}
+
+double StaticSolver::current_tolerance() const {
+  StoppingRule rule = options_.stopping;
+  rule.force_scale = model_.force_scale();
+  rule.n_dofs = static_cast<double>(model_.n_dofs());
+  return rule.tolerance(external_norm_, ksp_ ? reaction_norm_ : model_.last_reaction_norm());
+}
+
+SolveResult StaticSolver::solve() {
+  reissue_sizes_if_mesh_changed();
+  history_.clear();
+  const std::vector<double>& f = model_.external_forces();
+  double sum = 0;
+  for (double x : f) sum += x * x;
+  external_norm_ = std::sqrt(sum);
+  model_.enforce_constraints(model_.displacement());
+  // A free body has rigid motions: the static problem has no unique solution.
+  const std::size_t rigid_modes = model_.dim() == 3 ? 6 : 3;
+  if (model_.constraints().n_constrained_components() < rigid_modes)
+    throw std::invalid_argument(
+        "the body is not held: a static solve needs constraints that stop its " + std::to_string(rigid_modes) +
+        " rigid motions (fix some vertices with body.fix); only " +
+        std::to_string(model_.constraints().n_constrained_components()) + " displacement components are constrained");
+  return ksp_ ? solve_linear() : solve_nonlinear();
+}
+
+SolveResult StaticSolver::solve_linear() {
+  SolveResult result;
+  const double start = wall_seconds();
+  PetscLogDouble start_flops = 0;
+  SNEDE_PETSC(PetscGetFlops(&start_flops));
+  Vec u = model_.displacement(), rhs = nullptr, step = nullptr;
+  SNEDE_PETSC(VecDuplicate(u, &rhs));
+  SNEDE_PETSC(VecDuplicate(u, &step));
+  EvaluationReport report;
+  model_.residual(u, residual_, report);
+  throw_if_domain_error(report);
+  reaction_norm_ = model_.last_reaction_norm();
+  result.initial_residual_norm = norm_of(residual_);
+  // One Newton step of the quadratic problem: J δ = −F(u), solved by CG (§3.1).
+  model_.set_linearization_point(u);
+  SNEDE_PETSC(VecCopy(residual_, rhs));
+  SNEDE_PETSC(VecScale(rhs, -1.0));
+  SNEDE_PETSC(VecSet(step, 0.0));
+  SNEDE_PETSC(KSPSolve(ksp_, rhs, step));
+  SNEDE_PETSC(VecAXPY(u, 1.0, step));
+  KSPConvergedReason reason;
+  PetscInt iterations = 0;
+  SNEDE_PETSC(KSPGetConvergedReason(ksp_, &reason));
+  SNEDE_PETSC(KSPGetIterationNumber(ksp_, &iterations));
+  result.iterations = static_cast<int>(iterations);
+  result.reason = without_prefix(KSPConvergedReasons[reason]);
+  result.converged = reason > 0;
+  SNEDE_PETSC(VecDestroy(&rhs));
+  SNEDE_PETSC(VecDestroy(&step));
+  finish(result, start, start_flops);
+  return result;
+}
+
+SolveResult StaticSolver::solve_nonlinear() {
+  SolveResult result;
+  const double start = wall_seconds();
+  PetscLogDouble start_flops = 0;
+  SNEDE_PETSC(PetscGetFlops(&start_flops));
+  Vec u = model_.displacement();
+  EvaluationReport report;
+  model_.residual(u, residual_, report);
+  result.initial_residual_norm = norm_of(residual_);
+  SNEDE_PETSC(SNESSolve(snes_, nullptr, u));
+  SNESConvergedReason reason;
+  PetscInt iterations = 0, linear = 0;
+  SNEDE_PETSC(SNESGetConvergedReason(snes_, &reason));
+  SNEDE_PETSC(SNESGetIterationNumber(snes_, &iterations));
+  SNEDE_PETSC(SNESGetLinearSolveIterations(snes_, &linear));
+  result.iterations = static_cast<int>(iterations);
+  result.linear_iterations = static_cast<int>(linear);
+  result.reason = without_prefix(SNESConvergedReasons[reason]);
+  result.converged = reason > 0;
+  finish(result, start, start_flops);
+  return result;
+}
+
+void StaticSolver::finish(SolveResult& result, double start_seconds, PetscLogDouble start_flops) {
+  Vec u = model_.displacement();
+  // The verdict is checked on the final state, whatever PETSc said (§ "results, not crashes").
+  std::string why;
+  if (!model_.admissible(u, &why)) {
+    result.converged = false;
+    result.reason = why;
+  }
+  EvaluationReport report;
+  model_.residual(u, residual_, report);
+  result.residual_norm = norm_of(residual_);
+  if (!report.domain_errors.empty() || !std::isfinite(result.residual_norm)) {
+    result.converged = false;
+    result.reason = "DIVERGED_NONFINITE_STATE";
+  }
+  result.tolerance = current_tolerance();
+  EvaluationReport energy_report;
+  result.energy = model_.potential_energy(u, energy_report);
+  result.residual_history = history_;
+  result.seconds = wall_seconds() - start_seconds;
+  PetscLogDouble flops = 0;
+  SNEDE_PETSC(PetscGetFlops(&flops));
+  result.flops = flops - start_flops;
+}
+
+PetscErrorCode StaticSolver::residual_callback(SNES snes, Vec x, Vec F, void* context) {
+  return petsc_callback("snede static residual", [&] {
+    auto* self = static_cast<StaticSolver*>(context);
+    EvaluationReport report;
+    self->model_.residual(x, F, report);
+    const bool inverted = !report.inverted.empty() && forbids_inversion(self->model_.body().material());
+    if (!report.domain_errors.empty() || inverted) SNEDE_PETSC(SNESSetFunctionDomainError(snes));
+  });
+}
+
+PetscErrorCode StaticSolver::objective_callback(SNES snes, Vec x, PetscReal* value, void* context) {
+  return petsc_callback("snede static objective", [&] {
+    auto* self = static_cast<StaticSolver*>(context);
+    EvaluationReport report;
+    *value = self->model_.potential_energy(x, report);
+    if (!report.domain_errors.empty()) {
+      *value = std::numeric_limits<double>::infinity();
+      SNEDE_PETSC(SNESSetFunctionDomainError(snes));
+    }
+  });
+}
+
+PetscErrorCode StaticSolver::jacobian_callback(SNES, Vec x, Mat J, Mat, void* context) {
+  return petsc_callback("snede static jacobian", [&] {
+    static_cast<StaticSolver*>(context)->model_.set_linearization_point(x);
+    SNEDE_PETSC(MatAssemblyBegin(J, MAT_FINAL_ASSEMBLY));
+    SNEDE_PETSC(MatAssemblyEnd(J, MAT_FINAL_ASSEMBLY));
+  });
+}
+
+PetscErrorCode StaticSolver::snes_converged_callback(SNES snes, PetscInt it, PetscReal xnorm, PetscReal snorm,
+                                                     PetscReal fnorm, SNESConvergedReason* reason, void* context) {
+  return petsc_callback("snede stopping criterion", [&] {
+    auto* self = static_cast<StaticSolver*>(context);
+    // PETSc's default test catches NaN norms and the iteration limit.
+    SNEDE_PETSC(SNESConvergedDefault(snes, it, xnorm, snorm, fnorm, reason, nullptr));
+    self->history_.push_back(fnorm);
+    if (*reason < 0) return;
+    *reason = fnorm <= self->current_tolerance() ? SNES_CONVERGED_FNORM_ABS : SNES_CONVERGED_ITERATING;
+  });
+}
+
+PetscErrorCode StaticSolver::ksp_converged_callback(KSP ksp, PetscInt it, PetscReal rnorm, KSPConvergedReason* reason,
+                                                    void* context) {
+  return petsc_callback("snede stopping criterion", [&] {
+    auto* self = static_cast<StaticSolver*>(context);
+    (void)ksp;
+    self->history_.push_back(rnorm);
+    if (!std::isfinite(rnorm)) {
+      *reason = KSP_DIVERGED_NANORINF;
+      return;
+    }
+    // For a linear problem the CG residual b − Jδ is the equilibrium residual −F(u + δ).
+    *reason = rnorm <= self->current_tolerance() ? KSP_CONVERGED_ATOL : KSP_CONVERGED_ITERATING;
+  });
+}
+
+}  // namespace snede

@@ -1,0 +1,74 @@
+// Static relaxation (§2.4, §3.1, §4.4.2) with PETSc: linear CG (KSPCG on the tangent
+// shell), nonlinear CG (SNESNCG; Polak-Ribière or Fletcher-Reeves through
+// -<prefix>snes_ncg_type, line searches cp, snede_newton, snede_secant) and truncated
+// Newton (SNESNEWTONLS with an inner KSPCG on the shell and Eisenstat-Walker tolerances).
+// Every object carries the options prefix, and SetFromOptions is called after snede's
+// defaults, so the command line overrides everything.
+#pragma once
+
+#include <petscksp.h>
+#include <petscsnes.h>
+
+#include <string>
+#include <vector>
+
+#include "solve/model.hpp"
+#include "solve/solve_result.hpp"
+#include "solve/stopping.hpp"
+
+namespace snede {
+
+enum class StaticMethod { linear_cg, nonlinear_cg, newton };
+
+struct StaticOptions {
+  StaticMethod method = StaticMethod::newton;
+  StoppingRule stopping;  // force_scale and n_dofs are filled from the model
+  int max_iterations = 10000;
+  std::string options_prefix = "static_";
+};
+
+class StaticSolver {
+ public:
+  StaticSolver(Model& model, StaticOptions options);
+  ~StaticSolver();
+  StaticSolver(const StaticSolver&) = delete;
+  StaticSolver& operator=(const StaticSolver&) = delete;
+
+  // Relaxes the model's displacement in place (starting from it, constraints enforced).
+  SolveResult solve();
+  KSP ksp() const;  // linear CG's KSP, or Newton's inner KSP
+  SNES snes() const { return snes_; }
+  const StaticOptions& options() const { return options_; }
+  Model& model() { return model_; }
+
+ private:
+  void create_objects();
+  void reissue_sizes_if_mesh_changed();
+  double current_tolerance() const;
+  SolveResult solve_linear();
+  SolveResult solve_nonlinear();
+  void finish(SolveResult& result, double start_seconds, PetscLogDouble start_flops);
+
+  static PetscErrorCode residual_callback(SNES, Vec x, Vec F, void* context);
+  static PetscErrorCode objective_callback(SNES, Vec x, PetscReal* value, void* context);
+  static PetscErrorCode jacobian_callback(SNES, Vec x, Mat J, Mat P, void* context);
+  static PetscErrorCode snes_converged_callback(SNES, PetscInt it, PetscReal xnorm, PetscReal snorm,
+                                                PetscReal fnorm, SNESConvergedReason* reason, void* context);
+  static PetscErrorCode ksp_converged_callback(KSP, PetscInt it, PetscReal rnorm, KSPConvergedReason* reason,
+                                               void* context);
+
+  Model& model_;
+  StaticOptions options_;
+  KSP ksp_ = nullptr;    // linear CG only
+  SNES snes_ = nullptr;  // nonlinear methods only
+  Vec residual_ = nullptr;
+  std::uint64_t generation_ = 0;
+  double external_norm_ = 0;
+  double reaction_norm_ = 0;  // reactions used by the KSP test (at the start of a linear solve)
+  std::vector<double> history_;
+};
+
+// Registers snede's line searches with PETSc (idempotent): snede_newton, snede_secant.
+void register_line_searches();
+
+}  // namespace snede

@@ -1,0 +1,27 @@
+// Stopping criteria of §6.6: (6.8) ‖r‖ ≤ ε‖f_ext‖, and (6.9), which also counts reaction
+// forces as external forces and adds a round-off floor so that a body loaded only by
+// prescribed displacements can converge:
+//   ‖r‖ ≤ ε √(‖f_ext‖² + ‖f_react‖²) + (E·dH/√n) ε_round   (dH → H² in 3D).
+#pragma once
+
+#include <cmath>
+
+namespace snede {
+
+enum class StoppingCriterion { load_relative /* (6.8) */, with_reactions /* (6.9) */ };
+
+struct StoppingRule {
+  StoppingCriterion criterion = StoppingCriterion::with_reactions;
+  double rtol = 1e-6;             // ε
+  double round_tolerance = 1e-12; // ε_round
+  double force_scale = 0;         // E·dH (2D) or E·H² (3D)
+  double n_dofs = 1;
+
+  double tolerance(double external_norm, double reaction_norm) const {
+    if (criterion == StoppingCriterion::load_relative) return rtol * external_norm;
+    return rtol * std::sqrt(external_norm * external_norm + reaction_norm * reaction_norm) +
+           force_scale / std::sqrt(n_dofs) * round_tolerance;
+  }
+};
+
+}  // namespace snede

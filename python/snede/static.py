@@ -1,0 +1,70 @@
+"""Static relaxation: linear CG, nonlinear CG and truncated Newton through PETSc (§2.4, §3.1,
+§4.4.2). Every PETSc object carries ``options_prefix`` (default ``static_``), so the command
+line tunes it: ``-static_snes_monitor``, ``-static_snes_ncg_type fr``,
+``-static_snes_linesearch_type snede_secant``, ``-static_ksp_monitor``, ``-log_view``.
+"""
+from __future__ import annotations
+
+from snede import _snede
+from snede._petsc import PETSc
+from snede.result import SolveResult
+
+METHODS = ("cg", "ncg", "newton")
+LINE_SEARCHES = ("cp", "snede_newton", "snede_secant", "bt", "l2", "basic")
+
+
+class StaticSolver:
+    """``StaticSolver(body, method="newton", rtol=1e-6, ...)``; ``solve()`` relaxes
+    ``body.displacement`` in place and returns a :class:`snede.SolveResult`.
+
+    * ``method``: ``"cg"`` (linear CG, LinearElastic only), ``"ncg"`` (nonlinear CG,
+      Polak-Ribière by default; ``ncg_type="fr"`` for Fletcher-Reeves) or ``"newton"``
+      (truncated Newton: inner CG with Eisenstat-Walker tolerances).
+    * ``line_search`` (ncg): ``"cp"`` (PETSc's secant on the directional derivative, the
+      thesis's scale-dependent secant; default), ``"snede_secant"``, ``"snede_newton"``.
+    * ``criterion``: ``"6.9"`` (default; ‖r‖ ≤ rtol·√(‖f_ext‖² + ‖f_react‖²) plus a round-off
+      floor) or ``"6.8"`` (‖r‖ ≤ rtol·‖f_ext‖).
+    * ``petsc_options``: a dict of PETSc options without the prefix, e.g.
+      ``{"snes_monitor": None, "snes_max_it": 50}``; the command line still wins.
+    """
+
+    def __init__(self, body, method: str = "newton", rtol: float = 1e-6, *, criterion: str = "6.9",
+                 round_tolerance: float = 1e-12, max_iterations: int = 10000, line_search: str | None = None,
+                 ncg_type: str | None = None, options_prefix: str = "static_", petsc_options: dict | None = None):
+        if method not in METHODS:
+            raise ValueError(f"method must be one of {METHODS}, got {method!r}")
+        if not (rtol > 0):
+            raise ValueError(f"rtol must be positive, got {rtol}")
+        options = dict(petsc_options or {})
+        if line_search is not None:
+            if method != "ncg":
+                raise ValueError("line_search applies to method='ncg'")
+            if line_search not in LINE_SEARCHES:
+                raise ValueError(f"line_search must be one of {LINE_SEARCHES}, got {line_search!r}")
+            options.setdefault("snes_linesearch_type", line_search)
+        if ncg_type is not None:
+            if ncg_type not in ("prp", "fr", "hs", "dy", "cd"):
+                raise ValueError(f"ncg_type must be 'prp' or 'fr' (or hs, dy, cd), got {ncg_type!r}")
+            options.setdefault("snes_ncg_type", ncg_type)
+        database = PETSc.Options()
+        for key, value in options.items():
+            name = options_prefix + key.lstrip("-")
+            if not database.hasName(name):  # the command line wins
+                database.setValue(name, "" if value is None else str(value))
+        self.body = body
+        self.method = method
+        self._impl = _snede.StaticSolver(body._model, method, float(rtol), criterion, float(round_tolerance),
+                                         int(max_iterations), options_prefix)
+
+    def solve(self) -> SolveResult:
+        return SolveResult._from_engine(self._impl.solve())
+
+    @property
+    def ksp(self):
+        """The petsc4py KSP: linear CG's, or Newton's inner one."""
+        return self._impl.ksp
+
+    @property
+    def snes(self):
+        """The petsc4py SNES (None for linear CG)."""
+        return self._impl.snes
