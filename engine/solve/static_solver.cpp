@@ -86,6 +86,11 @@ void StaticSolver::create_objects() {
   if (options_.method == StaticMethod::nonlinear_cg) {
     SNEDE_PETSC(SNESSetType(snes_, SNESNCG));
     SNEDE_PETSC(SNESNCGSetType(snes_, SNES_NCG_PRP));
+    // The secant line search of §4.4.2 is scale-free; PETSc's cp (the scale-dependent
+    // secant) needs -snes_linesearch_damping set to the problem's step scale.
+    SNESLineSearch line_search = nullptr;
+    SNEDE_PETSC(SNESGetLineSearch(snes_, &line_search));
+    SNEDE_PETSC(SNESLineSearchSetType(line_search, "snede_secant"));
   } else {
     SNEDE_PETSC(SNESSetType(snes_, SNESNEWTONLS));
     SNEDE_PETSC(SNESSetJacobian(snes_, model_.tangent(), model_.tangent(), jacobian_callback, this));
@@ -95,8 +100,11 @@ void StaticSolver::create_objects() {
     PC pc = nullptr;
     SNEDE_PETSC(KSPGetPC(inner, &pc));
     SNEDE_PETSC(PCSetType(pc, PCNONE));
-    // Truncated Newton (§2.4.3): the inner CG stops early, tightening as the outer converges.
+    // Truncated Newton (§2.4.3): the inner CG stops early, tightening as the outer converges,
+    // and where the tangent is indefinite (far from the solution of a soft body) CG stops at
+    // the negative curvature and its iterate so far is used as the search direction.
     SNEDE_PETSC(SNESKSPSetUseEW(snes_, PETSC_TRUE));
+    SNEDE_PETSC(SNESSetMaxLinearSolveFailures(snes_, options_.max_iterations));
   }
   SNEDE_PETSC(SNESSetFromOptions(snes_));
 }

@@ -20,8 +20,11 @@ class StaticSolver:
     * ``method``: ``"cg"`` (linear CG, LinearElastic only), ``"ncg"`` (nonlinear CG,
       Polak-Ribière by default; ``ncg_type="fr"`` for Fletcher-Reeves) or ``"newton"``
       (truncated Newton: inner CG with Eisenstat-Walker tolerances).
-    * ``line_search`` (ncg): ``"cp"`` (PETSc's secant on the directional derivative, the
-      thesis's scale-dependent secant; default), ``"snede_secant"``, ``"snede_newton"``.
+    * ``line_search`` (ncg): ``"snede_secant"`` (default: the secant method of §4.4.2, whose
+      first slope comes from a tangent action, so it needs no scale), ``"snede_newton"``
+      (Newton on the directional derivative), or ``"cp"`` (PETSc's secant on the directional
+      derivative from λ = 0 and the initial step ``snes_linesearch_damping``: the thesis's
+      scale-dependent secant; set the damping to the problem's step scale).
     * ``criterion``: ``"6.9"`` (default; ‖r‖ ≤ rtol·√(‖f_ext‖² + ‖f_react‖²) plus a round-off
       floor) or ``"6.8"`` (‖r‖ ≤ rtol·‖f_ext‖).
     * ``petsc_options``: a dict of PETSc options without the prefix, e.g.
