@@ -148,9 +148,13 @@ class Mesh:
     def read(cls, path) -> "Mesh":
         """Read a mesh with meshio (gmsh .msh, VTK/VTU, XDMF, and every format meshio reads).
         Tetrahedra are taken if present, else triangles (whose z must be 0)."""
+        import contextlib
+        import io
+
         import meshio
 
-        data = meshio.read(str(path))
+        with contextlib.redirect_stdout(io.StringIO()):  # meshio's gmsh reader prints blank lines
+            data = meshio.read(str(path))
         blocks = {block.type: block.data for block in data.cells}
         if "tetra" in blocks:
             cells = np.concatenate([b.data for b in data.cells if b.type == "tetra"])
