@@ -14,6 +14,8 @@ void bind_core(py::module_& m);
 void bind_mesh(py::module_& m);
 void bind_fem(py::module_& m);
 void bind_solve(py::module_& m);
+void bind_dynamics(py::module_& m);
+void bind_io(py::module_& m);
 
 // A (rows, columns) numpy array holding a copy of `values`.
 template <class T>

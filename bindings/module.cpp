@@ -10,4 +10,6 @@ PYBIND11_MODULE(_snede, m) {
   snede::bindings::bind_mesh(m);
   snede::bindings::bind_fem(m);
   snede::bindings::bind_solve(m);
+  snede::bindings::bind_dynamics(m);
+  snede::bindings::bind_io(m);
 }

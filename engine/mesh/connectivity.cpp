@@ -61,14 +61,18 @@ Connectivity Connectivity::from_cells(int dim, std::span<const VertexId> cells) 
     } else {
       const FaceId b = keys[i + 1].face;
       const ElementId ea = c.faces_[a].element, eb = c.faces_[b].element;
+      for (std::size_t p = i; p < end; ++p)  // a repeated cell is named as such, first
+        for (std::size_t q = p + 1; q < end; ++q) {
+          const ElementId ep = c.faces_[keys[p].face].element, eq = c.faces_[keys[q].face].element;
+          if (c.elements_[ep].simplex.same_vertices(c.elements_[eq].simplex))
+            throw std::invalid_argument("Connectivity::from_cells: cells " + std::to_string(std::min(ep, eq)) +
+                                        " and " + std::to_string(std::max(ep, eq)) + " have the same vertices");
+        }
       if (end - i > 2)
         throw std::invalid_argument("Connectivity::from_cells: face " + c.faces_[a].simplex.to_string() +
                                     " is shared by " + std::to_string(end - i) + " cells (" +
                                     std::to_string(ea) + ", " + std::to_string(eb) +
                                     ", ...): not a manifold mesh");
-      if (c.elements_[ea].simplex.same_vertices(c.elements_[eb].simplex))
-        throw std::invalid_argument("Connectivity::from_cells: cells " + std::to_string(ea) + " and " +
-                                    std::to_string(eb) + " have the same vertices");
       if (c.faces_[a].simplex.sign() == c.faces_[b].simplex.sign())
         throw std::invalid_argument("Connectivity::from_cells: cells " + std::to_string(ea) + " and " +
                                     std::to_string(eb) + " lie on the same side of their common face " +
@@ -351,6 +355,7 @@ void Connectivity::remove_watcher(ConnectivityWatcher* watcher) {
 }
 
 void Connectivity::notify(const ConnectivityChange& change) {
+  ++revision_;
   for (ConnectivityWatcher* watcher : watchers_) watcher->on_change(*this, change);
 }
 

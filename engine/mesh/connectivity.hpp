@@ -90,6 +90,9 @@ class Connectivity {
   void add_watcher(ConnectivityWatcher* watcher);
   void remove_watcher(ConnectivityWatcher* watcher);
 
+  // Increases with every replace_elements / change_elements: a cheap "has it changed" test.
+  std::uint64_t revision() const { return revision_; }
+
   // Bytes held by the element, face and boundary containers (capacity, not just size).
   std::size_t memory_bytes() const;
 
@@ -112,6 +115,7 @@ class Connectivity {
   std::vector<FaceId> free_faces_;
   BoundaryMap boundary_;
   std::vector<ConnectivityWatcher*> watchers_;
+  std::uint64_t revision_ = 0;
 };
 
 }  // namespace snede

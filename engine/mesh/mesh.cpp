@@ -113,16 +113,15 @@ std::vector<VertexId> Mesh::boundary_faces() const {
 std::vector<FaceId> Mesh::find_faces(const std::vector<VertexId>& face_vertices) const {
   if (face_vertices.size() % dim_ != 0)
     throw std::invalid_argument("faces must be (n, " + std::to_string(dim_) + ") vertex ids");
+  // Keyed by the vertex set (positive orientation), so a boundary face of either sign is found.
+  auto unsigned_key = [](const Simplex& s) { return s.sign() > 0 ? s : s.mate(); };
   std::unordered_map<Simplex, FaceId, SimplexHash> wanted;
-  for (std::size_t i = 0; i < face_vertices.size() / dim_; ++i) {
-    const Simplex s(1, std::span<const VertexId>(face_vertices.data() + i * dim_, dim_));
-    wanted.emplace(s.sign() > 0 ? s : s.mate(), no_id);
-  }
+  for (std::size_t i = 0; i < face_vertices.size() / dim_; ++i)
+    wanted.emplace(unsigned_key(Simplex(1, std::span<const VertexId>(face_vertices.data() + i * dim_, dim_))), no_id);
   for (FaceId f = 0; f < connectivity_.face_capacity(); ++f) {
     if (!connectivity_.is_face(f)) continue;
-    const Simplex& s = connectivity_.face(f).simplex;
-    if (s.sign() < 0) continue;
-    if (auto it = wanted.find(s); it != wanted.end()) it->second = f;
+    if (auto it = wanted.find(unsigned_key(connectivity_.face(f).simplex)); it != wanted.end() && it->second == no_id)
+      it->second = f;
   }
   std::vector<FaceId> found;
   for (const auto& [s, f] : wanted) {

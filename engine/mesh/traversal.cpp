@@ -57,12 +57,12 @@ std::vector<ElementId> elements_around(const Connectivity& c, const Simplex& s, 
 }
 
 std::vector<ElementId> vertex_star(const Connectivity& c, VertexId v, ElementId start) {
-  if (start == no_id) {
-    for (ElementId e = 0; e < c.element_capacity() && start == no_id; ++e)
-      if (c.is_element(e) && c.element(e).simplex.contains(v)) start = e;
-    if (start == no_id) return {};
-  }
-  return elements_around(c, Simplex(1, {v}), start);
+  if (start != no_id) return elements_around(c, Simplex(1, {v}), start);
+  // No start: scan, which also finds the parts of a star that touch only at v (a "bowtie").
+  std::vector<ElementId> star;
+  for (ElementId e = 0; e < c.element_capacity(); ++e)
+    if (c.is_element(e) && c.element(e).simplex.contains(v)) star.push_back(e);
+  return star;
 }
 
 std::vector<FaceId> boundary_faces(const Connectivity& c) {

@@ -18,8 +18,9 @@ std::vector<ElementId> cycle_around(const Connectivity& c, FaceId entry, int j);
 // `s`, starting from `start` (which must contain s). For a vertex this is its star.
 std::vector<ElementId> elements_around(const Connectivity& c, const Simplex& s, ElementId start);
 
-// The star of vertex v (§7.3), starting the walk at an element containing v. Without a start
-// element the elements are scanned for one first (O(n)). Empty if no element contains v.
+// The star of vertex v (§7.3): with a start element, the elements reached by walking across
+// faces that contain v (the (v, ∅)-connected part); without one, every element containing v,
+// found by a scan (O(n)). Empty if no element contains v.
 std::vector<ElementId> vertex_star(const Connectivity& c, VertexId v, ElementId start = no_id);
 
 // Face ids of the boundary faces, sorted by their simplex (deterministic order).

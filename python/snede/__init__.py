@@ -16,10 +16,11 @@ from snede.mesh import Mesh, MeshQuality  # noqa: F401
 from snede.body import Body  # noqa: F401
 from snede.result import SolveResult  # noqa: F401
 from snede.static import StaticSolver  # noqa: F401
+from snede.dynamics import DynamicRelaxation  # noqa: F401
 from snede import meshing  # noqa: F401
 
 __all__ = [
-    "Mesh", "MeshQuality", "Body", "meshing", "StaticSolver", "SolveResult",
+    "Mesh", "MeshQuality", "Body", "meshing", "StaticSolver", "DynamicRelaxation", "SolveResult",
     "LinearElastic", "StVenantKirchhoff", "NeoHookean", "VerondaWestmann",
     "InvalidMesh", "PetscError", "DomainError", "PETSc",
 ]

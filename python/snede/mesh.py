@@ -118,7 +118,9 @@ class Mesh:
         self._impl.validate()
 
     def star(self, vertex: int) -> np.ndarray:
-        """Element ids of the cells containing ``vertex`` (O(n) to find the first one)."""
+        """Element ids of all cells containing ``vertex`` (a scan, O(n))."""
+        if not 0 <= int(vertex) < self.n_points:
+            raise ValueError(f"vertex {vertex} does not exist (the mesh has {self.n_points} points)")
         return np.asarray(self._impl.star(int(vertex)), dtype=np.int64)
 
     def connected_components(self) -> tuple[int, np.ndarray]:
@@ -153,8 +155,15 @@ class Mesh:
 
         import meshio
 
-        with contextlib.redirect_stdout(io.StringIO()):  # meshio's gmsh reader prints blank lines
-            data = meshio.read(str(path))
+        if not Path(path).exists():
+            raise FileNotFoundError(f"no mesh file {path}")
+        # meshio tries its ANSYS reader on .msh first, printing blank lines, and calls
+        # sys.exit on a file it cannot parse: silence the one and turn the other into an error.
+        try:
+            with contextlib.redirect_stdout(io.StringIO()):
+                data = meshio.read(str(path))
+        except SystemExit:
+            raise ValueError(f"{path}: meshio could not read this file") from None
         blocks = {block.type: block.data for block in data.cells}
         if "tetra" in blocks:
             cells = np.concatenate([b.data for b in data.cells if b.type == "tetra"])
@@ -179,7 +188,10 @@ class Mesh:
             points = np.column_stack([points, np.zeros(len(points))])
         kind = "tetra" if self.dim == 3 else "triangle"
         Path(path).parent.mkdir(parents=True, exist_ok=True)
-        meshio.Mesh(points, [(kind, self.cells)]).write(str(path))
+        # meshio's default for .msh is ANSYS Fluent; snede's .msh files are gmsh's.
+        gmsh = Path(path).suffix == ".msh"
+        meshio.Mesh(points, [(kind, self.cells)]).write(
+            str(path), **({"file_format": "gmsh22", "binary": False} if gmsh else {}))
 
     def __repr__(self) -> str:
         kind = "tetrahedra" if self.dim == 3 else "triangles"

@@ -79,7 +79,7 @@ def cylinder(length=0.1, radius=0.03, h=0.01, seed: int | None = None) -> Mesh:
             raise ValueError(f"{name} must be positive and finite, got {value}")
     initialized_here = not gmsh.isInitialized()
     if initialized_here:
-        gmsh.initialize(["gmsh", "-noenv"], readConfigFiles=False)
+        gmsh.initialize(readConfigFiles=False)
     try:
         gmsh.option.setNumber("General.Terminal", 0)
         gmsh.model.add("snede-cylinder")

@@ -1,0 +1,105 @@
+// Dynamic relaxation (§2.5, §4.1, §4.4.1): the damped motion M ü + η M u̇ = f(u) settles in
+// the static equilibrium, integrated by the explicit SS22 scheme (θ₁ = ½, θ₂ = 0) — central
+// differences — with lumped masses M and mass-proportional damping C = η M.
+//
+// The integrator is a PETSc TS type, "snede_ss22", for second-order ODEs ü = G(t, u) − η u̇:
+// G comes from TSSetRHSFunction, the velocity from TS2SetSolution, η from
+// set_ss22_damping or -<prefix>ts_ss22_damping. DynamicRelaxation drives it with
+// G(u) = −M⁻¹ P ∇Π(u) (the net force on the free motions) and carries an options prefix
+// (default "dynamic_"), so -dynamic_ts_monitor, -dynamic_ts_max_steps, -dynamic_ts_dt and
+// -dynamic_ts_ss22_damping apply; TSSetFromOptions runs after snede's defaults.
+#pragma once
+
+#include <petscts.h>
+
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "solve/model.hpp"
+#include "solve/solve_result.hpp"
+
+namespace snede {
+
+inline constexpr const char* ts_ss22 = "snede_ss22";
+
+// Registers "snede_ss22" with PETSc (idempotent).
+void register_ts_ss22();
+// η (1/s) of a TS of type snede_ss22; throws std::invalid_argument for another type or η < 0.
+void set_ss22_damping(TS ts, double damping);
+double ss22_damping(TS ts);
+
+class DynamicRelaxation {
+ public:
+  // damping_eta: η ≥ 0 (1/s). dt: the time step (s), or 0 for the CFL estimate (2.61), which
+  // is then renewed whenever the mesh changes size.
+  DynamicRelaxation(Model& model, double damping_eta, double dt = 0, const std::string& options_prefix = "dynamic_");
+  ~DynamicRelaxation();
+  DynamicRelaxation(const DynamicRelaxation&) = delete;
+  DynamicRelaxation& operator=(const DynamicRelaxation&) = delete;
+
+  // n time steps from the current state and velocity. converged = no divergence and an
+  // admissible final state; reason "CONVERGED_ITS", or a divergence reason.
+  SolveResult step(int n);
+  // Steps until ‖F(u)‖ ≤ rtol·√(‖f_ext‖² + ‖f_react‖²) (6.9), or max_steps ("DIVERGED_MAX_IT").
+  SolveResult run(double rtol, int max_steps);
+
+  // (2.61): Δt = (2/√3) h/c, c = √((λ+2μ)/ρ) (plane stress: √(E/((1−ν²)ρ))), h the
+  // smallest element size, taken as the diameter of the smallest inscribed sphere (circle).
+  double cfl_time_step() const;
+  // §4.4.1: a step is stable if an undamped run from the current state does not blow up
+  // within flop_budget flops (force kernel flops × elements per step). Starting from
+  // `initial` (0: the CFL estimate) the step is lowered by `reduction` until stable; a stable
+  // start is instead raised by the same factor while it stays stable. Returns the largest
+  // stable step found; the state, velocity, time and step count are restored.
+  double critical_time_step(double flop_budget = 50e6, double initial = 0, double reduction = 0.15);
+
+  double time_step() const;
+  void set_time_step(double dt);
+  double damping() const { return ss22_damping(ts_); }
+  // (n_points, dim) flattened; the model's displacement is the position.
+  std::vector<double> velocity();
+  void set_velocity(std::span<const double> values);
+  TS ts() const { return ts_; }
+  Model& model() { return model_; }
+
+ private:
+  enum class Mode { steps, relaxation, stability_trial };
+  SolveResult advance(PetscInt n_steps, Mode mode, double rtol);
+  // TSSolve for up to n_steps more steps (within the user's cap, except in a stability
+  // trial); returns the number taken.
+  PetscInt take_steps(PetscInt n_steps);
+  void reissue_sizes_if_mesh_changed();
+  void prepare_state();
+  void update_inverse_mass();
+  // (6.9) threshold for the current relaxation; 0 outside one.
+  double tolerance(double reaction_norm) const;
+  // Evaluates F(u): within the tolerance, finite and admissible?
+  bool converged_at(Vec u);
+  void after_step();
+
+  static PetscErrorCode acceleration_callback(TS ts, PetscReal t, Vec u, Vec a, void* context);
+  static PetscErrorCode post_step_callback(TS ts);
+
+  Model& model_;
+  TS ts_ = nullptr;
+  Vec velocity_ = nullptr;
+  Vec inverse_mass_ = nullptr;  // 1/m per dof (0 for a vertex without mass)
+  Vec residual_ = nullptr;
+  std::uint64_t generation_ = 0;
+  bool follows_cfl_ = false;
+
+  // Bookkeeping of the current advance() or stability trial.
+  Mode mode_ = Mode::steps;
+  double rtol_ = 0;
+  double external_norm_ = 0;
+  std::string failure_;            // a divergence reason, empty while all is well
+  bool converged_ = false;
+  double last_residual_norm_ = 0;  // ‖F(u_n)‖ from the latest force evaluation
+  double last_tolerance_ = 0;
+  double checked_residual_norm_ = 0;  // ‖F‖ from the latest converged_at()
+  std::vector<double> history_;
+};
+
+}  // namespace snede

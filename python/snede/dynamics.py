@@ -1,0 +1,93 @@
+"""Dynamic relaxation (§2.5, §4.1, §4.4.1): the damped motion M ü + η M u̇ = f(u) of a body
+with lumped masses, integrated by explicit SS22 / central differences until it settles in the
+static equilibrium. The integrator is PETSc's TS of type ``snede_ss22`` with options prefix
+``options_prefix`` (default ``dynamic_``), so the command line tunes it:
+``-dynamic_ts_monitor``, ``-dynamic_ts_max_steps 500`` (a cap on the total steps),
+``-dynamic_ts_dt 1e-3``, ``-dynamic_ts_ss22_damping 20``, ``-dynamic_ts_view``.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from snede import _snede
+from snede._petsc import PETSc
+from snede.result import SolveResult
+
+
+class DynamicRelaxation:
+    """``DynamicRelaxation(body, damping, dt=None)``: relax ``body.displacement`` in time.
+
+    * ``damping``: η (1/s) of the damping C = η M, ≥ 0. §4.1: the fastest relaxation has
+      η = 2√λ₁ (λ₁ the lowest eigenvalue of M⁻¹K); Table 4.4 lists 17–27 1/s for its cylinder.
+    * ``dt``: time step (s); None takes the CFL estimate (2.61) ``cfl_time_step``, renewed
+      when the mesh changes size. Above the critical step the motion blows up; that is
+      reported as ``reason == "DIVERGED_BLOW_UP"``, not raised.
+    * ``petsc_options``: PETSc options without the prefix, e.g. ``{"ts_monitor": None}``;
+      the command line still wins.
+
+    The state is ``body.displacement`` and ``velocity`` (both (n_points, dim)); it starts at
+    rest. After a cut or refinement the velocity is carried over like the displacement.
+    """
+
+    def __init__(self, body, damping: float, dt: float | None = None, *, options_prefix: str = "dynamic_",
+                 petsc_options: dict | None = None):
+        if dt is not None and not (math.isfinite(dt) and dt > 0):
+            raise ValueError(f"dt must be positive and finite (or None for the CFL estimate), got {dt}")
+        database = PETSc.Options()
+        for key, value in (petsc_options or {}).items():
+            name = options_prefix + key.lstrip("-")
+            if not database.hasName(name):  # the command line wins
+                database.setValue(name, "" if value is None else str(value))
+        self.body = body
+        self._impl = _snede.DynamicRelaxation(body._model, float(damping), float(dt or 0.0), options_prefix)
+
+    def step(self, n: int = 1) -> SolveResult:
+        """Take ``n`` time steps. ``converged`` is False only on divergence (blow-up, NaN,
+        inverted elements); ``residual_norm`` is ‖F(u)‖ at the final state."""
+        return SolveResult._from_engine(self._impl.step(int(n)))
+
+    def run(self, rtol: float = 1e-3, max_steps: int = 100000) -> SolveResult:
+        """Step until ‖F(u)‖ ≤ rtol·√(‖f_ext‖² + ‖f_react‖²) (criterion (6.9)), or
+        ``max_steps`` (``reason == "DIVERGED_MAX_IT"``)."""
+        return SolveResult._from_engine(self._impl.run(float(rtol), int(max_steps)))
+
+    def critical_time_step(self, flop_budget: float = 50e6, initial: float | None = None,
+                           reduction: float = 0.15) -> float:
+        """§4.4.1: the largest step for which an undamped run from the current state does not
+        blow up (‖u‖ > 1e15 or NaN) within ``flop_budget`` flops, searched from ``initial``
+        (None: the CFL estimate) in factors of (1 − ``reduction``). The state is restored."""
+        return self._impl.critical_time_step(float(flop_budget), float(initial or 0.0), float(reduction))
+
+    @property
+    def cfl_time_step(self) -> float:
+        """(2.61): (2/√3)·h/c, h the smallest inscribed-sphere diameter, c the dilatational
+        wave speed √((λ+2μ)/ρ) (plane stress: √(E/((1−ν²)ρ)))."""
+        return self._impl.cfl_time_step()
+
+    @property
+    def dt(self) -> float:
+        return self._impl.dt
+
+    @dt.setter
+    def dt(self, value: float) -> None:
+        self._impl.dt = float(value)
+
+    @property
+    def damping(self) -> float:
+        return self._impl.damping
+
+    @property
+    def velocity(self) -> np.ndarray:
+        """Velocity (m/s) at the half step behind the displacement, (n_points, dim) (a copy)."""
+        return self._impl.velocity
+
+    @velocity.setter
+    def velocity(self, v) -> None:
+        self._impl.velocity = np.ascontiguousarray(self.body._field("velocity", v))
+
+    @property
+    def ts(self):
+        """The petsc4py TS (type ``snede_ss22``)."""
+        return self._impl.ts

@@ -1,0 +1,114 @@
+"""Running a scene: solve with progress, write the XDMF series, the picture and a summary."""
+from __future__ import annotations
+
+import json
+import logging
+import resource
+import time
+from pathlib import Path
+
+import numpy as np
+
+import snede
+from snede.output import SeriesWriter
+from snede.plotting import plot_body
+
+log = logging.getLogger("snede")
+
+
+class _Progress:
+    """A tqdm bar fed by a PETSc monitor (iterations and residual norm)."""
+
+    def __init__(self, label: str, enabled: bool):
+        self.bar = None
+        if enabled:
+            from tqdm import tqdm
+
+            # disable=None: no bar when the output is not a terminal (logs, CI)
+            self.bar = tqdm(desc=label, unit=" it", leave=False, dynamic_ncols=True, disable=None)
+
+    def __call__(self, iteration: int, norm: float) -> None:
+        if self.bar is not None:
+            self.bar.update(max(0, iteration - self.bar.n))
+            self.bar.set_postfix_str(f"|r| = {norm:.2e}", refresh=False)
+
+    def close(self) -> None:
+        if self.bar is not None:
+            self.bar.close()
+
+
+def solve_scene(scene, method: str, rtol: float, progress: bool, max_iterations: int = 100000):
+    body = scene.body
+    bar = _Progress(f"{scene.name} ({method})", progress)
+    try:
+        if method == "dynamic":
+            if not hasattr(snede, "DynamicRelaxation"):
+                raise ValueError("dynamic relaxation is not available in this build")
+            solver = snede.DynamicRelaxation(body, damping=scene.damping)
+            solver.ts.setMonitor(lambda ts, step, t, u: bar(step, float("nan")))
+            result = solver.run(rtol=rtol, max_steps=max_iterations)
+        else:
+            solver = snede.StaticSolver(body, method, rtol=rtol, max_iterations=max_iterations)
+            if method == "cg":
+                solver.ksp.setMonitor(lambda ksp, it, norm: bar(it, norm))
+            else:
+                solver.snes.setMonitor(lambda snes, it, norm: bar(it, norm))
+            result = solver.solve()
+    finally:
+        bar.close()
+    return result
+
+
+def run(scene, method: str | None, rtol: float, out: Path, progress: bool = True) -> dict:
+    method = method or scene.default_method
+    body = scene.body
+    folder = Path(out) / scene.name
+    folder.mkdir(parents=True, exist_ok=True)
+    writer = SeriesWriter(folder / scene.name)
+    writer.write(body, time=0.0)
+    start = time.perf_counter()
+    result = solve_scene(scene, method, rtol, progress)
+    wall = time.perf_counter() - start
+    writer.write(body, time=1.0)
+    picture = plot_body(body, folder / f"{scene.name}.png", title=f"{scene.name}: {type(body.material).__name__}, {method}",
+                        scale=scene.plot_scale)
+    value = scene.probe(body)
+    summary = {
+        "scene": scene.name,
+        "description": scene.description,
+        "cells": body.mesh.n_cells,
+        "points": body.mesh.n_points,
+        "material": type(body.material).__name__,
+        "method": method,
+        "rtol": rtol,
+        "converged": result.converged,
+        "reason": result.reason,
+        "iterations": result.iterations,
+        "linear_iterations": result.linear_iterations,
+        "residual_norm": result.residual_norm,
+        "seconds": wall,
+        "mflop": result.flops / 1e6,
+        "probe": scene.probe_name,
+        "value": value,
+        "analytic": scene.analytic,
+        "error_percent": None if scene.analytic is None else 100 * abs(value - scene.analytic) / abs(scene.analytic),
+        "max_rss_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024,
+        "files": {"xdmf": str(writer.xdmf_path), "h5": str(writer.h5_path), "png": str(picture)},
+        **scene.details,
+    }
+    (folder / "summary.json").write_text(json.dumps(summary, indent=2))
+    if not result.converged:
+        log.warning("%s did not converge: %s after %d iterations", scene.name, result.reason, result.iterations)
+    return summary
+
+
+def print_table(summaries) -> None:
+    print(f"{'scene':<11} {'cells':>7} {'material':<18} {'method':<8} {'it':>6} {'reason':<24} {'s':>7} "
+          f"{'probe':<30} {'value':>11} {'analytic':>10} {'error %':>8}")
+    for s in summaries:
+        analytic = "" if s["analytic"] is None else f"{s['analytic']:.4g}"
+        error = "" if s["error_percent"] is None else f"{s['error_percent']:.2f}"
+        print(f"{s['scene']:<11} {s['cells']:>7} {s['material']:<18} {s['method']:<8} {s['iterations']:>6} "
+              f"{s['reason']:<24} {s['seconds']:>7.2f} {s['probe']:<30} {s['value']:>11.4g} {analytic:>10} {error:>8}")
+    for s in summaries:
+        print(f"  {s['scene']}: {s['files']['xdmf']} (ParaView), {s['files']['png']}")

@@ -1,0 +1,42 @@
+"""Built-in scenes for ``python -m snede run``: each module has ``build(options) -> Scene``."""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Callable
+
+import snede
+
+MATERIAL_NAMES = ("linear", "stvk", "neohookean", "veronda")
+
+
+@dataclass
+class Scene:
+    name: str
+    description: str
+    body: "snede.Body"
+    default_method: str
+    probe_name: str  # what `probe` measures, with its unit
+    probe: Callable[["snede.Body"], float]
+    analytic: float | None = None  # the probe's analytic value, where one exists
+    damping: float = 20.0  # η for dynamic relaxation (1/s)
+    plot_scale: float = 1.0  # displacement exaggeration in the picture
+    details: dict = field(default_factory=dict)
+
+
+def material(name: str, young: float, poisson: float, gamma: float = 8.0):
+    """A material by its command-line name."""
+    makers = {
+        "linear": lambda: snede.LinearElastic(young, poisson),
+        "stvk": lambda: snede.StVenantKirchhoff(young, poisson),
+        "neohookean": lambda: snede.NeoHookean(young, poisson),
+        "veronda": lambda: snede.VerondaWestmann(young, poisson, gamma),
+    }
+    if name not in makers:
+        raise ValueError(f"unknown material {name!r}: choose one of {', '.join(MATERIAL_NAMES)}")
+    return makers[name]()
+
+
+def builders() -> dict:
+    from snede.scenes import cantilever, cylinder, slab
+
+    return {"cantilever": cantilever, "cylinder": cylinder, "slab": slab}

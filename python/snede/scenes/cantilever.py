@@ -1,0 +1,26 @@
+"""§3.3: a 1.2 × 0.2 × 0.3 m beam (E = 1 MPa, ν = 0) fixed at x = 0 with 3 N at the tip.
+Beam theory gives the tip deflection y = 4F/(Ed) (l/h)³ = 8.64 mm (Table 3.1)."""
+import numpy as np
+
+import snede
+from snede.scenes import Scene, material
+
+LENGTH, HEIGHT, DEPTH, YOUNG, LOAD = 1.2, 0.2, 0.3, 1e6, 3.0
+DESCRIPTION = "§3.3 cantilever beam, 3 N tip load, analytic tip deflection 8.64 mm"
+
+
+def build(options) -> Scene:
+    n = options.divisions or 16
+    if n < 4 or n % 4:
+        raise ValueError(f"--divisions for the cantilever must be a multiple of 4 (n × n/4 × n/4 cubes), got {n}")
+    mesh = snede.meshing.box((LENGTH, HEIGHT, DEPTH), (n, n // 4, n // 4))
+    body = snede.Body(mesh, material(options.material or "linear", YOUNG, 0.0), density=1000.0)
+    x = mesh.points
+    body.fix(np.isclose(x[:, 0], 0.0))
+    tip = np.flatnonzero(np.isclose(x[:, 0], LENGTH))
+    body.add_nodal_force(tip, (0.0, -LOAD / len(tip), 0.0))
+    return Scene(
+        name="cantilever", description=DESCRIPTION, body=body, default_method="cg",
+        probe_name="tip deflection [m]", probe=lambda b: float(-b.displacement[tip, 1].mean()),
+        analytic=4 * LOAD / (YOUNG * DEPTH) * (LENGTH / HEIGHT) ** 3, damping=17.0, plot_scale=10.0,
+        details={"divisions": [n, n // 4, n // 4]})

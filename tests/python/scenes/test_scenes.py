@@ -1,0 +1,125 @@
+"""Scenes, the command line, output files and pictures."""
+import argparse
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import h5py
+import numpy as np
+import pytest
+
+import snede
+from snede import run_scene
+from snede.__main__ import main
+from snede.output import SeriesWriter
+from snede.scenes import builders
+
+ROOT = Path(__file__).resolve().parents[3]
+SMALL = {"cantilever": dict(divisions=8), "cylinder": dict(), "slab": dict(divisions=8)}
+
+
+def options(**given):
+    return argparse.Namespace(material=given.get("material"), divisions=given.get("divisions"),
+                              mesh_size=given.get("mesh_size"))
+
+
+def read_step(h5_path, step, mesh):
+    with h5py.File(h5_path, "r") as f:
+        return f[f"/step/{step}/displacement"][...], f[f"/mesh/{mesh}/cells"][...], f[f"/mesh/{mesh}/points"][...]
+
+
+def not_blank(png_path):
+    import matplotlib.image
+
+    image = matplotlib.image.imread(png_path)
+    return image.std() > 0.05 and len(np.unique(image.reshape(-1, image.shape[-1]), axis=0)) > 50
+
+
+@pytest.mark.parametrize("name", ["cantilever", "cylinder", "slab"])
+def test_builtin_scene_runs_and_writes_what_it_computed(name, tmp_path):
+    scene = builders()[name].build(options(**SMALL[name]))
+    summary = run_scene.run(scene, None, 1e-6, tmp_path, progress=False)
+    assert summary["converged"], summary
+    body = scene.body
+    u, cells, points = read_step(summary["files"]["h5"], 1, 0)
+    dim = body.dim
+    assert np.array_equal(u[:, :dim], body.displacement)
+    assert np.array_equal(cells, body.mesh.cells)
+    assert np.array_equal(points[:, :dim], body.mesh.points)
+    assert not_blank(summary["files"]["png"])
+    saved = json.loads((tmp_path / name / "summary.json").read_text())
+    assert saved["iterations"] == summary["iterations"] and saved["reason"] == summary["reason"]
+    xdmf = Path(summary["files"]["xdmf"]).read_text()
+    assert xdmf.count("<Grid Name=\"step") == 2 and "Tetrahedron" in xdmf if dim == 3 else "Triangle" in xdmf
+
+
+def test_cantilever_scene_reports_error_against_beam_theory(tmp_path):
+    scene = builders()["cantilever"].build(options(divisions=8))
+    summary = run_scene.run(scene, "cg", 1e-8, tmp_path, progress=False)
+    assert summary["analytic"] == pytest.approx(8.64e-3)
+    assert summary["error_percent"] == pytest.approx(100 * (1 - summary["value"] / 8.64e-3))
+    assert 0 < summary["error_percent"] < 60  # 8 × 2 × 2 cubes: coarse, stiffer than the beam
+
+
+def test_series_follows_a_topology_change(tmp_path):
+    mesh = snede.meshing.box((1.0, 1.0, 1.0), (2, 2, 2))
+    body = snede.Body(mesh, snede.LinearElastic(1e3, 0.3))
+    writer = SeriesWriter(tmp_path / "cut")
+    body.displacement = 0.01 * mesh.points
+    writer.write(body, 0.0)
+    writer.write(body, 0.5)  # same mesh: not written again
+    faces = np.concatenate([np.delete(mesh.cells, k, axis=1) for k in range(4)])
+    on = np.all(np.isclose(mesh.points[faces, 0], 0.5), axis=1)
+    mesh.dissect(np.unique(np.sort(faces[on], axis=1), axis=0))
+    writer.write(body, 1.0)
+    assert (writer.n_steps, writer.n_meshes) == (3, 2)
+    u, cells, points = read_step(writer.h5_path, 2, 1)
+    assert np.array_equal(u, body.displacement) and np.array_equal(cells, mesh.cells)
+    assert len(points) == mesh.n_points == 27 + 9
+    with h5py.File(writer.h5_path, "r") as f:
+        assert len(f["/mesh/0/points"]) == 27 and "2" not in f["/mesh"]
+    xdmf = writer.xdmf_path.read_text()
+    assert xdmf.count("/mesh/0/cells") == 2 and xdmf.count("/mesh/1/cells") == 1
+
+
+def run_cli(*args, cwd=None):
+    return subprocess.run([sys.executable, "-m", "snede", *args], capture_output=True, text=True,
+                          cwd=cwd or ROOT, timeout=300)
+
+
+def test_list_and_help():
+    listed = run_cli("list")
+    assert listed.returncode == 0 and all(name in listed.stdout for name in ("cantilever", "cylinder", "slab"))
+    helped = run_cli("run", "--help")
+    assert helped.returncode == 0 and "--material" in helped.stdout and "PETSc" in run_cli("--help").stdout
+
+
+@pytest.mark.parametrize("args, message", [
+    (("run", "nosuchscene"), "unknown scene"),
+    (("run", "cantilever", "--rtol", "-1"), "must be positive"),
+    (("run", "cantilever", "--divisions", "5"), "multiple of 4"),
+    (("run", "cantilever", "--material", "rubber"), "invalid choice"),
+    (("run", "cylinder", "--method", "cg"), "LinearElastic"),
+    (("run", "cantilever", "stray"), "unexpected argument"),
+])
+def test_bad_input_gives_a_message_not_a_traceback(args, message, tmp_path):
+    out = run_cli(*args, "--out", str(tmp_path)) if args[-1] != "stray" else run_cli(*args)
+    assert out.returncode != 0
+    assert message in out.stderr
+    assert "Traceback" not in out.stderr
+
+
+def test_cli_runs_a_scene_with_petsc_options(tmp_path):
+    out = run_cli("--quiet", "run", "slab", "--divisions", "4", "--out", str(tmp_path), "-static_ksp_monitor")
+    assert out.returncode == 0, out.stderr
+    assert "KSP Residual norm" in out.stdout and "CONVERGED" in out.stdout
+    assert (tmp_path / "slab" / "slab.xdmf").exists()
+
+
+def test_user_scene_script_runs(tmp_path):
+    script = ROOT / "examples" / "sagging_beam.py"
+    out = run_cli("run", str(script), cwd=tmp_path)
+    assert out.returncode == 0, out.stderr
+    assert "converged" in out.stdout
+    assert not_blank(tmp_path / "out" / "sagging_beam" / "sagging_beam.png")
