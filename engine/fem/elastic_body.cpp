@@ -184,39 +184,11 @@ double ElasticBody::energy(std::span<const double> u, EvaluationReport& report) 
   });
 }
 
-void ElasticBody::internal_forces(std::span<const double> u, std::span<double> f, EvaluationReport& report) const {
-  check_size("displacement", u);
-  check_size("force", f);
-  std::fill(f.begin(), f.end(), 0.0);
-  with_material(material_, [&](const auto& m) {
-    auto loop = [&](auto dimension) {
-      constexpr int D = decltype(dimension)::value;
-      std::size_t n = 0;
-      for_each_element<D>(mesh_.connectivity(), references<D>(), [&](ElementId e, const Vertices& v, const auto& ref) {
-        const Tensor<double, D> U = gather_differences<D>(u, v);
-        if (deformation_gradient<double, D>(ref, U).determinant() <= 0) {
-          report.inverted.push_back(e);
-          if (forbids_inversion(m)) return;
-        }
-        const Tensor<double, D> G = element_force_columns<double, D>(m, ref, U);
-        ++n;
-        if (!G.allFinite()) {
-          report.domain_errors.push_back(e);
-          return;
-        }
-        scatter_columns<D>(f, v, G);
-      });
-      log_flops(flops_.force, n);
-    };
-    dim() == 2 ? loop(std::integral_constant<int, 2>{}) : loop(std::integral_constant<int, 3>{});
-  });
-}
-
-void ElasticBody::tangent_apply(std::span<const double> u, std::span<const double> d, std::span<double> out,
-                                EvaluationReport& report) const {
-  check_size("displacement", u);
-  check_size("direction", d);
-  check_size("result", out);
+// Adds each element's columns (from `kernel`) into `out`, skipping and reporting inverted
+// elements of materials that forbid inversion and non-finite results.
+template <class Kernel>
+void ElasticBody::accumulate(std::span<const double> u, std::span<double> out, EvaluationReport& report,
+                             std::int64_t flops_per_element, Kernel&& kernel) const {
   std::fill(out.begin(), out.end(), 0.0);
   with_material(material_, [&](const auto& m) {
     auto loop = [&](auto dimension) {
@@ -228,7 +200,7 @@ void ElasticBody::tangent_apply(std::span<const double> u, std::span<const doubl
           report.inverted.push_back(e);
           if (forbids_inversion(m)) return;
         }
-        const Tensor<double, D> G = element_tangent_columns<double, D>(m, ref, U, gather_differences<D>(d, v));
+        const Tensor<double, D> G = kernel(m, ref, U, v);
         ++n;
         if (!G.allFinite()) {
           report.domain_errors.push_back(e);
@@ -236,9 +208,29 @@ void ElasticBody::tangent_apply(std::span<const double> u, std::span<const doubl
         }
         scatter_columns<D>(out, v, G);
       });
-      log_flops(flops_.tangent, n);
+      log_flops(flops_per_element, n);
     };
     dim() == 2 ? loop(std::integral_constant<int, 2>{}) : loop(std::integral_constant<int, 3>{});
+  });
+}
+
+void ElasticBody::internal_forces(std::span<const double> u, std::span<double> f, EvaluationReport& report) const {
+  check_size("displacement", u);
+  check_size("force", f);
+  accumulate(u, f, report, flops_.force, [](const auto& m, const auto& ref, const auto& U, const Vertices&) {
+    constexpr int D = std::decay_t<decltype(U)>::RowsAtCompileTime;
+    return element_force_columns<double, D>(m, ref, U);
+  });
+}
+
+void ElasticBody::tangent_apply(std::span<const double> u, std::span<const double> d, std::span<double> out,
+                                EvaluationReport& report) const {
+  check_size("displacement", u);
+  check_size("direction", d);
+  check_size("result", out);
+  accumulate(u, out, report, flops_.tangent, [d](const auto& m, const auto& ref, const auto& U, const Vertices& v) {
+    constexpr int D = std::decay_t<decltype(U)>::RowsAtCompileTime;
+    return element_tangent_columns<double, D>(m, ref, U, gather_differences<D>(d, v));
   });
 }
 

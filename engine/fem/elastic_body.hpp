@@ -80,6 +80,9 @@ class ElasticBody : public ConnectivityWatcher {
   const std::vector<ElementReference<D>>& references() const;
   void compute_reference(ElementId e);
   void check_size(const char* what, std::span<const double> a) const;
+  template <class Kernel>
+  void accumulate(std::span<const double> u, std::span<double> out, EvaluationReport& report,
+                  std::int64_t flops_per_element, Kernel&& kernel) const;
 
   Mesh& mesh_;
   Material material_;

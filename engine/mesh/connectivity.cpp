@@ -243,27 +243,7 @@ std::vector<ElementId> Connectivity::replace_elements(std::span<const ElementId>
   }
   // Pair created faces: first among the new faces (matched pairs never touch the boundary
   // map), then with the boundary; what stays unmatched joins the boundary.
-  for (FaceId f : created) {
-    if (faces_[f].mate != no_id) continue;
-    const Simplex minus = faces_[f].simplex.mate();
-    if (auto partner = new_faces.find(minus); partner != new_faces.end()) {
-      const FaceId g = partner->second;
-      if (faces_[g].mate == no_id && boundary_.erase(minus)) change.boundary_removed.push_back(minus);
-      link(f, g);
-    } else if (auto b = boundary_.find(minus); b != boundary_.end()) {
-      link(f, b->second);
-      change.boundary_removed.push_back(minus);
-      boundary_.erase(b);
-    } else {
-      boundary_.emplace(faces_[f].simplex, f);
-      change.boundary_added.push_back(f);
-    }
-  }
-  for (FaceId g : orphans) {
-    if (faces_[g].mate != no_id) continue;
-    boundary_.emplace(faces_[g].simplex, g);
-    change.boundary_added.push_back(g);
-  }
+  pair_faces(created, new_faces, orphans, change);
   change.added_elements = added;
   notify(change);
   return added;
@@ -323,10 +303,17 @@ void Connectivity::change_elements(std::span<const ElementSubstitution> substitu
   BoundaryMap local;
   for (FaceId f : affected) local.emplace(faces_[f].simplex, f);
   for (FaceId g : orphans) local.emplace(faces_[g].simplex, g);
-  for (FaceId f : affected) {
+  pair_faces(affected, local, orphans, change);
+  notify(change);
+}
+
+void Connectivity::pair_faces(std::span<const FaceId> unmatched, const BoundaryMap& local,
+                              std::span<const FaceId> orphans, ConnectivityChange& change) {
+  for (FaceId f : unmatched) {
     if (faces_[f].mate != no_id) continue;
     const Simplex minus = faces_[f].simplex.mate();
     if (auto partner = local.find(minus); partner != local.end() && faces_[partner->second].mate == no_id) {
+      if (boundary_.erase(minus)) change.boundary_removed.push_back(minus);  // a reused boundary face
       link(f, partner->second);
     } else if (auto b = boundary_.find(minus); b != boundary_.end()) {
       link(f, b->second);
@@ -342,7 +329,6 @@ void Connectivity::change_elements(std::span<const ElementSubstitution> substitu
     boundary_.emplace(faces_[g].simplex, g);
     change.boundary_added.push_back(g);
   }
-  notify(change);
 }
 
 void Connectivity::add_watcher(ConnectivityWatcher* watcher) {

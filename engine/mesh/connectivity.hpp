@@ -102,6 +102,10 @@ class Connectivity {
   void release_element(ElementId e);
   void release_face(FaceId f);
   void link(FaceId a, FaceId b);
+  // Links each unmatched face to its opposite, looked up among `local` faces first and then
+  // in the boundary; the rest, and orphans left without a mate, join the boundary.
+  void pair_faces(std::span<const FaceId> unmatched, const BoundaryMap& local, std::span<const FaceId> orphans,
+                  ConnectivityChange& change);
   // True if a face with simplex σ exists outside the elements being replaced.
   bool already_kept(const Simplex& sigma, const BoundaryMap& old_faces,
                     const std::unordered_set<ElementId>& old_set) const;

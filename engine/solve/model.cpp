@@ -40,15 +40,6 @@ class WriteView {
   PetscInt n_ = 0;
 };
 
-double young_modulus(const Material& material) {
-  return std::visit([](const auto& m) { return m.lame.mu * (3 * m.lame.lambda + 2 * m.lame.mu) / (m.lame.lambda + m.lame.mu); },
-                    material);
-}
-
-bool forbids_inversion(const Material& material) {
-  return std::visit([](const auto& m) { return std::decay_t<decltype(m)>::forbids_inversion; }, material);
-}
-
 }  // namespace
 
 Model::Model(ElasticBody& body) : body_(body), constraints_(body.dim()) {

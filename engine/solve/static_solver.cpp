@@ -6,32 +6,12 @@
 #include <limits>
 
 #include "core/error.hpp"
+#include "core/petsc_util.hpp"
 
 namespace snede {
 namespace {
 
 bool is_linear(const Material& material) { return std::holds_alternative<LinearElastic>(material); }
-
-bool forbids_inversion(const Material& material) {
-  return std::visit([](const auto& m) { return std::decay_t<decltype(m)>::forbids_inversion; }, material);
-}
-
-std::string without_prefix(const char* name) {
-  const std::string text = name ? name : "UNKNOWN";
-  return text;
-}
-
-double norm_of(Vec v) {
-  PetscReal n = 0;
-  SNEDE_PETSC(VecNorm(v, NORM_2, &n));
-  return n;
-}
-
-double wall_seconds() {
-  PetscLogDouble t = 0;
-  SNEDE_PETSC(PetscTime(&t));
-  return t;
-}
 
 }  // namespace
 
@@ -155,8 +135,7 @@ SolveResult StaticSolver::solve() {
 SolveResult StaticSolver::solve_linear() {
   SolveResult result;
   const double start = wall_seconds();
-  PetscLogDouble start_flops = 0;
-  SNEDE_PETSC(PetscGetFlops(&start_flops));
+  const double start_flops = logged_flops();
   Vec u = model_.displacement(), rhs = nullptr, step = nullptr;
   SNEDE_PETSC(VecDuplicate(u, &rhs));
   SNEDE_PETSC(VecDuplicate(u, &step));
@@ -164,7 +143,7 @@ SolveResult StaticSolver::solve_linear() {
   model_.residual(u, residual_, report);
   throw_if_domain_error(report);
   reaction_norm_ = model_.last_reaction_norm();
-  result.initial_residual_norm = norm_of(residual_);
+  result.initial_residual_norm = vec_norm(residual_);
   // One Newton step of the quadratic problem: J δ = −F(u), solved by CG (§3.1).
   model_.set_linearization_point(u);
   SNEDE_PETSC(VecCopy(residual_, rhs));
@@ -177,7 +156,7 @@ SolveResult StaticSolver::solve_linear() {
   SNEDE_PETSC(KSPGetConvergedReason(ksp_, &reason));
   SNEDE_PETSC(KSPGetIterationNumber(ksp_, &iterations));
   result.iterations = static_cast<int>(iterations);
-  result.reason = without_prefix(KSPConvergedReasons[reason]);
+  result.reason = std::string(KSPConvergedReasons[reason]);
   result.converged = reason > 0;
   SNEDE_PETSC(VecDestroy(&rhs));
   SNEDE_PETSC(VecDestroy(&step));
@@ -188,12 +167,11 @@ SolveResult StaticSolver::solve_linear() {
 SolveResult StaticSolver::solve_nonlinear() {
   SolveResult result;
   const double start = wall_seconds();
-  PetscLogDouble start_flops = 0;
-  SNEDE_PETSC(PetscGetFlops(&start_flops));
+  const double start_flops = logged_flops();
   Vec u = model_.displacement();
   EvaluationReport report;
   model_.residual(u, residual_, report);
-  result.initial_residual_norm = norm_of(residual_);
+  result.initial_residual_norm = vec_norm(residual_);
   SNEDE_PETSC(SNESSolve(snes_, nullptr, u));
   SNESConvergedReason reason;
   PetscInt iterations = 0, linear = 0;
@@ -202,13 +180,13 @@ SolveResult StaticSolver::solve_nonlinear() {
   SNEDE_PETSC(SNESGetLinearSolveIterations(snes_, &linear));
   result.iterations = static_cast<int>(iterations);
   result.linear_iterations = static_cast<int>(linear);
-  result.reason = without_prefix(SNESConvergedReasons[reason]);
+  result.reason = std::string(SNESConvergedReasons[reason]);
   result.converged = reason > 0;
   finish(result, start, start_flops);
   return result;
 }
 
-void StaticSolver::finish(SolveResult& result, double start_seconds, PetscLogDouble start_flops) {
+void StaticSolver::finish(SolveResult& result, double start_seconds, double start_flops) {
   Vec u = model_.displacement();
   // The verdict is checked on the final state, whatever PETSc said (§ "results, not crashes").
   std::string why;
@@ -218,7 +196,7 @@ void StaticSolver::finish(SolveResult& result, double start_seconds, PetscLogDou
   }
   EvaluationReport report;
   model_.residual(u, residual_, report);
-  result.residual_norm = norm_of(residual_);
+  result.residual_norm = vec_norm(residual_);
   if (!report.domain_errors.empty() || !std::isfinite(result.residual_norm)) {
     result.converged = false;
     result.reason = "DIVERGED_NONFINITE_STATE";
@@ -228,9 +206,7 @@ void StaticSolver::finish(SolveResult& result, double start_seconds, PetscLogDou
   result.energy = model_.potential_energy(u, energy_report);
   result.residual_history = history_;
   result.seconds = wall_seconds() - start_seconds;
-  PetscLogDouble flops = 0;
-  SNEDE_PETSC(PetscGetFlops(&flops));
-  result.flops = flops - start_flops;
+  result.flops = logged_flops() - start_flops;
 }
 
 PetscErrorCode StaticSolver::residual_callback(SNES snes, Vec x, Vec F, void* context) {

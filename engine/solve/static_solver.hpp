@@ -47,7 +47,7 @@ class StaticSolver {
   double current_tolerance() const;
   SolveResult solve_linear();
   SolveResult solve_nonlinear();
-  void finish(SolveResult& result, double start_seconds, PetscLogDouble start_flops);
+  void finish(SolveResult& result, double start_seconds, double start_flops);
 
   static PetscErrorCode residual_callback(SNES, Vec x, Vec F, void* context);
   static PetscErrorCode objective_callback(SNES, Vec x, PetscReal* value, void* context);
