@@ -8,6 +8,7 @@
 
 #include "core/counted.hpp"
 #include "core/error.hpp"
+#include "core/log_event.hpp"
 
 namespace snede {
 namespace {
@@ -154,6 +155,8 @@ void ElasticBody::check_size(const char* what, std::span<const double> a) const 
 }
 
 double ElasticBody::energy(std::span<const double> u, EvaluationReport& report) const {
+  static const PetscLogEvent event = log_event("SnedeEnergy");
+  ScopedEvent logged(event);
   check_size("displacement", u);
   return with_material(material_, [&](const auto& m) {
     auto loop = [&](auto dimension) {
@@ -215,6 +218,8 @@ void ElasticBody::accumulate(std::span<const double> u, std::span<double> out, E
 }
 
 void ElasticBody::internal_forces(std::span<const double> u, std::span<double> f, EvaluationReport& report) const {
+  static const PetscLogEvent event = log_event("SnedeForces");
+  ScopedEvent logged(event);
   check_size("displacement", u);
   check_size("force", f);
   accumulate(u, f, report, flops_.force, [](const auto& m, const auto& ref, const auto& U, const Vertices&) {
@@ -225,6 +230,8 @@ void ElasticBody::internal_forces(std::span<const double> u, std::span<double> f
 
 void ElasticBody::tangent_apply(std::span<const double> u, std::span<const double> d, std::span<double> out,
                                 EvaluationReport& report) const {
+  static const PetscLogEvent event = log_event("SnedeTangentApply");
+  ScopedEvent logged(event);
   check_size("displacement", u);
   check_size("direction", d);
   check_size("result", out);
