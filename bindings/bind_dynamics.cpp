@@ -15,7 +15,7 @@ void bind_dynamics(py::module_& m) {
       .def("run", &DynamicRelaxation::run, py::arg("rtol"), py::arg("max_steps"))
       .def("cfl_time_step", &DynamicRelaxation::cfl_time_step)
       .def("critical_time_step", &DynamicRelaxation::critical_time_step, py::arg("flop_budget"), py::arg("initial"),
-           py::arg("reduction"))
+           py::arg("reduction"), py::arg("min_steps"))
       .def_property("dt", &DynamicRelaxation::time_step, &DynamicRelaxation::set_time_step)
       .def_property_readonly("damping", &DynamicRelaxation::damping)
       .def_property(

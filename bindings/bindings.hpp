@@ -16,6 +16,7 @@ void bind_fem(py::module_& m);
 void bind_solve(py::module_& m);
 void bind_dynamics(py::module_& m);
 void bind_io(py::module_& m);
+void bind_topology(py::module_& m);
 
 // A (rows, columns) numpy array holding a copy of `values`.
 template <class T>

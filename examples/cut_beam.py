@@ -21,10 +21,7 @@ print("before the cut:", solver.solve())
 series.write(body, time=1.0)
 
 # The cut: interior faces on the plane x = 0.05 in the lower half (z ≤ 0.01).
-cells, points = mesh.cells, mesh.points
-faces = np.concatenate([np.delete(cells, k, axis=1) for k in range(4)])
-on_cut = np.all(np.isclose(points[faces, 0], 0.05), axis=1) & np.all(points[faces, 2] <= 0.01 + 1e-12, axis=1)
-copies = mesh.dissect(np.unique(np.sort(faces[on_cut], axis=1), axis=0))
+copies = mesh.dissect(mesh.faces_where(lambda x: np.isclose(x[:, 0], 0.05) & (x[:, 2] <= 0.01 + 1e-12)))
 print(f"cut: {len(copies)} vertices duplicated; the body now has {mesh.n_points} points")
 
 print("after the cut: ", solver.solve())  # same solver: sizes were reissued by the watcher

@@ -4,6 +4,8 @@
 
 #include <petscsys.h>
 
+#include <cmath>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 
@@ -22,6 +24,16 @@ class PetscException : public std::runtime_error {
 
 // Throws PetscException with PETSc's text for `code` if it is non-zero; `call` names the call.
 void check_petsc(PetscErrorCode code, const char* call, const char* file, int line);
+
+// Throws std::invalid_argument "<what> must be <expectation>, got <value>" unless ok.
+inline void require(bool ok, const std::string& what, const char* expectation, double value) {
+  if (ok) return;
+  std::ostringstream message;
+  message << what << " must be " << expectation << ", got " << value;
+  throw std::invalid_argument(message.str());
+}
+
+inline bool positive_finite(double x) { return x > 0 && std::isfinite(x); }
 
 // Runs `body` inside a callback that PETSc calls (MatMult of a shell, SNES function, ...):
 // a C++ exception becomes a PETSc error carrying its message, so it travels back through

@@ -54,9 +54,14 @@ template <int D>
 ElementQuality quality_of(const Corners<D>& x) {
   ElementQuality q;
   q.volume = signed_volume_of<D>(x);
-  double min_height = std::numeric_limits<double>::infinity();
-  for (int i = 0; i <= D; ++i) min_height = std::min(min_height, D * std::abs(q.volume) / facet_measure<D>(x, i));
+  double min_height = std::numeric_limits<double>::infinity(), facets = 0;
+  for (int i = 0; i <= D; ++i) {
+    const double facet = facet_measure<D>(x, i);
+    min_height = std::min(min_height, D * std::abs(q.volume) / facet);
+    facets += facet;
+  }
   q.aspect_ratio = min_height / longest_edge_of<D>(x);
+  q.inscribed_diameter = 2 * D * std::abs(q.volume) / facets;
   q.min_dihedral = std::numbers::pi;
   q.max_dihedral = 0;
   if constexpr (D == 2) {

@@ -11,6 +11,7 @@ struct ElementQuality {
   double aspect_ratio = 0;  // min height / max edge: 0.816 for the regular tetrahedron, 0.866 for the regular triangle
   double min_dihedral = 0;  // radians
   double max_dihedral = 0;  // radians
+  double inscribed_diameter = 0;  // 2r = 2·dim·|τ| / Σ facet measures: the element's length scale
 };
 
 // `corners`: (dim + 1, dim) coordinates, row-major; dim is 2 or 3.

@@ -11,4 +11,14 @@ import petsc4py
 petsc4py.init(sys.argv)
 from petsc4py import PETSc  # noqa: E402  (must follow init)
 
-__all__ = ["PETSc"]
+__all__ = ["PETSc", "set_prefixed_options"]
+
+
+def set_prefixed_options(prefix: str, options: dict | None) -> None:
+    """Put ``{name: value}`` into PETSc's options database under ``prefix`` (value None for a
+    flag), unless the name is already set: the command line wins over a script's defaults."""
+    database = PETSc.Options()
+    for key, value in (options or {}).items():
+        name = prefix + key.lstrip("-")
+        if not database.hasName(name):
+            database.setValue(name, "" if value is None else str(value))

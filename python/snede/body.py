@@ -156,6 +156,13 @@ class Body:
     def displacement(self, u) -> None:
         self._model.displacement = self._field("displacement", u)
 
+    def refine_around(self, point, h: float) -> int:
+        """Refine the mesh around ``point`` to edge length ``h`` (see ``Mesh.refine_around``)
+        in the middle of a simulation: new midpoints get the mean of their edge ends'
+        displacement (and constraints), so the state carries over and the next solve starts
+        from it. Returns how many cells were split."""
+        return self.mesh.refine_around(point, h)
+
     def flops_per_element(self) -> dict:
         """Flops per element of the energy, force and tangent-action kernels, counted by
         running them on a counting scalar type (Table 4.3's measure)."""

@@ -72,14 +72,8 @@ def cut_box(divisions: int, out: Path) -> None:
             print(_quality_line(name, cylinder))
 
     # Cut the box through the plane x = 1/2 (§7.3 dissect): every interior face on the plane.
-    cells, points = box.cells, box.points
     half = divisions // 2 / divisions
-    faces = []
-    for drop in range(4):
-        face = np.delete(cells, drop, axis=1)
-        on_plane = np.all(np.isclose(points[face, 0], half), axis=1)
-        faces.append(face[on_plane])
-    faces = np.unique(np.sort(np.concatenate(faces), axis=1), axis=0)
+    faces = box.faces_where(lambda x: np.isclose(x[:, 0], half))
     boundary_before = len(box.boundary_faces())
     start = time.perf_counter()
     split = box.dissect(faces)

@@ -12,7 +12,7 @@ import math
 import numpy as np
 
 from snede import _snede
-from snede._petsc import PETSc
+from snede._petsc import set_prefixed_options
 from snede.result import SolveResult
 
 
@@ -35,11 +35,7 @@ class DynamicRelaxation:
                  petsc_options: dict | None = None):
         if dt is not None and not (math.isfinite(dt) and dt > 0):
             raise ValueError(f"dt must be positive and finite (or None for the CFL estimate), got {dt}")
-        database = PETSc.Options()
-        for key, value in (petsc_options or {}).items():
-            name = options_prefix + key.lstrip("-")
-            if not database.hasName(name):  # the command line wins
-                database.setValue(name, "" if value is None else str(value))
+        set_prefixed_options(options_prefix, petsc_options)
         self.body = body
         self._impl = _snede.DynamicRelaxation(body._model, float(damping), float(dt or 0.0), options_prefix)
 
@@ -54,11 +50,13 @@ class DynamicRelaxation:
         return SolveResult._from_engine(self._impl.run(float(rtol), int(max_steps)))
 
     def critical_time_step(self, flop_budget: float = 50e6, initial: float | None = None,
-                           reduction: float = 0.15) -> float:
+                           reduction: float = 0.15, min_steps: int = 200) -> float:
         """§4.4.1: the largest step for which an undamped run from the current state does not
-        blow up (‖u‖ > 1e15 or NaN) within ``flop_budget`` flops, searched from ``initial``
-        (None: the CFL estimate) in factors of (1 − ``reduction``). The state is restored."""
-        return self._impl.critical_time_step(float(flop_budget), float(initial or 0.0), float(reduction))
+        blow up (‖u‖ > 1e15 or NaN) within ``flop_budget`` flops (and at least ``min_steps``
+        steps, which large meshes need), searched from ``initial`` (None: the CFL estimate) in
+        factors of (1 − ``reduction``). The state is restored."""
+        return self._impl.critical_time_step(float(flop_budget), float(initial or 0.0), float(reduction),
+                                             int(min_steps))
 
     @property
     def cfl_time_step(self) -> float:

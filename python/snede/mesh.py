@@ -135,6 +135,20 @@ class Mesh:
         """Bytes held by the coordinates and the connectivity (capacity, not just size)."""
         return self._impl.memory_bytes()
 
+    def faces_where(self, inside, interior: bool = True) -> np.ndarray:
+        """Faces whose vertices all satisfy ``inside`` — a boolean mask over the points, or a
+        function of the (n_points, dim) coordinates returning one — as (n, dim) sorted vertex
+        indices. With ``interior`` (default) only faces between two cells: what ``dissect``
+        takes, e.g. ``mesh.faces_where(lambda x: np.isclose(x[:, 0], 0.5))``."""
+        mask = np.asarray(inside(self.points) if callable(inside) else inside, dtype=bool)
+        if mask.shape != (self.n_points,):
+            raise ValueError(f"inside must give one boolean per point ({self.n_points}), got shape {mask.shape}")
+        cells = self.cells
+        faces = np.concatenate([np.delete(cells, k, axis=1) for k in range(cells.shape[1])])
+        faces = np.sort(faces[np.all(mask[faces], axis=1)], axis=1)
+        unique, counts = np.unique(faces, axis=0, return_counts=True)
+        return unique[counts == 2] if interior else unique
+
     # -- changes -----------------------------------------------------------------------
     def dissect(self, faces) -> np.ndarray:
         """Cut along interior faces (§7.3), given as ``(n, dim)`` vertex indices (either
@@ -144,6 +158,37 @@ class Mesh:
         if faces.dtype.kind not in "iu" or faces.ndim != 2 or faces.shape[1] != self.dim:
             raise ValueError(f"faces must be (n, {self.dim}) integer vertex indices, got {faces.shape} {faces.dtype}")
         return self._impl.dissect(np.ascontiguousarray(faces, dtype=np.int64))
+
+    # -- refinement (§6.5) -------------------------------------------------------------
+    def _bisection(self):
+        """The engine's bisection state (labelling and hierarchy), made on first use and kept
+        with the mesh so that later refinements continue the same labelling."""
+        bisection = self.__dict__.get("_bisection_impl")
+        if bisection is None:
+            bisection = self.__dict__["_bisection_impl"] = _snede.Bisection(self._impl)
+        return bisection
+
+    def refine_uniform(self, levels: int = 1) -> int:
+        """Bisect every cell ``levels`` times by conforming bisection (§6.5: newest-vertex in
+        2D, Maubach's in 3D). On ``meshing.rectangle`` and ``meshing.box`` each level doubles
+        the cell count exactly. Returns how many cells were split."""
+        if isinstance(levels, bool) or not isinstance(levels, (int, np.integer)) or levels < 0:
+            raise ValueError(f"levels must be a non-negative integer, got {levels!r}")
+        return self._bisection().refine_uniform(int(levels))
+
+    def refine_around(self, point, h: float) -> int:
+        """Bisect (§6.5 refine-around) until every cell containing ``point`` (shape (dim,))
+        has edges no longer than ``h``; the refinement spreads only as far as conformity
+        needs. Returns how many cells were split."""
+        point = np.asarray(point, dtype=np.float64)
+        if point.shape != (self.dim,):
+            raise ValueError(f"point must have shape ({self.dim},) for this {self.dim}-D mesh, got {point.shape}")
+        if not np.all(np.isfinite(point)):
+            raise ValueError(f"point must be finite, got {point}")
+        h = float(h)
+        if not (np.isfinite(h) and h > 0):
+            raise ValueError(f"h must be positive and finite, got {h}")
+        return self._bisection().refine_around(np.ascontiguousarray(point), h)
 
     # -- files -------------------------------------------------------------------------
     @classmethod

@@ -6,7 +6,7 @@ line tunes it: ``-static_snes_monitor``, ``-static_snes_ncg_type fr``,
 from __future__ import annotations
 
 from snede import _snede
-from snede._petsc import PETSc
+from snede._petsc import set_prefixed_options
 from snede.result import SolveResult
 
 METHODS = ("cg", "ncg", "newton")
@@ -49,11 +49,7 @@ class StaticSolver:
             if ncg_type not in ("prp", "fr", "hs", "dy", "cd"):
                 raise ValueError(f"ncg_type must be 'prp' or 'fr' (or hs, dy, cd), got {ncg_type!r}")
             options.setdefault("snes_ncg_type", ncg_type)
-        database = PETSc.Options()
-        for key, value in options.items():
-            name = options_prefix + key.lstrip("-")
-            if not database.hasName(name):  # the command line wins
-                database.setValue(name, "" if value is None else str(value))
+        set_prefixed_options(options_prefix, options)
         self.body = body
         self.method = method
         self._impl = _snede.StaticSolver(body._model, method, float(rtol), criterion, float(round_tolerance),

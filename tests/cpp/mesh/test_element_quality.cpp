@@ -42,3 +42,11 @@ TEST(ElementQuality, OrientationGivesTheSignOfTheVolume) {
   EXPECT_THROW(element_quality(4, x), std::invalid_argument);
   EXPECT_THROW(element_quality(3, std::vector<double>(5)), std::invalid_argument);
 }
+
+TEST(ElementQuality, InscribedDiameter) {
+  // regular tetrahedron of edge a: inradius a/√24; right triangle with legs 2, 1: r = (2 + 1 − √5)/2
+  const std::vector<double> x{1, 1, 1, 1, -1, -1, -1, 1, -1, -1, -1, 1};
+  EXPECT_NEAR(element_quality(3, x).inscribed_diameter, 2 * 2 * std::sqrt(2.0) / std::sqrt(24.0), 1e-14);
+  const std::vector<double> t{0, 0, 2, 0, 0, 1};
+  EXPECT_NEAR(element_quality(2, t).inscribed_diameter, 3 - std::sqrt(5.0), 1e-14);
+}

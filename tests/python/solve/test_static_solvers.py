@@ -83,14 +83,6 @@ def test_gravity_reactions_balance_weight():
     assert body.reaction_forces()[:, 2].sum() == pytest.approx(weight, rel=1e-7)
 
 
-def interior_half_plane_faces(mesh, x_cut, z_max):
-    """Interior faces on the plane x = x_cut with z below z_max: a cut from the bottom."""
-    cells, points = mesh.cells, mesh.points
-    faces = np.concatenate([np.delete(cells, k, axis=1) for k in range(4)])
-    on = np.all(np.isclose(points[faces, 0], x_cut), axis=1) & np.all(points[faces, 2] <= z_max + 1e-12, axis=1)
-    return np.unique(np.sort(faces[on], axis=1), axis=0)
-
-
 def test_solve_continues_after_a_cut_from_the_carried_over_state():
     body = soft_beam(divisions=(8, 2, 4))
     solver = snede.StaticSolver(body, "newton", rtol=1e-8, options_prefix="cut_")
@@ -98,7 +90,7 @@ def test_solve_continues_after_a_cut_from_the_carried_over_state():
     assert first.converged, first
     n_before, generation = body.mesh.n_points, body._model.generation
     u_before = body.displacement
-    split = body.mesh.dissect(interior_half_plane_faces(body.mesh, 0.05, 0.01))
+    split = body.mesh.dissect(body.mesh.faces_where(lambda x: np.isclose(x[:, 0], 0.05) & (x[:, 2] <= 0.01 + 1e-12)))
     assert len(split) > 0 and body._model.generation == generation + 1
     u_carried = body.displacement
     assert u_carried.shape == (body.mesh.n_points, 3) and body.mesh.n_points > n_before

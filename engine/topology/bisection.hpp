@@ -1,0 +1,58 @@
+// Conforming bisection refinement (§6.5) in 2D and 3D: Maubach's bisection of tagged
+// simplexes ([62]), which in 2D on right triangles is the thesis's hypotenuse (longest-edge,
+// newest-vertex) bisection and in 3D on the Kuhn box keeps every element in one of 3
+// similarity classes. Every change goes through Connectivity::replace_elements; new
+// midpoints are added with Mesh::add_vertex first, so watchers (the model) carry the state
+// over to them (§7.4).
+#pragma once
+
+#include <cstddef>
+#include <vector>
+
+#include "mesh/mesh.hpp"
+#include "topology/refinement_hierarchy.hpp"
+
+namespace snede {
+
+class Bisection {
+ public:
+  // Labels the mesh (initial_labelling) and watches it for as long as this object lives.
+  explicit Bisection(Mesh& mesh);
+  Bisection(const Bisection&) = delete;
+  Bisection& operator=(const Bisection&) = delete;
+
+  Mesh& mesh() { return mesh_; }
+  const Mesh& mesh() const { return mesh_; }
+  const RefinementHierarchy& hierarchy() const { return hierarchy_; }
+
+  // §6.5 bisect(e) for the refinement edge of `element`: every element around that edge
+  // whose refinement edge is another one is bisected first (recursively, with an explicit
+  // stack), then all elements around the edge are split at its midpoint at once, so no
+  // vertex is ever left hanging. Returns the number of elements split. Throws
+  // std::runtime_error if the labelling makes the recursion cycle (an incompatible mesh).
+  std::size_t bisect(ElementId element);
+
+  // §6.5 uniform refinement, `levels` times: every element present at the start of a level
+  // is bisected once (on the Kuhn box and on right-triangle grids, which are compatibly
+  // labelled, this doubles the element count exactly). Returns the number of elements split.
+  std::size_t refine_uniform(int levels);
+
+  std::size_t memory_bytes() const { return hierarchy_.memory_bytes(); }
+
+ private:
+  struct EdgeToBisect {
+    VertexId a, b;
+    NodeId node;  // a hierarchy node whose simplex contains the edge
+  };
+  // A live element containing edge (a, b), found below `node` (the edge is in a child of
+  // every split that did not bisect it).
+  ElementId live_element_with_edge(NodeId node, VertexId a, VertexId b) const;
+  // The simple-bisect of §6.5: `around` is every element containing (a, b), all of which
+  // have (a, b) as refinement edge.
+  std::size_t simple_bisect(VertexId a, VertexId b, const std::vector<ElementId>& around);
+
+  Mesh& mesh_;
+  RefinementHierarchy hierarchy_;
+};
+
+}  // namespace snede
