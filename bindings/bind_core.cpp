@@ -1,6 +1,7 @@
 #include "bindings.hpp"
 #include "core/error.hpp"
 #include "core/options.hpp"
+#include "core/petsc_util.hpp"
 
 #include <pybind11/stl.h>
 
@@ -8,6 +9,8 @@ namespace snede::bindings {
 
 void bind_core(py::module_& m) {
   py::register_exception<PetscException>(m, "PetscError", PyExc_RuntimeError);
+  m.def("petsc_allocated_bytes", &petsc_allocated_bytes,
+        "Bytes currently allocated by PETSc (tracked only with -malloc_debug or -malloc_view).");
   m.def("option_real", &option_real, py::arg("name"),
         "The real value of PETSc option `name` (with its '-'), or None if it is not set; a value "
         "that is not a number raises PetscError with PETSc's message.");

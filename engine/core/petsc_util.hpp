@@ -26,4 +26,12 @@ inline double logged_flops() {
   return flops;
 }
 
+// Bytes currently allocated through PetscMalloc: tracked only when PETSc runs with
+// -malloc_debug (or -malloc_view); 0 otherwise.
+inline double petsc_allocated_bytes() {
+  PetscLogDouble bytes = 0;
+  SNEDE_PETSC(PetscMallocGetCurrentUsage(&bytes));
+  return bytes;
+}
+
 }  // namespace snede
