@@ -1,5 +1,6 @@
 #include "bindings.hpp"
 #include "core/error.hpp"
+#include "core/petsc_util.hpp"
 #include "petsc4py_interop.hpp"
 #include "solve/model.hpp"
 #include "solve/solve_result.hpp"
@@ -20,25 +21,9 @@ std::vector<VertexId> vertex_ids(const IndexArray& a) {
 
 std::span<const double> view(const DoubleArray& a) { return {a.data(), static_cast<std::size_t>(a.size())}; }
 
-py::array_t<double> vec_to_array(Vec v, int dim) {
-  const PetscScalar* data = nullptr;
-  PetscInt n = 0;
-  SNEDE_PETSC(VecGetLocalSize(v, &n));
-  SNEDE_PETSC(VecGetArrayRead(v, &data));
-  std::vector<double> values(data, data + n);
-  SNEDE_PETSC(VecRestoreArrayRead(v, &data));
-  return to_array(values, dim);
-}
+py::array_t<double> vec_to_array(Vec v, int dim) { return to_array(vec_values(v), dim); }
 
-void array_to_vec(const DoubleArray& a, Vec v) {
-  PetscInt n = 0;
-  SNEDE_PETSC(VecGetLocalSize(v, &n));
-  if (a.size() != n) throw std::invalid_argument("expected " + std::to_string(n) + " values, got " + std::to_string(a.size()));
-  PetscScalar* data = nullptr;
-  SNEDE_PETSC(VecGetArray(v, &data));
-  std::copy(a.data(), a.data() + n, data);
-  SNEDE_PETSC(VecRestoreArray(v, &data));
-}
+void array_to_vec(const DoubleArray& a, Vec v) { set_vec_values(v, view(a)); }
 
 py::array_t<double> reactions_of(Model& model) {
   Vec R = nullptr;

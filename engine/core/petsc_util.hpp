@@ -4,6 +4,10 @@
 #include <petsctime.h>
 #include <petscvec.h>
 
+#include <span>
+#include <string>
+#include <vector>
+
 #include "core/error.hpp"
 
 namespace snede {
@@ -24,6 +28,30 @@ inline double logged_flops() {
   PetscLogDouble flops = 0;
   SNEDE_PETSC(PetscGetFlops(&flops));
   return flops;
+}
+
+// A copy of a sequential Vec's values.
+inline std::vector<double> vec_values(Vec v) {
+  const PetscScalar* data = nullptr;
+  PetscInt n = 0;
+  SNEDE_PETSC(VecGetLocalSize(v, &n));
+  SNEDE_PETSC(VecGetArrayRead(v, &data));
+  std::vector<double> values(data, data + n);
+  SNEDE_PETSC(VecRestoreArrayRead(v, &data));
+  return values;
+}
+
+// Sets a sequential Vec's values; throws std::invalid_argument if the sizes differ.
+inline void set_vec_values(Vec v, std::span<const double> values) {
+  PetscInt n = 0;
+  SNEDE_PETSC(VecGetLocalSize(v, &n));
+  if (values.size() != static_cast<std::size_t>(n))
+    throw std::invalid_argument("expected " + std::to_string(n) + " values (n_points × dim), got " +
+                                std::to_string(values.size()));
+  PetscScalar* data = nullptr;
+  SNEDE_PETSC(VecGetArray(v, &data));
+  std::copy(values.begin(), values.end(), data);
+  SNEDE_PETSC(VecRestoreArray(v, &data));
 }
 
 // Bytes currently allocated through PetscMalloc: tracked only when PETSc runs with

@@ -16,28 +16,6 @@ namespace {
 // A blown-up state (§4.4.1).
 constexpr double blow_up_norm = 1e15;
 
-std::vector<double> values_of(Vec v) {
-  const PetscScalar* data = nullptr;
-  PetscInt n = 0;
-  SNEDE_PETSC(VecGetLocalSize(v, &n));
-  SNEDE_PETSC(VecGetArrayRead(v, &data));
-  std::vector<double> values(data, data + n);
-  SNEDE_PETSC(VecRestoreArrayRead(v, &data));
-  return values;
-}
-
-void set_values(Vec v, std::span<const double> values) {
-  PetscInt n = 0;
-  SNEDE_PETSC(VecGetLocalSize(v, &n));
-  if (values.size() != static_cast<std::size_t>(n))
-    throw std::invalid_argument("expected " + std::to_string(n) + " values (n_points × dim), got " +
-                                std::to_string(values.size()));
-  PetscScalar* data = nullptr;
-  SNEDE_PETSC(VecGetArray(v, &data));
-  std::copy(values.begin(), values.end(), data);
-  SNEDE_PETSC(VecRestoreArray(v, &data));
-}
-
 void project_onto_allowed_motions(const Model& model, Vec v) {
   PetscScalar* data = nullptr;
   PetscInt n = 0;
@@ -145,14 +123,14 @@ void DynamicRelaxation::set_time_step(double dt) {
 
 std::vector<double> DynamicRelaxation::velocity() {
   reissue_sizes_if_mesh_changed();
-  return values_of(velocity_);
+  return vec_values(velocity_);
 }
 
 void DynamicRelaxation::set_velocity(std::span<const double> values) {
   reissue_sizes_if_mesh_changed();
   for (double x : values)
     if (!std::isfinite(x)) throw std::invalid_argument("velocity must be finite");
-  set_values(velocity_, values);
+  set_vec_values(velocity_, values);
 }
 
 void DynamicRelaxation::reissue_sizes_if_mesh_changed() {
@@ -160,7 +138,7 @@ void DynamicRelaxation::reissue_sizes_if_mesh_changed() {
   // The mesh changed size (a cut or a refinement): the velocity is carried over like the
   // displacement (a copy moves with its original, a midpoint with its edge), and the same TS
   // takes the new vectors, so a user's handle and options survive.
-  const std::vector<double> old_velocity = values_of(velocity_);
+  const std::vector<double> old_velocity = vec_values(velocity_);
   const auto n_old_points = static_cast<VertexId>(old_velocity.size() / model_.dim());
   const std::vector<double> carried = model_.carried_over(old_velocity, n_old_points);
   SNEDE_PETSC(VecDestroy(&velocity_));
@@ -170,7 +148,7 @@ void DynamicRelaxation::reissue_sizes_if_mesh_changed() {
   SNEDE_PETSC(VecDuplicate(u, &velocity_));
   SNEDE_PETSC(VecDuplicate(u, &inverse_mass_));
   SNEDE_PETSC(VecDuplicate(u, &residual_));
-  set_values(velocity_, carried);
+  set_vec_values(velocity_, carried);
   SNEDE_PETSC(TSReset(ts_));
   SNEDE_PETSC(TS2SetSolution(ts_, u, velocity_));
   generation_ = model_.generation();
@@ -190,7 +168,7 @@ void DynamicRelaxation::update_inverse_mass() {
   std::vector<double> inverse(mass.size() * model_.dim());
   for (std::size_t v = 0; v < mass.size(); ++v)
     for (int k = 0; k < model_.dim(); ++k) inverse[v * model_.dim() + k] = mass[v] > 0 ? 1 / mass[v] : 0.0;
-  set_values(inverse_mass_, inverse);
+  set_vec_values(inverse_mass_, inverse);
 }
 
 SolveResult DynamicRelaxation::step(int n) {
@@ -322,15 +300,15 @@ double DynamicRelaxation::critical_time_step(double flop_budget, double initial,
 
   // Everything a trial changes, restored after each trial and at the end.
   Vec u = model_.displacement();
-  const std::vector<double> u0 = values_of(u), v0 = values_of(velocity_);
+  const std::vector<double> u0 = vec_values(u), v0 = vec_values(velocity_);
   const double dt0 = time_step(), damping0 = damping();
   PetscReal t0 = 0;
   PetscInt steps0 = 0;
   SNEDE_PETSC(TSGetTime(ts_, &t0));
   SNEDE_PETSC(TSGetStepNumber(ts_, &steps0));
   auto restore = [&] {
-    set_values(u, u0);
-    set_values(velocity_, v0);
+    set_vec_values(u, u0);
+    set_vec_values(velocity_, v0);
     SNEDE_PETSC(TSSetTime(ts_, t0));
     SNEDE_PETSC(TSSetStepNumber(ts_, steps0));
     SNEDE_PETSC(TSSetTimeStep(ts_, dt0));
