@@ -13,7 +13,7 @@ from snede._snede import (  # noqa: F401
     VerondaWestmann,
 )
 from snede.mesh import Mesh, MeshQuality  # noqa: F401
-from snede.body import Body  # noqa: F401
+from snede.body import Body, LockingWarning  # noqa: F401
 from snede.result import SolveResult  # noqa: F401
 from snede.static import StaticSolver  # noqa: F401
 from snede.dynamics import DynamicRelaxation  # noqa: F401
@@ -22,6 +22,6 @@ from snede import meshing  # noqa: F401
 __all__ = [
     "Mesh", "MeshQuality", "Body", "meshing", "StaticSolver", "DynamicRelaxation", "SolveResult",
     "LinearElastic", "StVenantKirchhoff", "NeoHookean", "VerondaWestmann",
-    "InvalidMesh", "PetscError", "DomainError", "PETSc",
+    "InvalidMesh", "PetscError", "DomainError", "LockingWarning", "PETSc",
 ]
 __version__ = "0.1.0"

@@ -77,3 +77,14 @@ def test_body_parameters_are_checked():
     body = snede.Body(tet, material)
     with pytest.raises(ValueError, match="shape"):
         body.energy(np.zeros((3, 3)))
+
+
+def test_nearly_incompressible_material_warns_about_locking():
+    tet = single_element(3)
+    with pytest.warns(snede.LockingWarning, match="lock"):
+        snede.Body(tet, snede.NeoHookean(E, 0.49))
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        snede.Body(tet, snede.NeoHookean(E, 0.3))  # no warning
