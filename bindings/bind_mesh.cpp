@@ -95,6 +95,7 @@ void bind_mesh(py::module_& m) {
       .def_property_readonly("points", [](const Mesh& mesh) { return to_array(mesh.points(), mesh.dim()); })
       .def_property_readonly("cells", [](const Mesh& mesh) { return to_array(mesh.cells(), mesh.dim() + 1); })
       .def_property_readonly("cell_ids", &Mesh::cell_ids)
+      .def_property_readonly("revision", [](const Mesh& mesh) { return mesh.connectivity().revision(); })
       .def("boundary_faces", [](const Mesh& mesh) { return to_array(mesh.boundary_faces(), mesh.dim()); })
       .def("quality", &quality_arrays)
       .def("validate", &Mesh::validate)

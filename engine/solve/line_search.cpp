@@ -6,7 +6,8 @@
 // α₋₁), is PETSc's `cp` line search: a secant iteration on the directional derivative
 // F(x − λy)·y starting from λ = 0 and the initial step length (-snes_linesearch_damping).
 // PETSc writes the step as x − λy, so d = −y. Iterations stop when |δ| < rtol |δ₀|
-// (-snes_linesearch_rtol, ε_newton) or after -snes_linesearch_max_it steps (j_max).
+// (-snes_linesearch_rtol, ε_newton) or after -snes_linesearch_max_it steps (j_max). A step
+// into an inverted or overflowing state is halved back towards the last admissible one.
 #include <petsc/private/linesearchimpl.h>
 
 #include <cmath>
@@ -18,6 +19,9 @@ namespace snede {
 namespace {
 
 enum class Slope { tangent, secant };
+
+// How many times a step into an inadmissible state is halved before the search fails.
+constexpr int max_halvings = 30;
 
 void apply_line_search(SNESLineSearch ls, Slope slope_kind) {
   SNES snes = nullptr;
@@ -56,12 +60,21 @@ void apply_line_search(SNESLineSearch ls, Slope slope_kind) {
   PetscBool domain_error = PETSC_FALSE;
   for (PetscInt j = 0; j < max_its; ++j) {
     if (j > 0) {
-      SNEDE_PETSC(VecWAXPY(W, alpha, d, X));
-      SNEDE_PETSC(SNESComputeFunction(snes, W, G));
-      SNEDE_PETSC(SNESGetFunctionDomainError(snes, &domain_error));
+      // A trial step that inverts an element (or overflows) is halved back towards the
+      // last admissible α; the first admissible point ends the search.
+      bool shortened = false;
+      for (int halving = 0; halving <= max_halvings; ++halving) {
+        SNEDE_PETSC(VecWAXPY(W, alpha, d, X));
+        SNEDE_PETSC(SNESComputeFunction(snes, W, G));
+        SNEDE_PETSC(SNESGetFunctionDomainError(snes, &domain_error));
+        if (!domain_error) break;
+        alpha = 0.5 * (alpha + alpha_previous);
+        shortened = true;
+      }
       if (domain_error) break;
-      g = directional_derivative(G);
       evaluated_at_alpha = true;
+      if (shortened) break;
+      g = directional_derivative(G);
     }
     double slope;
     if (slope_kind == Slope::secant && j > 0) {

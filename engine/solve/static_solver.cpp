@@ -202,6 +202,13 @@ void StaticSolver::finish(SolveResult& result, double start_seconds, double star
     result.reason = "DIVERGED_NONFINITE_STATE";
   }
   result.tolerance = current_tolerance();
+  // Converged means the stopping criterion holds at the final state, whatever stopped PETSc
+  // (a line search's step tolerance, say). The factor allows CG's recursive residual to
+  // differ from the recomputed one by round-off.
+  if (result.converged && result.residual_norm > 2 * result.tolerance) {
+    result.converged = false;
+    result.reason = "DIVERGED_RESIDUAL_ABOVE_TOLERANCE (PETSc: " + result.reason + ")";
+  }
   EvaluationReport energy_report;
   result.energy = model_.potential_energy(u, energy_report);
   result.residual_history = history_;

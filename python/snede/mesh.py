@@ -99,8 +99,14 @@ class Mesh:
 
     @property
     def cell_ids(self) -> np.ndarray:
-        """(n_cells,) element id of each row of ``cells`` (ids stay stable across mesh changes)."""
-        return np.asarray(self._impl.cell_ids, dtype=np.int64)
+        """(n_cells,) element id of each row of ``cells`` (ids stay stable across mesh changes).
+        Cached until the connectivity changes."""
+        revision = self._impl.revision
+        if getattr(self, "_cell_ids_revision", None) != revision:
+            self._cell_ids = np.asarray(self._impl.cell_ids, dtype=np.int64)
+            self._cell_ids.flags.writeable = False
+            self._cell_ids_revision = revision
+        return self._cell_ids
 
     # -- queries -----------------------------------------------------------------------
     def boundary_faces(self) -> np.ndarray:

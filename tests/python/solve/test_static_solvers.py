@@ -161,3 +161,35 @@ def test_command_line_options_reach_the_solver():
     assert out.returncode == 0, out.stderr
     assert "SNES Function norm" in out.stdout
     assert "RESULT False 2" in out.stdout
+
+
+@pytest.mark.parametrize("line_search", ["snede_secant", "snede_newton"])
+def test_line_search_halves_a_step_into_inverted_elements(line_search):
+    """One edge shortened to 1/1000: a full secant step inverts its elements; the line search
+    must shorten the step instead of failing (it used to stop at iteration 0)."""
+    mesh = snede.meshing.box((0.1, 0.02, 0.02), (10, 2, 2))
+    points = mesh.points.copy()
+    at = lambda x, y, z: np.flatnonzero(np.all(np.isclose(points, (x, y, z)), axis=1))[0]  # noqa: E731
+    moved, anchor = at(0.05, 0.01, 0.01), at(0.06, 0.01, 0.01)
+    points[moved] = points[anchor] + 1e-3 * (points[moved] - points[anchor])
+    mesh = snede.Mesh(points, mesh.cells)
+    assert mesh.quality().aspect_ratio.min() < 1e-3
+    body = snede.Body(mesh, snede.NeoHookean(3e4, 0.3))
+    body.fix(np.isclose(mesh.points[:, 0], 0.0))
+    body.add_gravity((0.0, 0.0, -9.81))
+    result = snede.StaticSolver(body, "ncg", rtol=1e-3, line_search=line_search, max_iterations=50000,
+                                options_prefix=f"halve_{line_search}_").solve()
+    assert result.converged, result
+    assert len(body.inverted_elements(body.displacement)) == 0
+
+
+def test_converged_requires_the_criterion_at_the_final_state():
+    """Newton with PETSc's cp line search: SNES reports convergence on the norm its line search
+    left behind, but the residual recomputed at the final state is far above the tolerance.
+    snede must not call that converged."""
+    body = soft_beam()
+    result = snede.StaticSolver(body, "newton", rtol=1e-12, criterion="6.8", options_prefix="cp_atol_",
+                                petsc_options={"snes_linesearch_type": "cp"}).solve()
+    assert not result.converged
+    assert result.reason.startswith("DIVERGED_RESIDUAL_ABOVE_TOLERANCE")
+    assert result.residual_norm > 2 * result.tolerance
