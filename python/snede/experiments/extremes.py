@@ -300,22 +300,27 @@ def findings(rows) -> list[str]:
     if scaled:
         worst_linear = max(abs(r["ratio"] - 1) for r in scaled if r["material"] == "LinearElastic")
         neo = [r for r in scaled if r["material"] == "NeoHookean"]
+        stalled = [r for r in neo if r["reason"] == "DIVERGED_LINE_SEARCH"]
         bullets.append(
             f"**E, load ∝ E.** The linear cantilever is scale invariant (largest relative change {worst_linear:.1e}). "
-            "Neo-Hookean Newton at rtol 1e-8: " + _outcomes(neo) + ". Where it stops with DIVERGED_LINE_SEARCH its "
-            "deflection differs from the E = 1e6 one by only "
-            + ", ".join(f"{abs(r['ratio'] - 1):.0e}" for r in neo if not r["converged"])
-            + " (relative): the default energy backtracking stalls at round-off near rtol = 1e-8, and whether it gets "
-            "there varies from case to case; use rtol ≥ 1e-6 or `-static_snes_linesearch_type cp` for tighter "
-            "solves.")
+            "Neo-Hookean Newton at rtol 1e-8: " + _outcomes(neo) + "."
+            + (" Where it stops with DIVERGED_LINE_SEARCH its deflection differs from the E = 1e6 one by only "
+               + ", ".join(f"{abs(r['ratio'] - 1):.0e}" for r in stalled)
+               + " (relative): the default energy backtracking stalls at round-off near rtol = 1e-8, and whether "
+               "it gets there varies from case to case; use rtol ≥ 1e-6 or `-static_snes_linesearch_type cp` for "
+               "tighter solves." if stalled else ""))
     cylinder = pick("E (cylinder")
     if cylinder:
+        stuck = [r for r in cylinder if r["solver"] == "ncg" and not r["converged"] and r["iterations"] == 0]
         bullets.append(
             "**E, cylinder under gravity.** " + _outcomes(cylinder) + ". The softest cylinders hang many times "
-            "their length (column note). Where nonlinear CG fails at its first iteration, its first secant step "
-            "(scaled by the tangent at rest) inverts elements (at E = 100 Pa on the 1125-cell cylinder the full "
-            "step inverts 223 cells, checked separately) and the line search does not shorten it; Newton, whose "
-            "backtracking does, converges.")
+            "their length (column note)."
+            + (" Nonlinear CG fails at its first iteration there: its first secant step (scaled by the tangent at "
+               "rest) inverts elements (at E = 100 Pa on the 1125-cell cylinder the full step inverts 223 cells, "
+               "checked separately) and the line search does not recover." if stuck else
+               " From rest, nonlinear CG's first secant step is far too long for the softest material (at "
+               "E = 100 Pa the full step inverts 223 cells of the 1125-cell cylinder, checked separately); the rows "
+               "above show whether its line search recovers."))
     veronda = pick("Veronda-Westmann γ (cylinder")
     if veronda:
         newton = [r for r in veronda if r["solver"] == "newton"]

@@ -96,9 +96,9 @@ def scenes(quick: bool) -> list[Scene]:
         Scene("cantilever", "LinearElastic E = 1e6 Pa, ν = 0, 3 N at the tip (§3.3)",
               ("cg", "ncg", "newton", "dynamic"),
               [cantilever_choice(n) for n in cantilever_runs], [cantilever_choice(n) for n in cantilever_references],
-              lambda body, prefix: snede.StaticSolver(body, "cg", rtol=1e-10, criterion="6.8", max_iterations=100000,
+              lambda body, prefix: snede.StaticSolver(body, "cg", rtol=1e-9, criterion="6.8", max_iterations=100000,
                                                       options_prefix=prefix).solve(),
-              "linear CG, ‖r‖ ≤ 1e-10‖f_ext‖ (6.8)", 1e-10),
+              "linear CG, ‖r‖ ≤ 1e-9‖f_ext‖ (6.8; 1e-10 is below what CG attains in double precision here)", 1e-9),
         Scene("cylinder", "NeoHookean E = 1e4 Pa, ν = 0.3, ρ = 1000 kg/m³, gravity (Table 4.1)",
               ("ncg", "newton", "dynamic"), cylinder_runs, cylinder_references,
               lambda body, prefix: snede.StaticSolver(body, "newton", rtol=1e-8, criterion="6.8", max_iterations=500,
@@ -345,8 +345,8 @@ def describe(scene_list, references, rows, picks, tolerances, quick: bool, minut
         "**What is compared.** The tip deflection: the mean over the nodes of the free end face (x = max) of −u_y "
         "(cantilever) or −u_z (cylinder), defined on every mesh. Its error is measured against a reference "
         "extrapolated (Richardson, value = limit − C h², a fitted order as a check) from three fine meshes solved "
-        "at a tight tolerance, so it includes each run's discretization error, not only its solver error. Wall time is the "
-        "solve's own (`SolveResult.seconds`), from rest, without mesh generation. Every solver stops at "
+        "at a tight tolerance, so it includes each run's discretization error, not only its solver error. Wall "
+        "time is the solve's own (`SolveResult.seconds`), from rest, without mesh generation. Every solver stops at "
         "criterion (6.9) (the default: ‖r‖ ≤ rtol·√(‖f_ext‖² + ‖f_react‖²)); dynamic relaxation uses the CFL "
         "time step and η = 2√λ₁ with λ₁ estimated by the Rayleigh quotient of the reference solution "
         "(§4.1; an optimistic choice a user would have to tune). Hollow markers in the figure: not converged.", ""]
