@@ -26,8 +26,11 @@ void project_onto_allowed_motions(const Model& model, Vec v) {
 }
 
 // Modulus of the dilatational wave: λ + 2μ in 3D, E/(1 − ν²) = 4μ(λ+μ)/(λ+2μ) in plane stress.
+// Veronda-Westmann's small-strain stiffness has λ' = λ + 2μ(2γ − 1) (§4.3.4, see
+// veronda_westmann.hpp): with λ alone its default step was up to 3× too large at γ = 50.
 double dilatational_modulus(const Material& material, int dim) {
-  const Lame lame = std::visit([](const auto& m) { return m.lame; }, material);
+  Lame lame = std::visit([](const auto& m) { return m.lame; }, material);
+  if (const auto* vw = std::get_if<VerondaWestmann>(&material)) lame.lambda += 2 * lame.mu * (2 * vw->gamma - 1);
   return dim == 3 ? lame.lambda + 2 * lame.mu : 4 * lame.mu * (lame.lambda + lame.mu) / (lame.lambda + 2 * lame.mu);
 }
 

@@ -241,3 +241,4 @@ def test_inverting_load_is_never_reported_converged():
         assert len(body.inverted_elements(body.displacement)) == 0
     else:
         assert result.reason.startswith("DIVERGED")
+

@@ -193,3 +193,16 @@ def test_converged_requires_the_criterion_at_the_final_state():
     assert not result.converged
     assert result.reason.startswith("DIVERGED_RESIDUAL_ABOVE_TOLERANCE")
     assert result.residual_norm > 2 * result.tolerance
+
+
+@pytest.mark.parametrize("young", [1e2, 1e9])
+def test_newton_reaches_tight_tolerances_past_energy_round_off(young):
+    """Near the solution a Newton step's energy decrease is below Π's round-off and the
+    energy backtracking stops (DIVERGED_LINE_SEARCH); snede finishes with full Newton steps,
+    so a reference solution to ‖r‖ ≤ 1e-8‖f‖ is reachable at any stiffness scale."""
+    body, tip = cantilever((16, 4, 4), snede.NeoHookean(young, 0.3))
+    body.clear_loads()
+    body.add_nodal_force(tip, (0.0, -3e-4 * young / len(tip), 0.0))  # the same strain for every E
+    result = snede.StaticSolver(body, "newton", rtol=1e-8, criterion="6.8", options_prefix=f"roundoff_{young:g}_").solve()
+    assert result.converged, result
+    assert result.residual_norm <= result.tolerance
