@@ -11,11 +11,11 @@ follow; and an estimate of the bytes moved per element per force evaluation (con
 2 × 96 B read and written).
 """
 import argparse
-import time
 
 import numpy as np
 
 import snede
+from snede.experiments.common import best_seconds
 
 THESIS_TABLE_4_3 = {  # force, derivative flops per tetrahedron
     "LinearElastic": (129, 129),
@@ -24,15 +24,6 @@ THESIS_TABLE_4_3 = {  # force, derivative flops per tetrahedron
     "VerondaWestmann": (347, 797),
 }
 BYTES_PER_ELEMENT = 20 + 80 + 96 + 2 * 96
-
-
-def best_time(function, repeat):
-    best = float("inf")
-    for _ in range(repeat):
-        start = time.perf_counter()
-        function()
-        best = min(best, time.perf_counter() - start)
-    return best
 
 
 def main():
@@ -52,9 +43,9 @@ def main():
         for material in materials:
             body = snede.Body(mesh, material)
             name = type(material).__name__
-            t_energy = best_time(lambda: body.energy(u), args.repeat)
-            t_force = best_time(lambda: body.internal_forces(u), args.repeat)
-            t_tangent = best_time(lambda: body.tangent_apply(u, d), args.repeat)
+            t_energy = best_seconds(lambda: body.energy(u), args.repeat)
+            t_force = best_seconds(lambda: body.internal_forces(u), args.repeat)
+            t_tangent = best_seconds(lambda: body.tangent_apply(u, d), args.repeat)
             flops = body.flops_per_element()
             rate = mesh.n_cells / t_force
             thesis = THESIS_TABLE_4_3[name]

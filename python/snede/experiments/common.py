@@ -93,6 +93,16 @@ def run_solve(solve: Callable[[], object]) -> Outcome:
                    result.flops)
 
 
+def best_seconds(operation: Callable[[], object], repeats: int) -> float:
+    """The shortest wall time of ``repeats`` calls (the least disturbed by a shared machine)."""
+    best = float("inf")
+    for _ in range(repeats):
+        start = time.perf_counter()
+        operation()
+        best = min(best, time.perf_counter() - start)
+    return best
+
+
 def pyplot():
     """matplotlib.pyplot on the Agg backend (files only, no display)."""
     import matplotlib

@@ -16,7 +16,9 @@ import numpy as np
 
 import snede
 from snede import PETSc
-from snede.experiments.common import Column, markdown_table, options_prefix, parse_arguments, pyplot, write_csv
+from snede.experiments.common import (
+    Column, best_seconds, markdown_table, options_prefix, parse_arguments, pyplot, write_csv,
+)
 
 YOUNG, POISSON = 1e6, 0.25  # §3.3
 CUBE_DIVISIONS = 11  # 6·11³ = 7986 tetrahedra on 12³ = 1728 nodes: the cube of Figure 3.12
@@ -108,15 +110,6 @@ def matrix_bytes(mat, kind: str) -> int:
     if kind == "AIJ":
         return int(nonzeros * 12 + (rows + 1) * 4)
     return int(nonzeros / 9 * 76 + (rows / 3 + 1) * 4)
-
-
-def best_seconds(operation, repeats: int) -> float:
-    best = float("inf")
-    for _ in range(repeats):
-        start = time.perf_counter()
-        operation()
-        best = min(best, time.perf_counter() - start)
-    return best
 
 
 def element_stiffness_loop(body, rows: np.ndarray) -> tuple[np.ndarray, float]:
