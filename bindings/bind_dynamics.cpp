@@ -7,7 +7,6 @@
 namespace snede::bindings {
 
 void bind_dynamics(py::module_& m) {
-  using DoubleArray = py::array_t<double, py::array::c_style | py::array::forcecast>;
   py::class_<DynamicRelaxation>(m, "DynamicRelaxation")
       .def(py::init<Model&, double, double, const std::string&>(), py::arg("model"), py::arg("damping"),
            py::arg("dt"), py::arg("options_prefix"), py::keep_alive<1, 2>())

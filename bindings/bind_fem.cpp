@@ -6,9 +6,7 @@
 namespace snede::bindings {
 namespace {
 
-using DoubleArray = py::array_t<double, py::array::c_style | py::array::forcecast>;
 
-std::span<const double> view(const DoubleArray& a) { return {a.data(), static_cast<std::size_t>(a.size())}; }
 
 // Runs an evaluation that fills a (n_points, dim) array, raising DomainError on overflow.
 template <class Evaluate>

@@ -6,7 +6,6 @@
 namespace snede::bindings {
 namespace {
 
-using DoubleArray = py::array_t<double, py::array::c_style | py::array::forcecast>;
 
 void write_step(XdmfWriter& writer, double time, const Mesh& mesh, const DoubleArray& displacement,
                 const std::map<std::string, DoubleArray>& cell_fields) {

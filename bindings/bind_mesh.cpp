@@ -9,28 +9,23 @@
 namespace snede::bindings {
 namespace {
 
-using DoubleArray = py::array_t<double, py::array::c_style | py::array::forcecast>;
-using IndexArray = py::array_t<std::int64_t, py::array::c_style | py::array::forcecast>;
-
-std::vector<VertexId> to_vertex_ids(const IndexArray& a) {
-  std::vector<VertexId> ids(a.size());
-  for (py::ssize_t i = 0; i < a.size(); ++i) {
-    const std::int64_t v = a.data()[i];
-    if (v < 0 || v > std::numeric_limits<VertexId>::max())
-      throw std::invalid_argument("vertex id " + std::to_string(v) + " is out of range");
-    ids[i] = static_cast<VertexId>(v);
-  }
-  return ids;
-}
-
 Mesh make_mesh(const DoubleArray& points, const IndexArray& cells) {
   if (points.ndim() != 2 || cells.ndim() != 2) throw std::invalid_argument("points and cells must be 2-D arrays");
-  const int dim = static_cast<int>(points.shape(1));
-  if (cells.shape(1) != dim + 1)
-    throw std::invalid_argument("cells must have " + std::to_string(dim + 1) + " columns for " + std::to_string(dim) +
-                                "-D points, got " + std::to_string(cells.shape(1)));
+  const int space_dim = static_cast<int>(points.shape(1));
+  const int cell_dim = static_cast<int>(cells.shape(1)) - 1;
   std::vector<double> p(points.data(), points.data() + points.size());
-  return Mesh(dim, std::move(p), std::span<const std::int64_t>(cells.data(), cells.size()));
+  return Mesh(cell_dim, space_dim, std::move(p), std::span<const std::int64_t>(cells.data(), cells.size()));
+}
+
+VertexParents parents_of(const IndexArray& vertices, const DoubleArray& weights) {
+  const std::vector<VertexId> ids = vertex_ids(vertices);
+  return VertexParents::barycentric(ids, view(weights));
+}
+
+py::array_t<bool> live_vertices(const Mesh& mesh) {
+  py::array_t<bool> live(mesh.n_points());
+  for (VertexId v = 0; v < mesh.n_points(); ++v) live.mutable_at(v) = mesh.is_vertex(v);
+  return live;
 }
 
 py::dict quality_arrays(const Mesh& mesh) {
@@ -73,36 +68,49 @@ py::tuple components_of(const Mesh& mesh) {
   return py::make_tuple(n, py::array_t<int>(live.size(), live.data()));
 }
 
-py::array_t<VertexId> dissect_mesh(Mesh& mesh, const IndexArray& faces) {
-  std::vector<VertexId> split;
-  for (const SplitVertex& s : mesh.dissect(to_vertex_ids(faces))) {
-    split.push_back(s.original);
-    split.push_back(s.copy);
-  }
-  return to_array(split, 2);
-}
-
 }  // namespace
+
+std::vector<std::int32_t> vertex_ids(const IndexArray& a) {
+  std::vector<std::int32_t> ids(a.size());
+  for (py::ssize_t i = 0; i < a.size(); ++i) {
+    const std::int64_t v = a.data()[i];
+    if (v < 0 || v > std::numeric_limits<std::int32_t>::max())
+      throw std::invalid_argument("id " + std::to_string(v) + " is out of range");
+    ids[i] = static_cast<std::int32_t>(v);
+  }
+  return ids;
+}
 
 void bind_mesh(py::module_& m) {
   py::register_exception<InvalidMesh>(m, "InvalidMesh", PyExc_ValueError);
   py::class_<Mesh>(m, "Mesh")
       .def(py::init(&make_mesh), py::arg("points"), py::arg("cells"))
       .def_property_readonly("dim", &Mesh::dim)
+      .def_property_readonly("cell_dim", &Mesh::cell_dim)
+      .def_property_readonly("space_dim", &Mesh::space_dim)
+      .def_property_readonly("n_live_points", &Mesh::n_live_points)
+      .def_property_readonly("live_vertices", &live_vertices)
       .def_property_readonly("n_points", &Mesh::n_points)
       .def_property_readonly("n_cells", &Mesh::n_cells)
       .def_property_readonly("n_reoriented", &Mesh::n_reoriented)
       .def_property_readonly("points", [](const Mesh& mesh) { return to_array(mesh.points(), mesh.dim()); })
-      .def_property_readonly("cells", [](const Mesh& mesh) { return to_array(mesh.cells(), mesh.dim() + 1); })
+      .def_property_readonly("cells", [](const Mesh& mesh) { return to_array(mesh.cells(), mesh.cell_dim() + 1); })
       .def_property_readonly("cell_ids", &Mesh::cell_ids)
       .def_property_readonly("revision", [](const Mesh& mesh) { return mesh.connectivity().revision(); })
-      .def("boundary_faces", [](const Mesh& mesh) { return to_array(mesh.boundary_faces(), mesh.dim()); })
+      .def("boundary_faces", [](const Mesh& mesh) { return to_array(mesh.boundary_faces(), mesh.cell_dim()); })
       .def("quality", &quality_arrays)
       .def("validate", &Mesh::validate)
       .def("points_vec", &points_vec)
       .def("star", &star_of, py::arg("vertex"))
       .def("connected_components", &components_of)
-      .def("dissect", &dissect_mesh, py::arg("faces"))
+      .def("add_vertex", [](Mesh& mesh, const IndexArray& v, const DoubleArray& w) { return mesh.add_vertex(parents_of(v, w)); },
+           py::arg("parents"), py::arg("weights"))
+      .def("move_vertex", [](Mesh& mesh, VertexId v, const IndexArray& p, const DoubleArray& w) {
+             mesh.move_vertex(v, parents_of(p, w));
+           }, py::arg("vertex"), py::arg("parents"), py::arg("weights"))
+      .def("move_vertex_to", [](Mesh& mesh, VertexId v, const DoubleArray& x) { mesh.move_vertex(v, view(x)); },
+           py::arg("vertex"), py::arg("point"))
+      .def("remove_vertex", &Mesh::remove_vertex, py::arg("vertex"))
       .def("memory_bytes", [](const Mesh& mesh) {
         return mesh.connectivity().memory_bytes() + mesh.points().capacity() * sizeof(double);
       });

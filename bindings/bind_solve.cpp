@@ -11,16 +11,6 @@
 namespace snede::bindings {
 namespace {
 
-using DoubleArray = py::array_t<double, py::array::c_style | py::array::forcecast>;
-using IndexArray = py::array_t<std::int64_t, py::array::c_style | py::array::forcecast>;
-
-std::vector<VertexId> vertex_ids(const IndexArray& a) {
-  std::vector<VertexId> ids(a.data(), a.data() + a.size());
-  return ids;
-}
-
-std::span<const double> view(const DoubleArray& a) { return {a.data(), static_cast<std::size_t>(a.size())}; }
-
 py::array_t<double> vec_to_array(Vec v, int dim) { return to_array(vec_values(v), dim); }
 
 void array_to_vec(const DoubleArray& a, Vec v) { set_vec_values(v, view(a)); }
@@ -73,8 +63,18 @@ void bind_solve(py::module_& m) {
       .def("slide", [](Model& s, const IndexArray& v, const DoubleArray& t) { s.slide(vertex_ids(v), view(t)); })
       .def("release", [](Model& s, const IndexArray& v) { s.constraints().release(vertex_ids(v)); })
       .def("set_gravity", [](Model& s, const DoubleArray& g) { s.set_gravity(view(g)); })
-      .def("add_nodal_force", [](Model& s, const IndexArray& v, const DoubleArray& f) { s.add_nodal_force(vertex_ids(v), view(f)); })
+      .def("clear_gravity", &Model::clear_gravity)
+      .def("add_nodal_force", [](Model& s, const std::string& channel, const IndexArray& v, const DoubleArray& f) {
+             s.add_nodal_force(channel, vertex_ids(v), view(f));
+           }, py::arg("channel"), py::arg("vertices"), py::arg("forces"))
+      .def("set_nodal_forces", [](Model& s, const std::string& channel, const IndexArray& v, const DoubleArray& f) {
+             s.set_nodal_forces(channel, vertex_ids(v), view(f));
+           }, py::arg("channel"), py::arg("vertices"), py::arg("forces"))
+      .def("clear_channel", &Model::clear_channel, py::arg("channel"))
       .def("clear_loads", &Model::clear_loads)
+      .def_property_readonly("load_channels", &Model::load_channels)
+      .def("channel_forces", [](const Model& s, const std::string& c) { return to_array(s.channel_forces(c), s.dim()); })
+      .def_property_readonly("has_gravity", [](const Model& s) { return s.has_gravity(); })
       .def("external_forces", [](Model& s) { return to_array(s.external_forces(), s.dim()); })
       .def("reaction_forces", &reactions_of)
       .def_property_readonly("n_constrained", [](const Model& s) { return s.constraints().n_constrained(); })

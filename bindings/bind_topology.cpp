@@ -1,6 +1,7 @@
 #include "bindings.hpp"
 #include "mesh/mesh.hpp"
 #include "topology/bisection.hpp"
+#include "topology/dissect.hpp"
 #include "topology/refine_around.hpp"
 
 #include <pybind11/stl.h>
@@ -8,21 +9,29 @@
 namespace snede::bindings {
 namespace {
 
-using DoubleArray = py::array_t<double, py::array::c_style | py::array::forcecast>;
 
-std::span<const double> point_of(const DoubleArray& x) { return {x.data(), static_cast<std::size_t>(x.size())}; }
+py::array_t<VertexId> dissect_faces(Mesh& mesh, const IndexArray& faces) {
+  std::vector<VertexId> split;
+  for (const SplitVertex& s : dissect(mesh, vertex_ids(faces))) {
+    split.push_back(s.original);
+    split.push_back(s.copy);
+  }
+  return to_array(split, 2);
+}
 
 }  // namespace
 
 void bind_topology(py::module_& m) {
+  m.def("dissect", &dissect_faces, py::arg("mesh"), py::arg("faces"),
+        "§7.3 dissect along interior faces ((n, cell_dim) vertex ids); returns (original, copy) pairs");
   py::class_<Bisection>(m, "Bisection")
       .def(py::init<Mesh&>(), py::arg("mesh"), py::keep_alive<1, 2>())
       .def("refine_uniform", &Bisection::refine_uniform, py::arg("levels"))
       .def("refine_around",
-           [](Bisection& b, const DoubleArray& x, double h) { return refine_around(b, point_of(x), h); },
+           [](Bisection& b, const DoubleArray& x, double h) { return refine_around(b, view(x), h); },
            py::arg("point"), py::arg("h"))
       .def("bisect", &Bisection::bisect, py::arg("element"))
-      .def("locate_all", [](const Bisection& b, const DoubleArray& x) { return b.hierarchy().locate_all(point_of(x)); },
+      .def("locate_all", [](const Bisection& b, const DoubleArray& x) { return b.hierarchy().locate_all(view(x)); },
            py::arg("point"))
       .def("level", [](const Bisection& b, ElementId e) { return b.hierarchy().level(e); }, py::arg("element"))
       .def_property_readonly("n_nodes", [](const Bisection& b) { return b.hierarchy().n_nodes(); })

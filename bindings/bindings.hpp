@@ -4,6 +4,8 @@
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 
+#include <cstdint>
+#include <span>
 #include <vector>
 
 namespace snede::bindings {
@@ -17,6 +19,13 @@ void bind_solve(py::module_& m);
 void bind_dynamics(py::module_& m);
 void bind_io(py::module_& m);
 void bind_topology(py::module_& m);
+
+using DoubleArray = py::array_t<double, py::array::c_style | py::array::forcecast>;
+using IndexArray = py::array_t<std::int64_t, py::array::c_style | py::array::forcecast>;
+
+// Vertex (or element) ids from an integer array, each checked to fit a 32-bit id.
+std::vector<std::int32_t> vertex_ids(const IndexArray& a);
+inline std::span<const double> view(const DoubleArray& a) { return {a.data(), static_cast<std::size_t>(a.size())}; }
 
 // A (rows, columns) numpy array holding a copy of `values`.
 template <class T>

@@ -97,6 +97,9 @@ void throw_if_domain_error(const EvaluationReport& report) {
 ElasticBody::ElasticBody(Mesh& mesh, Material material, double density, double thickness)
     : mesh_(mesh), material_(std::move(material)), density_(density), thickness_(thickness) {
   require_positive("density", density);
+  if (mesh.is_surface())
+    throw std::invalid_argument("an elastic body needs a volume mesh (triangles in 2D or tetrahedra); membranes on "
+                                "surface meshes are not implemented");
   if (mesh.dim() == 2) {
     require_positive("thickness (required for a 2D, plane-stress body)", thickness);
   } else if (thickness != 0) {
@@ -146,6 +149,7 @@ void ElasticBody::on_change(const Connectivity&, const ConnectivityChange& chang
   // Only the elements that changed get new reference data (§7.4).
   for (ElementId e : change.added_elements) compute_reference(e);
   for (const auto& entry : change.changed_elements) compute_reference(entry.first);
+  for (ElementId e : change.reshaped_elements) compute_reference(e);  // a corner moved
 }
 
 void ElasticBody::check_size(const char* what, std::span<const double> a) const {

@@ -1,9 +1,12 @@
 #include "mesh/connectivity.hpp"
 
 #include <algorithm>
+#include <exception>
 #include <stdexcept>
 #include <string>
 #include <unordered_set>
+
+#include "mesh/traversal.hpp"
 
 namespace snede {
 namespace {
@@ -81,6 +84,12 @@ Connectivity Connectivity::from_cells(int dim, std::span<const VertexId> cells) 
     }
     i = end;
   }
+  for (std::size_t e = 0; e < n_cells; ++e)
+    for (VertexId v : c.elements_[e].simplex.vertices()) {
+      c.ensure_vertex_capacity(v);
+      ++c.vertex_uses_[v];
+      c.vertex_element_[v] = static_cast<ElementId>(e);
+    }
   return c;
 }
 
@@ -245,7 +254,7 @@ std::vector<ElementId> Connectivity::replace_elements(std::span<const ElementId>
   // map), then with the boundary; what stays unmatched joins the boundary.
   pair_faces(created, new_faces, orphans, change);
   change.added_elements = added;
-  notify(change);
+  notify(change, orphans);
   return added;
 }
 
@@ -304,7 +313,7 @@ void Connectivity::change_elements(std::span<const ElementSubstitution> substitu
   for (FaceId f : affected) local.emplace(faces_[f].simplex, f);
   for (FaceId g : orphans) local.emplace(faces_[g].simplex, g);
   pair_faces(affected, local, orphans, change);
-  notify(change);
+  notify(change, orphans);
 }
 
 void Connectivity::pair_faces(std::span<const FaceId> unmatched, const BoundaryMap& local,
@@ -331,25 +340,191 @@ void Connectivity::pair_faces(std::span<const FaceId> unmatched, const BoundaryM
   }
 }
 
-void Connectivity::add_watcher(ConnectivityWatcher* watcher) {
-  watchers_.push_back(watcher);
+std::int32_t Connectivity::n_vertex_uses(VertexId v) const {
+  return v >= 0 && static_cast<std::size_t>(v) < vertex_uses_.size() ? vertex_uses_[v] : 0;
+}
+
+ElementId Connectivity::vertex_element(VertexId v) const {
+  return v >= 0 && static_cast<std::size_t>(v) < vertex_element_.size() ? vertex_element_[v] : no_id;
+}
+
+void Connectivity::ensure_vertex_capacity(VertexId v) {
+  if (static_cast<std::size_t>(v) >= vertex_uses_.size()) {
+    vertex_uses_.resize(static_cast<std::size_t>(v) + 1, 0);
+    vertex_element_.resize(static_cast<std::size_t>(v) + 1, no_id);
+  }
+}
+
+void Connectivity::update_vertex_incidence(const ConnectivityChange& change, std::span<const FaceId> orphans) {
+  std::vector<VertexId> lost;  // vertices whose element hint may have died
+  auto leave = [&](const Simplex& s) {
+    for (VertexId v : s.vertices()) {
+      --vertex_uses_[v];
+      lost.push_back(v);
+    }
+  };
+  auto enter = [&](ElementId e) {
+    for (VertexId v : elements_[e].simplex.vertices()) {
+      ensure_vertex_capacity(v);
+      ++vertex_uses_[v];
+      vertex_element_[v] = e;
+    }
+  };
+  for (const auto& [e, simplex] : change.removed_elements) leave(simplex);
+  for (const auto& [e, old_simplex] : change.changed_elements) {
+    leave(old_simplex);
+    enter(e);
+  }
+  for (ElementId e : change.added_elements) enter(e);
+  for (VertexId v : lost) {
+    ElementId& hint = vertex_element_[v];
+    if (vertex_uses_[v] == 0) {
+      hint = no_id;
+      continue;
+    }
+    if (is_element(hint) && elements_[hint].simplex.contains(v)) continue;
+    // A surviving element next to the changed ones (its face lost its mate) contains v
+    // whenever v's star is connected through faces; otherwise (a pinched star) scan.
+    hint = no_id;
+    for (FaceId g : orphans)
+      if (is_face(g) && faces_[g].simplex.contains(v)) {
+        hint = faces_[g].element;
+        break;
+      }
+    for (ElementId e = 0; hint == no_id && e < element_capacity(); ++e)
+      if (is_element(e) && elements_[e].simplex.contains(v)) hint = e;
+  }
+}
+
+void Connectivity::stage_vertex_event(VertexEvent event) {
+  ensure_vertex_capacity(event.vertex);
+  staged_vertex_events_.push_back(std::move(event));
+}
+
+void Connectivity::notify_vertex_events() {
+  if (staged_vertex_events_.empty()) return;
+  ConnectivityChange change;
+  notify(change, {});
+}
+
+namespace {
+
+// Live elements around the moved vertices that are not otherwise reported as new or changed.
+std::vector<ElementId> reshaped_by(const Connectivity& c, const ConnectivityChange& change) {
+  std::unordered_set<ElementId> reported(change.added_elements.begin(), change.added_elements.end());
+  for (const auto& entry : change.changed_elements) reported.insert(entry.first);
+  std::unordered_set<ElementId> reshaped;
+  for (const VertexEvent& event : change.vertex_events) {
+    if (event.kind != VertexEventKind::moved || c.vertex_element(event.vertex) == no_id) continue;
+    for (ElementId e : vertex_star(c, event.vertex, c.vertex_element(event.vertex)))
+      if (!reported.count(e)) reshaped.insert(e);
+  }
+  std::vector<ElementId> sorted(reshaped.begin(), reshaped.end());
+  std::sort(sorted.begin(), sorted.end());
+  return sorted;
+}
+
+}  // namespace
+
+void Connectivity::notify(ConnectivityChange& change, std::span<const FaceId> orphans) {
+  change.vertex_events = std::move(staged_vertex_events_);
+  staged_vertex_events_.clear();
+  update_vertex_incidence(change, orphans);
+  change.reshaped_elements = reshaped_by(*this, change);
+  ++revision_;
+  for (const auto& [watcher, mode] : watchers_)
+    if (!in_batch() || mode == WatchMode::each_operation) watcher->on_change(*this, change);
+  if (in_batch()) merge_into_batch(change);
+}
+
+void Connectivity::merge_into_batch(const ConnectivityChange& change) {
+  for (const auto& [e, simplex] : change.removed_elements) {
+    if (batch_added_.erase(e)) continue;  // born and gone within the batch
+    if (auto it = batch_changed_.find(e); it != batch_changed_.end()) {
+      batch_.removed_elements.emplace_back(e, batch_.changed_elements[it->second].second);
+      batch_.changed_elements[it->second].first = no_id;
+      batch_changed_.erase(it);
+    } else {
+      batch_.removed_elements.emplace_back(e, simplex);
+    }
+  }
+  for (ElementId e : change.added_elements) {
+    batch_added_.insert(e);
+    batch_.added_elements.push_back(e);
+  }
+  for (const auto& [e, old_simplex] : change.changed_elements) {
+    if (batch_added_.count(e) || batch_changed_.count(e)) continue;
+    batch_changed_.emplace(e, batch_.changed_elements.size());
+    batch_.changed_elements.emplace_back(e, old_simplex);
+  }
+  batch_.boundary_removed.insert(batch_.boundary_removed.end(), change.boundary_removed.begin(),
+                                 change.boundary_removed.end());
+  batch_.boundary_added.insert(batch_.boundary_added.end(), change.boundary_added.begin(), change.boundary_added.end());
+  batch_.vertex_events.insert(batch_.vertex_events.end(), change.vertex_events.begin(), change.vertex_events.end());
+}
+
+ConnectivityChange Connectivity::take_batch() {
+  ConnectivityChange merged = std::move(batch_);
+  batch_ = ConnectivityChange{};
+  std::vector<ElementId> added;
+  for (ElementId e : merged.added_elements)
+    if (batch_added_.erase(e)) added.push_back(e);  // each live one once
+  merged.added_elements = std::move(added);
+  std::erase_if(merged.changed_elements, [](const auto& entry) { return entry.first == no_id; });
+  std::vector<FaceId> entered;
+  std::unordered_set<FaceId> seen;
+  for (FaceId f : merged.boundary_added)
+    if (is_face(f) && faces_[f].mate == no_id && seen.insert(f).second) entered.push_back(f);
+  merged.boundary_added = std::move(entered);
+  std::vector<Simplex> left;
+  std::unordered_set<Simplex, SimplexHash> seen_simplex;
+  for (const Simplex& sigma : merged.boundary_removed)
+    if (!boundary_.count(sigma) && seen_simplex.insert(sigma).second) left.push_back(sigma);
+  merged.boundary_removed = std::move(left);
+  merged.reshaped_elements = reshaped_by(*this, merged);
+  batch_added_.clear();
+  batch_changed_.clear();
+  return merged;
+}
+
+void Connectivity::begin_batch() { ++batch_depth_; }
+
+void Connectivity::end_batch() {
+  if (batch_depth_ == 0) throw std::logic_error("end_batch without begin_batch");
+  if (batch_depth_ == 1) notify_vertex_events();  // vertex events staged but not yet delivered
+  if (--batch_depth_ > 0) return;
+  ConnectivityChange merged = take_batch();
+  if (merged.empty()) return;
+  for (const auto& [watcher, mode] : watchers_)
+    if (mode == WatchMode::merged) watcher->on_change(*this, merged);
+}
+
+ChangeBatch::~ChangeBatch() noexcept(false) {
+  if (std::uncaught_exceptions() == 0) {
+    c_.end_batch();
+    return;
+  }
+  try {  // already unwinding: deliver what was done, but do not throw a second exception
+    c_.end_batch();
+  } catch (...) {
+  }
+}
+
+void Connectivity::add_watcher(ConnectivityWatcher* watcher, WatchMode mode) {
+  watchers_.emplace_back(watcher, mode);
   watcher->init(*this);
 }
 
 void Connectivity::remove_watcher(ConnectivityWatcher* watcher) {
-  watchers_.erase(std::remove(watchers_.begin(), watchers_.end(), watcher), watchers_.end());
-}
-
-void Connectivity::notify(const ConnectivityChange& change) {
-  ++revision_;
-  for (ConnectivityWatcher* watcher : watchers_) watcher->on_change(*this, change);
+  std::erase_if(watchers_, [watcher](const auto& entry) { return entry.first == watcher; });
 }
 
 std::size_t Connectivity::memory_bytes() const {
   // unordered_map: one node (key, value, next pointer, cached hash) per entry plus buckets.
   const std::size_t boundary_node = sizeof(Simplex) + sizeof(FaceId) + 2 * sizeof(void*);
   return elements_.capacity() * sizeof(Element) + faces_.capacity() * sizeof(Face) +
-         (free_elements_.capacity() + free_faces_.capacity()) * sizeof(std::int32_t) +
+         (free_elements_.capacity() + free_faces_.capacity() + vertex_uses_.capacity() +
+          vertex_element_.capacity()) * sizeof(std::int32_t) +
          boundary_.size() * boundary_node + boundary_.bucket_count() * sizeof(void*);
 }
 

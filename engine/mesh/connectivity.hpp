@@ -87,10 +87,27 @@ class Connectivity {
   // dead or repeated element or a substitution that is not injective on an element.
   void change_elements(std::span<const ElementSubstitution> substitutions);
 
-  void add_watcher(ConnectivityWatcher* watcher);
+  // Vertices: how many live elements contain v, and one of them (no_id if none). Kept
+  // exact by replace_elements and change_elements (O(size of the change) per call).
+  std::int32_t n_vertex_uses(VertexId v) const;
+  ElementId vertex_element(VertexId v) const;
+
+  // Vertex events (added, moved, removed) are recorded by the mesh and delivered with the
+  // next change; notify_vertex_events() delivers them on their own (a move or removal
+  // without element change). Moved vertices' stars become the change's reshaped_elements.
+  void stage_vertex_event(VertexEvent event);
+  void notify_vertex_events();
+
+  void add_watcher(ConnectivityWatcher* watcher, WatchMode mode = WatchMode::merged);
   void remove_watcher(ConnectivityWatcher* watcher);
 
-  // Increases with every replace_elements / change_elements: a cheap "has it changed" test.
+  // Batches (nestable; see ChangeBatch): merged watchers hear of the operations in a batch
+  // once, at its end.
+  void begin_batch();
+  void end_batch();
+  bool in_batch() const { return batch_depth_ > 0; }
+
+  // Increases with every operation: a cheap "has it changed" test.
   std::uint64_t revision() const { return revision_; }
 
   // Bytes held by the element, face and boundary containers (capacity, not just size).
@@ -109,7 +126,13 @@ class Connectivity {
   // True if a face with simplex σ exists outside the elements being replaced.
   bool already_kept(const Simplex& sigma, const BoundaryMap& old_faces,
                     const std::unordered_set<ElementId>& old_set) const;
-  void notify(const ConnectivityChange& change);
+  // Completes `change` (staged vertex events, reshaped elements), updates the vertex
+  // incidences and tells the watchers (or merges it into the open batch).
+  void notify(ConnectivityChange& change, std::span<const FaceId> orphans);
+  void update_vertex_incidence(const ConnectivityChange& change, std::span<const FaceId> orphans);
+  void ensure_vertex_capacity(VertexId v);
+  void merge_into_batch(const ConnectivityChange& change);
+  ConnectivityChange take_batch();
 
   int dim_;
   std::size_t n_elements_ = 0;
@@ -118,8 +141,30 @@ class Connectivity {
   std::vector<Face> faces_;
   std::vector<FaceId> free_faces_;
   BoundaryMap boundary_;
-  std::vector<ConnectivityWatcher*> watchers_;
+  std::vector<std::int32_t> vertex_uses_;      // by vertex id
+  std::vector<ElementId> vertex_element_;      // by vertex id
+  std::vector<VertexEvent> staged_vertex_events_;
+  std::vector<std::pair<ConnectivityWatcher*, WatchMode>> watchers_;
   std::uint64_t revision_ = 0;
+
+  // The open batch: what merged watchers will hear at its end.
+  int batch_depth_ = 0;
+  ConnectivityChange batch_;
+  std::unordered_set<ElementId> batch_added_;                     // added during the batch, still live
+  std::unordered_map<ElementId, std::size_t> batch_changed_;     // index into batch_.changed_elements
+};
+
+// Groups operations into one change for merged watchers: { ChangeBatch batch(c); ...edits... }.
+// The merged change is delivered when the outermost batch ends (at destruction).
+class ChangeBatch {
+ public:
+  explicit ChangeBatch(Connectivity& c) : c_(c) { c_.begin_batch(); }
+  ~ChangeBatch() noexcept(false);
+  ChangeBatch(const ChangeBatch&) = delete;
+  ChangeBatch& operator=(const ChangeBatch&) = delete;
+
+ private:
+  Connectivity& c_;
 };
 
 }  // namespace snede

@@ -118,4 +118,16 @@ ElementQuality element_quality(int dim, std::span<const double> corners) {
   });
 }
 
+std::array<double, 6> flattened_triangle(std::span<const double> corners) {
+  if (corners.size() != 9) throw std::invalid_argument("flattened_triangle: expected 9 coordinates");
+  const Eigen::Vector3d a(corners[0], corners[1], corners[2]);
+  const Eigen::Vector3d ab = Eigen::Vector3d(corners[3], corners[4], corners[5]) - a;
+  const Eigen::Vector3d ac = Eigen::Vector3d(corners[6], corners[7], corners[8]) - a;
+  const double length = ab.norm();
+  const Eigen::Vector3d e1 = length > 0 ? Eigen::Vector3d(ab / length) : Eigen::Vector3d::UnitX();
+  const double along = ac.dot(e1);
+  const double across = (ac - along * e1).norm();  // ≥ 0: the image is counter-clockwise
+  return {0.0, 0.0, length, 0.0, along, across};
+}
+
 }  // namespace snede

@@ -2,6 +2,7 @@
 // height over maximum edge, §3.2.3) and the extreme dihedral angles (interior angles in 2D).
 #pragma once
 
+#include <array>
 #include <span>
 
 namespace snede {
@@ -18,5 +19,9 @@ struct ElementQuality {
 double signed_volume(int dim, std::span<const double> corners);
 double longest_edge(int dim, std::span<const double> corners);
 ElementQuality element_quality(int dim, std::span<const double> corners);
+
+// A triangle in 3D (surface meshes, §5.3), `corners` (3, 3), laid flat in its own plane: its
+// (2, 2)-corner image with positive area, so that the 2D measures above apply to it.
+std::array<double, 6> flattened_triangle(std::span<const double> corners);
 
 }  // namespace snede

@@ -86,6 +86,18 @@ std::optional<std::string> find_violation(const Connectivity& c) {
       return "(7.5) " + face_text(c, f) + " is on the boundary but its opposite " +
              face_text(c, opposite->second) + " exists";
   }
+  // Vertex incidences: exact use counts, and a hint that is an element containing the vertex.
+  std::unordered_map<VertexId, std::int32_t> uses;
+  for (ElementId e : c.element_ids())
+    for (VertexId v : c.element(e).simplex.vertices()) ++uses[v];
+  for (const auto& [v, n] : uses) {
+    if (c.n_vertex_uses(v) != n)
+      return "vertex " + std::to_string(v) + " is used by " + std::to_string(n) + " elements but counted " +
+             std::to_string(c.n_vertex_uses(v));
+    const ElementId hint = c.vertex_element(v);
+    if (!c.is_element(hint) || !c.element(hint).simplex.contains(v))
+      return "vertex " + std::to_string(v) + " names element " + std::to_string(hint) + ", which does not contain it";
+  }
   return std::nullopt;
 }
 

@@ -1,5 +1,6 @@
 #include "solve/constraints.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -54,7 +55,7 @@ void Constraints::release(std::span<const VertexId> vertices) {
 
 std::size_t Constraints::n_constrained() const {
   std::size_t n = 0;
-  for (const auto& c : vertices_) n += c.kind != ConstraintKind::free;
+  for (const auto& c : vertices_) n += c.kind == ConstraintKind::fixed || c.kind == ConstraintKind::slide;
   return n;
 }
 
@@ -69,7 +70,7 @@ void Constraints::project(std::span<double> v) const {
   for (std::size_t i = 0; i < vertices_.size(); ++i) {
     const VertexConstraint& c = vertices_[i];
     double* x = v.data() + i * dim_;
-    if (c.kind == ConstraintKind::fixed) {
+    if (c.kind == ConstraintKind::fixed || c.kind == ConstraintKind::absent) {
       for (int k = 0; k < dim_; ++k) x[k] = 0;
     } else if (c.kind == ConstraintKind::slide) {
       double along = 0;
@@ -97,7 +98,7 @@ void Constraints::enforce(std::span<double> u) const {
   for (std::size_t i = 0; i < vertices_.size(); ++i) {
     const VertexConstraint& c = vertices_[i];
     double* x = u.data() + i * dim_;
-    if (c.kind == ConstraintKind::fixed) {
+    if (c.kind == ConstraintKind::fixed || c.kind == ConstraintKind::absent) {
       for (int k = 0; k < dim_; ++k) x[k] = c.anchor[k];
     } else if (c.kind == ConstraintKind::slide) {
       double along = 0;
@@ -110,16 +111,22 @@ void Constraints::enforce(std::span<double> u) const {
 void Constraints::inherit(VertexId v, const VertexParents& parents) {
   if (v >= n_points()) resize(v + 1);
   VertexConstraint inherited;
-  if (parents.count == 1) {
+  const bool all_fixed = std::all_of(parents.vertex.begin(), parents.vertex.end(), [&](VertexId p) {
+    return vertices_[p].kind == ConstraintKind::fixed;
+  });
+  if (parents.count() == 1) {
     inherited = vertices_[parents.vertex[0]];
-  } else if (parents.count == 2 && vertices_[parents.vertex[0]].kind == ConstraintKind::fixed &&
-             vertices_[parents.vertex[1]].kind == ConstraintKind::fixed) {
+  } else if (parents.count() > 1 && all_fixed) {
     inherited.kind = ConstraintKind::fixed;
-    for (int k = 0; k < dim_; ++k)
-      inherited.anchor[k] = parents.weight[0] * vertices_[parents.vertex[0]].anchor[k] +
-                            parents.weight[1] * vertices_[parents.vertex[1]].anchor[k];
+    for (std::size_t i = 0; i < parents.count(); ++i)
+      for (int k = 0; k < dim_; ++k) inherited.anchor[k] += parents.weight[i] * vertices_[parents.vertex[i]].anchor[k];
   }
   vertices_[v] = inherited;
+}
+
+void Constraints::remove(VertexId v) {
+  if (v >= n_points()) resize(v + 1);
+  vertices_[v] = VertexConstraint{ConstraintKind::absent, {0, 0, 0}, {0, 0, 0}};
 }
 
 }  // namespace snede

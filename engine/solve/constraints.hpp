@@ -12,7 +12,9 @@
 
 namespace snede {
 
-enum class ConstraintKind : std::uint8_t { free, fixed, slide };
+// absent: a removed vertex, in no element: out of the problem (P = 0, held at zero) but not a
+// support (no reaction, not counted as constrained).
+enum class ConstraintKind : std::uint8_t { free, fixed, slide, absent };
 
 struct VertexConstraint {
   ConstraintKind kind = ConstraintKind::free;
@@ -44,8 +46,10 @@ class Constraints {
   // u ← P u + (I − P) anchor: the nearest displacement that satisfies the constraints.
   void enforce(std::span<double> u) const;
   // A new vertex inherits its parents' constraint when they agree (one parent: its
-  // constraint; two fixed parents: fixed at the interpolated anchor); otherwise free.
+  // constraint; all parents fixed: fixed at the interpolated anchor); otherwise free.
   void inherit(VertexId v, const VertexParents& parents);
+  // v was removed from the mesh.
+  void remove(VertexId v);
 
  private:
   void check_vertex(VertexId v) const;

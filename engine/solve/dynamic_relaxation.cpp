@@ -59,6 +59,7 @@ DynamicRelaxation::DynamicRelaxation(Model& model, double damping_eta, double dt
     Vec u = model_.displacement();
     SNEDE_PETSC(VecDuplicate(u, &velocity_));
     SNEDE_PETSC(VecZeroEntries(velocity_));
+    model_.add_carried_field(&velocity_);  // follows cuts and refinements like the state
     SNEDE_PETSC(VecDuplicate(u, &inverse_mass_));
     SNEDE_PETSC(VecDuplicate(u, &residual_));
     SNEDE_PETSC(TSCreate(PETSC_COMM_SELF, &ts_));
@@ -84,6 +85,7 @@ DynamicRelaxation::DynamicRelaxation(Model& model, double damping_eta, double dt
     require(positive_finite(time_step()), "-" + options_prefix + "ts_dt", "positive and finite", time_step());
     follows_cfl_ = dt == 0 && time_step() == default_dt;
   } catch (...) {
+    model_.remove_carried_field(&velocity_);
     TSDestroy(&ts_);
     VecDestroy(&velocity_);
     VecDestroy(&inverse_mass_);
@@ -93,6 +95,7 @@ DynamicRelaxation::DynamicRelaxation(Model& model, double damping_eta, double dt
 }
 
 DynamicRelaxation::~DynamicRelaxation() {
+  model_.remove_carried_field(&velocity_);
   TSDestroy(&ts_);
   VecDestroy(&velocity_);
   VecDestroy(&inverse_mass_);
@@ -138,20 +141,14 @@ void DynamicRelaxation::set_velocity(std::span<const double> values) {
 
 void DynamicRelaxation::reissue_sizes_if_mesh_changed() {
   if (generation_ == model_.generation()) return;
-  // The mesh changed size (a cut or a refinement): the velocity is carried over like the
-  // displacement (a copy moves with its original, a midpoint with its edge), and the same TS
-  // takes the new vectors, so a user's handle and options survive.
-  const std::vector<double> old_velocity = vec_values(velocity_);
-  const auto n_old_points = static_cast<VertexId>(old_velocity.size() / model_.dim());
-  const std::vector<double> carried = model_.carried_over(old_velocity, n_old_points);
-  SNEDE_PETSC(VecDestroy(&velocity_));
+  // The mesh changed size (a cut or a refinement): the model has carried the velocity over
+  // like the displacement (a copy moves with its original, a midpoint with its edge); the
+  // same TS takes the new vectors, so a user's handle and options survive.
   SNEDE_PETSC(VecDestroy(&inverse_mass_));
   SNEDE_PETSC(VecDestroy(&residual_));
   Vec u = model_.displacement();
-  SNEDE_PETSC(VecDuplicate(u, &velocity_));
   SNEDE_PETSC(VecDuplicate(u, &inverse_mass_));
   SNEDE_PETSC(VecDuplicate(u, &residual_));
-  set_vec_values(velocity_, carried);
   SNEDE_PETSC(TSReset(ts_));
   SNEDE_PETSC(TS2SetSolution(ts_, u, velocity_));
   generation_ = model_.generation();

@@ -5,6 +5,7 @@
 #include <numeric>
 
 #include "core/error.hpp"
+#include "core/petsc_util.hpp"
 
 namespace snede {
 namespace {
@@ -45,7 +46,6 @@ class WriteView {
 Model::Model(ElasticBody& body) : body_(body), constraints_(body.dim()) {
   n_points_ = body_.mesh().n_points();
   constraints_.resize(n_points_);
-  nodal_forces_.assign(body_.n_dofs(), 0.0);
   create_vectors();
   body_.mesh().connectivity().add_watcher(this);
 }
@@ -81,36 +81,81 @@ void Model::slide(std::span<const VertexId> vertices, std::span<const double> di
 void Model::set_gravity(std::span<const double> g) {
   if (g.size() != static_cast<std::size_t>(dim()))
     throw std::invalid_argument("gravity must have " + std::to_string(dim()) + " components");
+  for (double x : g)
+    if (!std::isfinite(x)) throw std::invalid_argument("gravity must be finite, got " + std::to_string(x));
   gravity_.assign(g.begin(), g.end());
   external_valid_ = false;
 }
 
-void Model::add_nodal_force(std::span<const VertexId> vertices, std::span<const double> forces) {
+void Model::clear_gravity() {
+  gravity_.clear();
+  external_valid_ = false;
+}
+
+std::vector<double>& Model::channel(const std::string& name) {
+  if (name.empty()) throw std::invalid_argument("a load channel needs a name");
+  auto [it, created] = channels_.try_emplace(name);
+  if (created) it->second.assign(body_.n_dofs(), 0.0);
+  return it->second;
+}
+
+void Model::add_nodal_force(const std::string& name, std::span<const VertexId> vertices,
+                            std::span<const double> forces) {
   const bool one_for_all = forces.size() == static_cast<std::size_t>(dim());
   if (!one_for_all && forces.size() != vertices.size() * dim())
     throw std::invalid_argument("force must be one vector of " + std::to_string(dim()) +
                                 " components or one per vertex");
   for (std::size_t i = 0; i < vertices.size(); ++i) {
-    if (vertices[i] < 0 || vertices[i] >= n_points_)
+    if (!body_.mesh().is_vertex(vertices[i]))
       throw std::invalid_argument("vertex " + std::to_string(vertices[i]) + " does not exist");
-    for (int k = 0; k < dim(); ++k) {
-      const double value = forces[(one_for_all ? 0 : i * dim()) + k];
-      if (!std::isfinite(value)) throw std::invalid_argument("non-finite force on vertex " + std::to_string(vertices[i]));
-      nodal_forces_[static_cast<std::size_t>(vertices[i]) * dim() + k] += value;
-    }
+    for (int k = 0; k < dim(); ++k)
+      if (!std::isfinite(forces[(one_for_all ? 0 : i * dim()) + k]))
+        throw std::invalid_argument("non-finite force on vertex " + std::to_string(vertices[i]));
   }
+  std::vector<double>& f = channel(name);
+  for (std::size_t i = 0; i < vertices.size(); ++i)
+    for (int k = 0; k < dim(); ++k)
+      f[static_cast<std::size_t>(vertices[i]) * dim() + k] += forces[(one_for_all ? 0 : i * dim()) + k];
+  external_valid_ = false;
+}
+
+void Model::set_nodal_forces(const std::string& name, std::span<const VertexId> vertices,
+                             std::span<const double> forces) {
+  clear_channel(name);
+  add_nodal_force(name, vertices, forces);
+}
+
+void Model::clear_channel(const std::string& name) {
+  channels_.erase(name);
   external_valid_ = false;
 }
 
 void Model::clear_loads() {
   gravity_.clear();
-  std::fill(nodal_forces_.begin(), nodal_forces_.end(), 0.0);
+  channels_.clear();
   external_valid_ = false;
 }
 
+std::vector<std::string> Model::load_channels() const {
+  std::vector<std::string> names;
+  for (const auto& entry : channels_) names.push_back(entry.first);
+  return names;
+}
+
+std::vector<double> Model::channel_forces(const std::string& name) const {
+  const auto it = channels_.find(name);
+  return it == channels_.end() ? std::vector<double>(body_.n_dofs(), 0.0) : it->second;
+}
+
+void Model::add_carried_field(Vec* field) { carried_fields_.push_back(field); }
+
+void Model::remove_carried_field(Vec* field) { std::erase(carried_fields_, field); }
+
 const std::vector<double>& Model::external_forces() {
   if (!external_valid_) {
-    external_ = nodal_forces_;
+    external_.assign(body_.n_dofs(), 0.0);
+    for (const auto& entry : channels_)
+      for (std::size_t i = 0; i < external_.size(); ++i) external_[i] += entry.second[i];
     if (!gravity_.empty()) {
       const std::vector<double> g = body_.gravity_forces(gravity_);
       for (std::size_t i = 0; i < g.size(); ++i) external_[i] += g[i];
@@ -222,46 +267,55 @@ PetscErrorCode Model::tangent_mult_callback(Mat A, Vec d, Vec out) {
   });
 }
 
-std::vector<double> Model::carried_over(std::span<const double> old_values, VertexId n_old_points) const {
-  const VertexId n = body_.mesh().n_points();
-  std::vector<double> values(static_cast<std::size_t>(n) * dim(), 0.0);
-  std::copy(old_values.begin(), old_values.begin() + static_cast<std::size_t>(std::min(n, n_old_points)) * dim(),
-            values.begin());
-  for (VertexId v = n_old_points; v < n; ++v) {
-    const VertexParents parents = body_.mesh().parents(v);
-    for (int i = 0; i < parents.count; ++i)
-      for (int k = 0; k < dim(); ++k)
-        values[static_cast<std::size_t>(v) * dim() + k] +=
-            parents.weight[i] * values[static_cast<std::size_t>(parents.vertex[i]) * dim() + k];
+std::vector<double> Model::replayed(std::span<const double> old_values, const ConnectivityChange& change) const {
+  const int d = dim();
+  std::vector<double> values(old_values.begin(), old_values.end());
+  values.resize(body_.n_dofs(), 0.0);
+  std::vector<double> x(d);
+  for (const VertexEvent& event : change.vertex_events) {
+    double* at = values.data() + static_cast<std::size_t>(event.vertex) * d;
+    if (event.kind == VertexEventKind::removed || event.parents.count() == 0) {
+      if (event.kind != VertexEventKind::moved) std::fill(at, at + d, 0.0);  // moved to coordinates: kept
+      continue;
+    }
+    std::fill(x.begin(), x.end(), 0.0);  // parents' values as they were before this event
+    for (std::size_t i = 0; i < event.parents.count(); ++i)
+      for (int k = 0; k < d; ++k)
+        x[k] += event.parents.weight[i] * values[static_cast<std::size_t>(event.parents.vertex[i]) * d + k];
+    std::copy(x.begin(), x.end(), at);
   }
   return values;
 }
 
-void Model::on_change(const Connectivity&, const ConnectivityChange&) {
+void Model::on_change(const Connectivity&, const ConnectivityChange& change) {
   external_valid_ = false;  // gravity follows the element masses
+  if (change.vertex_events.empty()) return;
   const VertexId n_new = body_.mesh().n_points();
-  if (n_new == n_points_) return;
-  // Sizes change: carry the state over, then reissue vectors and the shell.
-  std::vector<double> u_old;
-  {
-    ReadView u(u_);
-    u_old.assign(u.span().begin(), u.span().end());
+  constraints_.resize(n_new);
+  for (const VertexEvent& event : change.vertex_events) {
+    if (event.kind == VertexEventKind::added) constraints_.inherit(event.vertex, event.parents);
+    if (event.kind == VertexEventKind::removed) constraints_.remove(event.vertex);
   }
-  const std::vector<double> u_new = carried_over(u_old, n_points_);
-  std::vector<double> forces = nodal_forces_;
-  forces.resize(static_cast<std::size_t>(n_new) * dim(), 0.0);  // loads are not inherited
-  nodal_forces_ = std::move(forces);
-  for (VertexId v = n_points_; v < n_new; ++v) constraints_.inherit(v, body_.mesh().parents(v));
-  VecDestroy(&u_);
-  VecDestroy(&u_linearization_);
-  MatDestroy(&tangent_);
-  n_points_ = n_new;
-  create_vectors();
-  {
-    WriteView u(u_);
-    std::copy(u_new.begin(), u_new.end(), u.span().begin());
+  for (auto& entry : channels_) {  // loads are not inherited: a new or removed vertex carries none
+    entry.second.resize(body_.n_dofs(), 0.0);
+    for (const VertexEvent& event : change.vertex_events)
+      if (event.kind != VertexEventKind::moved)
+        std::fill_n(entry.second.begin() + static_cast<std::ptrdiff_t>(event.vertex) * dim(), dim(), 0.0);
   }
-  ++generation_;
+  std::vector<Vec*> fields{&u_};
+  fields.insert(fields.end(), carried_fields_.begin(), carried_fields_.end());
+  std::vector<std::vector<double>> values;
+  for (Vec* field : fields) values.push_back(replayed(vec_values(*field), change));
+  if (n_new != n_points_) {
+    for (Vec* field : fields) VecDestroy(field);
+    VecDestroy(&u_linearization_);
+    MatDestroy(&tangent_);
+    n_points_ = n_new;
+    create_vectors();
+    for (std::size_t i = 1; i < fields.size(); ++i) SNEDE_PETSC(VecDuplicate(u_, fields[i]));
+    ++generation_;
+  }
+  for (std::size_t i = 0; i < fields.size(); ++i) set_vec_values(*fields[i], values[i]);
 }
 
 }  // namespace snede

@@ -1,8 +1,13 @@
 // The model (§2.4, §3.1, §6.6): an elastic body with constraints, loads and a displacement
-// state held in PETSc vectors. It is a connectivity watcher: after a mesh change it reissues
-// vector and shell sizes and carries the displacement over (surviving vertices keep theirs;
-// a new vertex gets the weighted sum of its parents' — the value of the element it was
-// created in: a copy keeps its original's, an edge midpoint the mean of the endpoints').
+// state held in PETSc vectors. The potential is a sum of named terms: the elastic body's
+// Π_int, gravity, and named nodal-force channels ("nodal", the needle's "friction", ...),
+// each set, changed or cleared alone.
+//
+// It is a connectivity watcher: it replays a change's vertex events on the state and on every
+// carried field (a dynamic solver's velocity) — an added vertex gets the weighted sum of its
+// parents' values, a vertex moved by parents is re-interpolated, a removed vertex is taken
+// out of the problem (held at zero) — and reissues vector and shell sizes when the vertex
+// count changed.
 //
 // The static problem is min Π(u) = Π_int(u) − f_extᵀu under the constraints. PETSc sees
 //   F(u) = P ∇Π(u) + (I − P)(u − anchor)      (residual; zero exactly at the solution)
@@ -14,6 +19,8 @@
 #include <petscvec.h>
 
 #include <cstdint>
+#include <map>
+#include <string>
 #include <vector>
 
 #include "fem/elastic_body.hpp"
@@ -40,11 +47,27 @@ class Model : public ConnectivityWatcher {
   void fix(std::span<const VertexId> vertices, std::span<const double> values);
   void slide(std::span<const VertexId> vertices, std::span<const double> direction);
 
+  // Gravity (dim components) on the lumped element masses; replaces a previous gravity.
   void set_gravity(std::span<const double> g);
-  void add_nodal_force(std::span<const VertexId> vertices, std::span<const double> forces);
+  void clear_gravity();
+  bool has_gravity() const { return !gravity_.empty(); }
+  // Nodal forces in the load channel `channel` (created on first use): one dim-vector for all
+  // listed vertices or one per vertex. add_ accumulates, set_ replaces the whole channel.
+  void add_nodal_force(const std::string& channel, std::span<const VertexId> vertices, std::span<const double> forces);
+  void set_nodal_forces(const std::string& channel, std::span<const VertexId> vertices, std::span<const double> forces);
+  void clear_channel(const std::string& channel);
+  // Clears gravity and every channel.
   void clear_loads();
-  // f_ext = gravity + nodal forces, (n_points, dim) flattened.
+  std::vector<std::string> load_channels() const;
+  // One channel's forces, (n_points, dim) flattened (zeros for an unknown channel).
+  std::vector<double> channel_forces(const std::string& channel) const;
+  // f_ext = gravity + all channels, (n_points, dim) flattened.
   const std::vector<double>& external_forces();
+
+  // A nodal field (block size dim, n_dofs entries) that follows the mesh like the state:
+  // replayed vertex events, reissued (the Vec is replaced) when the size changes.
+  void add_carried_field(Vec* field);
+  void remove_carried_field(Vec* field);
 
   Vec displacement() const { return u_; }  // the state; owned by the model
   Mat tangent() const { return tangent_; }  // J at the linearisation point
@@ -64,9 +87,6 @@ class Model : public ConnectivityWatcher {
   // True if u is finite and has no inverted element under a material that forbids it.
   bool admissible(Vec u, std::string* why = nullptr) const;
 
-  // Carry a nodal field (n_points_old × dim) over to the current points by parents.
-  std::vector<double> carried_over(std::span<const double> old_values, VertexId n_old_points) const;
-
   void init(const Connectivity&) override {}
   void on_change(const Connectivity& connectivity, const ConnectivityChange& change) override;
 
@@ -75,10 +95,15 @@ class Model : public ConnectivityWatcher {
   void tangent_mult(Vec d, Vec out);
   static PetscErrorCode tangent_mult_callback(Mat A, Vec d, Vec out);
 
+  // The vertex events of `change` applied to one nodal field, sized for `n_points` rows.
+  std::vector<double> replayed(std::span<const double> old_values, const ConnectivityChange& change) const;
+  std::vector<double>& channel(const std::string& name);
+
   ElasticBody& body_;
   Constraints constraints_;
   std::vector<double> gravity_;        // dim components, or empty
-  std::vector<double> nodal_forces_;   // n_dofs
+  std::map<std::string, std::vector<double>> channels_;  // name → n_dofs nodal forces
+  std::vector<Vec*> carried_fields_;
   std::vector<double> external_;       // cached f_ext
   bool external_valid_ = false;
   VertexId n_points_ = 0;

@@ -23,11 +23,7 @@ ElementId Bisection::live_element_with_edge(NodeId node, VertexId a, VertexId b)
 }
 
 std::size_t Bisection::simple_bisect(VertexId a, VertexId b, const std::vector<ElementId>& around) {
-  VertexParents midpoint_of;
-  midpoint_of.vertex = {a, b};
-  midpoint_of.weight = {0.5, 0.5};
-  midpoint_of.count = 2;
-  const VertexId midpoint = mesh_.add_vertex(midpoint_of);  // before replace_elements: watchers see it
+  const VertexId midpoint = mesh_.add_vertex(VertexParents::on_edge(a, b, 0.5));  // before replace_elements: watchers see it
   const Connectivity& c = mesh_.connectivity();
   std::vector<Simplex> halves;
   halves.reserve(2 * around.size());
@@ -78,6 +74,7 @@ std::size_t Bisection::bisect(ElementId element) {
 
 std::size_t Bisection::refine_uniform(int levels) {
   if (levels < 0) throw std::invalid_argument("refine_uniform: levels must be ≥ 0, got " + std::to_string(levels));
+  ChangeBatch batch(mesh_.connectivity());  // watchers reissue sizes once
   std::size_t n_split = 0;
   for (int level = 0; level < levels; ++level) {
     std::vector<NodeId> unsplit;

@@ -37,7 +37,7 @@ TaggedSimplex longest_edge_triangle(const Mesh& mesh, const Simplex& element) {
 }  // namespace
 
 TaggedSimplex initial_labelling(const Mesh& mesh, const Simplex& element) {
-  if (mesh.dim() == 2) return longest_edge_triangle(mesh, element);
+  if (mesh.cell_dim() == 2) return longest_edge_triangle(mesh, element);
   TaggedSimplex t;
   t.dim = 3;
   t.tag = 3;

@@ -28,6 +28,7 @@ std::size_t refine_around(Bisection& bisection, std::span<const double> x, doubl
   const std::vector<NodeId> roots = bisection.hierarchy().roots_containing(x);
   if (roots.empty()) throw std::invalid_argument("refine_around: point " + point_text(x) + " is outside the mesh");
   bool size_checked = false;
+  ChangeBatch batch(bisection.mesh().connectivity());  // one change for the watchers (§7.4)
   std::size_t n_split = 0;
   for (;;) {
     ElementId too_long = no_id;

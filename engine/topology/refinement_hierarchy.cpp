@@ -14,7 +14,9 @@ constexpr double on_face_tolerance = 1e-10;
 
 }  // namespace
 
-RefinementHierarchy::RefinementHierarchy(Mesh& mesh) : mesh_(mesh) { mesh_.connectivity().add_watcher(this); }
+RefinementHierarchy::RefinementHierarchy(Mesh& mesh) : mesh_(mesh) {
+  mesh_.connectivity().add_watcher(this, WatchMode::each_operation);  // follows every split
+}
 
 RefinementHierarchy::~RefinementHierarchy() { mesh_.connectivity().remove_watcher(this); }
 
@@ -77,7 +79,7 @@ TaggedSimplex RefinementHierarchy::relabelled(const TaggedSimplex& old_label, co
     } else {
       for (VertexId w : came) {
         const VertexParents parents = mesh_.parents(w);
-        if (parents.count == 1 && parents.vertex[0] == *g) image = w;
+        if (parents.count() == 1 && parents.vertex[0] == *g) image = w;
       }
     }
     if (image == no_id) return initial_labelling(mesh_, new_simplex);
@@ -134,6 +136,8 @@ std::array<double, max_dimension + 1> RefinementHierarchy::barycentric(const Tag
 }
 
 std::vector<NodeId> RefinementHierarchy::roots_containing(std::span<const double> x) const {
+  if (mesh_.is_surface())
+    throw std::invalid_argument("point location needs a volume mesh (triangles in 2D or tetrahedra); this is a surface");
   if (x.size() != static_cast<std::size_t>(mesh_.dim()))
     throw std::invalid_argument("locate: the point has " + std::to_string(x.size()) + " coordinates, the mesh is " +
                                 std::to_string(mesh_.dim()) + "-D");

@@ -141,6 +141,9 @@ class Body:
         """Remove the constraints of these vertices."""
         self._model.release(self._vertices(vertices))
 
+    # Loads are separate terms of the potential (§6.6): gravity and named nodal-force
+    # channels ("nodal" by default; a needle keeps its friction in "friction"), each set,
+    # changed or cleared without touching the others.
     def add_gravity(self, g=(0.0, 0.0, -9.81)) -> None:
         """Gravity (m/s²) acting on the element masses; replaces a previous gravity."""
         g = np.asarray(g, dtype=np.float64)
@@ -148,16 +151,35 @@ class Body:
             raise ValueError(f"g must have {self.dim} components, got shape {g.shape}")
         self._model.set_gravity(g)
 
-    def add_nodal_force(self, vertices, force) -> None:
-        """Add a force (newtons): one (dim,) vector on every listed vertex, or (n_vertices, dim)."""
-        self._model.add_nodal_force(self._vertices(vertices), np.asarray(force, dtype=np.float64))
+    def clear_gravity(self) -> None:
+        self._model.clear_gravity()
 
-    def clear_loads(self) -> None:
-        self._model.clear_loads()
+    def add_nodal_force(self, vertices, force, channel: str = "nodal") -> None:
+        """Add a force (newtons) to load channel ``channel``: one (dim,) vector on every listed
+        vertex, or (n_vertices, dim)."""
+        self._model.add_nodal_force(str(channel), self._vertices(vertices), np.asarray(force, dtype=np.float64))
 
-    def external_forces(self) -> np.ndarray:
-        """Gravity plus nodal forces, (n_points, dim)."""
-        return self._model.external_forces()
+    def set_nodal_forces(self, vertices, force, channel: str = "nodal") -> None:
+        """Replace the whole channel ``channel`` by these forces (other channels unchanged)."""
+        self._model.set_nodal_forces(str(channel), self._vertices(vertices), np.asarray(force, dtype=np.float64))
+
+    def clear_loads(self, channel: str | None = None) -> None:
+        """Clear one nodal-force channel, or with no argument every channel and gravity."""
+        if channel is None:
+            self._model.clear_loads()
+        else:
+            self._model.clear_channel(str(channel))
+
+    @property
+    def load_channels(self) -> list[str]:
+        """Names of the nodal-force channels in use."""
+        return list(self._model.load_channels)
+
+    def external_forces(self, channel: str | None = None) -> np.ndarray:
+        """Gravity plus every channel's nodal forces, or one channel's, (n_points, dim)."""
+        if channel is None:
+            return self._model.external_forces()
+        return self._model.channel_forces(str(channel))
 
     def reaction_forces(self) -> np.ndarray:
         """Forces the supports exert on the body at the current state, (I − P)∇Π(u)."""
@@ -176,7 +198,8 @@ class Body:
         """Refine the mesh around ``point`` to edge length ``h`` (see ``Mesh.refine_around``)
         in the middle of a simulation: new midpoints get the mean of their edge ends'
         displacement (and constraints), so the state carries over and the next solve starts
-        from it. Returns how many cells were split."""
+        from it. The whole refinement is one mesh change, so solver vectors are reissued once.
+        Returns how many cells were split."""
         return self.mesh.refine_around(point, h)
 
     def flops_per_element(self) -> dict:

@@ -1,4 +1,5 @@
-"""The user-facing simplicial mesh: triangles in 2D, tetrahedra in 3D (thesis §7)."""
+"""The user-facing simplicial mesh: triangles in 2D, tetrahedra in 3D, triangulated surfaces in
+3D (thesis §7, §5.3)."""
 from __future__ import annotations
 
 from pathlib import Path
@@ -29,14 +30,14 @@ def _as_points(points) -> np.ndarray:
     return np.ascontiguousarray(array, dtype=np.float64)
 
 
-def _as_cells(cells, dim: int) -> np.ndarray:
+def _as_cells(cells, space_dim: int) -> np.ndarray:
     array = np.asarray(cells)
     if array.dtype.kind not in "iu":
         raise ValueError(f"cells must be integer vertex indices, got dtype {array.dtype}")
-    if array.ndim != 2 or array.shape[1] != dim + 1:
-        raise ValueError(
-            f"cells must have shape (n_cells, {dim + 1}) for {dim}-D points, got {array.shape}"
-        )
+    allowed = (3,) if space_dim == 2 else (3, 4)
+    if array.ndim != 2 or array.shape[1] not in allowed:
+        expected = "(n_cells, 3) triangles" if space_dim == 2 else "(n_cells, 4) tetrahedra or (n_cells, 3) surface triangles"
+        raise ValueError(f"cells must have shape {expected} for {space_dim}-D points, got {array.shape}")
     if array.shape[0] == 0:
         raise ValueError("cells is empty: a mesh needs at least one cell")
     if array.dtype.kind == "u" and array.max() > np.iinfo(np.int64).max:
@@ -47,8 +48,11 @@ def _as_cells(cells, dim: int) -> np.ndarray:
 class Mesh:
     """A simplicial mesh with the connectivity of thesis §7.
 
-    ``Mesh(points, cells)``: ``points`` is ``(n_points, dim)`` with dim 2 or 3 (float64),
-    ``cells`` is ``(n_cells, dim + 1)`` integer vertex indices. Bad input raises
+    ``Mesh(points, cells)``: ``points`` is ``(n_points, space_dim)`` with space_dim 2 or 3
+    (float64), ``cells`` is ``(n_cells, cell_dim + 1)`` integer vertex indices: triangles in 2D,
+    tetrahedra in 3D, or triangles in 3D — a surface mesh (``cell_dim`` 2, ``space_dim`` 3,
+    §5.3), whose triangles are oriented consistently (a non-orientable surface is refused).
+    ``dim`` is ``space_dim``, the width of every nodal array. Bad input raises
     ``ValueError`` naming the problem and the offending index: wrong shapes or dtypes,
     out-of-range or repeated vertex indices in a cell, non-finite coordinates, zero-volume
     cells, a face shared by more than two cells, two cells overlapping across a face.
@@ -72,7 +76,32 @@ class Mesh:
     # -- properties --------------------------------------------------------------------
     @property
     def dim(self) -> int:
+        """Coordinate dimension (columns of ``points`` and of every nodal field)."""
         return self._impl.dim
+
+    @property
+    def cell_dim(self) -> int:
+        """2 for triangles (in 2D or on a surface), 3 for tetrahedra."""
+        return self._impl.cell_dim
+
+    @property
+    def space_dim(self) -> int:
+        return self._impl.space_dim
+
+    @property
+    def is_surface(self) -> bool:
+        """Triangles in 3D."""
+        return self.cell_dim < self.space_dim
+
+    @property
+    def n_live_points(self) -> int:
+        """Vertices not removed (``n_points`` counts rows, removed ones included)."""
+        return self._impl.n_live_points
+
+    @property
+    def live_vertices(self) -> np.ndarray:
+        """(n_points,) bool: False for a removed vertex, whose row is kept until reused."""
+        return self._impl.live_vertices
 
     @property
     def n_points(self) -> int:
@@ -110,8 +139,9 @@ class Mesh:
 
     # -- queries -----------------------------------------------------------------------
     def boundary_faces(self) -> np.ndarray:
-        """(n_faces, dim) vertex indices of the boundary faces (edges in 2D), oriented with the
-        outward normal in 3D and counter-clockwise around the body in 2D."""
+        """(n_faces, cell_dim) vertex indices of the boundary faces (edges of triangles, in 2D
+        or on a surface), oriented with the outward normal for tetrahedra and counter-clockwise
+        around the body in 2D."""
         return self._impl.boundary_faces()
 
     def quality(self) -> MeshQuality:
@@ -143,7 +173,7 @@ class Mesh:
 
     def faces_where(self, inside, interior: bool = True) -> np.ndarray:
         """Faces whose vertices all satisfy ``inside`` — a boolean mask over the points, or a
-        function of the (n_points, dim) coordinates returning one — as (n, dim) sorted vertex
+        function of the (n_points, dim) coordinates returning one — as (n, cell_dim) sorted vertex
         indices. With ``interior`` (default) only faces between two cells: what ``dissect``
         takes, e.g. ``mesh.faces_where(lambda x: np.isclose(x[:, 0], 0.5))``."""
         mask = np.asarray(inside(self.points) if callable(inside) else inside, dtype=bool)
@@ -157,13 +187,44 @@ class Mesh:
 
     # -- changes -----------------------------------------------------------------------
     def dissect(self, faces) -> np.ndarray:
-        """Cut along interior faces (§7.3), given as ``(n, dim)`` vertex indices (either
+        """Cut along interior faces (§7.3), given as ``(n, cell_dim)`` vertex indices (either
         orientation). Vertices whose star the cut splits are duplicated (same coordinates).
         Returns ``(n_new, 2)`` pairs ``(original, copy)``."""
         faces = np.asarray(faces)
-        if faces.dtype.kind not in "iu" or faces.ndim != 2 or faces.shape[1] != self.dim:
-            raise ValueError(f"faces must be (n, {self.dim}) integer vertex indices, got {faces.shape} {faces.dtype}")
-        return self._impl.dissect(np.ascontiguousarray(faces, dtype=np.int64))
+        if faces.dtype.kind not in "iu" or faces.ndim != 2 or faces.shape[1] != self.cell_dim:
+            raise ValueError(f"faces must be (n, {self.cell_dim}) integer vertex indices, got {faces.shape} {faces.dtype}")
+        return _snede.dissect(self._impl, np.ascontiguousarray(faces, dtype=np.int64))
+
+    # -- vertex lifecycle ----------------------------------------------------------------
+    def _parents(self, parents, weights) -> tuple[np.ndarray, np.ndarray]:
+        parents = np.atleast_1d(np.asarray(parents))
+        weights = np.atleast_1d(np.asarray(weights, dtype=np.float64))
+        if parents.dtype.kind not in "iu" or parents.ndim != 1 or weights.shape != parents.shape:
+            raise ValueError(f"parents must be 1-D vertex indices with one weight each, got {parents.shape} "
+                             f"{parents.dtype} and weights {weights.shape}")
+        return np.ascontiguousarray(parents, dtype=np.int64), np.ascontiguousarray(weights)
+
+    def add_vertex(self, parents, weights) -> int:
+        """Add a vertex at ``Σ weights[i]·x[parents[i]]`` (barycentric: weights sum to 1) and
+        return its id (a removed id is reused). Watchers (a Body) give it the interpolated
+        displacement with the next mesh change."""
+        return self._impl.add_vertex(*self._parents(parents, weights))
+
+    def move_vertex(self, vertex: int, parents=None, weights=None, *, point=None) -> None:
+        """Move ``vertex`` in the reference configuration, either to ``Σ weights[i]·x[parents[i]]``
+        (``parents`` may include ``vertex``; a Body re-interpolates its displacement the same
+        way) or to explicit coordinates ``point`` (the displacement is kept). Moving a vertex
+        can invert cells: ``snede.topology.snap_vertex`` refuses that, this does not."""
+        if (point is None) == (parents is None):
+            raise ValueError("give either parents and weights, or point")
+        if point is not None:
+            self._impl.move_vertex_to(int(vertex), np.ascontiguousarray(point, dtype=np.float64))
+        else:
+            self._impl.move_vertex(int(vertex), *self._parents(parents, weights))
+
+    def remove_vertex(self, vertex: int) -> None:
+        """Remove a vertex that no cell uses any more (its id is reused by a later addition)."""
+        self._impl.remove_vertex(int(vertex))
 
     # -- refinement (§6.5) -------------------------------------------------------------
     def _bisection(self):
@@ -200,7 +261,8 @@ class Mesh:
     @classmethod
     def read(cls, path) -> "Mesh":
         """Read a mesh with meshio (gmsh .msh, VTK/VTU, XDMF, and every format meshio reads).
-        Tetrahedra are taken if present, else triangles (whose z must be 0)."""
+        Tetrahedra are taken if present, else triangles: a 2D mesh when every z is 0, otherwise
+        a surface mesh in 3D."""
         import contextlib
         import io
 
@@ -222,9 +284,7 @@ class Mesh:
         elif "triangle" in blocks:
             cells = np.concatenate([b.data for b in data.cells if b.type == "triangle"])
             points = data.points
-            if points.shape[1] == 3:
-                if np.any(points[:, 2] != 0):
-                    raise ValueError(f"{path}: triangles with non-zero z (a surface in 3D) are not supported")
+            if points.shape[1] == 3 and np.all(points[:, 2] == 0):
                 points = points[:, :2]
         else:
             raise ValueError(f"{path}: no tetrahedra or triangles (cell types: {sorted(blocks)})")
@@ -237,7 +297,7 @@ class Mesh:
         points = self.points
         if self.dim == 2:
             points = np.column_stack([points, np.zeros(len(points))])
-        kind = "tetra" if self.dim == 3 else "triangle"
+        kind = "tetra" if self.cell_dim == 3 else "triangle"
         Path(path).parent.mkdir(parents=True, exist_ok=True)
         # meshio's default for .msh is ANSYS Fluent; snede's .msh files are gmsh's.
         gmsh = Path(path).suffix == ".msh"
@@ -245,5 +305,5 @@ class Mesh:
             str(path), **({"file_format": "gmsh22", "binary": False} if gmsh else {}))
 
     def __repr__(self) -> str:
-        kind = "tetrahedra" if self.dim == 3 else "triangles"
-        return f"<snede.Mesh {self.n_cells} {kind}, {self.n_points} points>"
+        kind = "tetrahedra" if self.cell_dim == 3 else "surface triangles" if self.is_surface else "triangles"
+        return f"<snede.Mesh {self.n_cells} {kind}, {self.n_live_points} points>"

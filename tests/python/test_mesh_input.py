@@ -46,7 +46,7 @@ def test_points_with_one_column():
 
 @pytest.mark.parametrize(
     "points, cells, expected_columns",
-    [(TET, [[0, 1, 2]], 4), (TET, [[0, 1, 2, 3, 0]], 4), (TRI, [[0, 1, 2, 0]], 3), (TRI, [[0, 1]], 3)],
+    [(TET, [[0, 1]], 4), (TET, [[0, 1, 2, 3, 0]], 4), (TRI, [[0, 1, 2, 0]], 3), (TRI, [[0, 1]], 3)],
 )
 def test_cells_with_wrong_column_count(points, cells, expected_columns):
     given = np.asarray(cells).shape

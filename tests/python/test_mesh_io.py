@@ -100,11 +100,15 @@ def test_read_2d_gives_2d_points(tmp_path):
     assert back.dim == 2 and back.points.shape == (9, 2)
 
 
-def test_read_refuses_a_curved_surface(tmp_path):
+def test_read_gives_a_surface_mesh_for_triangles_off_the_plane(tmp_path):
     points = np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]])
     meshio.Mesh(points, [("triangle", np.array([[0, 1, 2], [0, 2, 3]]))]).write(tmp_path / "s.vtu")
-    with pytest.raises(ValueError, match="non-zero z"):
-        snede.Mesh.read(tmp_path / "s.vtu")
+    mesh = snede.Mesh.read(tmp_path / "s.vtu")
+    assert (mesh.cell_dim, mesh.space_dim, mesh.n_cells) == (2, 3, 2)
+    mesh.write(tmp_path / "again.vtu")
+    again = snede.Mesh.read(tmp_path / "again.vtu")
+    np.testing.assert_array_equal(again.cells, mesh.cells)
+    np.testing.assert_array_equal(again.points, points)
 
 
 def test_read_refuses_a_file_without_cells_it_knows(tmp_path):

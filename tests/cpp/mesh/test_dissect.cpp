@@ -1,7 +1,7 @@
 #include <gtest/gtest.h>
 
 #include "fixtures.hpp"
-#include "mesh/dissect.hpp"
+#include "topology/dissect.hpp"
 #include "mesh/traversal.hpp"
 #include "mesh/validate.hpp"
 

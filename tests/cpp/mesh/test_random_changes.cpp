@@ -5,7 +5,7 @@
 #include <random>
 
 #include "fixtures.hpp"
-#include "mesh/dissect.hpp"
+#include "topology/dissect.hpp"
 #include "mesh/traversal.hpp"
 #include "mesh/validate.hpp"
 

@@ -5,6 +5,7 @@
 #include <random>
 
 #include "mesh/traversal.hpp"
+#include "topology/dissect.hpp"
 #include "topology/refine_around.hpp"
 #include "topology/refinement_checks.hpp"
 
@@ -96,7 +97,7 @@ TEST(RefinementHierarchy, FollowsChangesMadeByOtherOperations) {
     if (mesh.connectivity().neighbor(e, j) != no_id)
       for (VertexId v : s.subn(j).vertices()) interior_face.push_back(v);
   const VertexId n_points_before = mesh.n_points();
-  mesh.dissect(interior_face);
+  dissect(mesh, interior_face);
   EXPECT_GT(mesh.n_points(), n_points_before);
   for (ElementId live : mesh.cell_ids())
     for (VertexId v : mesh.connectivity().element(live).simplex.vertices())

@@ -5,7 +5,7 @@
 #include <span>
 #include <vector>
 
-#include "mesh/connectivity.hpp"
+#include "mesh/mesh.hpp"
 
 namespace snede {
 
@@ -21,5 +21,9 @@ struct SplitVertex {
 // Throws std::invalid_argument for a face that does not exist or lies on the boundary.
 std::vector<SplitVertex> dissect(Connectivity& c, std::span<const FaceId> cut_faces,
                                  const std::function<VertexId(VertexId)>& new_vertex);
+
+// The same on a mesh, faces given by their vertices ((n, cell_dim), either orientation); the
+// copies are new vertices with their original as only parent (same coordinates and fields).
+std::vector<SplitVertex> dissect(Mesh& mesh, const std::vector<VertexId>& face_vertices);
 
 }  // namespace snede

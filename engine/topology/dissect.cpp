@@ -1,4 +1,4 @@
-#include "mesh/dissect.hpp"
+#include "topology/dissect.hpp"
 
 #include <algorithm>
 #include <stdexcept>
@@ -69,6 +69,12 @@ std::vector<SplitVertex> dissect(Connectivity& c, std::span<const FaceId> cut_fa
   std::sort(list.begin(), list.end(), [](const auto& a, const auto& b) { return a.element < b.element; });
   c.change_elements(list);
   return split;
+}
+
+std::vector<SplitVertex> dissect(Mesh& mesh, const std::vector<VertexId>& face_vertices) {
+  const std::vector<FaceId> faces = mesh.find_faces(face_vertices);
+  return dissect(mesh.connectivity(), faces,
+                 [&mesh](VertexId original) { return mesh.add_vertex(VertexParents::copy_of(original)); });
 }
 
 }  // namespace snede
