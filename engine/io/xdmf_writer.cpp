@@ -74,7 +74,7 @@ void XdmfWriter::write_step(double time, const Mesh& mesh, std::span<const doubl
     write_dataset(group + "/points", points.data(), H5T_NATIVE_DOUBLE, n_points, 3);
     const std::vector<VertexId> cells32 = mesh.cells();
     const std::vector<std::int64_t> cells(cells32.begin(), cells32.end());
-    write_dataset(group + "/cells", cells.data(), H5T_NATIVE_INT64, n_cells, dim + 1);
+    write_dataset(group + "/cells", cells.data(), H5T_NATIVE_INT64, n_cells, mesh.cell_dim() + 1);
     ++n_meshes_;
     last_mesh_ = &mesh;
     last_revision_ = mesh.connectivity().revision();
@@ -85,7 +85,7 @@ void XdmfWriter::write_step(double time, const Mesh& mesh, std::span<const doubl
   for (std::int64_t v = 0; v < n_points; ++v)
     for (int k = 0; k < dim; ++k) u[v * 3 + k] = displacement[v * dim + k];
   write_dataset(group + "/displacement", u.data(), H5T_NATIVE_DOUBLE, n_points, 3);
-  Step step{time, n_meshes_ - 1, n_points, n_cells, dim, {}};
+  Step step{time, n_meshes_ - 1, n_points, n_cells, mesh.cell_dim(), {}};
   for (const CellField& field : cell_fields) {
     if (field.values.size() != static_cast<std::size_t>(n_cells))
       throw std::invalid_argument("cell field '" + field.name + "' has " + std::to_string(field.values.size()) +
@@ -109,9 +109,9 @@ void XdmfWriter::write_xdmf() const {
     const std::string step = "/step/" + std::to_string(i);
     out << " <Grid Name=\"step " << i << "\" GridType=\"Uniform\">\n"
         << "  <Time Value=\"" << s.time << "\"/>\n"
-        << "  <Topology TopologyType=\"" << (s.dim == 3 ? "Tetrahedron" : "Triangle") << "\" NumberOfElements=\""
+        << "  <Topology TopologyType=\"" << (s.cell_dim == 3 ? "Tetrahedron" : "Triangle") << "\" NumberOfElements=\""
         << s.n_cells << "\">\n"
-        << "   <DataItem Dimensions=\"" << s.n_cells << " " << s.dim + 1 << "\" NumberType=\"Int\" Precision=\"8\" "
+        << "   <DataItem Dimensions=\"" << s.n_cells << " " << s.cell_dim + 1 << "\" NumberType=\"Int\" Precision=\"8\" "
         << "Format=\"HDF\">" << h5 << ":" << mesh << "/cells</DataItem>\n  </Topology>\n"
         << "  <Geometry GeometryType=\"XYZ\">\n   <DataItem Dimensions=\"" << s.n_points
         << " 3\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">" << h5 << ":" << mesh

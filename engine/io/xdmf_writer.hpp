@@ -41,7 +41,7 @@ class XdmfWriter {
     double time;
     int mesh;
     std::int64_t n_points, n_cells;
-    int dim;
+    int cell_dim;  // 2: triangles (2D or a surface), 3: tetrahedra
     std::vector<std::string> fields;
   };
   void write_dataset(const std::string& path, const void* data, hid_t type, hsize_t rows, hsize_t columns);

@@ -108,3 +108,13 @@ def cylinder(length=0.1, radius=0.03, h=0.01, seed: int | None = None) -> Mesh:
     # gmsh lists nodes that are not in any tetrahedron (geometry points); keep only used ones.
     used, cells = np.unique(cells, return_inverse=True)
     return Mesh(points[used], cells.reshape(-1, 4))
+
+
+def boundary_surface(mesh: Mesh) -> tuple[Mesh, np.ndarray]:
+    """The boundary of a tetrahedral mesh as a surface mesh (triangles in 3D, outward
+    normals), with the volume mesh's id of each surface vertex: ``(surface, vertex_ids)``."""
+    if mesh.cell_dim != 3:
+        raise ValueError(f"boundary_surface needs a tetrahedral mesh, got cell_dim {mesh.cell_dim}")
+    faces = mesh.boundary_faces()
+    vertex_ids, local = np.unique(faces, return_inverse=True)
+    return Mesh(mesh.points[vertex_ids], local.reshape(faces.shape)), vertex_ids

@@ -43,6 +43,14 @@ class SeriesWriter:
         u = body.displacement if displacement is None else np.asarray(displacement, dtype=np.float64)
         inverted = np.zeros(body.mesh.n_cells)
         inverted[body.inverted_elements(u)] = 1.0
-        fields = {"aspect_ratio": body.mesh.quality().aspect_ratio, "inverted": inverted}
+        self.write_mesh(body.mesh, time, u, inverted=inverted, **cell_fields)
+
+    def write_mesh(self, mesh, time: float = 0.0, displacement=None, **cell_fields) -> None:
+        """Write a mesh without a body (a surface mesh, a mesh being edited) with its
+        ``aspect_ratio`` and ``min_angle`` (radians; the smallest dihedral angle for tetrahedra)
+        cell fields, an optional (n_points, dim) ``displacement`` and extra cell fields."""
+        u = np.zeros((mesh.n_points, mesh.dim)) if displacement is None else np.asarray(displacement, dtype=np.float64)
+        quality = mesh.quality()
+        fields = {"aspect_ratio": quality.aspect_ratio, "min_angle": quality.min_dihedral}
         fields.update({name: np.asarray(values, dtype=np.float64) for name, values in cell_fields.items()})
-        self._impl.write_step(float(time), body.mesh._impl, np.ascontiguousarray(u), fields)
+        self._impl.write_step(float(time), mesh._impl, np.ascontiguousarray(u), fields)
