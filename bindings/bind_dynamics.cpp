@@ -8,8 +8,9 @@ namespace snede::bindings {
 
 void bind_dynamics(py::module_& m) {
   py::class_<DynamicRelaxation>(m, "DynamicRelaxation")
-      .def(py::init<Model&, double, double, const std::string&>(), py::arg("model"), py::arg("damping"),
-           py::arg("dt"), py::arg("options_prefix"), py::keep_alive<1, 2>())
+      .def(py::init<Model&, double, double, const std::string&, const OptionList&>(), py::arg("model"),
+           py::arg("damping"), py::arg("dt"), py::arg("options_prefix"), py::arg("petsc_options"),
+           py::keep_alive<1, 2>())
       .def("step", &DynamicRelaxation::step, py::arg("n"))
       .def("run", &DynamicRelaxation::run, py::arg("rtol"), py::arg("max_steps"))
       .def("cfl_time_step", &DynamicRelaxation::cfl_time_step)

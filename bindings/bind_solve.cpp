@@ -26,7 +26,8 @@ py::array_t<double> reactions_of(Model& model) {
 
 std::unique_ptr<StaticSolver> make_static_solver(Model& model, const std::string& method, double rtol,
                                                  const std::string& criterion, double round_tolerance,
-                                                 int max_iterations, const std::string& prefix) {
+                                                 int max_iterations, const std::string& prefix,
+                                                 const OptionList& petsc_options) {
   StaticOptions options;
   if (method == "cg") options.method = StaticMethod::linear_cg;
   else if (method == "ncg") options.method = StaticMethod::nonlinear_cg;
@@ -39,6 +40,7 @@ std::unique_ptr<StaticSolver> make_static_solver(Model& model, const std::string
   options.stopping.round_tolerance = round_tolerance;
   options.max_iterations = max_iterations;
   options.options_prefix = prefix;
+  options.petsc_options = petsc_options;
   return std::make_unique<StaticSolver>(model, options);
 }
 
@@ -86,7 +88,8 @@ void bind_solve(py::module_& m) {
 
   py::class_<StaticSolver>(m, "StaticSolver")
       .def(py::init(&make_static_solver), py::arg("model"), py::arg("method"), py::arg("rtol"), py::arg("criterion"),
-           py::arg("round_tolerance"), py::arg("max_iterations"), py::arg("options_prefix"), py::keep_alive<1, 2>())
+           py::arg("round_tolerance"), py::arg("max_iterations"), py::arg("options_prefix"), py::arg("petsc_options"),
+           py::keep_alive<1, 2>())
       .def("solve", &StaticSolver::solve)
       .def_property_readonly("ksp", [](const StaticSolver& s) { return to_petsc4py(s.ksp()); })
       .def_property_readonly("snes", [](const StaticSolver& s) {

@@ -49,8 +49,9 @@ class MaxStepsGuard {
 
 // ---- DynamicRelaxation --------------------------------------------------------------------
 
-DynamicRelaxation::DynamicRelaxation(Model& model, double damping_eta, double dt, const std::string& options_prefix)
-    : model_(model) {
+DynamicRelaxation::DynamicRelaxation(Model& model, double damping_eta, double dt, const std::string& options_prefix,
+                                     const OptionList& petsc_options)
+    : model_(model), option_database_(options_prefix, petsc_options) {
   require_valid_damping(damping_eta);
   require(dt == 0 || positive_finite(dt), "dt", "positive and finite (or 0 for the CFL estimate)", dt);
   register_ts_ss22();
@@ -63,6 +64,13 @@ DynamicRelaxation::DynamicRelaxation(Model& model, double damping_eta, double dt
     SNEDE_PETSC(VecDuplicate(u, &inverse_mass_));
     SNEDE_PETSC(VecDuplicate(u, &residual_));
     SNEDE_PETSC(TSCreate(PETSC_COMM_SELF, &ts_));
+    option_database_.use_for(ts_);
+    TSAdapt adapt = nullptr;
+    SNEDE_PETSC(TSGetAdapt(ts_, &adapt));
+    option_database_.use_for(adapt);
+    SNES snes = nullptr;  // unused by SS22, but TSSetFromOptions creates and configures it
+    SNEDE_PETSC(TSGetSNES(ts_, &snes));
+    option_database_.use_for(snes);
     SNEDE_PETSC(TSSetOptionsPrefix(ts_, options_prefix.c_str()));
     SNEDE_PETSC(TSSetType(ts_, ts_ss22));
     set_ss22_damping(ts_, damping_eta);
@@ -77,6 +85,7 @@ DynamicRelaxation::DynamicRelaxation(Model& model, double damping_eta, double dt
     SNEDE_PETSC(TSSetMaxTime(ts_, PETSC_MAX_REAL));
     SNEDE_PETSC(TSSetExactFinalTime(ts_, TS_EXACTFINALTIME_STEPOVER));
     SNEDE_PETSC(TSSetFromOptions(ts_));
+    option_database_.mark_read_options_used();
     PetscBool is_ss22 = PETSC_FALSE;
     SNEDE_PETSC(PetscObjectTypeCompare(reinterpret_cast<PetscObject>(ts_), ts_ss22, &is_ss22));
     if (!is_ss22)
@@ -253,6 +262,7 @@ PetscInt DynamicRelaxation::take_steps(PetscInt n_steps) {
     SNEDE_PETSC(TSSetMaxSteps(ts_, target));
     SNEDE_PETSC(TSSolve(ts_, nullptr));
   }
+  option_database_.mark_read_options_used();  // a solve reads more (-ts_view)
   SNEDE_PETSC(TSGetStepNumber(ts_, &last));
   return last - first;
 }

@@ -7,7 +7,9 @@
 // set_ss22_damping or -<prefix>ts_ss22_damping. DynamicRelaxation drives it with
 // G(u) = −M⁻¹ P ∇Π(u) (the net force on the free motions) and carries an options prefix
 // (default "dynamic_"), so -dynamic_ts_monitor, -dynamic_ts_max_steps, -dynamic_ts_dt and
-// -dynamic_ts_ss22_damping apply; TSSetFromOptions runs after snede's defaults.
+// -dynamic_ts_ss22_damping apply; TSSetFromOptions runs after snede's defaults. The TS reads
+// its own options database (core/solver_options.hpp): the constructor's petsc_options, then
+// the command line over them.
 #pragma once
 
 #include <petscts.h>
@@ -17,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include "core/solver_options.hpp"
 #include "solve/model.hpp"
 #include "solve/solve_result.hpp"
 #include "solve/stopping.hpp"
@@ -27,8 +30,10 @@ namespace snede {
 class DynamicRelaxation {
  public:
   // damping_eta: η ≥ 0 (1/s). dt: the time step (s), or 0 for the CFL estimate (2.61), which
-  // is then renewed whenever the mesh changes size.
-  DynamicRelaxation(Model& model, double damping_eta, double dt = 0, const std::string& options_prefix = "dynamic_");
+  // is then renewed whenever the mesh changes size. petsc_options: this solver's PETSc options,
+  // without the prefix.
+  DynamicRelaxation(Model& model, double damping_eta, double dt = 0, const std::string& options_prefix = "dynamic_",
+                    const OptionList& petsc_options = {});
   ~DynamicRelaxation();
   DynamicRelaxation(const DynamicRelaxation&) = delete;
   DynamicRelaxation& operator=(const DynamicRelaxation&) = delete;
@@ -80,6 +85,7 @@ class DynamicRelaxation {
   static PetscErrorCode post_step_callback(TS ts);
 
   Model& model_;
+  SolverOptions option_database_;  // read by the PETSc objects below
   TS ts_ = nullptr;
   Vec velocity_ = nullptr;
   Vec inverse_mass_ = nullptr;  // 1/m per dof (0 for a vertex without mass)

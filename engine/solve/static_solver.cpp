@@ -19,7 +19,10 @@ constexpr double newton_finish_fraction = 1e-3;
 
 }  // namespace
 
-StaticSolver::StaticSolver(Model& model, StaticOptions options) : model_(model), options_(std::move(options)) {
+StaticSolver::StaticSolver(Model& model, StaticOptions options)
+    : model_(model),
+      options_(std::move(options)),
+      option_database_(options_.options_prefix, options_.petsc_options) {
   if (options_.stopping.rtol <= 0 || !std::isfinite(options_.stopping.rtol))
     throw std::invalid_argument("rtol must be positive, got " + std::to_string(options_.stopping.rtol));
   if (options_.method == StaticMethod::linear_cg && !is_linear(model.body().material()))
@@ -49,19 +52,29 @@ void StaticSolver::create_objects() {
   const char* prefix = options_.options_prefix.c_str();
   if (options_.method == StaticMethod::linear_cg) {
     SNEDE_PETSC(KSPCreate(PETSC_COMM_SELF, &ksp_));
+    option_database_.use_for(ksp_);
     SNEDE_PETSC(KSPSetOptionsPrefix(ksp_, prefix));
     SNEDE_PETSC(KSPSetType(ksp_, KSPCG));
     PC pc = nullptr;
     SNEDE_PETSC(KSPGetPC(ksp_, &pc));
+    option_database_.use_for(pc);
     SNEDE_PETSC(PCSetType(pc, PCNONE));  // matrix-free: no diagonal is formed
     SNEDE_PETSC(KSPSetOperators(ksp_, model_.tangent(), model_.tangent()));
     SNEDE_PETSC(KSPSetTolerances(ksp_, 0.0, 0.0, PETSC_DEFAULT, options_.max_iterations));
     SNEDE_PETSC(KSPSetConvergenceTest(ksp_, ksp_converged_callback, this, nullptr));
     SNEDE_PETSC(KSPSetFromOptions(ksp_));
+    option_database_.mark_read_options_used();
     return;
   }
   SNEDE_PETSC(SNESCreate(PETSC_COMM_SELF, &snes_));
-  SNEDE_PETSC(SNESSetOptionsPrefix(snes_, prefix));
+  option_database_.use_for(snes_);
+  SNEDE_PETSC(SNESSetOptionsPrefix(snes_, prefix));  // also creates the KSP
+  KSP inner = nullptr;
+  SNEDE_PETSC(SNESGetKSP(snes_, &inner));
+  option_database_.use_for(inner);
+  SNESLineSearch line_search = nullptr;
+  SNEDE_PETSC(SNESGetLineSearch(snes_, &line_search));
+  option_database_.use_for(line_search);
   SNEDE_PETSC(SNESSetApplicationContext(snes_, this));
   SNEDE_PETSC(SNESSetFunction(snes_, residual_, residual_callback, this));
   SNEDE_PETSC(SNESSetObjective(snes_, objective_callback, this));
@@ -72,17 +85,14 @@ void StaticSolver::create_objects() {
     SNEDE_PETSC(SNESNCGSetType(snes_, SNES_NCG_PRP));
     // The secant line search of §4.4.2 is scale-free; PETSc's cp (the scale-dependent
     // secant) needs -snes_linesearch_damping set to the problem's step scale.
-    SNESLineSearch line_search = nullptr;
-    SNEDE_PETSC(SNESGetLineSearch(snes_, &line_search));
     SNEDE_PETSC(SNESLineSearchSetType(line_search, "snede_secant"));
   } else {
     SNEDE_PETSC(SNESSetType(snes_, SNESNEWTONLS));
     SNEDE_PETSC(SNESSetJacobian(snes_, model_.tangent(), model_.tangent(), jacobian_callback, this));
-    KSP inner = nullptr;
-    SNEDE_PETSC(SNESGetKSP(snes_, &inner));
     SNEDE_PETSC(KSPSetType(inner, KSPCG));
     PC pc = nullptr;
     SNEDE_PETSC(KSPGetPC(inner, &pc));
+    option_database_.use_for(pc);
     SNEDE_PETSC(PCSetType(pc, PCNONE));
     // Truncated Newton (§2.4.3): the inner CG stops early, tightening as the outer converges,
     // and where the tangent is indefinite (far from the solution of a soft body) CG stops at
@@ -91,6 +101,7 @@ void StaticSolver::create_objects() {
     SNEDE_PETSC(SNESSetMaxLinearSolveFailures(snes_, options_.max_iterations));
   }
   SNEDE_PETSC(SNESSetFromOptions(snes_));
+  option_database_.mark_read_options_used();
 }
 
 void StaticSolver::reissue_sizes_if_mesh_changed() {
@@ -133,7 +144,9 @@ SolveResult StaticSolver::solve() {
         "the body is not held: a static solve needs constraints that stop its " + std::to_string(rigid_modes) +
         " rigid motions (fix some vertices with body.fix); only " +
         std::to_string(model_.constraints().n_constrained_components()) + " displacement components are constrained");
-  return ksp_ ? solve_linear() : solve_nonlinear();
+  SolveResult result = ksp_ ? solve_linear() : solve_nonlinear();
+  option_database_.mark_read_options_used();  // a solve reads more (-snes_view, -ksp_converged_reason)
+  return result;
 }
 
 SolveResult StaticSolver::solve_linear() {

@@ -2,8 +2,9 @@
 // shell), nonlinear CG (SNESNCG; Polak-Ribière or Fletcher-Reeves through
 // -<prefix>snes_ncg_type, line searches cp, snede_newton, snede_secant) and truncated
 // Newton (SNESNEWTONLS with an inner KSPCG on the shell and Eisenstat-Walker tolerances).
-// Every object carries the options prefix, and SetFromOptions is called after snede's
-// defaults, so the command line overrides everything.
+// Every object carries the options prefix and reads the solver's own options database
+// (core/solver_options.hpp); SetFromOptions is called after snede's defaults, so the
+// solver's options override the defaults and the command line overrides everything.
 #pragma once
 
 #include <petscksp.h>
@@ -12,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "core/solver_options.hpp"
 #include "solve/model.hpp"
 #include "solve/solve_result.hpp"
 #include "solve/stopping.hpp"
@@ -25,6 +27,7 @@ struct StaticOptions {
   StoppingRule stopping;  // force_scale and n_dofs are filled from the model
   int max_iterations = 10000;
   std::string options_prefix = "static_";
+  OptionList petsc_options;  // this solver's PETSc options, without the prefix
 };
 
 class StaticSolver {
@@ -59,6 +62,7 @@ class StaticSolver {
 
   Model& model_;
   StaticOptions options_;
+  SolverOptions option_database_;  // read by the PETSc objects below
   KSP ksp_ = nullptr;    // linear CG only
   SNES snes_ = nullptr;  // nonlinear methods only
   Vec residual_ = nullptr;

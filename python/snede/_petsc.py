@@ -11,14 +11,10 @@ import petsc4py
 petsc4py.init(sys.argv)
 from petsc4py import PETSc  # noqa: E402  (must follow init)
 
-__all__ = ["PETSc", "set_prefixed_options"]
+__all__ = ["PETSc", "option_list"]
 
 
-def set_prefixed_options(prefix: str, options: dict | None) -> None:
-    """Put ``{name: value}`` into PETSc's options database under ``prefix`` (value None for a
-    flag), unless the name is already set: the command line wins over a script's defaults."""
-    database = PETSc.Options()
-    for key, value in (options or {}).items():
-        name = prefix + key.lstrip("-")
-        if not database.hasName(name):
-            database.setValue(name, "" if value is None else str(value))
+def option_list(options: dict | None) -> list[tuple[str, str]]:
+    """``{name: value}`` (value None for a flag) as the engine's (name, value) strings; the
+    engine puts them in the solver's own options database, under its prefix."""
+    return [(str(name), "" if value is None else str(value)) for name, value in (options or {}).items()]

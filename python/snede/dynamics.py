@@ -12,7 +12,7 @@ import math
 import numpy as np
 
 from snede import _snede
-from snede._petsc import set_prefixed_options
+from snede._petsc import option_list
 from snede.result import SolveResult
 
 
@@ -24,8 +24,9 @@ class DynamicRelaxation:
     * ``dt``: time step (s); None takes the CFL estimate (2.61) ``cfl_time_step``, renewed
       when the mesh changes size. Above the critical step the motion blows up; that is
       reported as ``reason == "DIVERGED_BLOW_UP"``, not raised.
-    * ``petsc_options``: PETSc options without the prefix, e.g. ``{"ts_monitor": None}``;
-      the command line still wins.
+    * ``petsc_options``: PETSc options without the prefix, e.g. ``{"ts_monitor": None}``, for
+      this solver only; the command line (PETSc's global options, as they are when the solver
+      is made) still wins.
 
     The state is ``body.displacement`` and ``velocity`` (both (n_points, dim)); it starts at
     rest. After a cut or refinement the velocity is carried over like the displacement.
@@ -35,9 +36,9 @@ class DynamicRelaxation:
                  petsc_options: dict | None = None):
         if dt is not None and not (math.isfinite(dt) and dt > 0):
             raise ValueError(f"dt must be positive and finite (or None for the CFL estimate), got {dt}")
-        set_prefixed_options(options_prefix, petsc_options)
         self.body = body
-        self._impl = _snede.DynamicRelaxation(body._model, float(damping), float(dt or 0.0), options_prefix)
+        self._impl = _snede.DynamicRelaxation(body._model, float(damping), float(dt or 0.0), options_prefix,
+                                              option_list(petsc_options))
 
     def step(self, n: int = 1) -> SolveResult:
         """Take ``n`` time steps. ``converged`` is False only on divergence (blow-up, NaN,

@@ -6,7 +6,7 @@ line tunes it: ``-static_snes_monitor``, ``-static_snes_ncg_type fr``,
 from __future__ import annotations
 
 from snede import _snede
-from snede._petsc import set_prefixed_options
+from snede._petsc import option_list
 from snede.result import SolveResult
 
 METHODS = ("cg", "ncg", "newton")
@@ -28,7 +28,9 @@ class StaticSolver:
     * ``criterion``: ``"6.9"`` (default; ‖r‖ ≤ rtol·√(‖f_ext‖² + ‖f_react‖²) plus a round-off
       floor) or ``"6.8"`` (‖r‖ ≤ rtol·‖f_ext‖).
     * ``petsc_options``: a dict of PETSc options without the prefix, e.g.
-      ``{"snes_monitor": None, "snes_max_it": 50}``; the command line still wins.
+      ``{"snes_monitor": None, "snes_max_it": 50}``. They, ``line_search`` and ``ncg_type``
+      apply to this solver only, not to later solvers with the same prefix; the command line
+      (PETSc's global options, as they are when the solver is made) still wins.
     """
 
     def __init__(self, body, method: str = "newton", rtol: float = 1e-6, *, criterion: str = "6.9",
@@ -49,11 +51,10 @@ class StaticSolver:
             if ncg_type not in ("prp", "fr", "hs", "dy", "cd"):
                 raise ValueError(f"ncg_type must be 'prp' or 'fr' (or hs, dy, cd), got {ncg_type!r}")
             options.setdefault("snes_ncg_type", ncg_type)
-        set_prefixed_options(options_prefix, options)
         self.body = body
         self.method = method
         self._impl = _snede.StaticSolver(body._model, method, float(rtol), criterion, float(round_tolerance),
-                                         int(max_iterations), options_prefix)
+                                         int(max_iterations), options_prefix, option_list(options))
 
     def solve(self) -> SolveResult:
         return SolveResult._from_engine(self._impl.solve())

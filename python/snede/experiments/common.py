@@ -64,9 +64,8 @@ _prefix_numbers = itertools.count()
 
 
 def options_prefix(label: str) -> str:
-    """A PETSc options prefix no earlier solve in this process used: snede sets a solver's
-    ``petsc_options`` only where the database has no value yet, so a reused prefix would
-    silently keep the options of the first solver that used it."""
+    """A PETSc options prefix no other solve in this process uses, so that command-line options
+    for the default prefixes (``-static_…``, ``-dynamic_…``) leave an experiment's settings alone."""
     return re.sub(r"[^A-Za-z0-9]", "_", label) + f"_{next(_prefix_numbers)}_"
 
 

@@ -1,0 +1,70 @@
+#include "core/solver_options.hpp"
+
+#include <sstream>
+#include <stdexcept>
+
+#include "core/error.hpp"
+
+namespace snede {
+namespace {
+
+// The name without its leading '-'; throws if nothing usable is left.
+std::string bare_option_name(const std::string& name) {
+  const std::size_t start = name.find_first_not_of('-');
+  if (start == std::string::npos || name.find_first_of(" \t\n\r\f\v") != std::string::npos)
+    throw std::invalid_argument("PETSc option names must be non-empty and without white space, got '" + name + "'");
+  return name.substr(start);
+}
+
+PetscErrorCode destroy_database(void* database) {
+  auto options = static_cast<PetscOptions>(database);
+  return PetscOptionsDestroy(&options);
+}
+
+}  // namespace
+
+SolverOptions::SolverOptions(const std::string& prefix, const OptionList& options) {
+  OptionList own;
+  for (const auto& [name, value] : options) own.emplace_back("-" + prefix + bare_option_name(name), value);
+  SNEDE_PETSC(PetscContainerCreate(PETSC_COMM_SELF, &holder_));
+  try {
+    SNEDE_PETSC(PetscContainerSetUserDestroy(holder_, destroy_database));
+    SNEDE_PETSC(PetscOptionsCreate(&database_));
+    SNEDE_PETSC(PetscContainerSetPointer(holder_, database_));
+    for (const auto& [name, value] : own)
+      SNEDE_PETSC(PetscOptionsSetValue(database_, name.c_str(), value.empty() ? nullptr : value.c_str()));
+    // The global database as text ("-name value -flag ..."), inserted last so that it wins.
+    char* text = nullptr;
+    SNEDE_PETSC(PetscOptionsGetAll(nullptr, &text));
+    const std::string global = text;
+    SNEDE_PETSC(PetscFree(text));
+    SNEDE_PETSC(PetscOptionsInsertString(database_, global.c_str()));
+    std::istringstream tokens(global);
+    for (std::string token; tokens >> token;) {
+      PetscBool is_name = PETSC_FALSE;
+      SNEDE_PETSC(PetscOptionsValidKey(token.c_str(), &is_name));
+      if (is_name) global_names_.push_back(token.substr(1));
+    }
+  } catch (...) {
+    PetscContainerDestroy(&holder_);
+    throw;
+  }
+}
+
+SolverOptions::~SolverOptions() { PetscContainerDestroy(&holder_); }
+
+void SolverOptions::use_for(PetscObject object) const {
+  SNEDE_PETSC(PetscObjectSetOptions(object, database_));
+  SNEDE_PETSC(PetscObjectCompose(object, "snede_solver_options", reinterpret_cast<PetscObject>(holder_)));
+}
+
+void SolverOptions::mark_read_options_used() const {
+  for (const std::string& name : global_names_) {
+    PetscBool read = PETSC_FALSE, set = PETSC_FALSE;
+    SNEDE_PETSC(PetscOptionsUsed(database_, name.c_str(), &read));
+    // Looking an option up is what marks it used.
+    if (read) SNEDE_PETSC(PetscOptionsHasName(nullptr, nullptr, ("-" + name).c_str(), &set));
+  }
+}
+
+}  // namespace snede

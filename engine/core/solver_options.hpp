@@ -1,0 +1,50 @@
+// The PETSc options database of one solver. By default a PETSc object reads PETSc's global
+// database, which every solver with the same prefix shares: options a script gives one
+// solver (petsc_options=, a line search) written there would reach the next solver too.
+// Each solver therefore reads a private database holding its own options under its prefix,
+// then a copy of the global database (command line, PETSC_OPTIONS, petsc4py's
+// PETSc.Options) inserted over them, so that the command line still wins.
+#pragma once
+
+#include <petscsys.h>
+
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace snede {
+
+// PETSc options as (name, value): the name without the solver's prefix (leading '-' are
+// ignored), the value empty for a flag.
+using OptionList = std::vector<std::pair<std::string, std::string>>;
+
+class SolverOptions {
+ public:
+  // Throws std::invalid_argument naming an option name that is empty or holds white space.
+  SolverOptions(const std::string& prefix, const OptionList& options);
+  ~SolverOptions();
+  SolverOptions(const SolverOptions&) = delete;
+  SolverOptions& operator=(const SolverOptions&) = delete;
+
+  // Makes `object` read this database; call it before anything reads the object's options.
+  // The object keeps the database alive, since a petsc4py handle may outlive the solver.
+  // Of the children PETSc 3.18 creates, the KSP of a SNES, the PC of a KSP and the SNES of a
+  // TS take their parent's database; a SNES's line search and a TS's adaptor do not, so
+  // every object a solver configures is passed here.
+  void use_for(PetscObject object) const;
+  template <class Object>
+  void use_for(Object object) const {
+    use_for(reinterpret_cast<PetscObject>(object));
+  }
+
+  // Marks the global options this solver has read as used in the global database, so that
+  // -options_left lists only the options that no solver read.
+  void mark_read_options_used() const;
+
+ private:
+  PetscContainer holder_ = nullptr;  // owns the database; every object using it holds a reference
+  PetscOptions database_ = nullptr;
+  std::vector<std::string> global_names_;  // the copied global options, without '-'
+};
+
+}  // namespace snede
