@@ -74,6 +74,10 @@ class Mesh {
   // found). O(n) scan per call batch.
   std::vector<FaceId> find_faces(const std::vector<VertexId>& face_vertices) const;
 
+  // The weighted sum of the parents' coordinates, computed exactly as add_vertex and
+  // move_vertex compute it, so that an edit can test a new vertex's position (bit for bit)
+  // before adding it. Throws std::invalid_argument like add_vertex, naming `operation`.
+  std::vector<double> interpolated(const char* operation, const VertexParents& parents) const;
   // Adds a vertex at the weighted sum of its parents' coordinates (reusing a removed id if
   // there is one) and records the parents. Throws std::invalid_argument for a parent that is
   // not a live vertex or weights that are not barycentric.
@@ -95,7 +99,6 @@ class Mesh {
 
  private:
   void check_live_vertex(const char* operation, VertexId v) const;
-  std::vector<double> interpolated(const char* operation, const VertexParents& parents) const;
 
   int space_dim_;
   std::vector<double> points_;

@@ -1,0 +1,101 @@
+#include "topology/flip_edge.hpp"
+
+#include <optional>
+#include <stdexcept>
+
+#include "core/predicates.hpp"
+#include "topology/triangle_checks.hpp"
+
+namespace snede {
+
+namespace {
+
+// The two triangles of an interior edge: left = (a, b, c), right = (b, a, d), both positive.
+struct EdgeWings {
+  ElementId left, right;
+  VertexId c, d;
+};
+
+VertexId third_vertex(const Simplex& triangle, VertexId a, VertexId b) {
+  for (VertexId v : triangle.vertices())
+    if (v != a && v != b) return v;
+  throw std::logic_error("third_vertex: triangle " + triangle.to_string() + " is degenerate");
+}
+
+// The wings of (a, b), or the reason there are none.
+std::optional<EdgeWings> edge_wings(const Mesh& mesh, VertexId a, VertexId b, std::string& why_not) {
+  const std::string edge = "edge " + vertex_list({a, b});
+  if (a == b || !mesh.is_vertex(a) || !mesh.is_vertex(b)) {
+    why_not = edge + " does not exist: " + (a == b ? "its ends coincide" : "an end is not a vertex of the mesh");
+    return std::nullopt;
+  }
+  const std::vector<ElementId> sharing = cells_with_edge(mesh, a, b);
+  if (sharing.size() != 2) {
+    why_not = edge + (sharing.empty() ? " does not exist in the mesh" : " lies on the boundary");
+    return std::nullopt;
+  }
+  const Connectivity& c = mesh.connectivity();
+  EdgeWings wings{sharing[0], sharing[1], third_vertex(c.element(sharing[0]).simplex, a, b),
+                  third_vertex(c.element(sharing[1]).simplex, a, b)};
+  if (c.element(wings.left).simplex != Simplex(1, {a, b, wings.c})) {
+    std::swap(wings.left, wings.right);
+    std::swap(wings.c, wings.d);
+  }
+  return wings;
+}
+
+}  // namespace
+
+EditResult flip_edge(Mesh& mesh, VertexId a, VertexId b) {
+  if (mesh.cell_dim() != 2)
+    throw std::invalid_argument("flip_edge: needs a triangle mesh (2D or surface), not a tetrahedral mesh");
+  std::string why_not;
+  const std::optional<EdgeWings> wings = edge_wings(mesh, a, b, why_not);
+  if (!wings) return EditResult::refused("flip_edge: " + why_not);
+  const VertexId c = wings->c, d = wings->d;
+  const std::string flip = "flip_edge: flipping " + vertex_list({a, b}) + " to " + vertex_list({c, d});
+  if (c == d) return EditResult::refused(flip + ": both triangles have the same corners");
+  if (has_edge(mesh, c, d))
+    return EditResult::refused(flip + ": edge " + vertex_list({c, d}) +
+                               " already exists, the flip would duplicate it (Figure 5.9)");
+  const std::array<VertexId, 4> quadrilateral{a, d, b, c};
+  const RetriangulationPlane plane(mesh, quadrilateral);
+  if (!plane.has_normal()) return EditResult::refused(flip + ": the quadrilateral has no area");
+  for (const auto& [x, y, z] : {std::array<VertexId, 3>{a, d, c}, std::array<VertexId, 3>{b, c, d}}) {
+    const std::string problem = plane.triangle_problem(x, y, z);
+    if (!problem.empty()) {
+      const std::string convexity = mesh.is_surface() ? "" : " (quadrilateral " + vertex_list({a, d, b, c}) + " is not strictly convex)";
+      return EditResult::refused(flip + ": " + problem + convexity);
+    }
+  }
+  if (mesh.is_surface()) {
+    // §5.3.1: on a surface the new triangles must also face the way both old ones did.
+    const std::array<std::array<double, 3>, 2> old_normals{doubled_vector_area(mesh, a, b, c),
+                                                           doubled_vector_area(mesh, b, a, d)};
+    for (const auto& [x, y, z] : {std::array<VertexId, 3>{a, d, c}, std::array<VertexId, 3>{b, c, d}}) {
+      const std::array<double, 3> normal = doubled_vector_area(mesh, x, y, z);
+      for (const auto& old : old_normals)
+        if (!(normal[0] * old[0] + normal[1] * old[1] + normal[2] * old[2] > 0))
+          return EditResult::refused(flip + ": triangle " + vertex_list({x, y, z}) +
+                                     " would fold over (its normal points against an old triangle's)");
+    }
+  }
+  const std::array<ElementId, 2> old_triangles{wings->left, wings->right};
+  const std::array<Simplex, 2> new_triangles{Simplex(1, {a, d, c}), Simplex(1, {b, c, d})};
+  mesh.connectivity().replace_elements(old_triangles, new_triangles);
+  return EditResult::success();
+}
+
+bool is_locally_delaunay(const Mesh& mesh, VertexId a, VertexId b) {
+  if (mesh.cell_dim() != 2 || mesh.is_surface())
+    throw std::invalid_argument("is_locally_delaunay: needs a 2D triangle mesh");
+  const bool ends_are_vertices = a != b && mesh.is_vertex(a) && mesh.is_vertex(b);
+  const std::vector<ElementId> sharing = ends_are_vertices ? cells_with_edge(mesh, a, b) : std::vector<ElementId>{};
+  if (sharing.empty()) throw std::invalid_argument("is_locally_delaunay: edge " + vertex_list({a, b}) + " does not exist");
+  if (sharing.size() == 1) return true;
+  std::string why_not;
+  const EdgeWings wings = *edge_wings(mesh, a, b, why_not);
+  return in_circle(mesh.point(a).data(), mesh.point(b).data(), mesh.point(wings.c).data(), mesh.point(wings.d).data()) <= 0;
+}
+
+}  // namespace snede
