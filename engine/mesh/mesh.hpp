@@ -74,6 +74,10 @@ class Mesh {
   // found). O(n) scan per call batch.
   std::vector<FaceId> find_faces(const std::vector<VertexId>& face_vertices) const;
 
+  // The weighted sum of the parents' coordinates (space_dim numbers): bit for bit where
+  // add_vertex and move_vertex would put a vertex with these parents, so an edit can test
+  // the new position exactly before making it. Throws like add_vertex for bad parents.
+  std::vector<double> position(const VertexParents& parents) const { return interpolated("position", parents); }
   // Adds a vertex at the weighted sum of its parents' coordinates (reusing a removed id if
   // there is one) and records the parents. Throws std::invalid_argument for a parent that is
   // not a live vertex or weights that are not barycentric.
