@@ -209,9 +209,12 @@ std::vector<ElementId> Connectivity::replace_elements(std::span<const ElementId>
   ConnectivityChange change;
   // Discard old faces that do not occur again; their surviving mates become orphans that
   // join the boundary unless a new face pairs with them.
-  std::vector<FaceId> orphans;
+  // Nothing is released before every mate has been classified: a released face forgets its
+  // simplex, which would make the second face of a discarded pair look like an orphan.
+  std::vector<FaceId> orphans, discarded;
   for (const auto& [sigma, f] : old_faces) {
     if (new_faces.count(sigma)) continue;
+    discarded.push_back(f);
     const FaceId mate = faces_[f].mate;
     if (mate != no_id) {
       const bool mate_discarded = old_faces.count(faces_[mate].simplex) && !new_faces.count(faces_[mate].simplex);
@@ -223,8 +226,8 @@ std::vector<ElementId> Connectivity::replace_elements(std::span<const ElementId>
       boundary_.erase(sigma);
       change.boundary_removed.push_back(sigma);
     }
-    release_face(f);
   }
+  for (FaceId f : discarded) release_face(f);
   for (ElementId e : old_elements) {
     change.removed_elements.emplace_back(e, elements_[e].simplex);
     release_element(e);

@@ -2,8 +2,10 @@
 
 #include <array>
 #include <sstream>
+#include <vector>
 
 #include "core/predicates.hpp"
+#include "mesh/element_quality.hpp"
 
 namespace snede {
 namespace {
@@ -34,7 +36,12 @@ MovedShape shape_with_corner_at(const Mesh& mesh, ElementId e, VertexId corner, 
   } else {
     sign = orientation_3d(after[0], after[1], after[2], after[3]);
   }
-  return sign > 0 ? MovedShape::positive : sign == 0 ? MovedShape::flat : MovedShape::inverted;
+  if (sign < 0) return MovedShape::inverted;
+  if (sign == 0) return MovedShape::flat;
+  // Positive, but perhaps thinner than the mesh accepts (its measure lost in rounding).
+  std::vector<double> corners;
+  for (int i = 0; i < simplex.count(); ++i) corners.insert(corners.end(), after[i], after[i] + mesh.space_dim());
+  return has_zero_volume(mesh.cell_dim(), mesh.space_dim(), corners) ? MovedShape::flat : MovedShape::positive;
 }
 
 std::string spoiled_by_move(const Mesh& mesh, std::span<const ElementId> elements, VertexId corner,

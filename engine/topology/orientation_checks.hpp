@@ -7,6 +7,9 @@
 // surface triangle is flat when its corners are collinear (exact, collinear_3d) and flipped
 // when its normal turns by more than 90° (n_old · n_new ≤ 0, evaluated in floating point:
 // there is no exact predicate for it, and a turn near 90° is a bad edit either way).
+// An element of exactly positive orientation still counts as flat when its measure is below
+// the mesh's zero-volume tolerance (has_zero_volume): the mesh would refuse it, and its
+// rounded measure may even be ≤ 0.
 #pragma once
 
 #include <span>
