@@ -51,7 +51,7 @@ TEST(CollapseEdge, BoundaryEdgeIn2DKeepsTheMeshValid) {
 
 TEST(CollapseEdge, Figure310InteriorEdgeBetweenBoundaryVerticesIsRefusedIn2D) {
   // A strip of three squares: every vertex is on the boundary; collapsing the interior edge
-  // (1, 0)–(1, 1) would pinch the strip into two triangles fans meeting at one vertex.
+  // (1, 0)–(1, 1) would pinch the strip into two triangle fans meeting at one vertex.
   std::vector<double> points;
   for (int i = 0; i <= 3; ++i) points.insert(points.end(), {double(i), 0.0, double(i), 1.0});
   Mesh strip = mesh_of(2, points, grid_triangles(3, 1));  // vertex (i, j) is 2i + j
