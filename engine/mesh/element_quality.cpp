@@ -130,4 +130,19 @@ std::array<double, 6> flattened_triangle(std::span<const double> corners) {
   return {0.0, 0.0, length, 0.0, along, across};
 }
 
+double cell_measure(int cell_dim, int space_dim, std::span<const double> corners) {
+  if (cell_dim == space_dim) return signed_volume(cell_dim, corners);
+  return signed_volume(2, flattened_triangle(corners));
+}
+
+double cell_longest_edge(int cell_dim, int space_dim, std::span<const double> corners) {
+  return cell_dim == space_dim ? longest_edge(cell_dim, corners) : longest_edge(2, flattened_triangle(corners));
+}
+
+bool has_zero_volume(int cell_dim, int space_dim, std::span<const double> corners) {
+  constexpr double tolerance = 64 * std::numeric_limits<double>::epsilon();
+  const double scale = std::pow(cell_longest_edge(cell_dim, space_dim, corners), cell_dim);
+  return !(std::abs(cell_measure(cell_dim, space_dim, corners)) > tolerance * scale);
+}
+
 }  // namespace snede

@@ -24,4 +24,13 @@ ElementQuality element_quality(int dim, std::span<const double> corners);
 // (2, 2)-corner image with positive area, so that the 2D measures above apply to it.
 std::array<double, 6> flattened_triangle(std::span<const double> corners);
 
+// A cell of dimension cell_dim with corners (cell_dim + 1, space_dim) in space_dim ≥ cell_dim
+// coordinates: its signed volume (area ≥ 0 for a surface triangle) and longest edge.
+double cell_measure(int cell_dim, int space_dim, std::span<const double> corners);
+double cell_longest_edge(int cell_dim, int space_dim, std::span<const double> corners);
+// Whether the cell is degenerate: |V| ≤ 64ε·(longest edge)^cell_dim, a few ulps of its scale,
+// so that thin but real cells (aspect ratio 1e-6) are not. The mesh refuses such cells, and
+// edits refuse to make them.
+bool has_zero_volume(int cell_dim, int space_dim, std::span<const double> corners);
+
 }  // namespace snede

@@ -12,26 +12,12 @@
 namespace snede {
 namespace {
 
-// A cell is degenerate when |V| ≤ this · (longest edge)^cell_dim: a few ulps of the scale,
-// so that thin but real elements (aspect ratio 1e-6) are kept.
-constexpr double zero_volume_tolerance = 64 * std::numeric_limits<double>::epsilon();
-
 std::vector<double> gather_corners(int space_dim, const std::vector<double>& points, std::span<const VertexId> cell) {
   std::vector<double> corners;
   corners.reserve(cell.size() * space_dim);
   for (VertexId v : cell)
     for (int k = 0; k < space_dim; ++k) corners.push_back(points[static_cast<std::size_t>(v) * space_dim + k]);
   return corners;
-}
-
-// Signed volume of a volume cell; area (≥ 0) of a surface triangle.
-double cell_measure(int cell_dim, int space_dim, std::span<const double> corners) {
-  if (cell_dim == space_dim) return signed_volume(cell_dim, corners);
-  return signed_volume(2, flattened_triangle(corners));
-}
-
-double cell_longest_edge(int cell_dim, int space_dim, std::span<const double> corners) {
-  return cell_dim == space_dim ? longest_edge(cell_dim, corners) : longest_edge(2, flattened_triangle(corners));
 }
 
 std::vector<VertexId> checked_cells(int cell_dim, int space_dim, const std::vector<double>& points,
@@ -53,11 +39,10 @@ std::vector<VertexId> checked_cells(int cell_dim, int space_dim, const std::vect
     }
     const std::vector<double> corners = gather_corners(space_dim, points, cell);
     const double volume = cell_measure(cell_dim, space_dim, corners);
-    const double scale = std::pow(cell_longest_edge(cell_dim, space_dim, corners), cell_dim);
-    if (!(std::abs(volume) > zero_volume_tolerance * scale)) {
+    if (has_zero_volume(cell_dim, space_dim, corners)) {
       std::ostringstream message;
       message << "cell " << c << " has zero " << (cell_dim == 2 ? "area" : "volume") << " (" << volume
-              << " for a longest edge of " << std::pow(scale, 1.0 / cell_dim) << ")";
+              << " for a longest edge of " << cell_longest_edge(cell_dim, space_dim, corners) << ")";
       throw std::invalid_argument(message.str());
     }
     if (volume < 0) {

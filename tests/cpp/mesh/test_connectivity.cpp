@@ -102,6 +102,20 @@ TEST(Connectivity, RemovingAndAddingExposesAndCoversBoundary) {
   EXPECT_TRUE(watcher.matches(conn));
 }
 
+TEST(Connectivity, RemovingBothElementsOfAMatchedPairLeavesNoStaleFaceInTheBoundary) {
+  // abc, bdc and a third triangle cde: removing the first two discards the pair bc/cb.
+  constexpr VertexId e = 4;
+  Connectivity conn = connectivity_of(2, {{a, b, c}, {b, d, c}, {c, d, e}});
+  RecordingWatcher watcher;
+  conn.add_watcher(&watcher);
+  const std::vector<ElementId> remove{0, 1};
+  conn.replace_elements(remove, {});
+  EXPECT_FALSE(find_violation(conn));
+  EXPECT_EQ(conn.boundary().size(), 3u);
+  EXPECT_TRUE(conn.boundary().count(Simplex(1, {c, d})));  // cde's face, no longer matched
+  EXPECT_TRUE(watcher.matches(conn));
+}
+
 TEST(Connectivity, ReplaceElementsRejectsBadCallsWithoutChangingAnything) {
   Connectivity conn = connectivity_of(2, {{a, b, c}, {b, d, c}});
   const std::vector<ElementId> dead{5}, twice{0, 0}, none{};

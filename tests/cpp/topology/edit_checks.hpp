@@ -1,14 +1,24 @@
-// Meshes and checks shared by the tests of local triangle and tetrahedron edits (flip,
-// insertion, removal): a snapshot that must survive every refusal bit for bit, total measure,
-// jittered planar grids and a bumpy height-field surface.
+// Meshes and independent checks shared by the tests of local triangle and tetrahedron edits
+// (flip, insertion, removal, split, collapse, snap): a bit-for-bit snapshot for refused edits,
+// total measure, jittered and curved meshes, and an affine displacement field that every edit
+// must carry over exactly (parents interpolate it).
 #pragma once
 
+#include <gtest/gtest.h>
+
 #include <cmath>
+#include <numbers>
 #include <random>
+#include <set>
 #include <vector>
 
+#include "core/petsc_util.hpp"
+#include "fem/linear_elastic.hpp"
 #include "mesh/fixtures.hpp"
 #include "mesh/mesh.hpp"
+#include "solve/model.hpp"
+#include "topology/local_star.hpp"
+#include "topology/refinement_checks.hpp"
 
 namespace snede::testing {
 
@@ -63,9 +73,81 @@ inline Mesh bumpy_surface(int n, double height, double jitter, unsigned seed) {
   std::vector<double> points;
   for (VertexId v = 0; v < flat.n_points(); ++v) {
     const double x = flat.point(v)[0], y = flat.point(v)[1];
-    points.insert(points.end(), {x, y, height * std::sin(2 * M_PI * x) * std::sin(2 * M_PI * y)});
+    points.insert(points.end(), {x, y, height * std::sin(2 * std::numbers::pi * x) * std::sin(2 * std::numbers::pi * y)});
   }
   return mesh_from(2, 3, points, grid_triangles(n, n));
 }
+
+// The vertices joined to v by an edge, ascending.
+inline std::vector<VertexId> neighbours(const Mesh& mesh, VertexId v) {
+  std::set<VertexId> found;
+  for (ElementId e : local_star(mesh.connectivity(), v).elements)
+    for (VertexId w : mesh.connectivity().element(e).simplex.vertices())
+      if (w != v) found.insert(w);
+  return {found.begin(), found.end()};
+}
+
+// Elements containing both a and b.
+inline std::vector<ElementId> elements_with_edge(const Mesh& mesh, VertexId a, VertexId b) {
+  std::vector<ElementId> around;
+  for (ElementId e : local_star(mesh.connectivity(), a).elements)
+    if (mesh.connectivity().element(e).simplex.contains(b)) around.push_back(e);
+  return around;
+}
+
+inline bool on_boundary(const Mesh& mesh, VertexId v) {
+  for (const auto& entry : mesh.connectivity().boundary())
+    if (entry.first.contains(v)) return true;
+  return false;
+}
+
+// u = A X + b on the model's state; edits interpolate displacements with the same parents as
+// positions, so it must stay affine in the (moved) reference positions.
+struct AffineField {
+  int dim;
+  std::vector<double> A, b;  // (dim, dim) row-major, (dim)
+
+  explicit AffineField(int d) : dim(d) {
+    for (int i = 0; i < d; ++i) {
+      b.push_back(0.01 * (i + 1));
+      for (int j = 0; j < d; ++j) A.push_back(i == j ? 0.02 : 0.003 * (i + 2 * j + 1));
+    }
+  }
+  std::vector<double> at(std::span<const double> x) const {
+    std::vector<double> u(b);
+    for (int i = 0; i < dim; ++i)
+      for (int j = 0; j < dim; ++j) u[i] += A[i * dim + j] * x[j];
+    return u;
+  }
+  void set_on(Model& model, const Mesh& mesh) const {
+    std::vector<double> u(model.n_dofs(), 0.0);
+    for (VertexId v = 0; v < mesh.n_points(); ++v)
+      if (mesh.is_vertex(v)) std::ranges::copy(at(mesh.point(v)), u.begin() + v * dim);
+    set_vec_values(model.displacement(), u);
+  }
+  // The largest relative deviation from A X + b at a live vertex.
+  double deviation(const Model& model, const Mesh& mesh) const {
+    const std::vector<double> u = vec_values(model.displacement());
+    double worst = 0;
+    for (VertexId v = 0; v < mesh.n_points(); ++v) {
+      if (!mesh.is_vertex(v)) continue;
+      const std::vector<double> expected = at(mesh.point(v));
+      for (int k = 0; k < dim; ++k)
+        worst = std::max(worst, std::abs(u[v * dim + k] - expected[k]) / (std::abs(expected[k]) + 1e-2));
+    }
+    return worst;
+  }
+};
+
+// A linear elastic body with a model on `mesh` (plane stress in 2D).
+struct ModelOn {
+  ElasticBody body;
+  Model model;
+  explicit ModelOn(Mesh& mesh) : body(mesh, LinearElastic(1e4, 0.3), 1000.0, mesh.dim() == 2 ? 0.01 : 0.0), model(body) {}
+  double energy_density(const Mesh& mesh) {
+    EvaluationReport report;
+    return body.energy(vec_values(model.displacement()), report) / total_measure(mesh);
+  }
+};
 
 }  // namespace snede::testing

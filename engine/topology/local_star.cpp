@@ -1,0 +1,18 @@
+#include "topology/local_star.hpp"
+
+#include "mesh/traversal.hpp"
+
+namespace snede {
+
+LocalStar local_star(const Connectivity& c, VertexId v) {
+  const ElementId start = c.vertex_element(v);
+  if (start == no_id) return {};
+  LocalStar star{vertex_star(c, v, start), true};
+  if (star.elements.size() != static_cast<std::size_t>(c.n_vertex_uses(v))) {
+    star.elements = vertex_star(c, v);
+    star.face_connected = false;
+  }
+  return star;
+}
+
+}  // namespace snede
