@@ -4,6 +4,7 @@
 #include <stdexcept>
 
 #include "core/predicates.hpp"
+#include "topology/local_star.hpp"
 #include "topology/triangle_checks.hpp"
 
 namespace snede {
@@ -29,7 +30,7 @@ std::optional<EdgeWings> edge_wings(const Mesh& mesh, VertexId a, VertexId b, st
     why_not = edge + " does not exist: " + (a == b ? "its ends coincide" : "an end is not a vertex of the mesh");
     return std::nullopt;
   }
-  const std::vector<ElementId> sharing = cells_with_edge(mesh, a, b);
+  const std::vector<ElementId> sharing = elements_with_edge(mesh.connectivity(), a, b);
   if (sharing.size() != 2) {
     why_not = edge + (sharing.empty() ? " does not exist in the mesh" : " lies on the boundary");
     return std::nullopt;
@@ -55,7 +56,7 @@ EditResult flip_edge(Mesh& mesh, VertexId a, VertexId b) {
   const VertexId c = wings->c, d = wings->d;
   const std::string flip = "flip_edge: flipping " + vertex_list({a, b}) + " to " + vertex_list({c, d});
   if (c == d) return EditResult::refused(flip + ": both triangles have the same corners");
-  if (has_edge(mesh, c, d))
+  if (has_edge(mesh.connectivity(), c, d))
     return EditResult::refused(flip + ": edge " + vertex_list({c, d}) +
                                " already exists, the flip would duplicate it (Figure 5.9)");
   const std::array<VertexId, 4> quadrilateral{a, d, b, c};
@@ -90,7 +91,7 @@ bool is_locally_delaunay(const Mesh& mesh, VertexId a, VertexId b) {
   if (mesh.cell_dim() != 2 || mesh.is_surface())
     throw std::invalid_argument("is_locally_delaunay: needs a 2D triangle mesh");
   const bool ends_are_vertices = a != b && mesh.is_vertex(a) && mesh.is_vertex(b);
-  const std::vector<ElementId> sharing = ends_are_vertices ? cells_with_edge(mesh, a, b) : std::vector<ElementId>{};
+  const std::vector<ElementId> sharing = ends_are_vertices ? elements_with_edge(mesh.connectivity(), a, b) : std::vector<ElementId>{};
   if (sharing.empty()) throw std::invalid_argument("is_locally_delaunay: edge " + vertex_list({a, b}) + " does not exist");
   if (sharing.size() == 1) return true;
   std::string why_not;

@@ -15,4 +15,11 @@ LocalStar local_star(const Connectivity& c, VertexId v) {
   return star;
 }
 
+std::vector<ElementId> elements_with_edge(const Connectivity& c, VertexId a, VertexId b) {
+  std::vector<ElementId> around;
+  for (ElementId e : local_star(c, a).elements)
+    if (c.element(e).simplex.contains(b)) around.push_back(e);
+  return around;
+}
+
 }  // namespace snede

@@ -17,4 +17,10 @@ struct LocalStar {
 // misses some of the n_vertex_uses(v) elements does it scan the whole mesh.
 LocalStar local_star(const Connectivity& c, VertexId v);
 
+// The elements having both a and b as vertices (those around edge (a, b)).
+std::vector<ElementId> elements_with_edge(const Connectivity& c, VertexId a, VertexId b);
+
+// True if some element has both a and b as vertices.
+inline bool has_edge(const Connectivity& c, VertexId a, VertexId b) { return !elements_with_edge(c, a, b).empty(); }
+
 }  // namespace snede

@@ -1,6 +1,6 @@
 // Would moving one corner spoil an element? The geometric half of every edit that moves or
 // places a vertex (edge split, edge collapse, §3.2 node snapping): the edit computes the new
-// position once, in the doubles the mesh will store (Mesh::position), and asks here before
+// position once, in the doubles the mesh will store (Mesh::interpolated), and asks here before
 // it touches the mesh.
 //
 // Volume meshes are decided exactly (orientation_2d / orientation_3d on those doubles). A

@@ -7,6 +7,7 @@
 #include <unordered_set>
 
 #include "core/predicates.hpp"
+#include "topology/local_star.hpp"
 #include "topology/triangle_checks.hpp"
 
 namespace snede {
@@ -85,7 +86,7 @@ std::optional<std::vector<Simplex>> ear_triangulation(const Mesh& mesh, const Re
           problem = "triangle " + vertex_list({previous, tip, following}) + " would contain vertex " + std::to_string(q);
         delaunay = delaunay && !plane.in_circumcircle(previous, tip, following, q);
       }
-      if (problem.empty() && has_edge(mesh, previous, following))
+      if (problem.empty() && has_edge(mesh.connectivity(), previous, following))
         problem = "edge " + vertex_list({previous, following}) + " already exists";
       if (!problem.empty()) {
         last_problem = problem;
@@ -121,7 +122,7 @@ EditResult remove_vertex_by_flips(Mesh& mesh, VertexId v) {
   if (!mesh.is_vertex(v))
     throw std::invalid_argument("remove_vertex_by_flips: " + std::to_string(v) + " is not a vertex of the mesh");
   const std::string removing = "remove_vertex_by_flips of vertex " + std::to_string(v) + ": ";
-  const std::vector<ElementId> star = cells_around(mesh, v);
+  const std::vector<ElementId> star = local_star(mesh.connectivity(), v).elements;
   if (star.empty()) return EditResult::refused(removing + "it is in no cell (Mesh::remove_vertex removes it)");
   std::string why_not;
   const std::optional<Link> link = link_of(mesh, v, star, why_not);
@@ -136,7 +137,7 @@ EditResult remove_vertex_by_flips(Mesh& mesh, VertexId v) {
       return EditResult::refused(removing + "a boundary vertex is removed only when it lies straight between its "
                                             "boundary neighbours, and " + vertex_list({last, v, first}) +
                                  " is not a straight segment");
-    if (has_edge(mesh, last, first))
+    if (has_edge(mesh.connectivity(), last, first))
       return EditResult::refused(removing + "the new boundary edge " + vertex_list({last, first}) + " already exists");
   }
   const RetriangulationPlane plane(mesh, polygon);
@@ -145,7 +146,7 @@ EditResult remove_vertex_by_flips(Mesh& mesh, VertexId v) {
   if (!triangles) return EditResult::refused(removing + why_not);
   // A link of three vertices closes into one triangle; on a closed surface it may exist already.
   const Simplex& last_triangle = triangles->back();
-  for (ElementId e : cells_with_edge(mesh, last_triangle.vertex(0), last_triangle.vertex(1)))
+  for (ElementId e : elements_with_edge(mesh.connectivity(), last_triangle.vertex(0), last_triangle.vertex(1)))
     if (mesh.connectivity().element(e).simplex.same_vertices(last_triangle))
       return EditResult::refused(removing + "triangle " + last_triangle.to_string() + " already exists");
 

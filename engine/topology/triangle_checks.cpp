@@ -5,7 +5,6 @@
 #include <stdexcept>
 
 #include "core/predicates.hpp"
-#include "mesh/traversal.hpp"
 
 namespace snede {
 
@@ -24,22 +23,6 @@ Vector3 normalized(const Vector3& u) {
 }
 
 }  // namespace
-
-std::vector<ElementId> cells_around(const Mesh& mesh, VertexId v) {
-  const Connectivity& c = mesh.connectivity();
-  const ElementId start = c.vertex_element(v);
-  if (start == no_id) return {};
-  std::vector<ElementId> star = vertex_star(c, v, start);
-  if (static_cast<std::int32_t>(star.size()) != c.n_vertex_uses(v)) star = vertex_star(c, v);
-  return star;
-}
-
-std::vector<ElementId> cells_with_edge(const Mesh& mesh, VertexId a, VertexId b) {
-  std::vector<ElementId> sharing;
-  for (ElementId e : cells_around(mesh, a))
-    if (mesh.connectivity().element(e).simplex.contains(b)) sharing.push_back(e);
-  return sharing;
-}
 
 std::array<double, 3> doubled_vector_area(const Mesh& mesh, VertexId a, VertexId b, VertexId c) {
   return cross(difference(mesh.point(b), mesh.point(a)), difference(mesh.point(c), mesh.point(a)));

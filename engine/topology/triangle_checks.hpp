@@ -13,16 +13,6 @@
 
 namespace snede {
 
-// Every cell containing v: the walk from vertex_element(v) when it reaches all of them,
-// otherwise a scan (a vertex whose star is several fans joined only at v).
-std::vector<ElementId> cells_around(const Mesh& mesh, VertexId v);
-
-// The cells having both a and b as vertices (those sharing edge (a, b)).
-std::vector<ElementId> cells_with_edge(const Mesh& mesh, VertexId a, VertexId b);
-
-// True if some cell has both a and b as vertices.
-inline bool has_edge(const Mesh& mesh, VertexId a, VertexId b) { return !cells_with_edge(mesh, a, b).empty(); }
-
 // Twice the vector area of triangle (a, b, c) of a surface, (b − a) × (c − a) (floating point).
 std::array<double, 3> doubled_vector_area(const Mesh& mesh, VertexId a, VertexId b, VertexId c);
 

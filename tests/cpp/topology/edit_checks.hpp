@@ -87,14 +87,6 @@ inline std::vector<VertexId> neighbours(const Mesh& mesh, VertexId v) {
   return {found.begin(), found.end()};
 }
 
-// Elements containing both a and b.
-inline std::vector<ElementId> elements_with_edge(const Mesh& mesh, VertexId a, VertexId b) {
-  std::vector<ElementId> around;
-  for (ElementId e : local_star(mesh.connectivity(), a).elements)
-    if (mesh.connectivity().element(e).simplex.contains(b)) around.push_back(e);
-  return around;
-}
-
 inline bool on_boundary(const Mesh& mesh, VertexId v) {
   for (const auto& entry : mesh.connectivity().boundary())
     if (entry.first.contains(v)) return true;

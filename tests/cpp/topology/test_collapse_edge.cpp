@@ -67,7 +67,7 @@ TEST(CollapseEdge, Figure310InteriorEdgeBetweenBoundaryVerticesIsRefusedIn2D) {
 
 TEST(CollapseEdge, Figure310AnalogueIn3DTheDiagonalOfAKuhnCubeIsRefused) {
   Mesh cube = kuhn_cube(1);  // the main diagonal (0, 7) is interior, its ends are corners
-  ASSERT_EQ(elements_with_edge(cube, 0, 7).size(), 6u);
+  ASSERT_EQ(elements_with_edge(cube.connectivity(), 0, 7).size(), 6u);
   expect_refused(cube, 0, 7, 0.0, "link condition");
   expect_refused(cube, 7, 0, 0.5, "link condition");
   Mesh tetrahedron(3, {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1}, std::vector<std::int64_t>{0, 1, 2, 3});
@@ -151,7 +151,7 @@ TEST(CollapseEdge, InteriorEdgeIn3DRemovesItsRingAndKeepsTheVolume) {
   field.set_on(physics.model, mesh);
   const double energy = physics.energy_density(mesh);
   const VertexId keep = 62, gone = 63;  // (2, 2, 2) and (2, 2, 3)
-  const std::size_t ring = elements_with_edge(mesh, keep, gone).size();
+  const std::size_t ring = elements_with_edge(mesh.connectivity(), keep, gone).size();
   const std::size_t n_cells = mesh.n_cells();
   const EditResult result = collapse_edge(mesh, keep, gone, 0.5);
   ASSERT_TRUE(result.done) << result.reason;

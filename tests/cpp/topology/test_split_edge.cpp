@@ -21,7 +21,7 @@ TEST(SplitEdge, InteriorEdgeOfTheKuhnCubeSplitsItsWholeRingAndKeepsTheVolume) {
   ModelOn physics(mesh);
   const AffineField field(3);
   field.set_on(physics.model, mesh);
-  const std::size_t ring = elements_with_edge(mesh, kuhn_centre, kuhn_x_face).size();
+  const std::size_t ring = elements_with_edge(mesh.connectivity(), kuhn_centre, kuhn_x_face).size();
   ASSERT_GE(ring, 3u);
   const std::size_t n_cells = mesh.n_cells();
   const double t = 0.3;
@@ -30,9 +30,9 @@ TEST(SplitEdge, InteriorEdgeOfTheKuhnCubeSplitsItsWholeRingAndKeepsTheVolume) {
   EXPECT_NO_THROW(mesh.validate());
   EXPECT_EQ(mesh.n_cells(), n_cells + ring);
   EXPECT_NEAR(total_measure(mesh), 1.0, 1e-15);
-  EXPECT_EQ(elements_with_edge(mesh, kuhn_centre, kuhn_x_face).size(), 0u);
-  EXPECT_EQ(elements_with_edge(mesh, kuhn_centre, result.vertex).size(), ring);
-  EXPECT_EQ(elements_with_edge(mesh, result.vertex, kuhn_x_face).size(), ring);
+  EXPECT_EQ(elements_with_edge(mesh.connectivity(), kuhn_centre, kuhn_x_face).size(), 0u);
+  EXPECT_EQ(elements_with_edge(mesh.connectivity(), kuhn_centre, result.vertex).size(), ring);
+  EXPECT_EQ(elements_with_edge(mesh.connectivity(), result.vertex, kuhn_x_face).size(), ring);
   const std::vector<double> expected{(1 - t) * 0.5 + t * 1.0, 0.5, 0.5};
   EXPECT_EQ(coordinates(mesh, result.vertex), expected);
   EXPECT_EQ(mesh.parents(result.vertex).vertex, (std::vector<VertexId>{kuhn_centre, kuhn_x_face}));
@@ -55,7 +55,7 @@ TEST(SplitEdge, InteriorEdgeOfASurfaceSplitsBothTrianglesAndKeepsTheArea) {
   Mesh mesh = bumpy_surface(4, 0.2, 0.0, 1);  // vertex (i, j) is 5i + j
   const double area = total_measure(mesh);
   const VertexId a = 6, b = 12;  // (1, 1)–(2, 2): a diagonal
-  ASSERT_EQ(elements_with_edge(mesh, a, b).size(), 2u);
+  ASSERT_EQ(elements_with_edge(mesh.connectivity(), a, b).size(), 2u);
   const EditResult result = split_edge(mesh, a, b, 0.25);
   ASSERT_TRUE(result.done) << result.reason;
   EXPECT_NO_THROW(mesh.validate());
