@@ -17,11 +17,6 @@ Mesh make_mesh(const DoubleArray& points, const IndexArray& cells) {
   return Mesh(cell_dim, space_dim, std::move(p), std::span<const std::int64_t>(cells.data(), cells.size()));
 }
 
-VertexParents parents_of(const IndexArray& vertices, const DoubleArray& weights) {
-  const std::vector<VertexId> ids = vertex_ids(vertices);
-  return VertexParents::barycentric(ids, view(weights));
-}
-
 py::array_t<bool> live_vertices(const Mesh& mesh) {
   py::array_t<bool> live(mesh.n_points());
   for (VertexId v = 0; v < mesh.n_points(); ++v) live.mutable_at(v) = mesh.is_vertex(v);
@@ -69,6 +64,11 @@ py::tuple components_of(const Mesh& mesh) {
 }
 
 }  // namespace
+
+VertexParents parents_of(const IndexArray& vertices, const DoubleArray& weights) {
+  const std::vector<VertexId> ids = vertex_ids(vertices);
+  return VertexParents::barycentric(ids, view(weights));
+}
 
 std::vector<std::int32_t> vertex_ids(const IndexArray& a) {
   std::vector<std::int32_t> ids(a.size());

@@ -8,6 +8,8 @@
 #include <span>
 #include <vector>
 
+#include "mesh/vertex_parents.hpp"
+
 namespace snede::bindings {
 
 namespace py = pybind11;
@@ -19,12 +21,15 @@ void bind_solve(py::module_& m);
 void bind_dynamics(py::module_& m);
 void bind_io(py::module_& m);
 void bind_topology(py::module_& m);
+void bind_edits(py::module_& m);
 
 using DoubleArray = py::array_t<double, py::array::c_style | py::array::forcecast>;
 using IndexArray = py::array_t<std::int64_t, py::array::c_style | py::array::forcecast>;
 
 // Vertex (or element) ids from an integer array, each checked to fit a 32-bit id.
 std::vector<std::int32_t> vertex_ids(const IndexArray& a);
+// Barycentric parents from vertex ids and their weights (checked by VertexParents).
+VertexParents parents_of(const IndexArray& vertices, const DoubleArray& weights);
 inline std::span<const double> view(const DoubleArray& a) { return {a.data(), static_cast<std::size_t>(a.size())}; }
 
 // A (rows, columns) numpy array holding a copy of `values`.

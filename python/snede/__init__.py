@@ -5,6 +5,7 @@ Importing snede initialises PETSc once, through petsc4py (see ``snede._petsc``).
 from snede._petsc import PETSc  # noqa: F401  (initialises PETSc before the engine loads)
 from snede._snede import (  # noqa: F401
     DomainError,
+    EditResult,
     InvalidMesh,
     LinearElastic,
     NeoHookean,
@@ -22,6 +23,6 @@ from snede import meshing  # noqa: F401
 __all__ = [
     "Mesh", "MeshQuality", "Body", "meshing", "StaticSolver", "DynamicRelaxation", "SolveResult",
     "LinearElastic", "StVenantKirchhoff", "NeoHookean", "VerondaWestmann",
-    "InvalidMesh", "PetscError", "DomainError", "LockingWarning", "PETSc",
+    "EditResult", "InvalidMesh", "PetscError", "DomainError", "LockingWarning", "PETSc",
 ]
 __version__ = "0.1.0"

@@ -8,6 +8,7 @@ from typing import NamedTuple
 import numpy as np
 
 from snede import _snede
+from snede.mesh_edits import MeshEdits
 
 
 class MeshQuality(NamedTuple):
@@ -45,7 +46,7 @@ def _as_cells(cells, space_dim: int) -> np.ndarray:
     return np.ascontiguousarray(array, dtype=np.int64)
 
 
-class Mesh:
+class Mesh(MeshEdits):
     """A simplicial mesh with the connectivity of thesis §7.
 
     ``Mesh(points, cells)``: ``points`` is ``(n_points, space_dim)`` with space_dim 2 or 3
@@ -214,7 +215,7 @@ class Mesh:
         """Move ``vertex`` in the reference configuration, either to ``Σ weights[i]·x[parents[i]]``
         (``parents`` may include ``vertex``; a Body re-interpolates its displacement the same
         way) or to explicit coordinates ``point`` (the displacement is kept). Moving a vertex
-        can invert cells: ``snede.topology.snap_vertex`` refuses that, this does not."""
+        can invert cells: ``snap_vertex`` refuses that, this does not."""
         if (point is None) == (parents is None):
             raise ValueError("give either parents and weights, or point")
         if point is not None:
