@@ -35,6 +35,7 @@ void bind_topology(py::module_& m) {
            py::arg("point"))
       .def("level", [](const Bisection& b, ElementId e) { return b.hierarchy().level(e); }, py::arg("element"))
       .def_property_readonly("n_nodes", [](const Bisection& b) { return b.hierarchy().n_nodes(); })
+      .def_property_readonly("n_forced_splits", &Bisection::n_forced_splits)
       .def("memory_bytes", &Bisection::memory_bytes);
 }
 

@@ -28,7 +28,8 @@ std::size_t Bisection::simple_bisect(VertexId a, VertexId b, const std::vector<E
   std::vector<Simplex> halves;
   halves.reserve(2 * around.size());
   for (ElementId e : around) {
-    const TaggedSimplex& label = hierarchy_.label(e);
+    TaggedSimplex label = hierarchy_.label(e);
+    if (!label.has_refinement_edge(a, b)) label = label.with_refinement_edge(a, b);
     const Simplex& whole = c.element(e).simplex;
     // Substituting one endpoint keeps the orientation, so both halves stay positive.
     halves.push_back(whole.substituted(label.refinement_end(), midpoint));
@@ -63,10 +64,16 @@ std::size_t Bisection::bisect(ElementId element) {
     const bool cycles = std::any_of(pending.begin(), pending.end(), [&](const EdgeToBisect& p) {
       return std::minmax(p.a, p.b) == std::minmax(first.a, first.b);
     });
-    if (cycles || pending.size() >= max_pending)
-      throw std::runtime_error("bisection: bisecting edge (" + std::to_string(first.a) + ", " +
-                               std::to_string(first.b) + ") needs itself first; the mesh's labelling is not "
-                               "compatible (§6.5 assumes a right-triangle or Kuhn mesh)");
+    if (cycles || pending.size() >= max_pending) {
+      // Forced (see bisect's comment): the requested edge itself, now. Forcing an edge higher
+      // up the stack instead can leave the next one cycling again, without end.
+      const EdgeToBisect requested = pending.front();
+      const ElementId holder = live_element_with_edge(requested.node, requested.a, requested.b);
+      n_split += simple_bisect(requested.a, requested.b,
+                               elements_around(mesh_.connectivity(), Simplex(1, {requested.a, requested.b}), holder));
+      ++n_forced_splits_;
+      break;
+    }
     pending.push_back(first);
   }
   return n_split;

@@ -28,8 +28,11 @@ class Bisection {
   // §6.5 bisect(e) for the refinement edge of `element`: every element around that edge
   // whose refinement edge is another one is bisected first (recursively, with an explicit
   // stack), then all elements around the edge are split at its midpoint at once, so no
-  // vertex is ever left hanging. Returns the number of elements split. Throws
-  // std::runtime_error if the labelling makes the recursion cycle (an incompatible mesh).
+  // vertex is ever left hanging. Returns the number of elements split.
+  // When the recursion would cycle — a labelling that is not compatible, as elements made by
+  // other edits (flips, collapses, insertions) get — the requested edge is bisected at once:
+  // every element around it is relabelled to have it as refinement edge. The mesh stays
+  // conforming; only the bound on similarity classes is lost there (n_forced_splits counts).
   std::size_t bisect(ElementId element);
 
   // §6.5 uniform refinement, `levels` times: every element present at the start of a level
@@ -38,6 +41,8 @@ class Bisection {
   std::size_t refine_uniform(int levels);
 
   std::size_t memory_bytes() const { return hierarchy_.memory_bytes(); }
+  // How many edges were bisected against an incompatible labelling (see bisect).
+  std::size_t n_forced_splits() const { return n_forced_splits_; }
 
  private:
   struct EdgeToBisect {
@@ -47,12 +52,13 @@ class Bisection {
   // A live element containing edge (a, b), found below `node` (the edge is in a child of
   // every split that did not bisect it).
   ElementId live_element_with_edge(NodeId node, VertexId a, VertexId b) const;
-  // The simple-bisect of §6.5: `around` is every element containing (a, b), all of which
-  // have (a, b) as refinement edge.
+  // The simple-bisect of §6.5: `around` is every element containing (a, b); those whose
+  // refinement edge is another are relabelled first (a forced split).
   std::size_t simple_bisect(VertexId a, VertexId b, const std::vector<ElementId>& around);
 
   Mesh& mesh_;
   RefinementHierarchy hierarchy_;
+  std::size_t n_forced_splits_ = 0;
 };
 
 }  // namespace snede

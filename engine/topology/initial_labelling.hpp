@@ -7,7 +7,8 @@
 // id). On the Kuhn box of snede.meshing.box ids grow along each cube's path 000→111, so this
 // is Maubach's compatible labelling of the Kuhn split (3 similarity classes). On any other
 // mesh it is the sorted-global-order labelling of Alkämper, Gaspoz and Klöfkorn; Bisection
-// detects at run time when its recursive completion would not terminate.
+// detects at run time when its recursive completion would not terminate and then forces the
+// split (Bisection::bisect).
 #pragma once
 
 #include "mesh/mesh.hpp"

@@ -1,5 +1,7 @@
 #include "topology/tagged_simplex.hpp"
 
+#include <stdexcept>
+
 namespace snede {
 
 bool TaggedSimplex::contains(VertexId v) const {
@@ -11,6 +13,18 @@ bool TaggedSimplex::contains(VertexId v) const {
 bool TaggedSimplex::has_refinement_edge(VertexId a, VertexId b) const {
   const VertexId p = refinement_start(), q = refinement_end();
   return (p == a && q == b) || (p == b && q == a);
+}
+
+TaggedSimplex TaggedSimplex::with_refinement_edge(VertexId a, VertexId b) const {
+  TaggedSimplex t = *this;
+  t.tag = static_cast<std::int8_t>(dim);
+  int k = 1;
+  for (int i = 0; i <= dim; ++i)
+    if (vertex[i] != a && vertex[i] != b) t.vertex[k++] = vertex[i];
+  if (k != dim) throw std::invalid_argument("with_refinement_edge: (a, b) is not an edge of the simplex");
+  t.vertex[0] = a;
+  t.vertex[dim] = b;
+  return t;
 }
 
 std::array<TaggedSimplex, 2> TaggedSimplex::children(VertexId midpoint) const {

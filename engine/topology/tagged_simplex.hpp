@@ -25,6 +25,9 @@ struct TaggedSimplex {
   // have tag k − 1, or d after tag 1. Every d generations the cycle of tags repeats, which is
   // what bounds the number of similarity classes.
   std::array<TaggedSimplex, 2> children(VertexId midpoint) const;
+  // The same simplex relabelled so that (a, b), one of its edges, is the refinement edge:
+  // x0 = a, xd = b, the others in their current order, tag d.
+  TaggedSimplex with_refinement_edge(VertexId a, VertexId b) const;
 };
 
 }  // namespace snede
