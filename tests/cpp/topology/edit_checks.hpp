@@ -39,12 +39,6 @@ struct MeshSnapshot {
   friend bool operator==(const MeshSnapshot&, const MeshSnapshot&) = default;
 };
 
-inline Mesh mesh_from(int cell_dim, int space_dim, std::vector<double> points, const std::vector<std::vector<VertexId>>& cells) {
-  std::vector<std::int64_t> flat;
-  for (const auto& cell : cells) flat.insert(flat.end(), cell.begin(), cell.end());
-  return Mesh(cell_dim, space_dim, std::move(points), flat);
-}
-
 // Sum of cell measures (area, volume; surface area).
 inline double total_measure(const Mesh& mesh) {
   double sum = 0;

@@ -14,10 +14,15 @@
 
 namespace snede::testing {
 
-inline Mesh mesh_of(int dim, std::vector<double> points, const std::vector<std::vector<VertexId>>& cells) {
+// A mesh of cell_dim-simplices in space_dim from nested cell lists (surfaces: 2, 3).
+inline Mesh mesh_from(int cell_dim, int space_dim, std::vector<double> points, const std::vector<std::vector<VertexId>>& cells) {
   std::vector<std::int64_t> flat;
   for (const auto& cell : cells) flat.insert(flat.end(), cell.begin(), cell.end());
-  return Mesh(dim, std::move(points), flat);
+  return Mesh(cell_dim, space_dim, std::move(points), flat);
+}
+
+inline Mesh mesh_of(int dim, std::vector<double> points, const std::vector<std::vector<VertexId>>& cells) {
+  return mesh_from(dim, dim, std::move(points), cells);
 }
 
 // The unit square as n × n squares of two right triangles (the mesh of Figure 6.8).
