@@ -54,6 +54,13 @@ py::object points_vec(const Mesh& mesh) {
   return wrapped;
 }
 
+// The oriented vertices of a live element (its row of `cells`).
+std::vector<VertexId> element_vertices(const Mesh& mesh, ElementId e) {
+  if (!mesh.connectivity().is_element(e)) throw std::invalid_argument("element " + std::to_string(e) + " does not exist");
+  const auto oriented = mesh.connectivity().element(e).simplex.oriented_vertices();
+  return {oriented.begin(), oriented.begin() + mesh.cell_dim() + 1};
+}
+
 std::vector<ElementId> star_of(const Mesh& mesh, VertexId v) { return vertex_star(mesh.connectivity(), v); }
 
 py::tuple components_of(const Mesh& mesh) {
@@ -111,6 +118,9 @@ void bind_mesh(py::module_& m) {
       .def("move_vertex_to", [](Mesh& mesh, VertexId v, const DoubleArray& x) { mesh.move_vertex(v, view(x)); },
            py::arg("vertex"), py::arg("point"))
       .def("remove_vertex", &Mesh::remove_vertex, py::arg("vertex"))
+      .def("element_vertices", &element_vertices, py::arg("element"))
+      .def("begin_batch", [](Mesh& mesh) { mesh.connectivity().begin_batch(); })
+      .def("end_batch", [](Mesh& mesh) { mesh.connectivity().end_batch(); })
       .def("memory_bytes", [](const Mesh& mesh) {
         return mesh.connectivity().memory_bytes() + mesh.points().capacity() * sizeof(double);
       });

@@ -2,6 +2,7 @@
 3D (thesis §7, §5.3)."""
 from __future__ import annotations
 
+import contextlib
 from pathlib import Path
 from typing import NamedTuple
 
@@ -154,6 +155,11 @@ class Mesh(MeshEdits):
         cell; raise ``snede.InvalidMesh`` (a ValueError) describing the first violation."""
         self._impl.validate()
 
+    def element_vertices(self, element: int) -> np.ndarray:
+        """The vertices of the cell with element id ``element`` (stable across edits, unlike
+        row numbers), in its row order of ``cells``."""
+        return np.asarray(self._impl.element_vertices(int(element)), dtype=np.int64)
+
     def star(self, vertex: int) -> np.ndarray:
         """Element ids of all cells containing ``vertex`` (a scan, O(n))."""
         if not 0 <= int(vertex) < self.n_points:
@@ -195,6 +201,17 @@ class Mesh(MeshEdits):
         if faces.dtype.kind not in "iu" or faces.ndim != 2 or faces.shape[1] != self.cell_dim:
             raise ValueError(f"faces must be (n, {self.cell_dim}) integer vertex indices, got {faces.shape} {faces.dtype}")
         return _snede.dissect(self._impl, np.ascontiguousarray(faces, dtype=np.int64))
+
+    @contextlib.contextmanager
+    def batch(self):
+        """``with mesh.batch(): ...edits...``: a Body on the mesh hears of all the edits once, at
+        the end (one reissue of its vectors, fields carried through every step in order),
+        instead of once per edit. Nestable. Bodies must not be used inside the block."""
+        self._impl.begin_batch()
+        try:
+            yield self
+        finally:
+            self._impl.end_batch()
 
     # -- vertex lifecycle ----------------------------------------------------------------
     def _parents(self, parents, weights) -> tuple[np.ndarray, np.ndarray]:
@@ -264,7 +281,6 @@ class Mesh(MeshEdits):
         """Read a mesh with meshio (gmsh .msh, VTK/VTU, XDMF, and every format meshio reads).
         Tetrahedra are taken if present, else triangles: a 2D mesh when every z is 0, otherwise
         a surface mesh in 3D."""
-        import contextlib
         import io
 
         import meshio

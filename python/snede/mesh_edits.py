@@ -49,18 +49,18 @@ class MeshEdits:
         (a, b); ``result.vertex`` is the new vertex. Triangles, surfaces and tetrahedra."""
         return _snede.split_edge(self._impl, self._vertex(a, "a"), self._vertex(b, "b"), _fraction(t, "t"))
 
-    def insert_vertex(self, cell: int, weights) -> EditResult:
+    def insert_vertex(self, element: int, weights) -> EditResult:
         """Insert a vertex at barycentric ``weights`` (cell_dim + 1 numbers ≥ 0 summing to 1,
-        in the order of ``cells[cell]``) inside row ``cell`` of ``cells``, splitting it into 3
-        triangles or 4 tetrahedra; in 3D one zero weight puts it on a face, whose one or two
-        tetrahedra are split. Refused on an edge (use ``split_edge``) or too close to a side."""
-        row = _index(cell, "cell", self.n_cells)
+        in the order of ``element_vertices(element)``) in the cell with element id ``element``
+        (``cell_ids[row]`` for a row of ``cells``; ids, unlike rows, survive edits), splitting it
+        into 3 triangles or 4 tetrahedra; in 3D one zero weight puts it on a face, whose one or
+        two tetrahedra are split. Refused on an edge (use ``split_edge``) or too close to a side."""
+        if isinstance(element, bool) or not isinstance(element, (int, np.integer)):
+            raise ValueError(f"element must be an integer element id, got {element!r}")
         weights = np.ascontiguousarray(weights, dtype=np.float64)
         if weights.shape != (self.cell_dim + 1,):
             raise ValueError(f"weights must have shape ({self.cell_dim + 1},), got {weights.shape}")
-        element = int(self.cell_ids[row])
-        # The engine takes weights in the element's oriented order, which is the row's order.
-        return _snede.insert_vertex(self._impl, element, weights)
+        return _snede.insert_vertex(self._impl, int(element), weights)
 
     def collapse_edge(self, keep: int, gone: int, t: float = 0.0) -> EditResult:
         """Merge ``gone`` into ``keep`` (§3.2.3, Figure 3.10): the cells around the edge

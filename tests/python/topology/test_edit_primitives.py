@@ -81,7 +81,7 @@ def edits_2d(mesh):
     return {
         "flip_edge": (lambda: mesh.flip_edge(a, b), 0),
         "split_edge": (lambda: mesh.split_edge(a, b, 0.3), +2),
-        "insert_vertex": (lambda: mesh.insert_vertex(5, [0.2, 0.3, 0.5]), +2),
+        "insert_vertex": (lambda: mesh.insert_vertex(mesh.cell_ids[5], [0.2, 0.3, 0.5]), +2),
         "collapse_edge": (lambda: mesh.collapse_edge(a, b, 0.5), -2),
         "remove_vertex_by_flips": (lambda: mesh.remove_vertex_by_flips(v), -2),
         "snap_vertex": (lambda: mesh.snap_vertex(v, [v, neighbour], [0.7, 0.3]), 0),
@@ -109,8 +109,10 @@ def test_split_and_insert_report_the_new_vertex_where_its_parents_put_it():
     x_a, x_b = mesh.points[a], mesh.points[b]
     split = mesh.split_edge(a, b, 0.25)
     np.testing.assert_array_equal(mesh.points[split.vertex], 0.75 * x_a + 0.25 * x_b)
-    corners = mesh.cells[3]
-    inserted = mesh.insert_vertex(3, [0.5, 0.25, 0.25])
+    element = mesh.cell_ids[3]
+    corners = mesh.element_vertices(element)
+    np.testing.assert_array_equal(corners, mesh.cells[3])
+    inserted = mesh.insert_vertex(element, [0.5, 0.25, 0.25])
     np.testing.assert_allclose(mesh.points[inserted.vertex], mesh.points[corners].T @ [0.5, 0.25, 0.25], rtol=1e-15)
     assert "vertex=" in repr(inserted)
 
@@ -152,7 +154,7 @@ def test_refusals_say_why_and_change_nothing():
         "boundary": lambda: mesh.flip_edge(0, 1),
         "not an edge": lambda: mesh.split_edge(0, mesh.n_points - 1, 0.5),
         "t": lambda: mesh.split_edge(a, b, 1.0),
-        "edge": lambda: mesh.insert_vertex(0, [0.5, 0.5, 0.0]),
+        "edge": lambda: mesh.insert_vertex(mesh.cell_ids[0], [0.5, 0.5, 0.0]),
         "link": lambda: mesh.collapse_edge(*chord),
         "corner": lambda: mesh.remove_vertex_by_flips(corner),
         "flat|inverted": lambda: mesh.snap_vertex(v, [far], [1.0]),
@@ -178,8 +180,10 @@ def test_bad_arguments_raise_value_errors_naming_the_argument():
         mesh.split_edge(0, 4, float("nan"))
     with pytest.raises(ValueError, match="weights must have shape"):
         mesh.insert_vertex(0, [0.5, 0.5])
-    with pytest.raises(ValueError, match="cell 8 does not exist"):
-        mesh.insert_vertex(8, [0.2, 0.3, 0.5])
+    with pytest.raises(ValueError, match="element 1000 .*(not|dead)"):
+        mesh.insert_vertex(1000, [0.2, 0.3, 0.5])
+    with pytest.raises(ValueError, match="element must be an integer"):
+        mesh.insert_vertex(0.0, [0.2, 0.3, 0.5])
     with pytest.raises(ValueError, match="sum to|barycentric"):
         mesh.insert_vertex(0, [0.5, 0.5, 0.5])
     with pytest.raises(ValueError, match="sum to"):
@@ -197,8 +201,8 @@ def test_tetrahedral_split_insert_collapse_and_snap_keep_volume_and_the_field():
     n = mesh.n_cells
     assert mesh.split_edge(a, b, 0.5)
     assert mesh.n_cells == n + ring
-    assert mesh.insert_vertex(0, [0.1, 0.2, 0.3, 0.4])  # inside a cell: one tet → 4
-    assert mesh.insert_vertex(7, [0.0, 0.3, 0.3, 0.4])  # on a face: its two tets → 3 each
+    assert mesh.insert_vertex(mesh.cell_ids[0], [0.1, 0.2, 0.3, 0.4])  # inside a cell: one tet → 4
+    assert mesh.insert_vertex(mesh.cell_ids[7], [0.0, 0.3, 0.3, 0.4])  # on a face: its two tets → 3 each
     assert mesh.n_cells == n + ring + 3 + 4
     assert_carried_exactly(mesh, body, energy)
     v = interior_vertex(mesh)
@@ -230,7 +234,7 @@ def test_surface_edits_fold_nothing_and_keep_the_area_of_a_cube():
     n = surface.n_cells
     assert surface.split_edge(*next(e for e in edges_of(surface) if np.all(x[list(e), 2] == 0.0)), 0.5)
     assert surface.n_cells == n + 2
-    assert surface.insert_vertex(0, [0.2, 0.3, 0.5])
+    assert surface.insert_vertex(surface.cell_ids[0], [0.2, 0.3, 0.5])
     # The vertex (1/3, 1/3, 0) has a planar star: removing it keeps the area. Removing the
     # cube corner (0, 0, 0) is allowed too (its link can be triangulated without folding) but
     # cuts the corner off: the area shrinks.
@@ -244,3 +248,18 @@ def test_surface_edits_fold_nothing_and_keep_the_area_of_a_cube():
     assert surface.remove_vertex_by_flips(corner)
     surface.validate()
     assert surface.quality().volume.sum() < area - 1e-3
+
+
+def test_a_batch_of_edits_is_one_change_for_the_body():
+    mesh, body = sheet(8)
+    energy = body.energy(body.displacement)
+    generation = body._model.generation
+    with mesh.batch():
+        for element in mesh.cell_ids[::7].tolist():
+            assert mesh.insert_vertex(element, [0.2, 0.3, 0.5])
+        a, b = interior_edge(mesh)
+        assert mesh.split_edge(a, b)
+        assert mesh.remove_vertex_by_flips(interior_vertex(mesh))
+    assert body._model.generation == generation + 1
+    assert_carried_exactly(mesh, body, energy)
+    assert_solve_converges(mesh, body)
