@@ -267,10 +267,8 @@ PetscErrorCode Model::tangent_mult_callback(Mat A, Vec d, Vec out) {
   });
 }
 
-std::vector<double> Model::replayed(std::span<const double> old_values, const ConnectivityChange& change) const {
+void Model::replay(std::span<double> values, const ConnectivityChange& change) const {
   const int d = dim();
-  std::vector<double> values(old_values.begin(), old_values.end());
-  values.resize(body_.n_dofs(), 0.0);
   std::vector<double> x(d);
   for (const VertexEvent& event : change.vertex_events) {
     double* at = values.data() + static_cast<std::size_t>(event.vertex) * d;
@@ -284,7 +282,6 @@ std::vector<double> Model::replayed(std::span<const double> old_values, const Co
         x[k] += event.parents.weight[i] * values[static_cast<std::size_t>(event.parents.vertex[i]) * d + k];
     std::copy(x.begin(), x.end(), at);
   }
-  return values;
 }
 
 void Model::on_change(const Connectivity&, const ConnectivityChange& change) {
@@ -304,17 +301,23 @@ void Model::on_change(const Connectivity&, const ConnectivityChange& change) {
   }
   std::vector<Vec*> fields{&u_};
   fields.insert(fields.end(), carried_fields_.begin(), carried_fields_.end());
-  std::vector<std::vector<double>> values;
-  for (Vec* field : fields) values.push_back(replayed(vec_values(*field), change));
-  if (n_new != n_points_) {
-    for (Vec* field : fields) VecDestroy(field);
-    VecDestroy(&u_linearization_);
-    MatDestroy(&tangent_);
-    n_points_ = n_new;
-    create_vectors();
-    for (std::size_t i = 1; i < fields.size(); ++i) SNEDE_PETSC(VecDuplicate(u_, fields[i]));
-    ++generation_;
+  if (n_new == n_points_) {  // same rows (moves, removals, reused ids): in place, O(events)
+    for (Vec* field : fields) replay(WriteView(*field).span(), change);
+    return;
   }
+  std::vector<std::vector<double>> values;
+  for (Vec* field : fields) {
+    std::vector<double>& v = values.emplace_back(vec_values(*field));
+    v.resize(body_.n_dofs(), 0.0);
+    replay(v, change);
+  }
+  for (Vec* field : fields) VecDestroy(field);
+  VecDestroy(&u_linearization_);
+  MatDestroy(&tangent_);
+  n_points_ = n_new;
+  create_vectors();
+  for (std::size_t i = 1; i < fields.size(); ++i) SNEDE_PETSC(VecDuplicate(u_, fields[i]));
+  ++generation_;
   for (std::size_t i = 0; i < fields.size(); ++i) set_vec_values(*fields[i], values[i]);
 }
 

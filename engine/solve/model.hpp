@@ -95,8 +95,9 @@ class Model : public ConnectivityWatcher {
   void tangent_mult(Vec d, Vec out);
   static PetscErrorCode tangent_mult_callback(Mat A, Vec d, Vec out);
 
-  // The vertex events of `change` applied to one nodal field, sized for `n_points` rows.
-  std::vector<double> replayed(std::span<const double> old_values, const ConnectivityChange& change) const;
+  // The vertex events of `change` applied, in order, to one nodal field already sized for the
+  // mesh's rows.
+  void replay(std::span<double> values, const ConnectivityChange& change) const;
   std::vector<double>& channel(const std::string& name);
 
   ElasticBody& body_;
