@@ -28,6 +28,15 @@ std::unique_ptr<StaticSolver> make_static_solver(Model& model, const std::string
                                                  const std::string& criterion, double round_tolerance,
                                                  int max_iterations, const std::string& prefix,
                                                  const OptionList& petsc_options) {
+  return std::make_unique<StaticSolver>(
+      model, static_options(method, rtol, criterion, round_tolerance, max_iterations, prefix, petsc_options));
+}
+
+}  // namespace
+
+StaticOptions static_options(const std::string& method, double rtol, const std::string& criterion,
+                             double round_tolerance, int max_iterations, const std::string& prefix,
+                             const OptionList& petsc_options) {
   StaticOptions options;
   if (method == "cg") options.method = StaticMethod::linear_cg;
   else if (method == "ncg") options.method = StaticMethod::nonlinear_cg;
@@ -41,10 +50,8 @@ std::unique_ptr<StaticSolver> make_static_solver(Model& model, const std::string
   options.max_iterations = max_iterations;
   options.options_prefix = prefix;
   options.petsc_options = petsc_options;
-  return std::make_unique<StaticSolver>(model, options);
+  return options;
 }
-
-}  // namespace
 
 void bind_solve(py::module_& m) {
   py::class_<SolveResult>(m, "EngineSolveResult")

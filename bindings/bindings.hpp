@@ -8,7 +8,9 @@
 #include <span>
 #include <vector>
 
+#include "core/solver_options.hpp"
 #include "mesh/vertex_parents.hpp"
+#include "solve/static_solver.hpp"
 
 namespace snede::bindings {
 
@@ -22,6 +24,7 @@ void bind_dynamics(py::module_& m);
 void bind_io(py::module_& m);
 void bind_topology(py::module_& m);
 void bind_edits(py::module_& m);
+void bind_needle(py::module_& m);
 
 using DoubleArray = py::array_t<double, py::array::c_style | py::array::forcecast>;
 using IndexArray = py::array_t<std::int64_t, py::array::c_style | py::array::forcecast>;
@@ -30,6 +33,10 @@ using IndexArray = py::array_t<std::int64_t, py::array::c_style | py::array::for
 std::vector<std::int32_t> vertex_ids(const IndexArray& a);
 // Barycentric parents from vertex ids and their weights (checked by VertexParents).
 VertexParents parents_of(const IndexArray& vertices, const DoubleArray& weights);
+// A static solver's options from the Python arguments; std::invalid_argument names a bad one.
+StaticOptions static_options(const std::string& method, double rtol, const std::string& criterion,
+                             double round_tolerance, int max_iterations, const std::string& prefix,
+                             const OptionList& petsc_options);
 inline std::span<const double> view(const DoubleArray& a) { return {a.data(), static_cast<std::size_t>(a.size())}; }
 
 // A (rows, columns) numpy array holding a copy of `values`.

@@ -14,4 +14,5 @@ PYBIND11_MODULE(_snede, m) {
   snede::bindings::bind_io(m);
   snede::bindings::bind_topology(m);
   snede::bindings::bind_edits(m);
+  snede::bindings::bind_needle(m);
 }

@@ -194,17 +194,23 @@ void Model::residual(Vec u, Vec F, EvaluationReport& report) {
   for (std::size_t i = 0; i < offset.size(); ++i) r.span()[i] += offset[i] - held[i];
 }
 
-void Model::reaction_forces(Vec u, Vec R) {
+std::vector<double> Model::potential_gradient(Vec u) {
   EvaluationReport report;
+  std::vector<double> g(body_.n_dofs());
   {
     ReadView x(u);
-    WriteView r(R);
-    body_.internal_forces(x.span(), r.span(), report);
-    const std::vector<double>& f = external_forces();
-    for (std::size_t i = 0; i < f.size(); ++i) r.span()[i] = -r.span()[i] - f[i];
-    constraints_.project_complement(r.span());
+    body_.internal_forces(x.span(), g, report);
   }
   throw_if_domain_error(report);
+  const std::vector<double>& f = external_forces();
+  for (std::size_t i = 0; i < f.size(); ++i) g[i] = -g[i] - f[i];
+  return g;
+}
+
+void Model::reaction_forces(Vec u, Vec R) {
+  std::vector<double> g = potential_gradient(u);
+  constraints_.project_complement(g);
+  set_vec_values(R, g);
 }
 
 void Model::enforce_constraints(Vec u) const {

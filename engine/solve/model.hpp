@@ -79,6 +79,9 @@ class Model : public ConnectivityWatcher {
   void residual(Vec u, Vec F, EvaluationReport& report);
   // Reaction forces (I − P)∇Π(u): what the supports exert on the body.
   void reaction_forces(Vec u, Vec R);
+  // ∇Π(u) = −f_int(u) − f_ext, unprojected, (n_points, dim) flattened: at a constrained vertex
+  // in equilibrium, the force its support exerts on the body.
+  std::vector<double> potential_gradient(Vec u);
   // u ← P u + (I − P) anchor.
   void enforce_constraints(Vec u) const;
   double last_reaction_norm() const { return last_reaction_norm_; }

@@ -18,10 +18,12 @@ from snede.body import Body, LockingWarning  # noqa: F401
 from snede.result import SolveResult  # noqa: F401
 from snede.static import StaticSolver  # noqa: F401
 from snede.dynamics import DynamicRelaxation  # noqa: F401
+from snede.needle import FrictionProfile, NeedleInsertion  # noqa: F401
 from snede import meshing  # noqa: F401
 
 __all__ = [
     "Mesh", "MeshQuality", "Body", "meshing", "StaticSolver", "DynamicRelaxation", "SolveResult",
+    "FrictionProfile", "NeedleInsertion",
     "LinearElastic", "StVenantKirchhoff", "NeoHookean", "VerondaWestmann",
     "EditResult", "InvalidMesh", "PetscError", "DomainError", "LockingWarning", "PETSc",
 ]

@@ -1,0 +1,252 @@
+"""Needle insertion with stick-slip friction and adaptive bisection (§6.3–§6.7), 2D.
+
+A rigid straight needle enters a plane-stress body at ``entry`` along ``direction``. Nodes the
+tip passes (the end of each crossed edge closest to the shaft, §6.4) become needle nodes that
+stick to the needle or slip along it against dynamic friction; after every move the solution
+is relaxed and the needle nodes rearranged until no node changes state (§6.3.2, §6.7).
+
+    profile = snede.FrictionProfile.figure_6_4()
+    needle = snede.NeedleInsertion(body, entry=(0.0, 0.05), direction=(1.0, 0.0), friction=profile,
+                                   h_ref=0.1 / 2**6)
+    step = needle.advance(0.001)              # one update: NeedleStepReport
+    report = needle.insert(depth=0.07, step=0.001)   # InsertionReport
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from snede import _snede
+from snede._petsc import option_list
+
+
+class FrictionProfile:
+    """Friction force per unit shaft length (N/m; for a plane-stress sheet, across its whole
+    thickness) as a function of the distance from the tip along the shaft, in deformed
+    coordinates (Figure 6.4). Piecewise linear through ``(distance_from_tip, force_per_length)``
+    (distances increasing from 0), constant beyond the last sample."""
+
+    def __init__(self, distance_from_tip, force_per_length):
+        d = np.asarray(distance_from_tip, dtype=np.float64).ravel()
+        f = np.asarray(force_per_length, dtype=np.float64).ravel()
+        self._impl = _snede.FrictionProfile(list(d), list(f))
+
+    @classmethod
+    def uniform(cls, force_per_length: float) -> "FrictionProfile":
+        """The same force per length all along the shaft."""
+        return cls([0.0], [force_per_length])
+
+    @classmethod
+    def figure_6_4(cls, scale: float = 1.0) -> "FrictionProfile":
+        """A stand-in with the shape of Figure 6.4, which gives no numbers: a bulge at the tip
+        (the force needed to cut into the material) of 60 N/m over the first 5 mm, falling to a
+        plateau of 20 N/m of shaft friction from 10 mm on. ``scale`` multiplies it."""
+        return cls([0.0, 0.002, 0.005, 0.010], [scale * 40.0, scale * 60.0, scale * 45.0, scale * 20.0])
+
+    def __call__(self, distance):
+        """Force per length at the given distances from the tip."""
+        return np.vectorize(self._impl.at)(np.asarray(distance, dtype=np.float64))
+
+    def integral(self, a: float, b: float) -> float:
+        """∫ from a to b (distances from the tip, 0 ≤ a ≤ b) of the profile (N)."""
+        return self._impl.integral(float(a), float(b))
+
+    @property
+    def distances(self) -> np.ndarray:
+        return np.asarray(self._impl.distances)
+
+    @property
+    def force_per_length(self) -> np.ndarray:
+        return np.asarray(self._impl.force_per_length)
+
+    def __repr__(self) -> str:
+        return f"FrictionProfile(distance_from_tip={self.distances.tolist()}, force_per_length={self.force_per_length.tolist()})"
+
+
+@dataclass
+class NeedleStepReport:
+    """One update (§6.7). ``rearrangements`` counts the solves (each followed by a
+    rearrangement of the needle nodes); ``slipped``/``stuck``/``released``/``intercepted``
+    count node state changes; ``converged`` is False if a solve did not converge (``reason``
+    ``SOLVE_<PETSc reason>``) or the rearrangements did not settle
+    (``DIVERGED_REARRANGEMENT_LIMIT``)."""
+
+    rearrangements: int
+    solver_iterations: int
+    max_solver_iterations: int
+    slipped: int
+    stuck: int
+    released: int
+    intercepted: int
+    cells_split: int
+    converged: bool
+    reason: str
+    seconds: float
+
+    @classmethod
+    def _from_engine(cls, r) -> "NeedleStepReport":
+        return cls(**{name: getattr(r, name) for name in cls.__dataclass_fields__})
+
+
+@dataclass
+class InsertionReport:
+    """A whole insertion: ``updates`` needle moves, ``rearrangements`` solves in all,
+    ``update_rate`` = rearrangements per second (Table 6.5's "updates [Hz]"), CG (or Newton's
+    inner CG) iterations per solve on average and at most. ``converged`` is False if any
+    update was not; ``reason`` is the first failure's."""
+
+    updates: int
+    rearrangements: int
+    seconds: float
+    update_rate: float
+    mean_iterations: float
+    max_iterations: int
+    converged: bool
+    reason: str
+    steps: list
+
+    def __str__(self) -> str:
+        state = "converged" if self.converged else f"NOT converged ({self.reason})"
+        return (f"{self.updates} updates, {self.rearrangements} rearrangements in {self.seconds:.3f} s "
+                f"({self.update_rate:.0f} Hz), CG iterations {self.mean_iterations:.2f} mean / {self.max_iterations} max; {state}")
+
+
+class NeedleInsertion:
+    """``NeedleInsertion(body, entry, direction, friction, *, static_factor=2.0, h_ref=None,
+    method="cg", rtol=1e-3)`` on a 2D (plane-stress) ``snede.Body`` of any material.
+
+    * ``entry``, ``direction``: the needle's line (2 components each, metres); the tip starts
+      at ``entry`` (depth 0) and moves along ``direction`` (normalised). The line must meet the
+      body. Points are in deformed coordinates: the needle is an object in space.
+    * ``friction``: a :class:`FrictionProfile`; the dynamic threshold of a node is the profile
+      integrated over its share of the shaft (half-way to its neighbours along the shaft,
+      within the body); the static threshold is ``static_factor`` times it.
+    * ``h_ref``: refine by bisection (§6.5) around the tip to this edge length after every move.
+    * ``method``, ``rtol``, ``criterion``, ``petsc_options``, ``options_prefix`` (default
+      ``needle_``): the static solver (see :class:`snede.StaticSolver`); stopping (6.9).
+    * ``max_rearrangements``: per update; reaching it is reported, not hidden.
+
+    The body must be held (``body.fix``) as for any static solve. Needle nodes are taken only
+    from vertices the user has not constrained.
+    """
+
+    def __init__(self, body, entry, direction, friction: FrictionProfile, *, static_factor: float = 2.0,
+                 h_ref: float | None = None, method: str = "cg", rtol: float = 1e-3, criterion: str = "6.9",
+                 round_tolerance: float = 1e-8, max_iterations: int = 10000, max_rearrangements: int = 200,
+                 options_prefix: str = "needle_", petsc_options: dict | None = None):
+        if body.mesh.dim != 2 or body.mesh.is_surface:
+            raise ValueError(f"needle insertion needs a 2D plane-stress body; this body's mesh is {body.mesh.dim}-D")
+        if not isinstance(friction, FrictionProfile):
+            raise TypeError(f"friction must be a snede.FrictionProfile, got {type(friction).__name__}")
+        if not (rtol > 0):
+            raise ValueError(f"rtol must be positive, got {rtol}")
+        self.body = body
+        self.friction_profile = friction
+        bisection = body.mesh._bisection() if h_ref is not None else None
+        self._impl = _snede.NeedleInsertion(
+            body._model, bisection, np.asarray(entry, dtype=np.float64), np.asarray(direction, dtype=np.float64),
+            friction._impl, float(static_factor), None if h_ref is None else float(h_ref), int(max_rearrangements),
+            method, float(rtol), criterion, float(round_tolerance), int(max_iterations), options_prefix,
+            option_list(petsc_options))
+
+    def advance(self, distance: float) -> NeedleStepReport:
+        """Move the needle ``distance`` (≥ 0) further in and relax (one update of §6.7)."""
+        if not (np.isfinite(distance) and distance >= 0):
+            raise ValueError(f"the needle advances by a non-negative, finite distance; got {distance}")
+        return NeedleStepReport._from_engine(self._impl.advance(float(distance)))
+
+    def settle(self) -> NeedleStepReport:
+        """Relax and rearrange without moving the needle."""
+        return NeedleStepReport._from_engine(self._impl.settle())
+
+    def insert(self, depth: float, step: float, progress=None) -> InsertionReport:
+        """Advance in steps of ``step`` until the tip is ``depth`` from the entry point (the last
+        step shortened to land on it). ``progress(done, total, step_report)`` is called after
+        each update."""
+        if not (np.isfinite(step) and step > 0):
+            raise ValueError(f"step must be positive and finite, got {step}")
+        if not (np.isfinite(depth) and depth >= self.depth):
+            raise ValueError(f"depth must be finite and at least the current depth {self.depth}, got {depth}")
+        n_steps = int(np.ceil((depth - self.depth) / step - 1e-9))
+        steps = []
+        for k in range(n_steps):
+            distance = min(step, depth - self.depth)
+            steps.append(self.advance(distance))
+            if progress is not None:
+                progress(k + 1, n_steps, steps[-1])
+        return summarize(steps)
+
+    @property
+    def depth(self) -> float:
+        return self._impl.depth
+
+    @property
+    def tip(self) -> np.ndarray:
+        return np.asarray(self._impl.tip)
+
+    @property
+    def entry(self) -> np.ndarray:
+        return np.asarray(self._impl.entry)
+
+    @property
+    def direction(self) -> np.ndarray:
+        return np.asarray(self._impl.direction)
+
+    @property
+    def needle_nodes(self) -> np.ndarray:
+        """Vertex ids of the needle nodes."""
+        return np.asarray(self._impl.needle_nodes, dtype=np.int64)
+
+    @property
+    def sticking(self) -> np.ndarray:
+        """True per needle node that sticks (False: slips)."""
+        return np.asarray(self._impl.sticking, dtype=bool)
+
+    @property
+    def d_perp(self) -> np.ndarray:
+        """Each needle node's offset from the shaft (held while the needle moves), metres."""
+        return self._impl.d_perp
+
+    @property
+    def d_needle(self) -> np.ndarray:
+        """Each needle node's position along the shaft from the entry point (deformed)."""
+        return self._impl.d_needle
+
+    @property
+    def dynamic_thresholds(self) -> np.ndarray:
+        return self._impl.dynamic_thresholds
+
+    @property
+    def static_thresholds(self) -> np.ndarray:
+        return self._impl.static_thresholds
+
+    @property
+    def friction(self) -> np.ndarray:
+        """Friction force along the shaft on each slipping node (0 for sticking ones)."""
+        return self._impl.friction
+
+    def needle_forces(self) -> np.ndarray:
+        """Forces the needle exerts on the body at its needle nodes (support plus friction),
+        (n_needle_nodes, 2)."""
+        return self._impl.needle_forces()
+
+    def node_state(self) -> np.ndarray:
+        """Per mesh vertex: 0 not a needle node, 1 sticking, 2 slipping (a point field for output)."""
+        state = np.zeros(self.body.mesh.n_points, dtype=np.float64)
+        state[self.needle_nodes] = np.where(self.sticking, 1.0, 2.0)
+        return state
+
+
+def summarize(steps: list) -> InsertionReport:
+    """An InsertionReport over NeedleStepReports."""
+    rearrangements = sum(s.rearrangements for s in steps)
+    seconds = sum(s.seconds for s in steps)
+    iterations = sum(s.solver_iterations for s in steps)
+    failed = [s for s in steps if not s.converged]
+    return InsertionReport(
+        updates=len(steps), rearrangements=rearrangements, seconds=seconds,
+        update_rate=rearrangements / seconds if seconds > 0 else float("inf"),
+        mean_iterations=iterations / rearrangements if rearrangements else 0.0,
+        max_iterations=max((s.max_solver_iterations for s in steps), default=0),
+        converged=not failed, reason=failed[0].reason if failed else "CONVERGED", steps=steps)
