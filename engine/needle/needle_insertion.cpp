@@ -80,6 +80,12 @@ NeedleStepReport NeedleInsertion::advance(double distance) {
     throw std::invalid_argument("the needle advances by a non-negative, finite distance; got " +
                                 std::to_string(distance));
   const double start = wall_seconds();
+  NeedleStepReport report = advance_in_steps(distance, 0);
+  report.seconds = wall_seconds() - start;
+  return report;
+}
+
+void NeedleInsertion::move_needle(double distance) {
   depth_ += distance;
   // Sticking nodes move with the needle: their prescribed displacement follows it (§6.7).
   std::vector<VertexId> moved;
@@ -92,19 +98,46 @@ NeedleStepReport NeedleInsertion::advance(double distance) {
     anchors.push_back(c.anchor[1] + distance * direction_[1]);
   }
   if (!moved.empty()) model_.fix(moved, anchors);
+}
+
+NeedleStepReport NeedleInsertion::advance_in_steps(double distance, int halvings) {
+  move_needle(distance);
+  // A move that drags sticking nodes across their neighbours would start the solve from
+  // inverted elements, which a material forbidding inversion cannot relax: move in halves.
+  if (distance > 0 && halvings < max_halvings && !model_.admissible(model_.displacement())) {
+    move_needle(-distance);
+    NeedleStepReport first = advance_in_steps(0.5 * distance, halvings + 1);
+    if (!first.converged) return first;
+    return merged(first, advance_in_steps(0.5 * distance, halvings + 1));
+  }
   NeedleStepReport report;
   const std::size_t cells_before = model_.body().mesh().n_cells();
   refine_at_tip();
   report.cells_split = static_cast<int>(model_.body().mesh().n_cells() - cells_before);
   report.intercepted = intercept_nodes();
-  return solve_and_rearrange(report, start);
+  return solve_and_rearrange(report);
+}
+
+NeedleStepReport NeedleInsertion::merged(const NeedleStepReport& a, const NeedleStepReport& b) {
+  NeedleStepReport m = b;
+  m.rearrangements += a.rearrangements;
+  m.slipped += a.slipped;
+  m.stuck += a.stuck;
+  m.released += a.released;
+  m.intercepted += a.intercepted;
+  m.cells_split += a.cells_split;
+  m.solver_iterations += a.solver_iterations;
+  m.max_solver_iterations = std::max(a.max_solver_iterations, b.max_solver_iterations);
+  return m;
 }
 
 NeedleStepReport NeedleInsertion::settle() {
   const double start = wall_seconds();
   NeedleStepReport report;
   report.intercepted = intercept_nodes();
-  return solve_and_rearrange(report, start);
+  report = solve_and_rearrange(report);
+  report.seconds = wall_seconds() - start;
+  return report;
 }
 
 void NeedleInsertion::refine_at_tip() {
@@ -184,11 +217,14 @@ void NeedleInsertion::release(std::size_t index) {
 int NeedleInsertion::update_thresholds() {
   const std::vector<double> u = vec_values(model_.displacement());
   int released = 0;
+  for (NeedleNode& node : nodes_) node.d_needle = along(deformed_position(node.vertex, u));
+  // The node at the entry hovers about s = 0; one pulled back further than the mean spacing
+  // of needle nodes has left the body's part of the shaft.
+  const double spacing = nodes_.empty() ? 0.0 : (depth_ - std::min(body_entry_, depth_)) / static_cast<double>(nodes_.size());
   for (std::size_t i = nodes_.size(); i-- > 0;) {
-    NeedleNode& node = nodes_[i];
-    node.d_needle = along(deformed_position(node.vertex, u));
-    // Slid past the tip, or out of the body in front of the entry point: off the needle.
-    if (node.d_needle > depth_ || node.d_needle < 0) {
+    const NeedleNode& node = nodes_[i];
+    // Slid past the tip, or out of the body behind the entry point: off the needle.
+    if (node.d_needle > depth_ || node.d_needle < -spacing) {
       release(i);
       ++released;
     }
@@ -258,7 +294,7 @@ int NeedleInsertion::rearrange(NeedleStepReport& report) {
   return changes;
 }
 
-NeedleStepReport NeedleInsertion::solve_and_rearrange(NeedleStepReport report, double start_seconds) {
+NeedleStepReport NeedleInsertion::solve_and_rearrange(NeedleStepReport report) {
   report.released += update_thresholds();
   for (;;) {
     apply_friction();
@@ -280,7 +316,6 @@ NeedleStepReport NeedleInsertion::solve_and_rearrange(NeedleStepReport report, d
       break;
     }
   }
-  report.seconds = wall_seconds() - start_seconds;
   return report;
 }
 

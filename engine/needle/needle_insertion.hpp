@@ -10,12 +10,14 @@
 // share of the shaft (half-way to its neighbours along the shaft, clipped to the part inside
 // the body); the static threshold is static_factor times the dynamic one.
 //
-// One update (advance) is the interaction loop of §6.7: move the needle, refine to h_ref
+// One update (advance) is the interaction loop of §6.7: move the needle (in halves where the
+// move would invert elements of a material that forbids it), refine to h_ref
 // around the tip (§6.5, one batched change), add intercepted nodes, then solve and rearrange
 // (§6.3.2) until no node changes state: a sticking node whose reaction along the shaft
 // exceeds its static threshold slips; a slipping node whose elastic force along the shaft
 // has fallen below its dynamic threshold (by more than the solver's tolerance) sticks where
-// it is; nodes that slid past the tip or out of the body are released.
+// it is; nodes that slid past the tip, or back out of the body behind the entry point by more
+// than the mean spacing of needle nodes, are released.
 //
 // It watches the mesh: a vertex added by refinement between needle nodes joins the needle.
 #pragma once
@@ -107,7 +109,14 @@ class NeedleInsertion : public ConnectivityWatcher {
   void apply_friction();
   // One rearrangement pass after a solve: the number of nodes whose state changed.
   int rearrange(NeedleStepReport& report);
-  NeedleStepReport solve_and_rearrange(NeedleStepReport report, double start_seconds);
+  NeedleStepReport solve_and_rearrange(NeedleStepReport report);
+  // Shifts the depth and the sticking nodes' prescribed displacements.
+  void move_needle(double distance);
+  // advance without timing; halves the move (up to max_halvings times) where it would start
+  // the solve from inverted elements.
+  NeedleStepReport advance_in_steps(double distance, int halvings);
+  static NeedleStepReport merged(const NeedleStepReport& first, const NeedleStepReport& second);
+  static constexpr int max_halvings = 12;
   void release(std::size_t index);
   void add_node(NeedleNode node);
 
