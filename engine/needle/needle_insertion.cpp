@@ -36,6 +36,9 @@ NeedleInsertion::NeedleInsertion(Model& model, Bisection* bisection, const Point
   if (!(options_.static_factor >= 1.0) || !std::isfinite(options_.static_factor))
     throw std::invalid_argument("static_factor must be at least 1 (static friction ≥ dynamic), got " +
                                 std::to_string(options_.static_factor));
+  if (options_.solves_per_update < 0)
+    throw std::invalid_argument("solves_per_update must be 0 (until settled) or positive, got " +
+                                std::to_string(options_.solves_per_update));
   if (options_.max_rearrangements < 1)
     throw std::invalid_argument("max_rearrangements must be at least 1, got " +
                                 std::to_string(options_.max_rearrangements));
@@ -128,6 +131,7 @@ NeedleStepReport NeedleInsertion::merged(const NeedleStepReport& a, const Needle
   m.cells_split += a.cells_split;
   m.solver_iterations += a.solver_iterations;
   m.max_solver_iterations = std::max(a.max_solver_iterations, b.max_solver_iterations);
+  m.settled = b.settled;
   return m;
 }
 
@@ -309,7 +313,12 @@ NeedleStepReport NeedleInsertion::solve_and_rearrange(NeedleStepReport report) {
       break;
     }
     if (rearrange(report) == 0) break;
+    if (options_.solves_per_update > 0 && report.rearrangements >= options_.solves_per_update) {
+      report.settled = false;  // the next update solves with the new arrangement
+      break;
+    }
     if (report.rearrangements >= options_.max_rearrangements) {
+      report.settled = false;
       apply_friction();
       report.converged = false;
       report.reason = "DIVERGED_REARRANGEMENT_LIMIT";

@@ -50,6 +50,9 @@ struct NeedleOptions {
   double static_factor = 2.0;
   std::optional<double> h_ref;  // refine around the tip down to this edge length
   int max_rearrangements = 200; // per update; exceeding it is reported, not hidden
+  // The thesis's haptic loop (§6.7): at most this many solves per update (0: until settled);
+  // rearrangements still pending are carried into the next update, which is not a failure.
+  int solves_per_update = 0;
   std::string friction_channel = "friction";
 };
 
@@ -60,6 +63,7 @@ struct NeedleStepReport {
   int solver_iterations = 0;     // total over the solves
   int max_solver_iterations = 0;
   bool converged = true;         // every solve converged and the rearrangements settled
+  bool settled = true;           // no needle node changes state at the final solution
   std::string reason = "CONVERGED";
   double seconds = 0;
 };

@@ -123,10 +123,7 @@ void StaticSolver::reissue_sizes_if_mesh_changed() {
 }
 
 double StaticSolver::current_tolerance() const {
-  StoppingRule rule = options_.stopping;
-  rule.force_scale = model_.force_scale();
-  rule.n_dofs = static_cast<double>(model_.n_dofs());
-  return rule.tolerance(external_norm_, ksp_ ? reaction_norm_ : model_.last_reaction_norm());
+  return rule_.tolerance(external_norm_, ksp_ ? reaction_norm_ : model_.last_reaction_norm());
 }
 
 SolveResult StaticSolver::solve() {
@@ -136,6 +133,10 @@ SolveResult StaticSolver::solve() {
   double sum = 0;
   for (double x : f) sum += x * x;
   external_norm_ = std::sqrt(sum);
+  // The force scale is a scan of the mesh: once per solve, not once per iteration.
+  rule_ = options_.stopping;
+  rule_.force_scale = model_.force_scale();
+  rule_.n_dofs = static_cast<double>(model_.n_dofs());
   model_.enforce_constraints(model_.displacement());
   // A free body has rigid motions: the static problem has no unique solution.
   const std::size_t rigid_modes = model_.dim() == 3 ? 6 : 3;

@@ -67,6 +67,7 @@ class StaticSolver {
   SNES snes_ = nullptr;  // nonlinear methods only
   Vec residual_ = nullptr;
   std::uint64_t generation_ = 0;
+  StoppingRule rule_;  // the stopping rule of the current solve, scaled to the model
   double external_norm_ = 0;
   double reaction_norm_ = 0;  // reactions used by the KSP test (at the start of a linear solve)
   std::vector<double> history_;

@@ -69,8 +69,10 @@ class NeedleStepReport:
     """One update (§6.7). ``rearrangements`` counts the solves (each followed by a
     rearrangement of the needle nodes); ``slipped``/``stuck``/``released``/``intercepted``
     count node state changes; ``converged`` is False if a solve did not converge (``reason``
-    ``SOLVE_<PETSc reason>``) or the rearrangements did not settle
-    (``DIVERGED_REARRANGEMENT_LIMIT``)."""
+    ``SOLVE_<PETSc reason>``) or the rearrangements did not settle within
+    ``max_rearrangements`` (``DIVERGED_REARRANGEMENT_LIMIT``). ``settled`` is False when node
+    states still had to change at the end (with ``solves_per_update``, carried into the next
+    update)."""
 
     rearrangements: int
     solver_iterations: int
@@ -81,6 +83,7 @@ class NeedleStepReport:
     intercepted: int
     cells_split: int
     converged: bool
+    settled: bool
     reason: str
     seconds: float
 
@@ -126,6 +129,10 @@ class NeedleInsertion:
     * ``method``, ``rtol``, ``criterion``, ``petsc_options``, ``options_prefix`` (default
       ``needle_``): the static solver (see :class:`snede.StaticSolver`); stopping (6.9).
     * ``max_rearrangements``: per update; reaching it is reported, not hidden.
+    * ``solves_per_update``: None (default) relaxes and rearranges until no node changes state
+      in every update; an integer k allows at most k solves per update and carries pending
+      rearrangements into the next one — the thesis's haptic loop (§6.7, Table 6.5) is k = 1,
+      which bounds the work per update.
 
     The body must be held (``body.fix``) as for any static solve. Needle nodes are taken only
     from vertices the user has not constrained.
@@ -134,7 +141,7 @@ class NeedleInsertion:
     def __init__(self, body, entry, direction, friction: FrictionProfile, *, static_factor: float = 2.0,
                  h_ref: float | None = None, method: str = "cg", rtol: float = 1e-3, criterion: str = "6.9",
                  round_tolerance: float = 1e-8, max_iterations: int = 10000, max_rearrangements: int = 200,
-                 options_prefix: str = "needle_", petsc_options: dict | None = None):
+                 solves_per_update: int | None = None, options_prefix: str = "needle_", petsc_options: dict | None = None):
         if body.mesh.dim != 2 or body.mesh.is_surface:
             raise ValueError(f"needle insertion needs a 2D plane-stress body; this body's mesh is {body.mesh.dim}-D")
         if not isinstance(friction, FrictionProfile):
@@ -147,7 +154,7 @@ class NeedleInsertion:
         self._impl = _snede.NeedleInsertion(
             body._model, bisection, np.asarray(entry, dtype=np.float64), np.asarray(direction, dtype=np.float64),
             friction._impl, float(static_factor), None if h_ref is None else float(h_ref), int(max_rearrangements),
-            method, float(rtol), criterion, float(round_tolerance), int(max_iterations), options_prefix,
+            int(solves_per_update or 0), method, float(rtol), criterion, float(round_tolerance), int(max_iterations), options_prefix,
             option_list(petsc_options))
 
     def advance(self, distance: float) -> NeedleStepReport:
@@ -162,8 +169,9 @@ class NeedleInsertion:
 
     def insert(self, depth: float, step: float, progress=None) -> InsertionReport:
         """Advance in steps of ``step`` until the tip is ``depth`` from the entry point (the last
-        step shortened to land on it). ``progress(done, total, step_report)`` is called after
-        each update."""
+        step shortened to land on it), then, with ``solves_per_update``, keep updating in place
+        until no node changes state (as the thesis's automated insertion does).
+        ``progress(done, total, step_report)`` is called after each update."""
         if not (np.isfinite(step) and step > 0):
             raise ValueError(f"step must be positive and finite, got {step}")
         if not (np.isfinite(depth) and depth >= self.depth):
@@ -175,6 +183,8 @@ class NeedleInsertion:
             steps.append(self.advance(distance))
             if progress is not None:
                 progress(k + 1, n_steps, steps[-1])
+        while steps and steps[-1].converged and not steps[-1].settled:
+            steps.append(self.advance(0.0))
         return summarize(steps)
 
     @property
