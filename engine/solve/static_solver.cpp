@@ -14,8 +14,10 @@ namespace {
 bool is_linear(const Material& material) { return std::holds_alternative<LinearElastic>(material); }
 
 // Newton finishes with full steps after a line-search failure only this close to the
-// solution (residual relative to the starting one).
+// solution: the residual this far below the starting one, or within this factor of the
+// tolerance (a warm start, as in every needle update, begins close already).
 constexpr double newton_finish_fraction = 1e-3;
+constexpr double newton_finish_tolerances = 1e2;
 
 }  // namespace
 
@@ -207,7 +209,8 @@ SolveResult StaticSolver::solve_nonlinear() {
   // tolerances. There, full Newton steps converge quadratically: finish with them. The
   // final state is checked against the criterion like any other.
   if (options_.method == StaticMethod::newton && reason == SNES_DIVERGED_LINE_SEARCH && !history_.empty() &&
-      history_.back() <= newton_finish_fraction * result.initial_residual_norm) {
+      (history_.back() <= newton_finish_fraction * result.initial_residual_norm ||
+       history_.back() <= newton_finish_tolerances * current_tolerance())) {
     SNESLineSearch line_search = nullptr;
     SNESLineSearchType type = nullptr;
     SNEDE_PETSC(SNESGetLineSearch(snes_, &line_search));

@@ -166,3 +166,16 @@ def test_one_solve_per_update_carries_rearrangements_over_and_ends_settled():
     along, elastic = shaft_components(body, needle)
     stick = needle.sticking
     assert np.all(np.abs(along[stick]) <= needle.static_thresholds[stick] * (1 + 1e-6))
+
+
+@pytest.mark.parametrize("material", [snede.StVenantKirchhoff(34e3, 0.34), snede.NeoHookean(34e3, 0.34),
+                                      snede.VerondaWestmann(34e3, 0.34, 2.0)], ids=lambda m: type(m).__name__)
+def test_every_nonlinear_material_inserts_with_newton_and_keeps_the_thresholds(material):
+    body = slab_body(H_START, material)
+    needle = needle_for(body, H_REF, rtol=1e-6, method="newton")
+    report = needle.insert(0.03, h(H_REF))
+    assert report.converged, report.reason
+    along, _ = shaft_components(body, needle)
+    stick = needle.sticking
+    assert np.all(np.abs(along[stick]) <= needle.static_thresholds[stick] * (1 + 1e-4))
+    assert len(body.inverted_elements(body.displacement)) == 0
