@@ -35,14 +35,17 @@ def _parser() -> argparse.ArgumentParser:
     commands = parser.add_subparsers(dest="command", required=True)
     commands.add_parser("list", help="list the built-in scenes")
     run = commands.add_parser("run", help="run a built-in scene, or a scene script (a .py file)")
-    run.add_argument("scene", help="cantilever, cylinder, slab, or path/to/scene.py")
+    run.add_argument("scene", help="cantilever, cylinder, slab, needle, or path/to/scene.py")
     run.add_argument("--material", choices=MATERIAL_NAMES, help="material model (default: the scene's)")
     run.add_argument("--method", choices=METHODS,
                      help="cg: linear CG (linear material); ncg: nonlinear CG; newton: truncated Newton; "
                           "dynamic: damped explicit dynamics (default: the scene's)")
-    run.add_argument("--rtol", type=_positive_float, default=1e-6,
-                     help="relaxation tolerance ε of the stopping criterion (6.9) (default 1e-6)")
-    run.add_argument("--divisions", type=int, help="structured mesh resolution (cantilever: n × n/4 × n/4; slab: n × n)")
+    run.add_argument("--rtol", type=_positive_float,
+                     help="relaxation tolerance ε of the stopping criterion (6.9) (default 1e-6; needle: 1e-3)")
+    run.add_argument("--divisions", type=int,
+                     help="structured mesh resolution (cantilever: n × n/4 × n/4; slab: n × n; needle: n × n, n a power of 2)")
+    run.add_argument("--speed", type=_positive_float,
+                     help="needle: insertion speed, in h_ref per update (default 0.1)")
     run.add_argument("--mesh-size", type=_positive_float, help="target edge length (m) for gmsh meshes (cylinder)")
     run.add_argument("--out", type=Path, default=Path("out"), help="output folder (default out/)")
     demo = commands.add_parser("demo", help="run the default scenes and the cutting demo")

@@ -1,5 +1,5 @@
-"""`make demo`: the built-in scenes (cantilever, cylinder, slab) with their table, files and
-pictures, then a box cut in two through the §7 connectivity layer."""
+"""`make demo`: the built-in scenes (cantilever, cylinder, slab, needle) with their table, files
+and pictures, then a box cut in two through the §7 connectivity layer."""
 from __future__ import annotations
 
 import time
@@ -49,8 +49,8 @@ def run(out: Path = Path("out"), progress: bool = True) -> int:
     from snede.scenes import builders
 
     print(f"snede {snede.__version__} on PETSc {'.'.join(map(str, snede.PETSc.Sys.getVersion()))}\n")
-    defaults = argparse.Namespace(material=None, divisions=None, mesh_size=None)
-    summaries = [run_scene.run(module.build(defaults), None, 1e-6, out, progress) for module in builders().values()]
+    defaults = argparse.Namespace(material=None, divisions=None, mesh_size=None, speed=None)
+    summaries = [run_scene.run(module.build(defaults), None, None, out, progress) for module in builders().values()]
     run_scene.print_table(summaries)
     print()
     cut_box(20, Path(out) / "cut")

@@ -1,5 +1,5 @@
 """Pictures of a body: the reference mesh as a wireframe and the deformed mesh coloured by
-displacement magnitude (matplotlib, off-screen)."""
+displacement magnitude (matplotlib, off-screen), and animations of 2D frames (GIF)."""
 from __future__ import annotations
 
 from pathlib import Path
@@ -16,9 +16,22 @@ def _figure():
     return plt
 
 
-def plot_body(body, path, title: str = "", displacement=None, scale: float = 1.0) -> Path:
+def draw_2d(ax, points, cells, u, scale: float = 1.0, vmax: float | None = None):
+    """Reference wireframe (grey) and the deformed mesh coloured by |u|; returns the colour mapping."""
+    deformed = points + scale * u
+    ax.triplot(points[:, 0], points[:, 1], cells, color="0.75", linewidth=0.4)
+    shaded = ax.tripcolor(deformed[:, 0], deformed[:, 1], cells, np.linalg.norm(u, axis=1), shading="gouraud",
+                          cmap="viridis", vmin=0.0 if vmax is not None else None, vmax=vmax)
+    ax.set_aspect("equal")
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("y [m]")
+    return shaded
+
+
+def plot_body(body, path, title: str = "", displacement=None, scale: float = 1.0, decorate=None) -> Path:
     """Save a PNG of the body: reference wireframe (grey) and deformed surface coloured by
-    |u| (metres). ``scale`` exaggerates the displacement (stated in the title if ≠ 1)."""
+    |u| (metres). ``scale`` exaggerates the displacement (stated in the title if ≠ 1);
+    ``decorate(ax)`` draws on top of a 2D picture."""
     plt = _figure()
     u = body.displacement if displacement is None else np.asarray(displacement)
     magnitude = np.linalg.norm(u, axis=1)
@@ -28,11 +41,9 @@ def plot_body(body, path, title: str = "", displacement=None, scale: float = 1.0
         title = f"{title} (displacement ×{scale:g})"
     if mesh.dim == 2:
         fig, ax = plt.subplots(figsize=(6, 5))
-        ax.triplot(points[:, 0], points[:, 1], mesh.cells, color="0.75", linewidth=0.4)
-        shaded = ax.tripcolor(deformed[:, 0], deformed[:, 1], mesh.cells, magnitude, shading="gouraud", cmap="viridis")
-        ax.set_aspect("equal")
-        ax.set_xlabel("x [m]")
-        ax.set_ylabel("y [m]")
+        shaded = draw_2d(ax, points, mesh.cells, u, scale)
+        if decorate is not None:
+            decorate(ax)
     else:
         from mpl_toolkits.mplot3d.art3d import Line3DCollection, Poly3DCollection
 
@@ -63,5 +74,27 @@ def plot_body(body, path, title: str = "", displacement=None, scale: float = 1.0
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(path, dpi=120, bbox_inches="tight")
+    plt.close(fig)
+    return path
+
+
+def animate(frames, path, draw, fps: int = 10) -> Path:
+    """Save a GIF (matplotlib's Pillow writer) with one picture per frame: ``draw(ax, frame)``
+    draws it on an axis without ticks or frame, emptied before each frame."""
+    plt = _figure()
+    from matplotlib.animation import PillowWriter
+
+    fig = plt.figure(figsize=(4.5, 4))
+    ax = fig.add_axes((0, 0, 1, 1))
+    ax.set_axis_off()  # clearing and laying out ticks would cost more than drawing the mesh
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    writer = PillowWriter(fps=fps)
+    with writer.saving(fig, str(path), dpi=72):
+        for frame in frames:
+            for artist in [*ax.collections, *ax.lines, *ax.texts]:
+                artist.remove()
+            draw(ax, frame)
+            writer.grab_frame()
     plt.close(fig)
     return path

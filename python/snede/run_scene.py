@@ -5,6 +5,7 @@ import json
 import logging
 import resource
 import time
+from functools import partial
 from pathlib import Path
 
 import numpy as np
@@ -16,21 +17,22 @@ from snede.plotting import plot_body
 log = logging.getLogger("snede")
 
 
-class _Progress:
-    """A tqdm bar fed by a PETSc monitor (iterations and residual norm)."""
+class Progress:
+    """A tqdm bar: fed by a PETSc monitor (iterations, residual norm) or by a loop (``total``)."""
 
-    def __init__(self, label: str, enabled: bool):
+    def __init__(self, label: str, enabled: bool, total: int | None = None, unit: str = " it"):
         self.bar = None
         if enabled:
             from tqdm import tqdm
 
             # disable=None: no bar when the output is not a terminal (logs, CI)
-            self.bar = tqdm(desc=label, unit=" it", leave=False, dynamic_ncols=True, disable=None)
+            self.bar = tqdm(desc=label, total=total, unit=unit, leave=False, dynamic_ncols=True, disable=None)
 
-    def __call__(self, iteration: int, norm: float) -> None:
+    def __call__(self, count: int, status: str = "") -> None:
         if self.bar is not None:
-            self.bar.update(max(0, iteration - self.bar.n))
-            self.bar.set_postfix_str(f"|r| = {norm:.2e}", refresh=False)
+            self.bar.update(max(0, count - self.bar.n))
+            if status:
+                self.bar.set_postfix_str(status, refresh=False)
 
     def close(self) -> None:
         if self.bar is not None:
@@ -39,40 +41,50 @@ class _Progress:
 
 def solve_scene(scene, method: str, rtol: float, progress: bool, max_iterations: int = 100000):
     body = scene.body
-    bar = _Progress(f"{scene.name} ({method})", progress)
+    bar = Progress(f"{scene.name} ({method})", progress)
     try:
         if method == "dynamic":
             if not hasattr(snede, "DynamicRelaxation"):
                 raise ValueError("dynamic relaxation is not available in this build")
             solver = snede.DynamicRelaxation(body, damping=scene.damping)
-            solver.ts.setMonitor(lambda ts, step, t, u: bar(step, float("nan")))
+            solver.ts.setMonitor(lambda ts, step, t, u: bar(step))
             result = solver.run(rtol=rtol, max_steps=max_iterations)
         else:
             solver = snede.StaticSolver(body, method, rtol=rtol, max_iterations=max_iterations)
             if method == "cg":
-                solver.ksp.setMonitor(lambda ksp, it, norm: bar(it, norm))
+                solver.ksp.setMonitor(lambda ksp, it, norm: bar(it, f"|r| = {norm:.2e}"))
             else:
-                solver.snes.setMonitor(lambda snes, it, norm: bar(it, norm))
+                solver.snes.setMonitor(lambda snes, it, norm: bar(it, f"|r| = {norm:.2e}"))
             result = solver.solve()
     finally:
         bar.close()
     return result
 
 
-def run(scene, method: str | None, rtol: float, out: Path, progress: bool = True) -> dict:
+def solve_once(scene, method: str, rtol: float, writer, folder: Path, progress: bool) -> dict:
+    """A static scene: the unloaded state, one solve, the solution; its summary entries."""
+    writer.write(scene.body, time=0.0)
+    start = time.perf_counter()
+    result = solve_scene(scene, method, rtol, progress)
+    wall = time.perf_counter() - start
+    writer.write(scene.body, time=1.0)
+    return {"converged": result.converged, "reason": result.reason, "iterations": result.iterations,
+            "linear_iterations": result.linear_iterations, "residual_norm": result.residual_norm,
+            "seconds": wall, "mflop": result.flops / 1e6}
+
+
+def run(scene, method: str | None, rtol: float | None, out: Path, progress: bool = True) -> dict:
     method = method or scene.default_method
+    rtol = rtol or scene.default_rtol
     body = scene.body
     folder = Path(out) / scene.name
     folder.mkdir(parents=True, exist_ok=True)
     writer = SeriesWriter(folder / scene.name)
-    writer.write(body, time=0.0)
-    start = time.perf_counter()
-    result = solve_scene(scene, method, rtol, progress)
-    wall = time.perf_counter() - start
-    writer.write(body, time=1.0)
+    outcome = (scene.evolve or partial(solve_once, scene))(method, rtol, writer, folder, progress)
     picture = plot_body(body, folder / f"{scene.name}.png", title=f"{scene.name}: {type(body.material).__name__}, {method}",
-                        scale=scene.plot_scale)
+                        scale=scene.plot_scale, decorate=scene.decorate)
     value = scene.probe(body)
+    files = outcome.pop("files", {})
     summary = {
         "scene": scene.name,
         "description": scene.description,
@@ -81,24 +93,18 @@ def run(scene, method: str | None, rtol: float, out: Path, progress: bool = True
         "material": type(body.material).__name__,
         "method": method,
         "rtol": rtol,
-        "converged": result.converged,
-        "reason": result.reason,
-        "iterations": result.iterations,
-        "linear_iterations": result.linear_iterations,
-        "residual_norm": result.residual_norm,
-        "seconds": wall,
-        "mflop": result.flops / 1e6,
+        **outcome,
         "probe": scene.probe_name,
         "value": value,
         "analytic": scene.analytic,
         "error_percent": None if scene.analytic is None else 100 * abs(value - scene.analytic) / abs(scene.analytic),
         "max_rss_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024,
-        "files": {"xdmf": str(writer.xdmf_path), "h5": str(writer.h5_path), "png": str(picture)},
+        "files": {"xdmf": str(writer.xdmf_path), "h5": str(writer.h5_path), "png": str(picture), **files},
         **scene.details,
     }
     (folder / "summary.json").write_text(json.dumps(summary, indent=2))
-    if not result.converged:
-        log.warning("%s did not converge: %s after %d iterations", scene.name, result.reason, result.iterations)
+    if not summary["converged"]:
+        log.warning("%s did not converge: %s after %d iterations", scene.name, summary["reason"], summary["iterations"])
     return summary
 
 
@@ -111,4 +117,7 @@ def print_table(summaries) -> None:
         print(f"{s['scene']:<11} {s['cells']:>7} {s['material']:<18} {s['method']:<8} {s['iterations']:>6} "
               f"{s['reason']:<24} {s['seconds']:>7.2f} {s['probe']:<30} {s['value']:>11.4g} {analytic:>10} {error:>8}")
     for s in summaries:
-        print(f"  {s['scene']}: {s['files']['xdmf']} (ParaView), {s['files']['png']}")
+        others = [path for kind, path in s["files"].items() if kind not in ("xdmf", "h5")]
+        print(f"  {s['scene']}: {s['files']['xdmf']} (ParaView), {', '.join(others)}")
+        if s.get("notes"):
+            print(f"  {s['scene']}: {s['notes']}")

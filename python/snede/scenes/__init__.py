@@ -21,6 +21,11 @@ class Scene:
     damping: float = 20.0  # η for dynamic relaxation (1/s)
     plot_scale: float = 1.0  # displacement exaggeration in the picture
     details: dict = field(default_factory=dict)
+    default_rtol: float = 1e-6
+    # A scene that is not one static solve (the needle insertion) runs itself:
+    # evolve(method, rtol, writer, folder, progress) -> summary entries (see run_scene.solve_once).
+    evolve: Callable | None = None
+    decorate: Callable | None = None  # decorate(ax): marks on the 2D picture
 
 
 def material(name: str, young: float, poisson: float, gamma: float = 8.0):
@@ -37,6 +42,6 @@ def material(name: str, young: float, poisson: float, gamma: float = 8.0):
 
 
 def builders() -> dict:
-    from snede.scenes import cantilever, cylinder, slab
+    from snede.scenes import cantilever, cylinder, needle, slab
 
-    return {"cantilever": cantilever, "cylinder": cylinder, "slab": slab}
+    return {"cantilever": cantilever, "cylinder": cylinder, "slab": slab, "needle": needle}

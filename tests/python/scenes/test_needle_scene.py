@@ -1,0 +1,81 @@
+"""The needle scene: a short insertion writes a series whose steps follow the refined mesh and
+carry the needle node state, a picture, an animation and a summary."""
+import argparse
+import json
+import re
+from pathlib import Path
+
+import h5py
+import meshio
+import numpy as np
+import pytest
+from PIL import Image
+
+from snede import run_scene
+from snede.scenes import needle
+
+from test_scenes import not_blank, run_cli
+
+
+@pytest.fixture(scope="module")
+def inserted(tmp_path_factory):
+    """h_start = h2, one h_ref per update: 45 updates, a couple of seconds."""
+    out = tmp_path_factory.mktemp("needle")
+    scene = needle.build(argparse.Namespace(material=None, divisions=4, mesh_size=None, speed=1.0))
+    return scene, run_scene.run(scene, None, None, out, progress=False), out
+
+
+def test_insertion_converges_and_reports_rates(inserted):
+    scene, summary, out = inserted
+    assert summary["converged"], summary
+    assert summary["updates"] == 45 and summary["rearrangements"] >= summary["updates"]
+    assert summary["update_rate_hz"] > 0 and summary["rtol"] == 1e-3 and summary["method"] == "cg"
+    assert summary["needle_nodes"] == summary["stick"] + summary["slip"] > 0
+    assert summary["value"] > 0  # friction drags the body along the insertion
+    assert json.loads((out / "needle" / "summary.json").read_text())["rearrangements"] == summary["rearrangements"]
+
+
+def test_files_are_written(inserted):
+    _, summary, _ = inserted
+    files = {kind: Path(path) for kind, path in summary["files"].items()}
+    assert set(files) == {"xdmf", "h5", "png", "gif"} and all(path.exists() for path in files.values())
+    assert not_blank(files["png"])
+    with Image.open(files["gif"]) as gif:
+        assert gif.n_frames == summary["frames"]
+
+
+def test_series_follows_the_refined_mesh_with_the_node_state(inserted):
+    scene, summary, _ = inserted
+    xdmf = Path(summary["files"]["xdmf"])
+    steps = xdmf.read_text().count('<Grid Name="step')
+    assert steps == summary["frames"] and 10 <= steps <= 52  # every few updates, plus start and end
+    with h5py.File(summary["files"]["h5"], "r") as f:
+        assert len(f["/mesh"]) > 1  # the mesh was refined at the tip: new meshes in the series
+        state = f[f"/step/{steps - 1}/needle_state"][...]
+    assert np.array_equal(state, scene.evolve.__self__.needle.node_state())
+    assert (state == 1).sum() == summary["stick"] and (state == 2).sum() == summary["slip"]
+    points = [int(n) for n in re.findall(r'<DataItem Dimensions="(\d+) 3"[^>]*>[^<]*/points<', xdmf.read_text())]
+    with meshio.xdmf.TimeSeriesReader(xdmf) as reader:
+        reader.read_points_cells()
+        for k in range(reader.num_steps):
+            depth, point_data, _ = reader.read_data(k)
+            assert point_data["needle_state"].shape == (points[k],)
+            assert set(np.unique(point_data["needle_state"])) <= {0.0, 1.0, 2.0}
+    assert depth == pytest.approx(0.07) and points[-1] == summary["points"]
+
+
+def test_cli_runs_the_needle(tmp_path):
+    out = run_cli("--quiet", "run", "needle", "--divisions", "4", "--speed", "3", "--out", str(tmp_path))
+    assert out.returncode == 0, out.stderr
+    assert "needle force along shaft" in out.stdout and "rearrangements" in out.stdout
+    assert (tmp_path / "needle" / "needle.gif").exists()
+
+
+@pytest.mark.parametrize("args, message", [
+    (("--method", "dynamic"), "cg, ncg, newton"),
+    (("--divisions", "6"), "power of 2"),
+    (("--speed", "0"), "must be positive"),
+])
+def test_bad_needle_options_give_a_message(args, message, tmp_path):
+    out = run_cli("run", "needle", *args, "--out", str(tmp_path))
+    assert out.returncode != 0 and message in out.stderr and "Traceback" not in out.stderr
