@@ -1,5 +1,6 @@
 #include "solve/static_solver.hpp"
 
+#include <petscdmshell.h>
 #include <petsctime.h>
 
 #include <cmath>
@@ -118,6 +119,14 @@ void StaticSolver::reissue_sizes_if_mesh_changed() {
     SNEDE_PETSC(KSPSetOperators(ksp_, model_.tangent(), model_.tangent()));
   } else {
     SNEDE_PETSC(SNESReset(snes_));
+    // SNESReset keeps the SNES's DM, whose global vector still has the old size (NCG
+    // duplicates it): a fresh shell DM, then the callbacks it carries set again.
+    DM dm = nullptr;
+    SNEDE_PETSC(DMShellCreate(PETSC_COMM_SELF, &dm));
+    SNEDE_PETSC(DMShellSetGlobalVector(dm, residual_));
+    SNEDE_PETSC(SNESSetDM(snes_, dm));
+    SNEDE_PETSC(DMDestroy(&dm));
+    SNEDE_PETSC(SNESSetObjective(snes_, objective_callback, this));
     SNEDE_PETSC(SNESSetFunction(snes_, residual_, residual_callback, this));
     if (options_.method == StaticMethod::newton)
       SNEDE_PETSC(SNESSetJacobian(snes_, model_.tangent(), model_.tangent(), jacobian_callback, this));

@@ -206,3 +206,18 @@ def test_newton_reaches_tight_tolerances_past_energy_round_off(young):
     result = snede.StaticSolver(body, "newton", rtol=1e-8, criterion="6.8", options_prefix=f"roundoff_{young:g}_").solve()
     assert result.converged, result
     assert result.residual_norm <= result.tolerance
+
+
+@pytest.mark.parametrize("method", ["ncg", "newton"])
+def test_a_solver_continues_after_the_mesh_is_refined_and_agrees_with_a_new_one(method):
+    mesh = snede.meshing.rectangle((0.1, 0.1), (8, 8))
+    body = snede.Body(mesh, snede.NeoHookean(34e3, 0.3), thickness=0.01)
+    body.fix(np.isclose(mesh.points[:, 0], 0.1))
+    body.add_nodal_force([0], [[0.01, 0.0]])
+    solver = snede.StaticSolver(body, method, rtol=1e-8)
+    assert solver.solve().converged
+    body.refine_around((0.03, 0.05), 0.1 / 2**5)
+    continued = solver.solve()
+    assert continued.converged, continued
+    fresh = snede.StaticSolver(body, method, rtol=1e-8).solve()
+    assert fresh.energy == pytest.approx(continued.energy, rel=1e-8)
