@@ -46,7 +46,7 @@ void XdmfWriter::write_dataset(const std::string& path, const void* data, hid_t 
 }
 
 void XdmfWriter::write_step(double time, const Mesh& mesh, std::span<const double> displacement,
-                            const std::vector<CellField>& cell_fields) {
+                            const std::vector<CellField>& cell_fields, const std::vector<PointField>& point_fields) {
   const int dim = mesh.dim();
   const auto n_points = static_cast<std::int64_t>(mesh.n_points());
   const auto n_cells = static_cast<std::int64_t>(mesh.n_cells());
@@ -85,13 +85,21 @@ void XdmfWriter::write_step(double time, const Mesh& mesh, std::span<const doubl
   for (std::int64_t v = 0; v < n_points; ++v)
     for (int k = 0; k < dim; ++k) u[v * 3 + k] = displacement[v * dim + k];
   write_dataset(group + "/displacement", u.data(), H5T_NATIVE_DOUBLE, n_points, 3);
-  Step step{time, n_meshes_ - 1, n_points, n_cells, mesh.cell_dim(), {}};
+  for (const PointField& field : point_fields)
+    if (field.values.size() != static_cast<std::size_t>(n_points))
+      throw std::invalid_argument("point field '" + field.name + "' has " + std::to_string(field.values.size()) +
+                                  " values for " + std::to_string(n_points) + " points");
+  Step step{time, n_meshes_ - 1, n_points, n_cells, mesh.cell_dim(), {}, {}};
   for (const CellField& field : cell_fields) {
     if (field.values.size() != static_cast<std::size_t>(n_cells))
       throw std::invalid_argument("cell field '" + field.name + "' has " + std::to_string(field.values.size()) +
                                   " values for " + std::to_string(n_cells) + " cells");
     write_dataset(group + "/" + field.name, field.values.data(), H5T_NATIVE_DOUBLE, n_cells, 0);
     step.fields.push_back(field.name);
+  }
+  for (const PointField& field : point_fields) {
+    write_dataset(group + "/" + field.name, field.values.data(), H5T_NATIVE_DOUBLE, n_points, 0);
+    step.point_fields.push_back(field.name);
   }
   steps_.push_back(std::move(step));
   write_xdmf();
@@ -119,10 +127,13 @@ void XdmfWriter::write_xdmf() const {
         << "  <Attribute Name=\"displacement\" AttributeType=\"Vector\" Center=\"Node\">\n   <DataItem Dimensions=\""
         << s.n_points << " 3\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">" << h5 << ":" << step
         << "/displacement</DataItem>\n  </Attribute>\n";
-    for (const std::string& field : s.fields)
-      out << "  <Attribute Name=\"" << field << "\" AttributeType=\"Scalar\" Center=\"Cell\">\n   <DataItem Dimensions=\""
-          << s.n_cells << "\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">" << h5 << ":" << step << "/" << field
-          << "</DataItem>\n  </Attribute>\n";
+    auto scalar = [&](const std::string& field, const char* center, std::int64_t n) {
+      out << "  <Attribute Name=\"" << field << "\" AttributeType=\"Scalar\" Center=\"" << center
+          << "\">\n   <DataItem Dimensions=\"" << n << "\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">" << h5
+          << ":" << step << "/" << field << "</DataItem>\n  </Attribute>\n";
+    };
+    for (const std::string& field : s.fields) scalar(field, "Cell", s.n_cells);
+    for (const std::string& field : s.point_fields) scalar(field, "Node", s.n_points);
     out << " </Grid>\n";
   }
   out << "</Grid>\n</Domain>\n</Xdmf>\n";

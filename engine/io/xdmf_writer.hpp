@@ -20,6 +20,11 @@ struct CellField {
   std::vector<double> values;  // one per row of mesh.cells()
 };
 
+struct PointField {
+  std::string name;
+  std::vector<double> values;  // one per mesh point (row of the coordinates)
+};
+
 class XdmfWriter {
  public:
   // Writes `<base>.h5` and `<base>.xdmf` (overwriting them).
@@ -29,8 +34,9 @@ class XdmfWriter {
   XdmfWriter& operator=(const XdmfWriter&) = delete;
 
   // displacement: (n_points, dim); written as 3-component vectors (z = 0 in 2D).
+  // Field names must be distinct and not "displacement".
   void write_step(double time, const Mesh& mesh, std::span<const double> displacement,
-                  const std::vector<CellField>& cell_fields);
+                  const std::vector<CellField>& cell_fields, const std::vector<PointField>& point_fields = {});
   int n_steps() const { return static_cast<int>(steps_.size()); }
   int n_meshes() const { return n_meshes_; }
   std::string xdmf_path() const { return base_ + ".xdmf"; }
@@ -42,7 +48,8 @@ class XdmfWriter {
     int mesh;
     std::int64_t n_points, n_cells;
     int cell_dim;  // 2: triangles (2D or a surface), 3: tetrahedra
-    std::vector<std::string> fields;
+    std::vector<std::string> fields;        // cell fields
+    std::vector<std::string> point_fields;
   };
   void write_dataset(const std::string& path, const void* data, hid_t type, hsize_t rows, hsize_t columns);
   void write_xdmf() const;

@@ -2,11 +2,7 @@
 
 Each step stores the displacement and per-cell fields: ``aspect_ratio`` (reference shape,
 §3.2.3) and ``inverted`` (1 where det F ≤ 0), and any extra point fields. When the mesh changes
-between steps (a cut, a refinement) the new mesh is written and the step points to it.
-
-The engine's writer knows cell fields only; point fields are added here, next to its
-datasets (``/step/<i>/<name>``), and declared in the XDMF file it rewrites at every step.
-"""
+between steps (a cut, a refinement) the new mesh is written and the step points to it."""
 from __future__ import annotations
 
 from pathlib import Path
@@ -23,7 +19,6 @@ class SeriesWriter:
         base = Path(base)
         base.parent.mkdir(parents=True, exist_ok=True)
         self._impl = _snede.XdmfWriter(str(base))
-        self._point_fields: dict[int, list[tuple[str, int]]] = {}  # step -> [(name, n_points)]
 
     @property
     def xdmf_path(self) -> Path:
@@ -59,33 +54,7 @@ class SeriesWriter:
         ``point_fields``."""
         u = np.zeros((mesh.n_points, mesh.dim)) if displacement is None else np.asarray(displacement, dtype=np.float64)
         points = {name: np.asarray(values, dtype=np.float64).ravel() for name, values in (point_fields or {}).items()}
-        for name, values in points.items():
-            if len(values) != mesh.n_points:
-                raise ValueError(f"point field {name!r} has {len(values)} values for {mesh.n_points} points")
         quality = mesh.quality()
         fields = {"aspect_ratio": quality.aspect_ratio, "min_angle": quality.min_dihedral}
         fields.update({name: np.asarray(values, dtype=np.float64) for name, values in cell_fields.items()})
-        self._impl.write_step(float(time), mesh._impl, np.ascontiguousarray(u), fields)
-        if points:
-            self._add_point_fields(self.n_steps - 1, points)
-        if self._point_fields:
-            self._declare_point_fields()
-
-    def _add_point_fields(self, step: int, fields: dict) -> None:
-        import h5py
-
-        with h5py.File(self.h5_path, "r+") as f:  # the engine closes the file between steps
-            for name, values in fields.items():
-                f[f"/step/{step}/{name}"] = values
-        self._point_fields[step] = [(name, len(values)) for name, values in fields.items()]
-
-    def _declare_point_fields(self) -> None:
-        """Add the point fields' attributes to the steps of the XDMF file the engine rewrote."""
-        h5 = self.h5_path.name
-        blocks = self.xdmf_path.read_text().split(" </Grid>\n")  # one per step, then the closing tail
-        for step, fields in self._point_fields.items():
-            blocks[step] += "".join(
-                f'  <Attribute Name="{name}" AttributeType="Scalar" Center="Node">\n   <DataItem Dimensions="{n}" '
-                f'NumberType="Float" Precision="8" Format="HDF">{h5}:/step/{step}/{name}</DataItem>\n  </Attribute>\n'
-                for name, n in fields)
-        self.xdmf_path.write_text(" </Grid>\n".join(blocks))
+        self._impl.write_step(float(time), mesh._impl, np.ascontiguousarray(u), fields, points)

@@ -6,6 +6,7 @@ import sys
 from pathlib import Path
 
 import h5py
+import meshio
 import numpy as np
 import pytest
 
@@ -79,6 +80,18 @@ def test_series_follows_a_topology_change(tmp_path):
         assert len(f["/mesh/0/points"]) == 27 and "2" not in f["/mesh"]
     xdmf = writer.xdmf_path.read_text()
     assert xdmf.count("/mesh/0/cells") == 2 and xdmf.count("/mesh/1/cells") == 1
+
+
+def test_series_writes_point_fields_that_meshio_reads_and_refuses_a_wrong_length(tmp_path):
+    mesh = snede.meshing.rectangle((1.0, 1.0), (2, 2))
+    writer = SeriesWriter(tmp_path / "points")
+    writer.write_mesh(mesh, 0.0, point_fields={"height": mesh.points[:, 1]})
+    with meshio.xdmf.TimeSeriesReader(str(writer.xdmf_path)) as reader:
+        reader.read_points_cells()
+        _, point_data, _ = reader.read_data(0)
+    np.testing.assert_array_equal(point_data["height"], mesh.points[:, 1])
+    with pytest.raises(ValueError, match="point field 'height' has 3 values for 9 points"):
+        writer.write_mesh(mesh, 1.0, point_fields={"height": [1.0, 2.0, 3.0]})
 
 
 def run_cli(*args, cwd=None):
