@@ -13,7 +13,7 @@ Point2 point2(const DoubleArray& a, const char* name) {
 
 std::unique_ptr<NeedleInsertion> make_needle(Model& model, Bisection* bisection, const DoubleArray& entry,
                                              const DoubleArray& direction, const FrictionProfile& friction,
-                                             double static_factor, std::optional<double> h_ref, int max_rearrangements, int solves_per_update,
+                                             double static_factor, std::optional<double> h_ref, int max_rearrangements, int solves_per_update, bool extrapolate,
                                              const std::string& method, double rtol, const std::string& criterion,
                                              double round_tolerance, int max_iterations, const std::string& prefix,
                                              const OptionList& petsc_options) {
@@ -22,6 +22,7 @@ std::unique_ptr<NeedleInsertion> make_needle(Model& model, Bisection* bisection,
   options.h_ref = h_ref;
   options.max_rearrangements = max_rearrangements;
   options.solves_per_update = solves_per_update;
+  options.extrapolate = extrapolate;
   return std::make_unique<NeedleInsertion>(
       model, bisection, point2(entry, "entry"), point2(direction, "direction"), friction, options,
       static_options(method, rtol, criterion, round_tolerance, max_iterations, prefix, petsc_options));
@@ -60,7 +61,7 @@ void bind_needle(py::module_& m) {
 
   py::class_<NeedleInsertion>(m, "NeedleInsertion")
       .def(py::init(&make_needle), py::arg("model"), py::arg("bisection"), py::arg("entry"), py::arg("direction"),
-           py::arg("friction"), py::arg("static_factor"), py::arg("h_ref"), py::arg("max_rearrangements"), py::arg("solves_per_update"),
+           py::arg("friction"), py::arg("static_factor"), py::arg("h_ref"), py::arg("max_rearrangements"), py::arg("solves_per_update"), py::arg("extrapolate"),
            py::arg("method"), py::arg("rtol"), py::arg("criterion"), py::arg("round_tolerance"),
            py::arg("max_iterations"), py::arg("options_prefix"), py::arg("petsc_options"), py::keep_alive<1, 2>(),
            py::keep_alive<1, 3>())

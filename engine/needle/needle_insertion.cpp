@@ -60,10 +60,41 @@ NeedleInsertion::NeedleInsertion(Model& model, Bisection* bisection, const Point
                                 " never meets the body");
   solver_ = std::make_unique<StaticSolver>(model_, std::move(solver_options));
   node_of_vertex_.assign(mesh.n_points(), -1);
+  create_predictor_vectors();
   model_.body().mesh().connectivity().add_watcher(this);
 }
 
-NeedleInsertion::~NeedleInsertion() { model_.body().mesh().connectivity().remove_watcher(this); }
+NeedleInsertion::~NeedleInsertion() {
+  model_.body().mesh().connectivity().remove_watcher(this);
+  model_.remove_carried_field(&rate_);
+  model_.remove_carried_field(&start_);
+  VecDestroy(&rate_);
+  VecDestroy(&start_);
+}
+
+void NeedleInsertion::create_predictor_vectors() {
+  SNEDE_PETSC(VecDuplicate(model_.displacement(), &rate_));
+  SNEDE_PETSC(VecDuplicate(model_.displacement(), &start_));
+  SNEDE_PETSC(VecZeroEntries(rate_));
+  model_.add_carried_field(&rate_);
+  model_.add_carried_field(&start_);
+}
+
+void NeedleInsertion::predict(double distance) {
+  Vec u = model_.displacement();
+  SNEDE_PETSC(VecCopy(u, start_));
+  if (!options_.extrapolate || !have_rate_ || distance <= 0) return;
+  SNEDE_PETSC(VecAXPY(u, distance, rate_));
+  model_.enforce_constraints(u);
+  if (!model_.admissible(u)) SNEDE_PETSC(VecCopy(start_, u));  // no worse than the last state
+}
+
+void NeedleInsertion::record_rate(double distance) {
+  if (distance <= 0) return;
+  SNEDE_PETSC(VecWAXPY(rate_, -1.0, start_, model_.displacement()));
+  SNEDE_PETSC(VecScale(rate_, 1.0 / distance));
+  have_rate_ = true;
+}
 
 Point2 NeedleInsertion::deformed_position(VertexId v, std::span<const double> u) const {
   const auto X = model_.body().mesh().point(v);
@@ -114,11 +145,14 @@ NeedleStepReport NeedleInsertion::advance_in_steps(double distance, int halvings
     return merged(first, advance_in_steps(0.5 * distance, halvings + 1));
   }
   NeedleStepReport report;
+  predict(distance);
   const std::size_t cells_before = model_.body().mesh().n_cells();
   refine_at_tip();
   report.cells_split = static_cast<int>(model_.body().mesh().n_cells() - cells_before);
   report.intercepted = intercept_nodes();
-  return solve_and_rearrange(report);
+  report = solve_and_rearrange(report);
+  if (report.converged) record_rate(distance);
+  return report;
 }
 
 NeedleStepReport NeedleInsertion::merged(const NeedleStepReport& a, const NeedleStepReport& b) {

@@ -22,6 +22,8 @@
 // It watches the mesh: a vertex added by refinement between needle nodes joins the needle.
 #pragma once
 
+#include <petscvec.h>
+
 #include <memory>
 #include <optional>
 #include <string>
@@ -53,6 +55,9 @@ struct NeedleOptions {
   // The thesis's haptic loop (§6.7): at most this many solves per update (0: until settled);
   // rearrangements still pending are carried into the next update, which is not a failure.
   int solves_per_update = 0;
+  // Start each update's solve from the last state plus the last update's displacement change
+  // per unit of needle travel (a linear predictor) instead of from the last state.
+  bool extrapolate = false;
   std::string friction_channel = "friction";
 };
 
@@ -135,6 +140,14 @@ class NeedleInsertion : public ConnectivityWatcher {
   std::unique_ptr<StaticSolver> solver_;
   std::vector<NeedleNode> nodes_;
   double last_tolerance_ = 0;
+  // Predictor (a warm start better than the last state): the displacement change per unit of
+  // needle travel in the last update, carried through mesh changes like the state.
+  Vec rate_ = nullptr;
+  Vec start_ = nullptr;  // the state at the start of the current update
+  bool have_rate_ = false;
+  void predict(double distance);
+  void record_rate(double distance);
+  void create_predictor_vectors();
 };
 
 }  // namespace snede

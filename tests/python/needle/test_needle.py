@@ -154,9 +154,10 @@ def test_bad_input_names_the_value():
         snede.NeedleInsertion(body3, (0.0, 0.5), (1.0, 0.0), profile)
 
 
-def test_one_solve_per_update_carries_rearrangements_over_and_ends_settled():
+@pytest.mark.parametrize("extrapolate", [False, True])
+def test_one_solve_per_update_carries_rearrangements_over_and_ends_settled(extrapolate):
     body = slab_body(H_START)
-    needle = needle_for(body, H_REF, rtol=1e-6, solves_per_update=1)
+    needle = needle_for(body, H_REF, rtol=1e-6, solves_per_update=1, extrapolate=extrapolate)
     report = needle.insert(0.04, h(H_REF))
     assert report.converged
     assert all(step.rearrangements == 1 for step in report.steps)
