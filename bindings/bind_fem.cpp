@@ -69,22 +69,41 @@ py::dict flops_of(const ElasticBody& body) {
   return out;
 }
 
+// A material's class with what every material shows: Lamé parameters, E, ν and a repr
+// naming them (γ too where there is one).
+template <class M>
+py::class_<M> bind_material(py::module_& m, const char* name) {
+  py::class_<M> material(m, name);
+  material.def_property_readonly("lame", [](const M& s) { return py::make_tuple(s.lame.lambda, s.lame.mu); })
+      .def_property_readonly("E", [](const M& s) { return young_modulus(s.lame); })
+      .def_property_readonly("nu", [](const M& s) { return poisson_ratio(s.lame); })
+      .def("__repr__", [name](const M& s) {
+        std::string text = std::string(name) + "(E=" + py::repr(py::float_(young_modulus(s.lame))).cast<std::string>() +
+                           ", nu=" + py::repr(py::float_(poisson_ratio(s.lame))).cast<std::string>();
+        if constexpr (requires { s.gamma; }) text += ", gamma=" + py::repr(py::float_(s.gamma)).cast<std::string>();
+        return text + ")";
+      });
+  return material;
+}
+
 }  // namespace
 
 void bind_fem(py::module_& m) {
   py::register_exception<DomainError>(m, "DomainError", PyExc_ArithmeticError);
-  py::class_<LinearElastic>(m, "LinearElastic")
-      .def(py::init<double, double>(), py::arg("E"), py::arg("nu"))
-      .def_property_readonly("lame", [](const LinearElastic& s) { return py::make_tuple(s.lame.lambda, s.lame.mu); });
-  py::class_<StVenantKirchhoff>(m, "StVenantKirchhoff")
-      .def(py::init<double, double>(), py::arg("E"), py::arg("nu"))
-      .def_property_readonly("lame", [](const StVenantKirchhoff& s) { return py::make_tuple(s.lame.lambda, s.lame.mu); });
-  py::class_<NeoHookean>(m, "NeoHookean")
-      .def(py::init<double, double>(), py::arg("E"), py::arg("nu"))
-      .def_property_readonly("lame", [](const NeoHookean& s) { return py::make_tuple(s.lame.lambda, s.lame.mu); });
-  py::class_<VerondaWestmann>(m, "VerondaWestmann")
-      .def(py::init<double, double, double>(), py::arg("E"), py::arg("nu"), py::arg("gamma"))
-      .def_property_readonly("lame", [](const VerondaWestmann& s) { return py::make_tuple(s.lame.lambda, s.lame.mu); })
+  auto linear = bind_material<LinearElastic>(m, "LinearElastic");
+  linear.def(py::init<double, double>(), py::arg("E"), py::arg("nu"));
+  auto stvk = bind_material<StVenantKirchhoff>(m, "StVenantKirchhoff");
+  stvk.def(py::init<double, double>(), py::arg("E"), py::arg("nu"));
+  auto neo = bind_material<NeoHookean>(m, "NeoHookean");
+  neo.def(py::init<double, double>(), py::arg("E"), py::arg("nu"));
+  auto veronda = bind_material<VerondaWestmann>(m, "VerondaWestmann");
+  veronda.def(py::init<double, double, double>(), py::arg("E"), py::arg("nu"), py::arg("gamma"))
+      .def(py::init([](double, double) -> VerondaWestmann {
+             throw std::invalid_argument(
+                 "VerondaWestmann(E, nu, gamma) needs gamma, its exponential stiffening (dimensionless, > 0; "
+                 "e.g. 8 as in §4.3)");
+           }),
+           py::arg("E"), py::arg("nu"))
       .def_readonly("gamma", &VerondaWestmann::gamma);
 
   py::class_<ElasticBody>(m, "ElasticBody")

@@ -87,8 +87,8 @@ constexpr bool forbids_inversion(const M&) {
 void throw_if_domain_error(const EvaluationReport& report) {
   if (report.domain_errors.empty()) return;
   std::ostringstream message;
-  message << report.domain_errors.size() << " element(s) gave a non-finite result (exponential overflow: "
-          << "the deformation is too large for this material's nonlinearity), e.g. element";
+  message << report.domain_errors.size() << " element(s) gave a non-finite result (overflow: the deformation is "
+          << "too large for this material's nonlinearity, or the values beyond double range), e.g. element";
   for (std::size_t i = 0; i < std::min<std::size_t>(5, report.domain_errors.size()); ++i)
     message << " " << report.domain_errors[i];
   throw DomainError(message.str());

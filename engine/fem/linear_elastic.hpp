@@ -18,7 +18,7 @@ struct LinearElastic {
 
   template <int D>
   double effective_lambda() const {
-    return D == 3 ? lame.lambda : 2 * lame.lambda * lame.mu / (lame.lambda + 2 * lame.mu);
+    return D == 3 ? lame.lambda : 2 * lame.lambda / (lame.lambda + 2 * lame.mu) * lame.mu;  // no λμ: E up to 1e300
   }
   template <class T, int D>
   T energy(const Tensor<T, D>& F) const {

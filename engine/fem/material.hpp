@@ -19,9 +19,11 @@ inline bool forbids_inversion(const Material& material) {
   return std::visit([](const auto& m) { return std::decay_t<decltype(m)>::forbids_inversion; }, material);
 }
 
+inline double young_modulus(const Lame& lame) { return lame.mu * ((3 * lame.lambda + 2 * lame.mu) / (lame.lambda + lame.mu)); }
+inline double poisson_ratio(const Lame& lame) { return lame.lambda / (2 * (lame.lambda + lame.mu)); }
+
 inline double young_modulus(const Material& material) {
-  return std::visit([](const auto& m) { return m.lame.mu * (3 * m.lame.lambda + 2 * m.lame.mu) / (m.lame.lambda + m.lame.mu); },
-                    material);
+  return std::visit([](const auto& m) { return young_modulus(m.lame); }, material);
 }
 
 }  // namespace snede

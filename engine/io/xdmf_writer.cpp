@@ -10,6 +10,30 @@ void check_hdf5(herr_t status, const std::string& what) {
   if (status < 0) throw std::runtime_error("HDF5 failed to " + what);
 }
 
+// Text as it may stand in an XML attribute value or element.
+std::string xml_escaped(const std::string& text) {
+  std::string out;
+  for (char c : text) {
+    switch (c) {
+      case '&': out += "&amp;"; break;
+      case '<': out += "&lt;"; break;
+      case '>': out += "&gt;"; break;
+      case '"': out += "&quot;"; break;
+      case '\'': out += "&apos;"; break;
+      default: out += c;
+    }
+  }
+  return out;
+}
+
+// A field name must name one HDF5 dataset of the step: not empty, no '/', not a name taken.
+void check_field_name(const std::string& name, const std::vector<std::string>& taken) {
+  if (name.empty() || name.find('/') != std::string::npos || name == "." || name == "..")
+    throw std::invalid_argument("field name '" + name + "' is not usable: give a non-empty name without '/'");
+  for (const std::string& other : taken)
+    if (other == name) throw std::invalid_argument("field name '" + name + "' is used twice in one step");
+}
+
 std::string file_name(const std::string& path) {
   const auto slash = path.find_last_of('/');
   return slash == std::string::npos ? path : path.substr(slash + 1);
@@ -53,6 +77,21 @@ void XdmfWriter::write_step(double time, const Mesh& mesh, std::span<const doubl
   if (displacement.size() != static_cast<std::size_t>(n_points * dim))
     throw std::invalid_argument("displacement has " + std::to_string(displacement.size()) + " values, expected " +
                                 std::to_string(n_points * dim));
+  std::vector<std::string> names{"displacement"};
+  for (const CellField& field : cell_fields) {
+    check_field_name(field.name, names);
+    names.push_back(field.name);
+    if (field.values.size() != static_cast<std::size_t>(n_cells))
+      throw std::invalid_argument("cell field '" + field.name + "' has " + std::to_string(field.values.size()) +
+                                  " values for " + std::to_string(n_cells) + " cells");
+  }
+  for (const PointField& field : point_fields) {
+    check_field_name(field.name, names);
+    names.push_back(field.name);
+    if (field.values.size() != static_cast<std::size_t>(n_points))
+      throw std::invalid_argument("point field '" + field.name + "' has " + std::to_string(field.values.size()) +
+                                  " values for " + std::to_string(n_points) + " points");
+  }
   // The file is open only while a step is written, so readers (ParaView, h5py) can open it
   // between steps.
   file_ = H5Fopen(h5_path().c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
@@ -85,15 +124,8 @@ void XdmfWriter::write_step(double time, const Mesh& mesh, std::span<const doubl
   for (std::int64_t v = 0; v < n_points; ++v)
     for (int k = 0; k < dim; ++k) u[v * 3 + k] = displacement[v * dim + k];
   write_dataset(group + "/displacement", u.data(), H5T_NATIVE_DOUBLE, n_points, 3);
-  for (const PointField& field : point_fields)
-    if (field.values.size() != static_cast<std::size_t>(n_points))
-      throw std::invalid_argument("point field '" + field.name + "' has " + std::to_string(field.values.size()) +
-                                  " values for " + std::to_string(n_points) + " points");
   Step step{time, n_meshes_ - 1, n_points, n_cells, mesh.cell_dim(), {}, {}};
   for (const CellField& field : cell_fields) {
-    if (field.values.size() != static_cast<std::size_t>(n_cells))
-      throw std::invalid_argument("cell field '" + field.name + "' has " + std::to_string(field.values.size()) +
-                                  " values for " + std::to_string(n_cells) + " cells");
     write_dataset(group + "/" + field.name, field.values.data(), H5T_NATIVE_DOUBLE, n_cells, 0);
     step.fields.push_back(field.name);
   }
@@ -108,7 +140,7 @@ void XdmfWriter::write_step(double time, const Mesh& mesh, std::span<const doubl
 void XdmfWriter::write_xdmf() const {
   std::ofstream out(xdmf_path());
   if (!out) throw std::runtime_error("cannot write " + xdmf_path());
-  const std::string h5 = file_name(h5_path());
+  const std::string h5 = xml_escaped(file_name(h5_path()));
   out << "<?xml version=\"1.0\"?>\n<Xdmf Version=\"3.0\">\n<Domain>\n"
       << "<Grid Name=\"series\" GridType=\"Collection\" CollectionType=\"Temporal\">\n";
   for (std::size_t i = 0; i < steps_.size(); ++i) {
@@ -128,9 +160,9 @@ void XdmfWriter::write_xdmf() const {
         << s.n_points << " 3\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">" << h5 << ":" << step
         << "/displacement</DataItem>\n  </Attribute>\n";
     auto scalar = [&](const std::string& field, const char* center, std::int64_t n) {
-      out << "  <Attribute Name=\"" << field << "\" AttributeType=\"Scalar\" Center=\"" << center
+      out << "  <Attribute Name=\"" << xml_escaped(field) << "\" AttributeType=\"Scalar\" Center=\"" << center
           << "\">\n   <DataItem Dimensions=\"" << n << "\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">" << h5
-          << ":" << step << "/" << field << "</DataItem>\n  </Attribute>\n";
+          << ":" << step << "/" << xml_escaped(field) << "</DataItem>\n  </Attribute>\n";
     };
     for (const std::string& field : s.fields) scalar(field, "Cell", s.n_cells);
     for (const std::string& field : s.point_fields) scalar(field, "Node", s.n_points);

@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "core/error.hpp"
+#include "core/norms.hpp"
 #include "core/petsc_util.hpp"
 
 namespace snede {
@@ -205,10 +206,7 @@ SolveResult DynamicRelaxation::advance(PetscInt n_steps, Mode mode, double rtol)
   stopping_.rtol = rtol;
   stopping_.force_scale = model_.force_scale();
   stopping_.n_dofs = static_cast<double>(model_.n_dofs());
-  const std::vector<double>& f = model_.external_forces();
-  double sum = 0;
-  for (double x : f) sum += x * x;
-  external_norm_ = std::sqrt(sum);
+  external_norm_ = euclidean_norm(model_.external_forces());
   history_.clear();
   failure_.clear();
   converged_ = false;

@@ -5,6 +5,7 @@
 #include <numeric>
 
 #include "core/error.hpp"
+#include "core/norms.hpp"
 #include "core/petsc_util.hpp"
 
 namespace snede {
@@ -185,7 +186,7 @@ void Model::residual(Vec u, Vec F, EvaluationReport& report) {
     reaction[i] = r.span()[i];
   }
   constraints_.project_complement(reaction);
-  last_reaction_norm_ = std::sqrt(std::inner_product(reaction.begin(), reaction.end(), reaction.begin(), 0.0));
+  last_reaction_norm_ = euclidean_norm(reaction);
   constraints_.project(r.span());
   // (I − P)(u − anchor): zero while the constraints hold; pulls them back otherwise.
   std::vector<double> offset(x.span().begin(), x.span().end());
@@ -262,6 +263,8 @@ void Model::tangent_mult(Vec d, Vec out) {
   std::vector<double> complement(direction.span().begin(), direction.span().end());
   constraints_.project_complement(complement);
   for (std::size_t i = 0; i < complement.size(); ++i) result.span()[i] += complement[i];
+  if (operator_scale_ != 1)
+    for (double& x : result.span()) x *= operator_scale_;
   throw_if_domain_error(report);
 }
 

@@ -70,7 +70,10 @@ class Model : public ConnectivityWatcher {
   void remove_carried_field(Vec* field);
 
   Vec displacement() const { return u_; }  // the state; owned by the model
-  Mat tangent() const { return tangent_; }  // J at the linearisation point
+  Mat tangent() const { return tangent_; }  // J at the linearisation point (times operator_scale)
+  // The shell applies scale·J: a solver may divide a whole linear system by a force scale
+  // to keep CG's dot products in range; 1 otherwise.
+  void set_operator_scale(double scale) { operator_scale_ = scale; }
   void set_linearization_point(Vec u);
 
   // Π(u) = Π_int(u) − f_extᵀu (+∞ for an inverted element of a material forbidding it).
@@ -116,6 +119,7 @@ class Model : public ConnectivityWatcher {
   Mat tangent_ = nullptr;
   std::uint64_t generation_ = 0;
   double last_reaction_norm_ = 0;
+  double operator_scale_ = 1;
 };
 
 }  // namespace snede

@@ -7,6 +7,7 @@
 #include <limits>
 
 #include "core/error.hpp"
+#include "core/norms.hpp"
 #include "core/petsc_util.hpp"
 
 namespace snede {
@@ -28,6 +29,11 @@ StaticSolver::StaticSolver(Model& model, StaticOptions options)
       option_database_(options_.options_prefix, options_.petsc_options) {
   if (options_.stopping.rtol <= 0 || !std::isfinite(options_.stopping.rtol))
     throw std::invalid_argument("rtol must be positive, got " + std::to_string(options_.stopping.rtol));
+  if (!(options_.stopping.round_tolerance >= 0) || !std::isfinite(options_.stopping.round_tolerance))
+    throw std::invalid_argument("round_tolerance must be finite and non-negative, got " +
+                                std::to_string(options_.stopping.round_tolerance));
+  if (options_.max_iterations < 1)
+    throw std::invalid_argument("max_iterations must be at least 1, got " + std::to_string(options_.max_iterations));
   if (options_.method == StaticMethod::linear_cg && !is_linear(model.body().material()))
     throw std::invalid_argument(
         "method 'cg' (linear CG) solves the linear problem and needs LinearElastic; use 'ncg' or 'newton' for "
@@ -140,10 +146,7 @@ double StaticSolver::current_tolerance() const {
 SolveResult StaticSolver::solve() {
   reissue_sizes_if_mesh_changed();
   history_.clear();
-  const std::vector<double>& f = model_.external_forces();
-  double sum = 0;
-  for (double x : f) sum += x * x;
-  external_norm_ = std::sqrt(sum);
+  external_norm_ = euclidean_norm(model_.external_forces());
   // The force scale is a scan of the mesh: once per solve, not once per iteration.
   rule_ = options_.stopping;
   rule_.force_scale = model_.force_scale();
@@ -176,8 +179,17 @@ SolveResult StaticSolver::solve_linear() {
   // One Newton step of the quadratic problem: J δ = −F(u), solved by CG (§3.1).
   model_.set_linearization_point(u);
   SNEDE_PETSC(VecCopy(residual_, rhs));
-  SNEDE_PETSC(VecScale(rhs, -1.0));
+  // CG runs on the whole system divided by the force scale E·t·H (E·H² in 3D), so its dot
+  // products stay in range whatever the units (E = 1e155 Pa overflows p·Ap otherwise); the
+  // iterate δ keeps its units.
+  rhs_scale_ = std::isfinite(rule_.force_scale) && rule_.force_scale > 0 ? rule_.force_scale : 1.0;
+  SNEDE_PETSC(VecScale(rhs, -1.0 / rhs_scale_));
   SNEDE_PETSC(VecSet(step, 0.0));
+  model_.set_operator_scale(1.0 / rhs_scale_);
+  struct RestoreScale {
+    Model& model;
+    ~RestoreScale() { model.set_operator_scale(1.0); }
+  } restore{model_};
   SNEDE_PETSC(KSPSolve(ksp_, rhs, step));
   SNEDE_PETSC(VecAXPY(u, 1.0, step));
   KSPConvergedReason reason;
@@ -253,6 +265,11 @@ void StaticSolver::finish(SolveResult& result, double start_seconds, double star
     result.reason = "DIVERGED_NONFINITE_STATE";
   }
   result.tolerance = current_tolerance();
+  // A criterion that overflowed (or a load that is not finite) cannot be met honestly.
+  if (result.converged && !std::isfinite(result.tolerance)) {
+    result.converged = false;
+    result.reason = "DIVERGED_NONFINITE_TOLERANCE";
+  }
   // Converged means the stopping criterion holds at the final state, whatever stopped PETSc
   // (a line search's step tolerance, say). The factor allows CG's recursive residual to
   // differ from the recomputed one by round-off.
@@ -305,6 +322,10 @@ PetscErrorCode StaticSolver::snes_converged_callback(SNES snes, PetscInt it, Pet
     SNEDE_PETSC(SNESConvergedDefault(snes, it, xnorm, snorm, fnorm, reason, nullptr));
     self->history_.push_back(fnorm);
     if (*reason < 0) return;
+    if (!std::isfinite(self->current_tolerance())) {
+      *reason = SNES_DIVERGED_FNORM_NAN;
+      return;
+    }
     *reason = fnorm <= self->current_tolerance() ? SNES_CONVERGED_FNORM_ABS : SNES_CONVERGED_ITERATING;
   });
 }
@@ -314,8 +335,9 @@ PetscErrorCode StaticSolver::ksp_converged_callback(KSP ksp, PetscInt it, PetscR
   return petsc_callback("snede stopping criterion", [&] {
     auto* self = static_cast<StaticSolver*>(context);
     (void)ksp;
+    rnorm *= self->rhs_scale_;  // the residual in newtons
     self->history_.push_back(rnorm);
-    if (!std::isfinite(rnorm)) {
+    if (!std::isfinite(rnorm) || !std::isfinite(self->current_tolerance())) {
       *reason = KSP_DIVERGED_NANORINF;
       return;
     }

@@ -19,7 +19,7 @@ struct StoppingRule {
 
   double tolerance(double external_norm, double reaction_norm) const {
     if (criterion == StoppingCriterion::load_relative) return rtol * external_norm;
-    return rtol * std::sqrt(external_norm * external_norm + reaction_norm * reaction_norm) +
+    return rtol * std::hypot(external_norm, reaction_norm) +
            force_scale / std::sqrt(n_dofs) * round_tolerance;
   }
 };

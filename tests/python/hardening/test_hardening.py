@@ -1,0 +1,74 @@
+"""Issue 14 items: convergence is never reported at overflow and does not depend on the units;
+solver arguments are checked; materials say what they are; XDMF names are escaped."""
+import xml.etree.ElementTree as ElementTree
+
+import meshio
+import numpy as np
+import pytest
+
+import snede
+from snede.output import SeriesWriter
+
+
+def sagging_sheet(young):
+    mesh = snede.meshing.rectangle((1.0, 0.2), (10, 2))
+    body = snede.Body(mesh, snede.LinearElastic(young, 0.3), thickness=0.01, density=1.0)
+    body.fix(np.isclose(mesh.points[:, 0], 0.0))
+    body.add_gravity((0.0, -9.81 * young / 1e5))  # loads scaled with E: the same displacement
+    return body
+
+
+def test_the_displacement_does_not_depend_on_the_units_from_1e_minus3_to_1e155():
+    reference = sagging_sheet(1e5)
+    assert snede.StaticSolver(reference, "cg", rtol=1e-10).solve().converged
+    for young in (1e-3, 1.0, 1e150, 1e155):
+        body = sagging_sheet(young)
+        result = snede.StaticSolver(body, "cg", rtol=1e-10).solve()
+        assert result.converged and np.isfinite(result.tolerance), (young, result)
+        np.testing.assert_allclose(body.displacement, reference.displacement, rtol=1e-7,
+                                   atol=1e-9 * np.abs(reference.displacement).max())
+
+
+@pytest.mark.parametrize("method", ["cg", "newton"])
+def test_loads_beyond_double_range_are_never_converged(method):
+    body = sagging_sheet(1e5)
+    body.add_gravity((0.0, -1e300))
+    result = snede.StaticSolver(body, method, rtol=1e-6).solve()
+    assert not result.converged
+
+
+@pytest.mark.parametrize("kwargs, fragment", [
+    ({"round_tolerance": -1.0}, "round_tolerance must be finite and non-negative"),
+    ({"round_tolerance": float("nan")}, "round_tolerance"),
+    ({"max_iterations": -1}, "max_iterations must be at least 1, got -1"),
+])
+def test_solver_arguments_are_checked_with_the_value(kwargs, fragment):
+    with pytest.raises(ValueError, match=fragment):
+        snede.StaticSolver(sagging_sheet(1e5), "cg", **kwargs)
+
+
+def test_materials_show_their_parameters():
+    assert repr(snede.NeoHookean(34e3, 0.34)) == "NeoHookean(E=34000.0, nu=0.34)"
+    veronda = snede.VerondaWestmann(3e3, 0.3, 8.0)
+    assert repr(veronda).startswith("VerondaWestmann(E=3000.0") and "gamma=8.0" in repr(veronda)
+    assert veronda.E == pytest.approx(3e3) and veronda.nu == pytest.approx(0.3)
+    with pytest.raises(ValueError, match="needs gamma"):
+        snede.VerondaWestmann(3e3, 0.3)
+
+
+def test_xdmf_field_names_are_escaped_and_bad_ones_refused(tmp_path):
+    mesh = snede.meshing.rectangle((1.0, 1.0), (2, 2))
+    writer = SeriesWriter(tmp_path / "names")
+    odd = 'E<1&2 "x"'
+    writer.write_mesh(mesh, 0.0, **{odd: np.arange(mesh.n_cells, dtype=float)})
+    names = [a.get("Name") for a in ElementTree.parse(writer.xdmf_path).iter("Attribute")]
+    assert odd in names
+    with meshio.xdmf.TimeSeriesReader(str(writer.xdmf_path)) as reader:
+        reader.read_points_cells()
+        _, _, cell_data = reader.read_data(0)
+    np.testing.assert_array_equal(cell_data[odd][0], np.arange(mesh.n_cells))
+    for bad in ("a/b", ""):
+        with pytest.raises(ValueError, match="not usable"):
+            writer.write_mesh(mesh, 1.0, **{bad: np.zeros(mesh.n_cells)})
+    with pytest.raises(ValueError, match="used twice"):
+        writer.write_mesh(mesh, 1.0, point_fields={"aspect_ratio": np.zeros(mesh.n_points)})
