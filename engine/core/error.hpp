@@ -48,6 +48,23 @@ PetscErrorCode petsc_callback(const char* name, Body&& body) noexcept {
   }
 }
 
+// The snede object a PETSc callback belongs to. A petsc4py handle can keep a PETSc object
+// alive after its snede owner was deleted; the owner then clears its contexts, and a call
+// through the handle raises this error instead of reaching freed memory.
+template <class Owner>
+Owner& callback_owner(void* context, const char* owner_name) {
+  if (!context)
+    throw std::runtime_error(std::string("this PETSc object belonged to a snede ") + owner_name +
+                             " that has been deleted; keep the " + owner_name + " alive while you use it");
+  return *static_cast<Owner*>(context);
+}
+
+// The error a callback left behind by a deleted owner returns (PETSc keeps a non-null context
+// when a callback is replaced with a null one, so owners install these instead).
+inline PetscErrorCode orphaned_callback_error(const char* owner_name) {
+  return petsc_callback(owner_name, [&] { callback_owner<int>(nullptr, owner_name); });
+}
+
 }  // namespace snede
 
 // Wrap every PETSc call made by the engine: SNEDE_PETSC(VecCreate(comm, &v));

@@ -106,6 +106,9 @@ DynamicRelaxation::DynamicRelaxation(Model& model, double damping_eta, double dt
 
 DynamicRelaxation::~DynamicRelaxation() {
   model_.remove_carried_field(&velocity_);
+  TSSetApplicationContext(ts_, nullptr);  // a petsc4py handle may outlive this solver
+  TSSetRHSFunction(ts_, nullptr,
+                   [](TS, PetscReal, Vec, Vec, void*) { return orphaned_callback_error("DynamicRelaxation"); }, nullptr);
   TSDestroy(&ts_);
   VecDestroy(&velocity_);
   VecDestroy(&inverse_mass_);
@@ -360,7 +363,7 @@ double DynamicRelaxation::critical_time_step(double flop_budget, double initial,
 
 PetscErrorCode DynamicRelaxation::acceleration_callback(TS, PetscReal, Vec u, Vec a, void* context) {
   return petsc_callback("snede dynamic relaxation force", [&] {
-    auto* self = static_cast<DynamicRelaxation*>(context);
+    auto* self = &callback_owner<DynamicRelaxation>(context, "DynamicRelaxation");
     Model& model = self->model_;
     EvaluationReport report;
     model.residual(u, a, report);  // F(u) = P∇Π(u) on u's constraints
@@ -382,7 +385,7 @@ PetscErrorCode DynamicRelaxation::post_step_callback(TS ts) {
   return petsc_callback("snede dynamic relaxation post-step", [&] {
     void* context = nullptr;
     SNEDE_PETSC(TSGetApplicationContext(ts, &context));
-    static_cast<DynamicRelaxation*>(context)->after_step();
+    callback_owner<DynamicRelaxation>(context, "DynamicRelaxation").after_step();
   });
 }
 

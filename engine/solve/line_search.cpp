@@ -28,7 +28,7 @@ void apply_line_search(SNESLineSearch ls, Slope slope_kind) {
   SNEDE_PETSC(SNESLineSearchGetSNES(ls, &snes));
   void* context = nullptr;
   SNEDE_PETSC(SNESGetApplicationContext(snes, &context));
-  Model& model = static_cast<StaticSolver*>(context)->model();
+  Model& model = callback_owner<StaticSolver>(context, "StaticSolver").model();
   Vec X, F, Y, W, G;
   SNEDE_PETSC(SNESLineSearchGetVecs(ls, &X, &F, &Y, &W, &G));
   PetscReal steptol, maxstep, rtol, atol, ltol;

@@ -53,6 +53,7 @@ Model::Model(ElasticBody& body) : body_(body), constraints_(body.dim()) {
 
 Model::~Model() {
   body_.mesh().connectivity().remove_watcher(this);
+  MatShellSetContext(tangent_, nullptr);  // a petsc4py handle may outlive the model
   VecDestroy(&u_);
   VecDestroy(&u_linearization_);
   MatDestroy(&tangent_);
@@ -272,7 +273,7 @@ PetscErrorCode Model::tangent_mult_callback(Mat A, Vec d, Vec out) {
   return petsc_callback("snede tangent shell MatMult", [&] {
     void* context = nullptr;
     SNEDE_PETSC(MatShellGetContext(A, &context));
-    static_cast<Model*>(context)->tangent_mult(d, out);
+    callback_owner<Model>(context, "Body").tangent_mult(d, out);
   });
 }
 

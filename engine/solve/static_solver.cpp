@@ -43,6 +43,18 @@ StaticSolver::StaticSolver(Model& model, StaticOptions options)
 }
 
 StaticSolver::~StaticSolver() {
+  // A petsc4py handle may outlive this solver: leave its callbacks without a context.
+  constexpr const char* owner = "StaticSolver";
+  if (snes_) {
+    SNESSetApplicationContext(snes_, nullptr);  // the line searches find their solver here
+    SNESSetFunction(snes_, nullptr, [](SNES, Vec, Vec, void*) { return orphaned_callback_error(owner); }, nullptr);
+    SNESSetObjective(snes_, [](SNES, Vec, PetscReal*, void*) { return orphaned_callback_error(owner); }, nullptr);
+    if (options_.method == StaticMethod::newton)
+      SNESSetJacobian(snes_, nullptr, nullptr, [](SNES, Vec, Mat, Mat, void*) { return orphaned_callback_error(owner); },
+                      nullptr);
+    SNESSetConvergenceTest(snes_, snes_converged_callback, nullptr, nullptr);
+  }
+  if (ksp_) KSPSetConvergenceTest(ksp_, ksp_converged_callback, nullptr, nullptr);
   KSPDestroy(&ksp_);
   SNESDestroy(&snes_);
   VecDestroy(&residual_);
@@ -286,7 +298,7 @@ void StaticSolver::finish(SolveResult& result, double start_seconds, double star
 
 PetscErrorCode StaticSolver::residual_callback(SNES snes, Vec x, Vec F, void* context) {
   return petsc_callback("snede static residual", [&] {
-    auto* self = static_cast<StaticSolver*>(context);
+    auto* self = &callback_owner<StaticSolver>(context, "StaticSolver");
     EvaluationReport report;
     self->model_.residual(x, F, report);
     const bool inverted = !report.inverted.empty() && forbids_inversion(self->model_.body().material());
@@ -296,7 +308,7 @@ PetscErrorCode StaticSolver::residual_callback(SNES snes, Vec x, Vec F, void* co
 
 PetscErrorCode StaticSolver::objective_callback(SNES snes, Vec x, PetscReal* value, void* context) {
   return petsc_callback("snede static objective", [&] {
-    auto* self = static_cast<StaticSolver*>(context);
+    auto* self = &callback_owner<StaticSolver>(context, "StaticSolver");
     EvaluationReport report;
     *value = self->model_.potential_energy(x, report);
     if (!report.domain_errors.empty()) {
@@ -308,7 +320,7 @@ PetscErrorCode StaticSolver::objective_callback(SNES snes, Vec x, PetscReal* val
 
 PetscErrorCode StaticSolver::jacobian_callback(SNES, Vec x, Mat J, Mat, void* context) {
   return petsc_callback("snede static jacobian", [&] {
-    static_cast<StaticSolver*>(context)->model_.set_linearization_point(x);
+    callback_owner<StaticSolver>(context, "StaticSolver").model_.set_linearization_point(x);
     SNEDE_PETSC(MatAssemblyBegin(J, MAT_FINAL_ASSEMBLY));
     SNEDE_PETSC(MatAssemblyEnd(J, MAT_FINAL_ASSEMBLY));
   });
@@ -317,7 +329,7 @@ PetscErrorCode StaticSolver::jacobian_callback(SNES, Vec x, Mat J, Mat, void* co
 PetscErrorCode StaticSolver::snes_converged_callback(SNES snes, PetscInt it, PetscReal xnorm, PetscReal snorm,
                                                      PetscReal fnorm, SNESConvergedReason* reason, void* context) {
   return petsc_callback("snede stopping criterion", [&] {
-    auto* self = static_cast<StaticSolver*>(context);
+    auto* self = &callback_owner<StaticSolver>(context, "StaticSolver");
     // PETSc's default test catches NaN norms and the iteration limit.
     SNEDE_PETSC(SNESConvergedDefault(snes, it, xnorm, snorm, fnorm, reason, nullptr));
     self->history_.push_back(fnorm);
@@ -333,7 +345,7 @@ PetscErrorCode StaticSolver::snes_converged_callback(SNES snes, PetscInt it, Pet
 PetscErrorCode StaticSolver::ksp_converged_callback(KSP ksp, PetscInt it, PetscReal rnorm, KSPConvergedReason* reason,
                                                     void* context) {
   return petsc_callback("snede stopping criterion", [&] {
-    auto* self = static_cast<StaticSolver*>(context);
+    auto* self = &callback_owner<StaticSolver>(context, "StaticSolver");
     (void)ksp;
     rnorm *= self->rhs_scale_;  // the residual in newtons
     self->history_.push_back(rnorm);

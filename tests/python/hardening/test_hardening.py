@@ -72,3 +72,54 @@ def test_xdmf_field_names_are_escaped_and_bad_ones_refused(tmp_path):
             writer.write_mesh(mesh, 1.0, **{bad: np.zeros(mesh.n_cells)})
     with pytest.raises(ValueError, match="used twice"):
         writer.write_mesh(mesh, 1.0, point_fields={"aspect_ratio": np.zeros(mesh.n_points)})
+
+
+ORPHANED_HANDLE = """
+import gc, sys
+import numpy as np
+import snede
+from snede import PETSc
+
+mesh = snede.meshing.rectangle((1.0, 0.2), (6, 2))
+body = snede.Body(mesh, snede.LinearElastic(1e3, 0.3), thickness=0.01)
+body.fix(np.isclose(mesh.points[:, 0], 0.0))
+body.add_gravity((0.0, -9.81))
+x = body._model.displacement_vec.duplicate()
+which = sys.argv[1]
+if which == "snes":
+    owner = snede.StaticSolver(body, "newton"); handle = owner.snes
+    use = lambda: handle.solve(None, x)
+elif which == "ncg":
+    owner = snede.StaticSolver(body, "ncg"); handle = owner.snes
+    use = lambda: handle.solve(None, x)
+elif which == "ksp":
+    owner = snede.StaticSolver(body, "cg"); handle = owner.ksp
+    use = lambda: handle.solve(x.duplicate(), x)
+elif which == "ts":
+    owner = snede.DynamicRelaxation(body, damping=20.0); handle = owner.ts
+    use = lambda: handle.step()
+elif which == "tangent":
+    owner = body; handle = body._model.tangent_mat
+    use = lambda: handle.mult(x.duplicate(), x)
+del owner
+if which == "tangent":
+    del body
+gc.collect()
+try:
+    use()
+except PETSc.Error as error:
+    print("raised", error)
+else:
+    print("no error")
+"""
+
+
+@pytest.mark.parametrize("which", ["snes", "ncg", "ksp", "ts", "tangent"])
+def test_a_petsc4py_handle_used_after_its_owner_was_deleted_raises_instead_of_crashing(which):
+    import subprocess
+    import sys
+
+    result = subprocess.run([sys.executable, "-c", ORPHANED_HANDLE, which], capture_output=True, text=True,
+                            timeout=120)
+    assert result.returncode == 0, (result.returncode, result.stderr[-2000:])
+    assert result.stdout.startswith("raised"), result.stdout + result.stderr[-2000:]
