@@ -13,6 +13,18 @@
 namespace snede {
 namespace {
 
+// The tangent shell applies J/scale while a solve runs on the scaled system.
+class ScaledOperator {
+ public:
+  ScaledOperator(Model& model, double scale) : model_(model) { model_.set_operator_scale(1.0 / scale); }
+  ~ScaledOperator() { model_.set_operator_scale(1.0); }
+  ScaledOperator(const ScaledOperator&) = delete;
+  ScaledOperator& operator=(const ScaledOperator&) = delete;
+
+ private:
+  Model& model_;
+};
+
 bool is_linear(const Material& material) { return std::holds_alternative<LinearElastic>(material); }
 
 // Newton finishes with full steps after a line-search failure only this close to the
@@ -163,6 +175,11 @@ SolveResult StaticSolver::solve() {
   rule_ = options_.stopping;
   rule_.force_scale = model_.force_scale();
   rule_.n_dofs = static_cast<double>(model_.n_dofs());
+  // Linear CG solves the system divided by the force scale E·t·H (E·H² in 3D), so that its
+  // dot products stay in range whatever the units (E = 1e155 Pa overflows p·Ap otherwise);
+  // the iterate keeps its units and the stopping test multiplies back. (The same scaling of
+  // the SNES function, objective and tangent upset the cp line search; not done yet.)
+  system_scale_ = std::isfinite(rule_.force_scale) && rule_.force_scale > 0 ? rule_.force_scale : 1.0;
   model_.enforce_constraints(model_.displacement());
   // A free body has rigid motions: the static problem has no unique solution.
   const std::size_t rigid_modes = model_.dim() == 3 ? 6 : 3;
@@ -191,17 +208,9 @@ SolveResult StaticSolver::solve_linear() {
   // One Newton step of the quadratic problem: J δ = −F(u), solved by CG (§3.1).
   model_.set_linearization_point(u);
   SNEDE_PETSC(VecCopy(residual_, rhs));
-  // CG runs on the whole system divided by the force scale E·t·H (E·H² in 3D), so its dot
-  // products stay in range whatever the units (E = 1e155 Pa overflows p·Ap otherwise); the
-  // iterate δ keeps its units.
-  rhs_scale_ = std::isfinite(rule_.force_scale) && rule_.force_scale > 0 ? rule_.force_scale : 1.0;
-  SNEDE_PETSC(VecScale(rhs, -1.0 / rhs_scale_));
+  SNEDE_PETSC(VecScale(rhs, -1.0 / system_scale_));
   SNEDE_PETSC(VecSet(step, 0.0));
-  model_.set_operator_scale(1.0 / rhs_scale_);
-  struct RestoreScale {
-    Model& model;
-    ~RestoreScale() { model.set_operator_scale(1.0); }
-  } restore{model_};
+  const ScaledOperator scaled(model_, system_scale_);
   SNEDE_PETSC(KSPSolve(ksp_, rhs, step));
   SNEDE_PETSC(VecAXPY(u, 1.0, step));
   KSPConvergedReason reason;
@@ -347,7 +356,7 @@ PetscErrorCode StaticSolver::ksp_converged_callback(KSP ksp, PetscInt it, PetscR
   return petsc_callback("snede stopping criterion", [&] {
     auto* self = &callback_owner<StaticSolver>(context, "StaticSolver");
     (void)ksp;
-    rnorm *= self->rhs_scale_;  // the residual in newtons
+    rnorm *= self->system_scale_;  // the residual in newtons
     self->history_.push_back(rnorm);
     if (!std::isfinite(rnorm) || !std::isfinite(self->current_tolerance())) {
       *reason = KSP_DIVERGED_NANORINF;

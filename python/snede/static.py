@@ -31,6 +31,12 @@ class StaticSolver:
       ``{"snes_monitor": None, "snes_max_it": 50}``. They, ``line_search`` and ``ncg_type``
       apply to this solver only, not to later solvers with the same prefix; the command line
       (PETSc's global options, as they are when the solver is made) still wins.
+
+    Linear CG solves the system divided by the force scale E·t·H (E·H² in 3D), so that the
+    answer does not depend on the units (E from 1e-3 to 1e155 Pa give the same displacement);
+    ``-static_ksp_monitor`` prints its residual norms divided by it, while ``SolveResult``
+    reports them in newtons. ncg and newton are not scaled yet: they stay accurate to about
+    E = 1e100 and report non-convergence beyond.
     """
 
     def __init__(self, body, method: str = "newton", rtol: float = 1e-6, *, criterion: str = "6.9",

@@ -18,18 +18,21 @@ def sagging_sheet(young):
     return body
 
 
-def test_the_displacement_does_not_depend_on_the_units_from_1e_minus3_to_1e155():
+# Linear CG runs on the scaled system; ncg and newton are not scaled yet (honest beyond about
+# E = 1e100: see the next test), which issue 14 still asks for.
+@pytest.mark.parametrize("method", ["cg"])
+def test_the_displacement_does_not_depend_on_the_units_from_1e_minus3_to_1e155(method):
     reference = sagging_sheet(1e5)
     assert snede.StaticSolver(reference, "cg", rtol=1e-10).solve().converged
     for young in (1e-3, 1.0, 1e150, 1e155):
         body = sagging_sheet(young)
-        result = snede.StaticSolver(body, "cg", rtol=1e-10).solve()
+        result = snede.StaticSolver(body, method, rtol=1e-10).solve()
         assert result.converged and np.isfinite(result.tolerance), (young, result)
         np.testing.assert_allclose(body.displacement, reference.displacement, rtol=1e-7,
                                    atol=1e-9 * np.abs(reference.displacement).max())
 
 
-@pytest.mark.parametrize("method", ["cg", "newton"])
+@pytest.mark.parametrize("method", ["cg", "ncg", "newton"])
 def test_loads_beyond_double_range_are_never_converged(method):
     body = sagging_sheet(1e5)
     body.add_gravity((0.0, -1e300))
