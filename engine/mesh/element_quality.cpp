@@ -141,8 +141,19 @@ double cell_longest_edge(int cell_dim, int space_dim, std::span<const double> co
 
 bool has_zero_volume(int cell_dim, int space_dim, std::span<const double> corners) {
   constexpr double tolerance = 64 * std::numeric_limits<double>::epsilon();
-  const double scale = std::pow(cell_longest_edge(cell_dim, space_dim, corners), cell_dim);
-  return !(std::abs(cell_measure(cell_dim, space_dim, corners)) > tolerance * scale);
+  // Decided on the corners relative to the first one, divided by a power of two near their
+  // extent: the same doubles scaled exactly, so the decision is the same at every scale and
+  // neither L^d nor the measure overflows for coordinates of 1e300.
+  std::vector<double> x(corners.begin(), corners.end());
+  double extent = 0;
+  for (std::size_t i = 0; i < x.size(); ++i) extent = std::max(extent, std::abs(x[i] - corners[i % space_dim]));
+  if (extent > 0 && std::isfinite(extent)) {
+    int exponent = 0;
+    std::frexp(extent, &exponent);
+    for (std::size_t i = 0; i < x.size(); ++i) x[i] = std::ldexp(x[i] - corners[i % space_dim], -exponent);
+  }
+  const double scale = std::pow(cell_longest_edge(cell_dim, space_dim, x), cell_dim);
+  return !(std::abs(cell_measure(cell_dim, space_dim, x)) > tolerance * scale);
 }
 
 }  // namespace snede

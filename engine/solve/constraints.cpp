@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <unordered_map>
 
 namespace snede {
 
@@ -15,6 +16,17 @@ void Constraints::check_vertex(VertexId v) const {
 void Constraints::fix(std::span<const VertexId> vertices, std::span<const double> values) {
   if (!values.empty() && values.size() != vertices.size() * dim_)
     throw std::invalid_argument("fix: values must be (n_vertices, " + std::to_string(dim_) + ")");
+  // A vertex listed twice must not be given two different displacements (the last would win
+  // silently). Checked before anything changes.
+  std::unordered_map<VertexId, std::size_t> first_listed;
+  for (std::size_t i = 0; i < vertices.size() && !values.empty(); ++i) {
+    const auto [it, first] = first_listed.try_emplace(vertices[i], i);
+    if (!first && !std::equal(values.begin() + i * dim_, values.begin() + (i + 1) * dim_,
+                              values.begin() + it->second * dim_))
+      throw std::invalid_argument("fix: vertex " + std::to_string(vertices[i]) + " is listed twice (entries " +
+                                  std::to_string(it->second) + " and " + std::to_string(i) +
+                                  ") with different values");
+  }
   for (std::size_t i = 0; i < vertices.size(); ++i) {
     check_vertex(vertices[i]);
     VertexConstraint& c = vertices_[vertices[i]];

@@ -126,3 +126,22 @@ def test_a_petsc4py_handle_used_after_its_owner_was_deleted_raises_instead_of_cr
                             timeout=120)
     assert result.returncode == 0, (result.returncode, result.stderr[-2000:])
     assert result.stdout.startswith("raised"), result.stdout + result.stderr[-2000:]
+
+
+def test_fixing_one_vertex_twice_with_different_values_is_refused_and_changes_nothing():
+    body = sagging_sheet(1e5)
+    with pytest.raises(ValueError, match="vertex 3 is listed twice .* different values"):
+        body.fix([3, 5, 3], [[0.0, 0.0], [0.0, 0.0], [0.1, 0.0]])
+    assert np.abs(body.reaction_forces()[3]).max() == 0.0 and np.all(body.displacement[3] == 0)
+    body.fix([3, 3], [[0.1, 0.0], [0.1, 0.0]])  # the same value twice is harmless
+    assert body.displacement[3, 0] == 0.1
+
+
+@pytest.mark.parametrize("scale", [1e-150, 1.0, 1e150, 1e300])
+def test_a_mesh_is_accepted_at_any_coordinate_scale_and_a_flat_cell_refused_at_each(scale):
+    points = scale * np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0], [1.0, 1.0]])
+    mesh = snede.Mesh(points, [[0, 1, 2], [1, 3, 2]])
+    mesh.validate()
+    flat = scale * np.array([[0.0, 0.0], [1.0, 0.0], [2.0, 0.0]])
+    with pytest.raises(ValueError, match="zero"):
+        snede.Mesh(flat, [[0, 1, 2]])
