@@ -1,7 +1,15 @@
 """Command line: ``python -m snede run SCENE [options] [PETSc options]``, ``list``, ``demo``.
 
-Options snede does not know and that start with '-' are PETSc's (``-static_snes_monitor``,
-``-log_view``); PETSc read them from sys.argv when snede was imported.
+Options starting with ``--`` are snede's: one snede does not know is an error (a script run by
+``run path/to/scene.py`` gets the ones snede does not know, as its own arguments). Options
+starting with a single ``-`` (and their values) are PETSc's (``-static_snes_monitor``,
+``-log_view``): PETSc read them, and only them, from sys.argv when snede was imported (see
+``snede._argv``). At the end, options with snede's prefixes (static_, dynamic_, needle_) that
+no solver read are reported, as PETSc's ``-options_left`` does for all options.
+
+``-h``/``--help`` is snede's help; ``-help`` is PETSc's: PETSc prints its options as the
+solvers are set up (with ``run SCENE``, the scene runs); without a command, snede's help
+follows PETSc's general one.
 """
 from __future__ import annotations
 
@@ -12,6 +20,8 @@ import sys
 from pathlib import Path
 
 METHODS = ("cg", "ncg", "newton", "dynamic")
+PREFIXES = ("static_", "dynamic_", "needle_")  # the options prefixes of snede's solvers
+SCENE_OPTIONS = ("divisions", "mesh_size", "speed")  # apply to the scenes whose OPTIONS name them
 
 
 def _positive_float(text: str) -> float:
@@ -24,17 +34,35 @@ def _positive_float(text: str) -> float:
     return value
 
 
+def _positive_int(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not an integer: {text!r}") from None
+    if value <= 0:
+        raise argparse.ArgumentTypeError(f"must be positive, got {text}")
+    return value
+
+
 def _parser() -> argparse.ArgumentParser:
     from snede.scenes import MATERIAL_NAMES
 
     parser = argparse.ArgumentParser(
         prog="python -m snede",
-        description="snede: soft deformable objects whose meshes change. Options starting with '-' that snede "
-                    "does not know are passed to PETSc (e.g. -static_snes_monitor, -log_view).")
-    parser.add_argument("--quiet", action="store_true", help="only warnings and the final table")
+        description="snede: soft deformable objects whose meshes change. Options starting with '--' are snede's; "
+                    "options starting with a single '-' are passed to PETSc (e.g. -static_snes_monitor, -log_view; "
+                    "-help: PETSc's help, printed as the solvers are set up).")
+    quiet = "only warnings and the final table"
+    parser.add_argument("--quiet", action="store_true", help=quiet)
     commands = parser.add_subparsers(dest="command", required=True)
     commands.add_parser("list", help="list the built-in scenes")
-    run = commands.add_parser("run", help="run a built-in scene, or a scene script (a .py file)")
+    run = commands.add_parser("run", help="run a built-in scene, or a scene script (a .py file)",
+                              description="Run a built-in scene, or a scene script (a .py file: it gets the "
+                                          "arguments snede does not know). Options starting with a single '-' "
+                                          "are PETSc's (e.g. -static_snes_monitor; -help lists the solvers' "
+                                          "options as they are set up).")
+    # SUPPRESS: `--quiet run ...` is not undone by the subcommand's default
+    run.add_argument("--quiet", action="store_true", default=argparse.SUPPRESS, help=quiet)
     run.add_argument("scene", help="cantilever, cylinder, slab, needle, or path/to/scene.py")
     run.add_argument("--material", choices=MATERIAL_NAMES, help="material model (default: the scene's)")
     run.add_argument("--method", choices=METHODS,
@@ -42,64 +70,97 @@ def _parser() -> argparse.ArgumentParser:
                           "dynamic: damped explicit dynamics (default: the scene's)")
     run.add_argument("--rtol", type=_positive_float,
                      help="relaxation tolerance ε of the stopping criterion (6.9) (default 1e-6; needle: 1e-3)")
-    run.add_argument("--divisions", type=int,
+    run.add_argument("--divisions", type=_positive_int,
                      help="structured mesh resolution (cantilever: n × n/4 × n/4; slab: n × n; needle: n × n, n a power of 2)")
     run.add_argument("--speed", type=_positive_float,
                      help="needle: insertion speed, in h_ref per update (default 0.1)")
     run.add_argument("--mesh-size", type=_positive_float, help="target edge length (m) for gmsh meshes (cylinder)")
     run.add_argument("--out", type=Path, default=Path("out"), help="output folder (default out/)")
     demo = commands.add_parser("demo", help="run the default scenes and the cutting demo")
+    demo.add_argument("--quiet", action="store_true", default=argparse.SUPPRESS, help=quiet)
     demo.add_argument("--out", type=Path, default=Path("out"), help="output folder (default out/)")
     return parser
 
 
-def _split_petsc(unknown: list[str]) -> list[str]:
-    """The tokens that are not PETSc options ('-name' optionally followed by a value)."""
-    return [a for i, a in enumerate(unknown)
-            if not a.startswith("-") and (i == 0 or not unknown[i - 1].startswith("-"))]
+def _check_scene_options(parser, args, module) -> None:
+    """An option of SCENE_OPTIONS given to a scene that does not use it is an error."""
+    for name in SCENE_OPTIONS:
+        if getattr(args, name, None) is not None and name not in module.OPTIONS:
+            own = ", ".join("--" + o.replace("_", "-") for o in module.OPTIONS) or "none"
+            parser.error(f"--{name.replace('_', '-')} does not apply to the {args.scene} scene "
+                         f"(its options: {own})")
+
+
+def _warn_unused(logger) -> None:
+    from snede._petsc import unused_options
+
+    unused = unused_options(PREFIXES)
+    for name, value in unused or ():
+        logger.warning("PETSc option -%s%s was not used (misspelled, or not for this scene's solver?)",
+                       name, "" if value is None else f" {value}")
 
 
 def main(argv: list[str] | None = None) -> int:
+    from snede._argv import split
+
     parser = _parser()
-    args, unknown = parser.parse_known_args(argv)
-    stray = _split_petsc(unknown)
-    if stray:
-        parser.error(f"unexpected argument(s): {' '.join(stray)}")
+    ours, petsc = split(sys.argv[1:] if argv is None else list(argv))
+    if "-help" in petsc and not any(command in ours for command in ("list", "run", "demo")):
+        parser.print_help()  # PETSc printed its general help at initialisation
+        print("\nPETSc's options of a scene's solvers: python -m snede run SCENE -help")
+        return 0
+    args, unknown = parser.parse_known_args(ours)
+    script = args.command == "run" and args.scene.endswith(".py")
+    if unknown and not script:
+        options = [a.split("=", 1)[0] for a in unknown if a.startswith("-")]
+        if options:
+            parser.error(f"unknown option(s): {' '.join(options)} (snede's options start with '--', "
+                         "PETSc's with a single '-'; see --help)")
+        parser.error(f"unexpected argument(s): {' '.join(unknown)}")
     handler = logging.StreamHandler()
     handler.setFormatter(logging.Formatter("%(levelname)s: %(message)s"))
     logger = logging.getLogger("snede")
     logger.addHandler(handler)
     logger.setLevel(logging.WARNING if args.quiet else logging.INFO)
-    import snede  # noqa: F401  (initialises PETSc with sys.argv)
+    import snede  # (initialised PETSc with the PETSc options of sys.argv)
+
+    try:
+        code = _command(parser, args, unknown, petsc)
+    except (snede.PetscError, ValueError, OSError) as error:  # a bad PETSc option value, bad input
+        print(f"error: {error}", file=sys.stderr)
+        return 2
+    if args.command != "list":
+        _warn_unused(logger)
+    return code
+
+
+def _command(parser, args, unknown, petsc) -> int:
     from snede import run_scene
     from snede.scenes import builders
 
-    try:
-        if args.command == "list":
-            for name, module in builders().items():
-                print(f"{name:<11} {module.DESCRIPTION}")
-            return 0
-        if args.command == "demo":
-            from snede import demo
+    if args.command == "list":
+        for name, module in builders().items():
+            print(f"{name:<11} {module.DESCRIPTION}")
+        return 0
+    if args.command == "demo":
+        from snede import demo
 
-            return demo.run(args.out, progress=not args.quiet)
-        if args.scene.endswith(".py"):
-            script = Path(args.scene)
-            if not script.exists():
-                parser.error(f"scene script {script} does not exist")
-            sys.argv = [str(script), *unknown]
-            runpy.run_path(str(script), run_name="__main__")
-            return 0
-        scenes = builders()
-        if args.scene not in scenes:
-            parser.error(f"unknown scene {args.scene!r}: choose one of {', '.join(scenes)}, or give a .py file")
-        scene = scenes[args.scene].build(args)
-        summary = run_scene.run(scene, args.method, args.rtol, args.out, progress=not args.quiet)
-        run_scene.print_table([summary])
-        return 0 if summary["converged"] else 1
-    except (ValueError, OSError) as error:
-        print(f"error: {error}", file=sys.stderr)
-        return 2
+        return demo.run(args.out, progress=not args.quiet)
+    if args.scene.endswith(".py"):
+        script = Path(args.scene)
+        if not script.exists():
+            parser.error(f"scene script {script} does not exist")
+        sys.argv = [str(script), *unknown, *petsc]
+        runpy.run_path(str(script), run_name="__main__")
+        return 0
+    scenes = builders()
+    if args.scene not in scenes:
+        parser.error(f"unknown scene {args.scene!r}: choose one of {', '.join(scenes)}, or give a .py file")
+    _check_scene_options(parser, args, scenes[args.scene])
+    scene = scenes[args.scene].build(args)
+    summary = run_scene.run(scene, args.method, args.rtol, args.out, progress=not args.quiet)
+    run_scene.print_table([summary])
+    return 0 if summary["converged"] else 1
 
 
 if __name__ == "__main__":

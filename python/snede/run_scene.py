@@ -73,8 +73,18 @@ def solve_once(scene, method: str, rtol: float, writer, folder: Path, progress: 
             "seconds": wall, "mflop": result.flops / 1e6}
 
 
+def fitting_method(scene) -> str:
+    """The scene's default method, unless that is linear CG and the body's material is not
+    linear (``--material neohookean`` on the cantilever): then truncated Newton."""
+    if scene.default_method == "cg" and not isinstance(scene.body.material, snede.LinearElastic):
+        return "newton"
+    return scene.default_method
+
+
 def run(scene, method: str | None, rtol: float | None, out: Path, progress: bool = True) -> dict:
-    method = method or scene.default_method
+    """Solve (or evolve) the scene with ``method`` (None: ``fitting_method(scene)``), write the
+    series, the picture and summary.json; the summary."""
+    method = method or fitting_method(scene)
     rtol = rtol or scene.default_rtol
     body = scene.body
     folder = Path(out) / scene.name

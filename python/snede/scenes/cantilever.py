@@ -6,12 +6,15 @@ import snede
 from snede.scenes import Scene, material
 
 LENGTH, HEIGHT, DEPTH, YOUNG, LOAD = 1.2, 0.2, 0.3, 1e6, 3.0
+OPTIONS = ("divisions",)  # the scene options it uses (the command line refuses the others)
 DESCRIPTION = "§3.3 cantilever beam, 3 N tip load, analytic tip deflection 8.64 mm"
 
 
 def build(options) -> Scene:
-    n = options.divisions or 16
-    if n < 4 or n % 4:
+    n = 16 if options.divisions is None else options.divisions
+    if n <= 0:
+        raise ValueError(f"--divisions must be positive, got {n}")
+    if n % 4:
         raise ValueError(f"--divisions for the cantilever must be a multiple of 4 (n × n/4 × n/4 cubes), got {n}")
     mesh = snede.meshing.box((LENGTH, HEIGHT, DEPTH), (n, n // 4, n // 4))
     body = snede.Body(mesh, material(options.material or "linear", YOUNG, 0.0), density=1000.0)

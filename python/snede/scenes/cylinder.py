@@ -8,6 +8,7 @@ import snede
 from snede.scenes import Scene, material
 
 MESHES = Path(__file__).resolve().parents[3] / "meshes"
+OPTIONS = ("mesh_size",)  # the scene options it uses (the command line refuses the others)
 DESCRIPTION = "§4.2 soft cylinder under gravity (Table 4.1 parameters), no analytic solution"
 ETA_CRIT = {"linear": 17.0, "stvk": 20.0, "neohookean": 21.0, "veronda": 27.0}  # Table 4.4
 

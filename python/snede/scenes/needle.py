@@ -15,6 +15,7 @@ from snede.plotting import animate, draw_2d
 from snede.scenes import Scene, material
 from snede.scenes.needle_slab import DEPTH, DIRECTION, ENTRY, POISSON, YOUNG, h, needle_for, slab_body
 
+OPTIONS = ("divisions", "speed")  # the scene options it uses (the command line refuses the others)
 DESCRIPTION = "§6.8.1 needle inserted 70 mm into the slab: stick-slip friction, bisection at the tip"
 H_START, H_REF, SPEED, FRAMES = 3, 6, 0.1, 40
 METHODS = ("cg", "ncg", "newton")
@@ -116,6 +117,8 @@ class Insertion:
 def _h_start(divisions: int | None) -> int:
     if divisions is None:
         return H_START
+    if divisions <= 0:
+        raise ValueError(f"--divisions must be positive, got {divisions}")
     k = round(math.log2(divisions)) if divisions > 0 else -1
     if not 1 <= k <= H_REF or 2 ** k != divisions:
         raise ValueError(f"--divisions for the needle must be a power of 2 from 2 to {2 ** H_REF}, got {divisions}")

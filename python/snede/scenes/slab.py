@@ -8,6 +8,7 @@ import snede
 from snede.scenes import Scene, material
 
 SIZE, THICKNESS, DEPTH, TOTAL_FORCE = 0.1, 0.01, 0.07, 0.2
+OPTIONS = ("divisions",)  # the scene options it uses (the command line refuses the others)
 DESCRIPTION = "§6.8.1 plane-stress slab with a needle-like line load (Figure 6.4 shape)"
 
 
@@ -18,8 +19,10 @@ def friction_profile(s):
 
 
 def build(options) -> Scene:
-    n = options.divisions or 16
-    if n < 2 or n % 2:
+    n = 16 if options.divisions is None else options.divisions
+    if n <= 0:
+        raise ValueError(f"--divisions must be positive, got {n}")
+    if n % 2:
         raise ValueError(f"--divisions for the slab must be even (the load line is y = 0.05), got {n}")
     mesh = snede.meshing.rectangle((SIZE, SIZE), (n, n))
     body = snede.Body(mesh, material(options.material or "linear", 34e3, 0.34), density=1000.0, thickness=THICKNESS)

@@ -109,6 +109,57 @@ def test_list_and_help():
     assert listed.returncode == 0 and all(name in listed.stdout for name in ("cantilever", "cylinder", "slab"))
     helped = run_cli("run", "--help")
     assert helped.returncode == 0 and "--material" in helped.stdout and "PETSc" in run_cli("--help").stdout
+    assert "--quiet" in helped.stdout  # also accepted after `run` (issue 14 item 4)
+
+
+def test_single_dash_help_is_petscs_and_then_snedes():
+    """`-help` was parsed by argparse as `-h elp`. Now it is PETSc's option: without a command,
+    PETSc's general help and then snede's usage, exit 0."""
+    out = run_cli("-help")
+    assert out.returncode == 0, out.stderr
+    assert "PETSc" in out.stdout and "usage: python -m snede" in out.stdout and "{list,run,demo}" in out.stdout
+    assert "elp" not in out.stderr and "Traceback" not in out.stderr
+
+
+def test_single_dash_help_with_a_scene_lists_its_solvers_options(tmp_path):
+    out = run_cli("--quiet", "run", "slab", "--divisions", "4", "--out", str(tmp_path), "-help")
+    assert out.returncode == 0, out.stderr
+    assert "-static_ksp_type" in out.stdout  # PETSc's help for the scene's KSP
+
+
+def test_snede_arguments_do_not_reach_petscs_options_database(tmp_path):
+    """petsc4py.init got all of sys.argv: `-m run` became the option -m, `--method cg` -method.
+    A scene script run by the command line prints PETSc's database: only the PETSc option."""
+    script = tmp_path / "show_options.py"
+    script.write_text("import snede\nprint('OPTIONS', sorted(snede.PETSc.Options().getAll()))\n")
+    out = run_cli("--quiet", "run", str(script), "--method", "cg", "-static_ksp_rtol", "-1e-3", cwd=tmp_path)
+    assert out.returncode == 0, out.stderr
+    line = next(l for l in out.stdout.splitlines() if l.startswith("OPTIONS"))
+    names = eval(line[len("OPTIONS"):])
+    assert "static_ksp_rtol" in names
+    assert not {"m", "method", "run", "quiet"} & set(names), names
+
+
+def test_misspelled_petsc_options_with_our_prefixes_are_reported_at_the_end(tmp_path):
+    out = run_cli("--quiet", "run", "slab", "--divisions", "4", "--out", str(tmp_path),
+                  "-static_ksp_monitr", "-static_ksp_rtol", "1e-9", "-dynamic_ts_monitor", "-malloc_dump_x")
+    assert out.returncode == 0, out.stderr
+    assert "-static_ksp_monitr was not used" in out.stderr
+    assert "-dynamic_ts_monitor was not used" in out.stderr  # the slab solves statically
+    assert "static_ksp_rtol" not in out.stderr  # read by the KSP
+    assert "malloc_dump_x" not in out.stderr  # not one of snede's prefixes: PETSc's business
+
+
+def test_a_nonlinear_material_alone_chooses_newton(tmp_path):
+    """--material neohookean on a scene whose default method is linear CG failed (CG refuses a
+    nonlinear material); without --method the method now fits the material."""
+    out = run_cli("--quiet", "run", "cantilever", "--divisions", "4", "--material", "neohookean",
+                  "--out", str(tmp_path))
+    assert out.returncode == 0, out.stderr
+    assert re.search(r"^cantilever\s+\d+\s+NeoHookean\s+newton\s+\d+\s+CONVERGED_\w+\s", out.stdout, re.M), out.stdout
+    scene = builders()["slab"].build(options(divisions=4, material="stvk"))
+    assert run_scene.fitting_method(scene) == "newton"
+    assert run_scene.fitting_method(builders()["slab"].build(options(divisions=4))) == "cg"
 
 
 @pytest.mark.parametrize("args, message", [
@@ -118,10 +169,27 @@ def test_list_and_help():
     (("run", "cantilever", "--material", "rubber"), "invalid choice"),
     (("run", "cylinder", "--method", "cg"), "LinearElastic"),
     (("run", "cantilever", "stray"), "unexpected argument"),
+    # issue 14 item 4: a misspelled snede option was passed to PETSc and ignored
+    (("run", "cantilever", "--materail", "veronda"), "unknown option(s): --materail"),
+    (("run", "cantilever", "--divisions=8", "--quite"), "unknown option(s): --quite"),
+    # a bad PETSc value: the message, not a traceback
+    (("run", "cantilever", "--divisions", "4", "-static_ksp_type", "foo"), "Unable to find requested KSP type foo"),
+    (("run", "cantilever", "--divisions", "4", "--method", "newton", "-static_snes_type", "foo"),
+     "Unable to find requested SNES type foo"),
+    # --divisions 0 was the default; -8 said "multiple of 4"
+    (("run", "cantilever", "--divisions", "0"), "--divisions: must be positive, got 0"),
+    (("run", "cantilever", "--divisions", "-8"), "--divisions: must be positive, got -8"),
+    (("run", "needle", "--divisions", "0"), "--divisions: must be positive, got 0"),
+    # options that do not apply to the scene were ignored
+    (("run", "cylinder", "--divisions", "8"), "--divisions does not apply to the cylinder scene"),
+    (("run", "cantilever", "--mesh-size", "0.05"), "--mesh-size does not apply to the cantilever scene"),
+    (("run", "slab", "--mesh-size", "0.05"), "--mesh-size does not apply to the slab scene"),
+    (("run", "needle", "--mesh-size", "0.05"), "--mesh-size does not apply to the needle scene"),
+    (("run", "slab", "--speed", "1"), "--speed does not apply to the slab scene"),
 ])
 def test_bad_input_gives_a_message_not_a_traceback(args, message, tmp_path):
     out = run_cli(*args, "--out", str(tmp_path)) if args[-1] != "stray" else run_cli(*args)
-    assert out.returncode != 0
+    assert out.returncode == 2, out.stderr
     assert message in out.stderr
     assert "Traceback" not in out.stderr
 
@@ -144,3 +212,12 @@ def test_user_scene_script_runs(tmp_path):
     assert re.search(r"^converged \(CONVERGED_\w+\) after \d+ iterations", out.stdout, re.M), out.stdout
     assert "NOT converged" not in out.stdout
     assert not_blank(tmp_path / "out" / "sagging_beam" / "sagging_beam.png")
+
+
+def test_argv_split_gives_petsc_only_single_dash_options_and_their_values():
+    from snede._argv import split
+
+    others, petsc = split(["run", "cantilever", "--method", "cg", "-static_ksp_rtol", "-1e-8", "-log_view",
+                           "--divisions", "-8", "-h", "-static_ksp_monitor", "-h", "--quiet"])
+    assert petsc == ["-static_ksp_rtol", "-1e-8", "-log_view", "-static_ksp_monitor"]
+    assert others == ["run", "cantilever", "--method", "cg", "--divisions", "-8", "-h", "-h", "--quiet"]
