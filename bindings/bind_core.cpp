@@ -14,6 +14,8 @@ void bind_core(py::module_& m) {
   m.def("option_real", &option_real, py::arg("name"),
         "The real value of PETSc option `name` (with its '-'), or None if it is not set; a value "
         "that is not a number raises PetscError with PETSc's message.");
+  m.def("option_used", &option_used, py::arg("name"),
+        "Whether a PETSc object has read option `name` (without its '-') from the global database.");
 }
 
 }  // namespace snede::bindings

@@ -12,4 +12,10 @@ std::optional<double> option_real(const std::string& name) {
   return static_cast<double>(value);
 }
 
+bool option_used(const std::string& name) {
+  PetscBool used = PETSC_FALSE;
+  SNEDE_PETSC(PetscOptionsUsed(nullptr, name.c_str(), &used));
+  return used == PETSC_TRUE;
+}
+
 }  // namespace snede

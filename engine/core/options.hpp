@@ -10,4 +10,8 @@ namespace snede {
 // A value that is not a number raises PetscException carrying PETSc's message.
 std::optional<double> option_real(const std::string& name);
 
+// Whether some PETSc object has read option `name` (without its leading '-') from the global
+// database, as -options_left reports at exit.
+bool option_used(const std::string& name);
+
 }  // namespace snede

@@ -95,7 +95,7 @@ def _warn_unused(logger) -> None:
     from snede._petsc import unused_options
 
     unused = unused_options(PREFIXES)
-    for name, value in unused or ():
+    for name, value in unused:
         logger.warning("PETSc option -%s%s was not used (misspelled, or not for this scene's solver?)",
                        name, "" if value is None else f" {value}")
 

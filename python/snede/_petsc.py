@@ -33,41 +33,11 @@ def option_list(options: dict | None) -> list[tuple[str, str]]:
     return [(str(name), "" if value is None else str(value)) for name, value in (options or {}).items()]
 
 
-def _library():
-    """libpetsc as loaded in this process (found in /proc/self/maps), or None."""
-    import ctypes
-
-    try:
-        with open("/proc/self/maps") as maps:
-            paths = {line.split()[-1] for line in maps if "libpetsc" in line and line.rstrip().endswith(tuple("0123456789o"))}
-    except OSError:
-        return None
-    for path in sorted(paths):
-        try:
-            library = ctypes.CDLL(path)
-            library.PetscOptionsUsed  # noqa: B018  (the symbol must exist)
-            return library
-        except (OSError, AttributeError):
-            continue
-    return None
-
-
-def unused_options(prefixes: tuple[str, ...]) -> list[tuple[str, str | None]] | None:
+def unused_options(prefixes: tuple[str, ...]) -> list[tuple[str, str | None]]:
     """The options of the global database whose name starts with one of ``prefixes`` and that
     no PETSc object has read so far (``PetscOptionsUsed``, as ``-options_left`` reports at
-    exit), as ``(name, value)``; None when this cannot be checked (libpetsc not found)."""
-    import ctypes
+    exit), as ``(name, value)``."""
+    from snede import _snede
 
-    library = _library()
-    if library is None:
-        return None
-    unused = []
-    for name, value in PETSc.Options().getAll().items():
-        if not name.startswith(prefixes):
-            continue
-        used = ctypes.c_int(0)  # PetscBool, an enum
-        if library.PetscOptionsUsed(None, name.encode(), ctypes.byref(used)) != 0:
-            return None
-        if not used.value:
-            unused.append((name, value))
-    return unused
+    return [(name, value) for name, value in PETSc.Options().getAll().items()
+            if name.startswith(prefixes) and not _snede.option_used(name)]
