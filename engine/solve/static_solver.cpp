@@ -51,7 +51,14 @@ StaticSolver::StaticSolver(Model& model, StaticOptions options)
         "method 'cg' (linear CG) solves the linear problem and needs LinearElastic; use 'ncg' or 'newton' for "
         "nonlinear materials");
   register_line_searches();
-  create_objects();
+  try {
+    create_objects();
+  } catch (...) {  // a bad option: release what was made (the destructor will not run)
+    KSPDestroy(&ksp_);
+    SNESDestroy(&snes_);
+    VecDestroy(&residual_);
+    throw;
+  }
 }
 
 StaticSolver::~StaticSolver() {

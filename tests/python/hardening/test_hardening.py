@@ -145,3 +145,47 @@ def test_a_mesh_is_accepted_at_any_coordinate_scale_and_a_flat_cell_refused_at_e
     flat = scale * np.array([[0.0, 0.0], [1.0, 0.0], [2.0, 0.0]])
     with pytest.raises(ValueError, match="zero"):
         snede.Mesh(flat, [[0, 1, 2]])
+
+
+FAILED_CONSTRUCTIONS = """
+import numpy as np
+import snede
+from snede import _snede
+
+mesh = snede.meshing.rectangle((1.0, 0.2), (6, 2))
+body = snede.Body(mesh, snede.LinearElastic(1e3, 0.3), thickness=0.01)
+body.fix(np.isclose(mesh.points[:, 0], 0.0))
+
+def fail(method):
+    try:
+        snede.StaticSolver(body, method, petsc_options={"snes_type" if method != "cg" else "ksp_type": "nosuchtype"})
+    except snede.PetscError:
+        return
+    raise SystemExit("a bad type was accepted")
+
+for method in ("cg", "ncg", "newton"):
+    for _ in range(20):
+        fail(method)  # warm-up: PETSc's registries and caches
+before = _snede.petsc_allocated_bytes()
+for method in ("cg", "ncg", "newton"):
+    for _ in range(300):
+        fail(method)
+print(before, _snede.petsc_allocated_bytes())
+"""
+
+
+def test_failed_solver_constructions_leave_petsc_memory_flat():
+    import os
+    import subprocess
+    import sys
+
+    env = dict(os.environ, PETSC_OPTIONS="-malloc_debug")
+    result = subprocess.run([sys.executable, "-c", FAILED_CONSTRUCTIONS], capture_output=True, text=True,
+                            timeout=300, env=env)
+    assert result.returncode == 0, result.stderr[-2000:]
+    # The first line; PETSc's -malloc_debug report of what is still allocated at exit follows.
+    before, after = map(float, result.stdout.splitlines()[0].split())
+    assert before > 0  # -malloc_debug tracks PETSc's allocations
+    # 900 failed constructions: the ~25 kB each they used to leak would be over 20 MB; about
+    # 50 bytes each remain (option strings, PetscStrallocpy).
+    assert after - before < 100e3, (before, after)
