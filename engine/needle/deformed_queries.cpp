@@ -6,16 +6,16 @@
 namespace snede {
 namespace {
 
-Point2 deformed(const Mesh& mesh, std::span<const double> u, VertexId v) {
-  const auto X = mesh.point(v);
-  const std::size_t i = static_cast<std::size_t>(v) * 2;
-  return {X[0] + u[i], X[1] + u[i + 1]};
-}
-
 double cross(const Point2& a, const Point2& b) { return a[0] * b[1] - a[1] * b[0]; }
 Point2 minus(const Point2& a, const Point2& b) { return {a[0] - b[0], a[1] - b[1]}; }
 
 }  // namespace
+
+Point2 deformed_point(const Mesh& mesh, std::span<const double> u, VertexId v) {
+  const auto X = mesh.point(v);
+  const std::size_t i = static_cast<std::size_t>(v) * 2;
+  return {X[0] + u[i], X[1] + u[i + 1]};
+}
 
 std::optional<Point2> reference_position(const Mesh& mesh, std::span<const double> u, const Point2& x) {
   const Connectivity& c = mesh.connectivity();
@@ -24,8 +24,8 @@ std::optional<Point2> reference_position(const Mesh& mesh, std::span<const doubl
   for (ElementId e = 0; e < c.element_capacity(); ++e) {
     if (!c.is_element(e)) continue;
     const Simplex& t = c.element(e).simplex;
-    const Point2 p0 = deformed(mesh, u, t.vertex(0)), p1 = deformed(mesh, u, t.vertex(1)),
-                 p2 = deformed(mesh, u, t.vertex(2));
+    const Point2 p0 = deformed_point(mesh, u, t.vertex(0)), p1 = deformed_point(mesh, u, t.vertex(1)),
+                 p2 = deformed_point(mesh, u, t.vertex(2));
     const double area = cross(minus(p1, p0), minus(p2, p0));
     if (area == 0) continue;
     const double l1 = cross(minus(x, p0), minus(p2, p0)) / area;
@@ -55,7 +55,7 @@ std::vector<ShaftCrossing> shaft_crossings(const Mesh& mesh, std::span<const dou
       const Face& face = c.face(f);
       if (face.mate != no_id && face.mate < f) continue;  // each interior edge once
       const VertexId vp = face.simplex.vertex(0), vq = face.simplex.vertex(1);
-      const Point2 p = deformed(mesh, u, vp), q = deformed(mesh, u, vq);
+      const Point2 p = deformed_point(mesh, u, vp), q = deformed_point(mesh, u, vq);
       if (std::max(p[0], q[0]) < lo[0] || std::min(p[0], q[0]) > hi[0] || std::max(p[1], q[1]) < lo[1] ||
           std::min(p[1], q[1]) > hi[1])
         continue;

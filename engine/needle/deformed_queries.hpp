@@ -15,6 +15,9 @@ namespace snede {
 
 using Point2 = std::array<double, 2>;
 
+// Where vertex v is in the deformed mesh: X_v + u_v. u: (n_points, 2).
+Point2 deformed_point(const Mesh& mesh, std::span<const double> u, VertexId v);
+
 // The reference position of the material point that sits at x in the deformed mesh (the
 // barycentric coordinates of x in the deformed triangle containing it, applied to the
 // reference corners), or nothing if x is outside the deformed body. u: (n_points, 2).

@@ -51,9 +51,11 @@ NeedleInsertion::NeedleInsertion(Model& model, Bisection* bisection, const Point
   const Mesh& mesh = model_.body().mesh();
   const std::vector<double> u = vec_values(model_.displacement());
   double reach = 0;
-  for (VertexId v = 0; v < mesh.n_points(); ++v)
-    if (mesh.is_vertex(v)) reach = std::max(reach, std::hypot(mesh.point(v)[0] + u[2 * v] - entry_[0],
-                                                              mesh.point(v)[1] + u[2 * v + 1] - entry_[1]));
+  for (VertexId v = 0; v < mesh.n_points(); ++v) {
+    if (!mesh.is_vertex(v)) continue;
+    const Point2 x = deformed_point(mesh, u, v);
+    reach = std::max(reach, std::hypot(x[0] - entry_[0], x[1] - entry_[1]));
+  }
   const Point2 far{entry_[0] + 2 * reach * direction_[0], entry_[1] + 2 * reach * direction_[1]};
   if (shaft_crossings(mesh, u, entry_, far).empty() && !reference_position(mesh, u, entry_))
     throw std::invalid_argument("the needle from entry " + point_text(entry_) + " along " + point_text(direction_) +
@@ -94,11 +96,6 @@ void NeedleInsertion::record_rate(double distance) {
   SNEDE_PETSC(VecWAXPY(rate_, -1.0, start_, model_.displacement()));
   SNEDE_PETSC(VecScale(rate_, 1.0 / distance));
   have_rate_ = true;
-}
-
-Point2 NeedleInsertion::deformed_position(VertexId v, std::span<const double> u) const {
-  const auto X = model_.body().mesh().point(v);
-  return {X[0] + u[2 * static_cast<std::size_t>(v)], X[1] + u[2 * static_cast<std::size_t>(v) + 1]};
 }
 
 double NeedleInsertion::along(const Point2& x) const {
@@ -211,7 +208,7 @@ int NeedleInsertion::intercept_nodes() {
     const VertexId v = c.near;
     if (static_cast<std::size_t>(v) < node_of_vertex_.size() && node_of_vertex_[v] >= 0) continue;
     if (model_.constraints()[v].kind != ConstraintKind::free) continue;  // held by the user
-    const Point2 x = deformed_position(v, u);
+    const Point2 x = deformed_point(model_.body().mesh(), u, v);
     const double s = along(x);
     if (s < 0 || s > depth_) continue;  // caught once the tip has passed it
     NeedleNode node;
@@ -235,7 +232,7 @@ void NeedleInsertion::stick(NeedleNode& node, std::span<const double> u) {
   model_.fix(std::span<const VertexId>(&node.vertex, 1), anchor);
 }
 
-void NeedleInsertion::slip(NeedleNode& node, double sign, std::span<const double>) {
+void NeedleInsertion::slip(NeedleNode& node, double sign) {
   node.sticking = false;
   node.slip_sign = sign >= 0 ? 1 : -1;
   model_.slide(std::span<const VertexId>(&node.vertex, 1), direction_);
@@ -244,7 +241,11 @@ void NeedleInsertion::slip(NeedleNode& node, double sign, std::span<const double
 void NeedleInsertion::release(std::size_t index) {
   const VertexId v = nodes_[index].vertex;
   model_.constraints().release(std::span<const VertexId>(&v, 1));
-  node_of_vertex_[v] = -1;
+  erase_node(index);
+}
+
+void NeedleInsertion::erase_node(std::size_t index) {
+  node_of_vertex_[nodes_[index].vertex] = -1;
   if (index + 1 != nodes_.size()) {
     nodes_[index] = nodes_.back();
     node_of_vertex_[nodes_[index].vertex] = static_cast<std::int32_t>(index);
@@ -255,7 +256,7 @@ void NeedleInsertion::release(std::size_t index) {
 int NeedleInsertion::update_thresholds() {
   const std::vector<double> u = vec_values(model_.displacement());
   int released = 0;
-  for (NeedleNode& node : nodes_) node.d_needle = along(deformed_position(node.vertex, u));
+  for (NeedleNode& node : nodes_) node.d_needle = along(deformed_point(model_.body().mesh(), u, node.vertex));
   // The node at the entry hovers about s = 0; one pulled back further than the mean spacing
   // of needle nodes has left the body's part of the shaft.
   const double spacing = nodes_.empty() ? 0.0 : (depth_ - std::min(body_entry_, depth_)) / static_cast<double>(nodes_.size());
@@ -312,7 +313,7 @@ int NeedleInsertion::rearrange(NeedleStepReport& report) {
     if (node.sticking) {
       // g is the force the needle exerts to hold the node; along the shaft it is friction.
       if (std::abs(g_along) > node.static_threshold) {
-        slip(node, g_along, u);
+        slip(node, g_along);
         ++report.slipped;
         ++changes;
       }
@@ -387,15 +388,7 @@ void NeedleInsertion::on_change(const Connectivity&, const ConnectivityChange& c
   for (const VertexEvent& event : change.vertex_events) {
     const VertexId v = event.vertex;
     if (event.kind == VertexEventKind::removed) {
-      if (node_index(v) >= 0) {
-        const std::size_t index = static_cast<std::size_t>(node_index(v));
-        node_of_vertex_[v] = -1;
-        if (index + 1 != nodes_.size()) {
-          nodes_[index] = nodes_.back();
-          node_of_vertex_[nodes_[index].vertex] = static_cast<std::int32_t>(index);
-        }
-        nodes_.pop_back();
-      }
+      if (node_index(v) >= 0) erase_node(static_cast<std::size_t>(node_index(v)));  // the model let it go
       continue;
     }
     if (event.kind != VertexEventKind::added || event.parents.count() == 0) continue;
@@ -421,10 +414,10 @@ void NeedleInsertion::on_change(const Connectivity&, const ConnectivityChange& c
     NeedleNode node;
     node.vertex = v;
     node.d_perp = d_perp;
-    node.d_needle = along(deformed_position(v, u));
+    node.d_needle = along(deformed_point(model_.body().mesh(), u, v));
     node.sticking = sticking_parents == event.parents.count();
     add_node(node);
-    if (!node.sticking) slip(nodes_.back(), slip_sign, u);
+    if (!node.sticking) slip(nodes_.back(), slip_sign);
   }
 }
 

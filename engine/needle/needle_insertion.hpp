@@ -105,13 +105,13 @@ class NeedleInsertion : public ConnectivityWatcher {
   void on_change(const Connectivity& connectivity, const ConnectivityChange& change) override;
 
  private:
-  Point2 deformed_position(VertexId v, std::span<const double> u) const;
   double along(const Point2& x) const;   // position along the shaft from the entry point
   double across(const Point2& x) const;  // signed offset from the shaft
   void refine_at_tip();
   int intercept_nodes();
   void stick(NeedleNode& node, std::span<const double> u);
-  void slip(NeedleNode& node, double sign, std::span<const double> u);
+  // Slides along the shaft from where it is; friction pulls it in direction sign (±1).
+  void slip(NeedleNode& node, double sign);
   // Positions along the shaft, shares, thresholds; releases nodes off the needle. Returns the
   // number released.
   int update_thresholds();
@@ -126,7 +126,9 @@ class NeedleInsertion : public ConnectivityWatcher {
   NeedleStepReport advance_in_steps(double distance, int halvings);
   static NeedleStepReport merged(const NeedleStepReport& first, const NeedleStepReport& second);
   static constexpr int max_halvings = 12;
+  // Frees the vertex's constraint and drops the node; erase_node only drops it.
   void release(std::size_t index);
+  void erase_node(std::size_t index);
   void add_node(NeedleNode node);
 
   Model& model_;
