@@ -26,12 +26,22 @@ std::string xml_escaped(const std::string& text) {
   return out;
 }
 
-// A field name must name one HDF5 dataset of the step: not empty, no '/', not a name taken.
-void check_field_name(const std::string& name, const std::vector<std::string>& taken) {
-  if (name.empty() || name.find('/') != std::string::npos || name == "." || name == "..")
-    throw std::invalid_argument("field name '" + name + "' is not usable: give a non-empty name without '/'");
-  for (const std::string& other : taken)
-    if (other == name) throw std::invalid_argument("field name '" + name + "' is used twice in one step");
+// Each field must name one HDF5 dataset of the step (not empty, no '/', not a name taken)
+// and hold one value per cell or point; `taken` collects the names.
+template <class Field>
+void check_fields(const std::vector<Field>& fields, const char* kind, std::int64_t n, const char* what,
+                  std::vector<std::string>& taken) {
+  for (const Field& field : fields) {
+    const std::string& name = field.name;
+    if (name.empty() || name.find('/') != std::string::npos || name == "." || name == "..")
+      throw std::invalid_argument("field name '" + name + "' is not usable: give a non-empty name without '/'");
+    for (const std::string& other : taken)
+      if (other == name) throw std::invalid_argument("field name '" + name + "' is used twice in one step");
+    taken.push_back(name);
+    if (field.values.size() != static_cast<std::size_t>(n))
+      throw std::invalid_argument(std::string(kind) + " field '" + name + "' has " +
+                                  std::to_string(field.values.size()) + " values for " + std::to_string(n) + " " + what);
+  }
 }
 
 std::string file_name(const std::string& path) {
@@ -78,20 +88,8 @@ void XdmfWriter::write_step(double time, const Mesh& mesh, std::span<const doubl
     throw std::invalid_argument("displacement has " + std::to_string(displacement.size()) + " values, expected " +
                                 std::to_string(n_points * dim));
   std::vector<std::string> names{"displacement"};
-  for (const CellField& field : cell_fields) {
-    check_field_name(field.name, names);
-    names.push_back(field.name);
-    if (field.values.size() != static_cast<std::size_t>(n_cells))
-      throw std::invalid_argument("cell field '" + field.name + "' has " + std::to_string(field.values.size()) +
-                                  " values for " + std::to_string(n_cells) + " cells");
-  }
-  for (const PointField& field : point_fields) {
-    check_field_name(field.name, names);
-    names.push_back(field.name);
-    if (field.values.size() != static_cast<std::size_t>(n_points))
-      throw std::invalid_argument("point field '" + field.name + "' has " + std::to_string(field.values.size()) +
-                                  " values for " + std::to_string(n_points) + " points");
-  }
+  check_fields(cell_fields, "cell", n_cells, "cells", names);
+  check_fields(point_fields, "point", n_points, "points", names);
   // The file is open only while a step is written, so readers (ParaView, h5py) can open it
   // between steps.
   file_ = H5Fopen(h5_path().c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
