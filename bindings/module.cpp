@@ -15,4 +15,5 @@ PYBIND11_MODULE(_snede, m) {
   snede::bindings::bind_topology(m);
   snede::bindings::bind_edits(m);
   snede::bindings::bind_needle(m);
+  snede::bindings::bind_cutting(m);
 }

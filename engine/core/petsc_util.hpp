@@ -30,6 +30,37 @@ inline double logged_flops() {
   return flops;
 }
 
+// Read-only and writable views of a sequential Vec as spans (RAII restore).
+class ReadView {
+ public:
+  explicit ReadView(Vec v) : v_(v) {
+    SNEDE_PETSC(VecGetArrayRead(v_, &data_));
+    SNEDE_PETSC(VecGetLocalSize(v_, &n_));
+  }
+  ~ReadView() { VecRestoreArrayRead(v_, &data_); }
+  std::span<const double> span() const { return {data_, static_cast<std::size_t>(n_)}; }
+
+ private:
+  Vec v_;
+  const PetscScalar* data_ = nullptr;
+  PetscInt n_ = 0;
+};
+
+class WriteView {
+ public:
+  explicit WriteView(Vec v) : v_(v) {
+    SNEDE_PETSC(VecGetArray(v_, &data_));
+    SNEDE_PETSC(VecGetLocalSize(v_, &n_));
+  }
+  ~WriteView() { VecRestoreArray(v_, &data_); }
+  std::span<double> span() const { return {data_, static_cast<std::size_t>(n_)}; }
+
+ private:
+  Vec v_;
+  PetscScalar* data_ = nullptr;
+  PetscInt n_ = 0;
+};
+
 // A copy of a sequential Vec's values.
 inline std::vector<double> vec_values(Vec v) {
   const PetscScalar* data = nullptr;

@@ -50,6 +50,24 @@ double facet_measure(const Corners<D>& x, int i) {
   }
 }
 
+// Dihedral angle at each edge (i, j) of tetrahedron_edges: the angle between the two faces
+// containing it, measured from the components of the other two corners orthogonal to the edge.
+std::array<double, 6> dihedral_angles_of(const Corners<3>& x) {
+  std::array<double, 6> angles{};
+  for (int e = 0; e < 6; ++e) {
+    const auto [i, j] = tetrahedron_edges[e];
+    int k = 0;
+    while (k == i || k == j) ++k;
+    const int l = 6 - i - j - k;
+    const Eigen::Vector3d edge = (x.row(j) - x.row(i)).normalized();
+    Eigen::Vector3d u = x.row(k) - x.row(i), w = x.row(l) - x.row(i);
+    u -= u.dot(edge) * edge;
+    w -= w.dot(edge) * edge;
+    angles[e] = std::atan2(u.cross(w).norm(), u.dot(w));
+  }
+  return angles;
+}
+
 template <int D>
 ElementQuality quality_of(const Corners<D>& x) {
   ElementQuality q;
@@ -72,21 +90,9 @@ ElementQuality quality_of(const Corners<D>& x) {
       q.max_dihedral = std::max(q.max_dihedral, angle);
     }
   } else {
-    // Dihedral angle at edge (i, j): angle between the two faces containing it, measured
-    // from the components of the other two corners orthogonal to the edge.
-    for (int i = 0; i < 4; ++i)
-      for (int j = i + 1; j < 4; ++j) {
-        int k = 0;
-        while (k == i || k == j) ++k;
-        int l = 6 - i - j - k;
-        const Eigen::Vector3d edge = (x.row(j) - x.row(i)).normalized();
-        Eigen::Vector3d u = x.row(k) - x.row(i), w = x.row(l) - x.row(i);
-        u -= u.dot(edge) * edge;
-        w -= w.dot(edge) * edge;
-        const double angle = std::atan2(u.cross(w).norm(), u.dot(w));
-        q.min_dihedral = std::min(q.min_dihedral, angle);
-        q.max_dihedral = std::max(q.max_dihedral, angle);
-      }
+    const std::array<double, 6> angles = dihedral_angles_of(x);
+    q.min_dihedral = *std::min_element(angles.begin(), angles.end());
+    q.max_dihedral = *std::max_element(angles.begin(), angles.end());
   }
   return q;
 }
@@ -116,6 +122,10 @@ ElementQuality element_quality(int dim, std::span<const double> corners) {
   return dispatch(dim, corners, [](const auto& x) {
     return quality_of<std::decay_t<decltype(x)>::ColsAtCompileTime>(x);
   });
+}
+
+std::array<double, 6> dihedral_angles(std::span<const double> corners) {
+  return dihedral_angles_of(Corners<3>(corners_of<3>(corners)));
 }
 
 std::array<double, 6> flattened_triangle(std::span<const double> corners) {

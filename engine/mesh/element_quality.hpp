@@ -20,6 +20,11 @@ double signed_volume(int dim, std::span<const double> corners);
 double longest_edge(int dim, std::span<const double> corners);
 ElementQuality element_quality(int dim, std::span<const double> corners);
 
+// The edges of a tetrahedron as pairs of corner indices, in the order dihedral_angles uses.
+inline constexpr std::array<std::array<int, 2>, 6> tetrahedron_edges{{{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}}};
+// A tetrahedron's dihedral angle (radians) at each of tetrahedron_edges; `corners` (4, 3).
+std::array<double, 6> dihedral_angles(std::span<const double> corners);
+
 // A triangle in 3D (surface meshes, §5.3), `corners` (3, 3), laid flat in its own plane: its
 // (2, 2)-corner image with positive area, so that the 2D measures above apply to it.
 std::array<double, 6> flattened_triangle(std::span<const double> corners);

@@ -9,40 +9,6 @@
 #include "core/petsc_util.hpp"
 
 namespace snede {
-namespace {
-
-// Read-only and writable views of a sequential Vec as spans (RAII restore).
-class ReadView {
- public:
-  explicit ReadView(Vec v) : v_(v) {
-    SNEDE_PETSC(VecGetArrayRead(v_, &data_));
-    SNEDE_PETSC(VecGetLocalSize(v_, &n_));
-  }
-  ~ReadView() { VecRestoreArrayRead(v_, &data_); }
-  std::span<const double> span() const { return {data_, static_cast<std::size_t>(n_)}; }
-
- private:
-  Vec v_;
-  const PetscScalar* data_ = nullptr;
-  PetscInt n_ = 0;
-};
-
-class WriteView {
- public:
-  explicit WriteView(Vec v) : v_(v) {
-    SNEDE_PETSC(VecGetArray(v_, &data_));
-    SNEDE_PETSC(VecGetLocalSize(v_, &n_));
-  }
-  ~WriteView() { VecRestoreArray(v_, &data_); }
-  std::span<double> span() const { return {data_, static_cast<std::size_t>(n_)}; }
-
- private:
-  Vec v_;
-  PetscScalar* data_ = nullptr;
-  PetscInt n_ = 0;
-};
-
-}  // namespace
 
 Model::Model(ElasticBody& body) : body_(body), constraints_(body.dim()) {
   n_points_ = body_.mesh().n_points();

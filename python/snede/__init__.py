@@ -19,11 +19,12 @@ from snede.result import SolveResult  # noqa: F401
 from snede.static import StaticSolver  # noqa: F401
 from snede.dynamics import DynamicRelaxation  # noqa: F401
 from snede.needle import FrictionProfile, NeedleInsertion  # noqa: F401
+from snede.cutting import TetrahedralCutter, CutReport  # noqa: F401
 from snede import meshing  # noqa: F401
 
 __all__ = [
     "Mesh", "MeshQuality", "Body", "meshing", "StaticSolver", "DynamicRelaxation", "SolveResult",
-    "FrictionProfile", "NeedleInsertion",
+    "FrictionProfile", "NeedleInsertion", "TetrahedralCutter", "CutReport",
     "LinearElastic", "StVenantKirchhoff", "NeoHookean", "VerondaWestmann",
     "EditResult", "InvalidMesh", "PetscError", "DomainError", "LockingWarning", "PETSc",
 ]

@@ -1,0 +1,53 @@
+#include "bindings.hpp"
+#include "cutting/tetrahedral_cutter.hpp"
+
+#include <pybind11/stl.h>
+
+namespace snede::bindings {
+namespace {
+
+std::unique_ptr<TetrahedralCutter> make_cutter(Mesh& mesh, Model* model, bool snap, bool remove_degeneracies,
+                                               double min_aspect_ratio, double large_angle, bool fix_free_pieces) {
+  CutterOptions options;
+  options.snap = snap;
+  options.remove_degeneracies = remove_degeneracies;
+  options.degeneracy.min_aspect_ratio = min_aspect_ratio;
+  options.degeneracy.large_angle = large_angle;
+  options.fix_free_pieces = fix_free_pieces;
+  return std::make_unique<TetrahedralCutter>(mesh, model, options);
+}
+
+}  // namespace
+
+void bind_cutting(py::module_& m) {
+  py::class_<CutReport>(m, "CutReport")
+      .def_readonly("sweeps", &CutReport::sweeps)
+      .def_readonly("faces_selected", &CutReport::faces_selected)
+      .def_readonly("faces_dissected", &CutReport::faces_dissected)
+      .def_readonly("vertices_split", &CutReport::vertices_split)
+      .def_readonly("vertices_snapped", &CutReport::vertices_snapped)
+      .def_readonly("snaps_refused", &CutReport::snaps_refused)
+      .def_readonly("degenerate_found", &CutReport::degenerate_found)
+      .def_readonly("degenerate_shapes", &CutReport::degenerate_shapes)
+      .def_readonly("edges_collapsed", &CutReport::edges_collapsed)
+      .def_readonly("edges_split", &CutReport::edges_split)
+      .def_readonly("faces_split", &CutReport::faces_split)
+      .def_readonly("elements_cut_free", &CutReport::elements_cut_free)
+      .def_readonly("components", &CutReport::components)
+      .def_readonly("free_pieces", &CutReport::free_pieces)
+      .def_readonly("pieces_fixed", &CutReport::pieces_fixed)
+      .def_readonly("seconds", &CutReport::seconds);
+
+  py::class_<TetrahedralCutter>(m, "TetrahedralCutter")
+      .def(py::init(&make_cutter), py::arg("mesh"), py::arg("model"), py::arg("snap"), py::arg("remove_degeneracies"),
+           py::arg("min_aspect_ratio"), py::arg("large_angle"), py::arg("fix_free_pieces"), py::keep_alive<1, 2>(),
+           py::keep_alive<1, 3>())
+      .def("cut_triangle", [](TetrahedralCutter& c, const DoubleArray& corners) { return c.cut_triangle(view(corners)); },
+           py::arg("corners"))
+      .def("move", [](TetrahedralCutter& c, const DoubleArray& scalpel) { return c.move(view(scalpel)); },
+           py::arg("scalpel"))
+      .def_property_readonly("placed", &TetrahedralCutter::placed)
+      .def("incision_faces", [](const TetrahedralCutter& c) { return to_array(c.incision_faces(), 3); });
+}
+
+}  // namespace snede::bindings

@@ -1,0 +1,251 @@
+#include "cutting/tetrahedral_cutter.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include "core/petsc_util.hpp"
+#include "core/predicates.hpp"
+#include "cutting/node_snapping.hpp"
+#include "mesh/traversal.hpp"
+#include "topology/dissect.hpp"
+
+namespace snede {
+
+void CutReport::add(const CutReport& o) {
+  sweeps += o.sweeps;
+  faces_selected += o.faces_selected;
+  faces_dissected += o.faces_dissected;
+  vertices_split += o.vertices_split;
+  vertices_snapped += o.vertices_snapped;
+  snaps_refused += o.snaps_refused;
+  degenerate_found += o.degenerate_found;
+  for (int k = 0; k < 4; ++k) degenerate_shapes[k] += o.degenerate_shapes[k];
+  edges_collapsed += o.edges_collapsed;
+  edges_split += o.edges_split;
+  faces_split += o.faces_split;
+  elements_cut_free += o.elements_cut_free;
+  components = o.components;
+  free_pieces += o.free_pieces;
+  pieces_fixed += o.pieces_fixed;
+  seconds += o.seconds;
+}
+
+TetrahedralCutter::TetrahedralCutter(Mesh& mesh, Model* model, CutterOptions options)
+    : mesh_(mesh), model_(model), options_(options) {
+  if (mesh.cell_dim() != 3 || mesh.space_dim() != 3)
+    throw std::invalid_argument("TetrahedralCutter: the mesh must be tetrahedral (3D cells in 3D), got cell_dim " +
+                                std::to_string(mesh.cell_dim()) + " in " + std::to_string(mesh.space_dim()) + "D");
+  if (model && &model->body().mesh() != &mesh)
+    throw std::invalid_argument("TetrahedralCutter: the model's body is on another mesh");
+  const DegeneracyOptions& d = options.degeneracy;
+  if (!(d.min_aspect_ratio > 0 && d.min_aspect_ratio < 1))
+    throw std::invalid_argument("TetrahedralCutter: min_aspect_ratio must be in (0, 1), got " + std::to_string(d.min_aspect_ratio));
+  if (!(d.large_angle > 0 && d.large_angle < std::acos(-1.0)))
+    throw std::invalid_argument("TetrahedralCutter: large_angle must be in (0, π), got " + std::to_string(d.large_angle));
+  components_ = connected_components(mesh_.connectivity()).second;
+  mesh_.connectivity().add_watcher(this);
+}
+
+TetrahedralCutter::~TetrahedralCutter() { mesh_.connectivity().remove_watcher(this); }
+
+bool TetrahedralCutter::constrained(VertexId v) const {
+  if (!model_) return false;
+  const ConstraintKind kind = model_->constraints()[v].kind;
+  return kind == ConstraintKind::fixed || kind == ConstraintKind::slide;
+}
+
+CutReport TetrahedralCutter::cut_triangle(std::span<const double> corners) {
+  const SweepTriangle sweep(corners);  // validates before anything changes
+  const double start = wall_seconds();
+  CutReport report;
+  report.sweeps = 1;
+  report.components = components_;
+  const int index = n_sweeps_++;
+  sweeps_.emplace(index, sweep);
+
+  FaceSelection selection;
+  {
+    std::optional<ReadView> u;
+    if (model_) u.emplace(model_->displacement());
+    const DeformedPositions x(mesh_, u ? u->span().data() : nullptr);
+    selection = selector_.select(mesh_.connectivity(), x, sweep, index);
+  }
+  // Faces selected earlier but left joined by their dissection are cut again with the new ones.
+  for (const auto& [f, simplex] : joined_) {
+    const Connectivity& c = mesh_.connectivity();
+    if (c.is_face(f) && c.face(f).simplex == simplex && c.face(f).mate != no_id) selection.faces.push_back(f);
+  }
+  std::sort(selection.faces.begin(), selection.faces.end());
+  selection.faces.erase(std::unique(selection.faces.begin(), selection.faces.end()), selection.faces.end());
+  report.faces_selected = static_cast<int>(selection.faces.size());
+
+  if (!selection.faces.empty()) {
+    if (options_.snap) snap(selection, report);
+    std::vector<VertexId> region;
+    {
+      ChangeBatch batch(mesh_.connectivity());
+      region = dissect_selected(selection.faces, report);
+      if (options_.remove_degeneracies && !region.empty()) {
+        const DegeneracyReport d = remove_degeneracies(mesh_, region, options_.degeneracy);
+        report.degenerate_found = d.found;
+        report.degenerate_shapes = d.by_shape;
+        report.edges_collapsed = d.edges_collapsed;
+        report.edges_split = d.edges_split;
+        report.faces_split = d.faces_split;
+        report.elements_cut_free = d.cut_free;
+      }
+    }
+    if (report.faces_dissected > 0 || report.elements_cut_free > 0) count_pieces(report);
+  }
+  const int oldest = selector_.oldest_sweep();  // planes older than every remembered mark are not needed
+  sweeps_.erase(sweeps_.begin(), sweeps_.lower_bound(oldest >= 0 ? std::min(oldest, index) : index));
+  report.seconds = wall_seconds() - start;
+  return report;
+}
+
+void TetrahedralCutter::snap(const FaceSelection& selection, CutReport& report) {
+  std::vector<VertexId> vertices;
+  for (FaceId f : selection.faces)
+    for (VertexId v : mesh_.connectivity().face(f).simplex.vertices()) vertices.push_back(v);
+  std::sort(vertices.begin(), vertices.end());
+  vertices.erase(std::unique(vertices.begin(), vertices.end()), vertices.end());
+  for (VertexId v : vertices) {
+    if (placed_.count(v)) continue;
+    if (constrained(v)) {  // a support stays where the user put it
+      ++report.snaps_refused;
+      continue;
+    }
+    const int sweep = selector_.marking_sweep(v);
+    const auto plane = sweeps_.find(sweep);
+    if (plane == sweeps_.end()) continue;
+    // Read again for every vertex: each snap moves the vertex before it, with its displacement.
+    std::optional<ReadView> u;
+    if (model_) u.emplace(model_->displacement());
+    const DeformedPositions x(mesh_, u ? u->span().data() : nullptr);
+    const EditResult result = snap_to_sweep(mesh_, x, v, plane->second);
+    if (result.done) {
+      ++report.vertices_snapped;
+      placed_.insert(v);
+    } else {
+      ++report.snaps_refused;
+    }
+  }
+}
+
+std::vector<VertexId> TetrahedralCutter::dissect_selected(std::vector<FaceId> faces, CutReport& report) {
+  Connectivity& c = mesh_.connectivity();
+  std::vector<FaceId> mates;
+  for (FaceId f : faces) mates.push_back(c.face(f).mate);
+  const std::vector<SplitVertex> split =
+      dissect(c, faces, [this](VertexId v) { return mesh_.add_vertex(VertexParents::copy_of(v)); });
+  report.vertices_split = static_cast<int>(split.size());
+  joined_.clear();
+  std::vector<VertexId> region;
+  for (std::size_t i = 0; i < faces.size(); ++i) {
+    const Face& face = c.face(faces[i]);
+    if (face.mate != no_id) {
+      joined_.push_back({faces[i], face.simplex});
+      continue;
+    }
+    ++report.faces_dissected;
+    for (FaceId side : {faces[i], mates[i]}) incision_[side] = c.face(side).simplex;
+    for (VertexId v : face.simplex.vertices()) region.push_back(v), placed_.insert(v);
+  }
+  for (const SplitVertex& s : split) {
+    selector_.copy_vertex(s.original, s.copy);
+    placed_.insert(s.copy);
+    region.push_back(s.copy);
+  }
+  return region;
+}
+
+void TetrahedralCutter::count_pieces(CutReport& report) {
+  const Connectivity& c = mesh_.connectivity();
+  const auto [label, n] = connected_components(c);
+  report.components = components_ = n;
+  std::vector<char> supported(n, 0);
+  std::vector<ElementId> first(n, no_id);
+  for (ElementId e = 0; e < c.element_capacity(); ++e) {
+    if (label[e] < 0) continue;
+    if (first[label[e]] == no_id) first[label[e]] = e;
+    if (!supported[label[e]])
+      for (VertexId v : c.element(e).simplex.vertices())
+        if (constrained(v)) supported[label[e]] = 1;
+  }
+  for (int piece = 0; piece < n; ++piece) {
+    if (supported[piece]) continue;
+    ++report.free_pieces;
+    if (!options_.fix_free_pieces || !model_) continue;
+    // §3.3: fixed on one face, where it is now, so that the static problem stays well posed.
+    const Simplex face = c.element(first[piece]).simplex.subn(0);
+    std::vector<VertexId> vertices(face.vertices().begin(), face.vertices().end());
+    std::vector<double> values;
+    {
+      const ReadView u(model_->displacement());
+      for (VertexId v : vertices)
+        for (int k = 0; k < 3; ++k) values.push_back(u.span()[3 * static_cast<std::size_t>(v) + k]);
+    }
+    model_->fix(vertices, values);
+    ++report.pieces_fixed;
+  }
+}
+
+CutReport TetrahedralCutter::move(std::span<const double> scalpel) {
+  if (scalpel.size() != 6)
+    throw std::invalid_argument("TetrahedralCutter.move: the scalpel is a segment, (2, 3) coordinates; got " +
+                                std::to_string(scalpel.size()) + " numbers");
+  for (std::size_t i = 0; i < 6; ++i)
+    if (!std::isfinite(scalpel[i]))
+      throw std::invalid_argument("TetrahedralCutter.move: scalpel end " + std::to_string(i / 3) + " coordinate " +
+                                  std::to_string(i % 3) + " is " + std::to_string(scalpel[i]) + ", not finite");
+  std::array<double, 6> now;
+  std::copy(scalpel.begin(), scalpel.end(), now.begin());
+  if (now[0] == now[3] && now[1] == now[4] && now[2] == now[5])
+    throw std::invalid_argument("TetrahedralCutter.move: the scalpel's two ends coincide (a segment of zero length)");
+  CutReport report;
+  if (scalpel_) {
+    const std::array<double, 6>& was = *scalpel_;
+    // The quadrilateral p0 p1 q1 q0 swept from (p0, p1) to (q0, q1), as two triangles.
+    const std::array<std::array<double, 9>, 2> halves{{
+        {was[0], was[1], was[2], was[3], was[4], was[5], now[3], now[4], now[5]},
+        {was[0], was[1], was[2], now[3], now[4], now[5], now[0], now[1], now[2]},
+    }};
+    for (const auto& triangle : halves) {
+      const std::array<const double*, 3> p{triangle.data(), triangle.data() + 3, triangle.data() + 6};
+      if (collinear_3d(p[0], p[1], p[2])) continue;  // this half swept no area
+      report.add(cut_triangle(triangle));
+    }
+  }
+  scalpel_ = now;
+  report.components = components_;
+  return report;
+}
+
+std::vector<VertexId> TetrahedralCutter::incision_faces() const {
+  const Connectivity& c = mesh_.connectivity();
+  std::vector<VertexId> faces;
+  for (const auto& [f, simplex] : incision_) {
+    if (!c.is_face(f) || c.face(f).simplex != simplex || c.face(f).mate != no_id) continue;
+    const auto corners = simplex.oriented_vertices();
+    faces.insert(faces.end(), corners.begin(), corners.begin() + 3);
+  }
+  return faces;
+}
+
+void TetrahedralCutter::on_change(const Connectivity& c, const ConnectivityChange& change) {
+  for (const VertexEvent& event : change.vertex_events)
+    if (event.kind == VertexEventKind::removed) {
+      selector_.forget_vertex(event.vertex);
+      placed_.erase(event.vertex);
+    }
+  // A face whose vertices were substituted (a collapse) leaves the boundary under its old
+  // simplex and returns under its new one: the incision follows it.
+  std::unordered_set<Simplex, SimplexHash> left(change.boundary_removed.begin(), change.boundary_removed.end());
+  for (FaceId f : change.boundary_added)
+    if (const auto it = incision_.find(f); it != incision_.end() && left.count(it->second)) it->second = c.face(f).simplex;
+  std::erase_if(incision_, [&](const auto& entry) { return !c.is_face(entry.first) || c.face(entry.first).simplex != entry.second; });
+}
+
+}  // namespace snede

@@ -1,0 +1,105 @@
+// Cutting a tetrahedral body with a scalpel (§3.2–§3.3), in the deformed configuration of a
+// running simulation.
+//
+// The scalpel is a line segment; moving it sweeps a quadrilateral, processed as two sweep
+// triangles. Each sweep triangle is one cut step:
+//  1. face selection (§3.2.1, face_selection.hpp),
+//  2. node snapping of the selected faces' vertices onto the sweep (§3.2.2, node_snapping.hpp),
+//  3. dissection along the selected faces (§7.3, dissect.hpp),
+//  4. degeneracy removal around the cut (§3.2.3, degeneracy_removal.hpp),
+//  5. the pieces (§3.3): a piece that the cut separates from every constraint is reported and,
+//     by option, fixed on one face so that the next static solve is well posed.
+// Steps 3–5 are one change for the mesh's watchers, so a body (its displacement, velocity and
+// constraints carried to new and moved vertices by their parents) reissues its sizes once per
+// sweep triangle, and the solvers continue on the new mesh from the carried state.
+#pragma once
+
+#include <array>
+#include <map>
+#include <optional>
+#include <span>
+#include <unordered_map>
+#include <unordered_set>
+#include <vector>
+
+#include "cutting/face_selection.hpp"
+#include "solve/model.hpp"
+#include "topology/degeneracy_removal.hpp"
+
+namespace snede {
+
+struct CutterOptions {
+  bool snap = true;
+  bool remove_degeneracies = true;
+  DegeneracyOptions degeneracy;
+  bool fix_free_pieces = true;
+};
+
+struct CutReport {
+  int sweeps = 0;              // sweep triangles processed
+  int faces_selected = 0;
+  int faces_dissected = 0;     // selected faces the dissection opened (others stay joined, Figure 7.7)
+  int vertices_split = 0;      // vertex copies the dissection made
+  int vertices_snapped = 0;
+  int snaps_refused = 0;
+  int degenerate_found = 0;
+  std::array<int, 4> degenerate_shapes{};  // needles, spindles, slivers, caps among them
+  int edges_collapsed = 0;
+  int edges_split = 0;
+  int faces_split = 0;         // cap removals: a vertex inserted in a face
+  int elements_cut_free = 0;
+  int components = 0;          // pieces of the body after the cut
+  int free_pieces = 0;         // pieces without any constraint
+  int pieces_fixed = 0;        // of those, fixed on one face (fix_free_pieces)
+  double seconds = 0;
+
+  void add(const CutReport& other);
+};
+
+class TetrahedralCutter : public ConnectivityWatcher {
+ public:
+  // Cuts `mesh` (tetrahedral). With a model (whose body is on this mesh) the scalpel acts on
+  // the deformed body X + u and free pieces can be fixed; without one, on the mesh as it is.
+  // Throws std::invalid_argument for a mesh that is not tetrahedral or bad thresholds.
+  TetrahedralCutter(Mesh& mesh, Model* model, CutterOptions options);
+  ~TetrahedralCutter() override;
+  TetrahedralCutter(const TetrahedralCutter&) = delete;
+  TetrahedralCutter& operator=(const TetrahedralCutter&) = delete;
+
+  // One sweep triangle, corners (3, 3) in deformed coordinates. Throws std::invalid_argument,
+  // before changing anything, for non-finite or collinear corners. A triangle that misses the
+  // body gives an empty report.
+  CutReport cut_triangle(std::span<const double> corners);
+  // Moves the scalpel, a segment (2, 3), from its previous position: the two sweep triangles
+  // between them. The first call only places the scalpel. Throws std::invalid_argument for a
+  // non-finite or zero-length segment; a move that sweeps no area gives an empty report.
+  CutReport move(std::span<const double> scalpel);
+  bool placed() const { return scalpel_.has_value(); }
+
+  // The incision: the boundary faces the cuts opened, (n, 3) vertex ids oriented outward.
+  std::vector<VertexId> incision_faces() const;
+  const CutterOptions& options() const { return options_; }
+
+  void init(const Connectivity&) override {}
+  void on_change(const Connectivity& connectivity, const ConnectivityChange& change) override;
+
+ private:
+  void snap(const FaceSelection& selection, CutReport& report);
+  std::vector<VertexId> dissect_selected(std::vector<FaceId> faces, CutReport& report);
+  void count_pieces(CutReport& report);
+  bool constrained(VertexId v) const;
+
+  Mesh& mesh_;
+  Model* model_;
+  CutterOptions options_;
+  FaceSelector selector_;
+  std::map<int, SweepTriangle> sweeps_;          // by index: those whose planes marked nodes still remembered
+  int n_sweeps_ = 0;
+  std::unordered_set<VertexId> placed_;          // vertices already snapped or on the incision
+  std::vector<std::pair<FaceId, Simplex>> joined_;  // selected faces the dissection left joined
+  std::unordered_map<FaceId, Simplex> incision_;
+  std::optional<std::array<double, 6>> scalpel_;
+  int components_ = 0;  // pieces of the body, counted at construction and after each cut
+};
+
+}  // namespace snede

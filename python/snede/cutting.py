@@ -1,0 +1,147 @@
+"""Cutting tetrahedral bodies with a scalpel (thesis §3.2–§3.3).
+
+The scalpel is a line segment in deformed space. Each ``move`` sweeps the quadrilateral
+between its last and its new position, processed as two sweep triangles; each sweep triangle
+selects faces of the mesh (§3.2.1), snaps their vertices onto the sweep (§3.2.2), dissects
+the mesh along them (§7.3) and removes the flat elements the snapping left (§3.2.3). A Body
+on the mesh keeps its displacement, velocity and constraints across the cut, so a solver
+continues from where it was.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, fields
+
+import numpy as np
+
+from snede import _snede
+from snede.mesh import Mesh
+
+
+@dataclass(frozen=True)
+class CutReport:
+    """What one ``move`` or ``cut_triangle`` did.
+
+    ``faces_dissected`` counts selected faces the dissection opened; a face whose vertices'
+    stars do not split yet (Figure 7.7) stays joined and is cut again with the next sweep.
+    ``degenerate_found`` counts the flat elements (aspect ratio below the threshold) around the
+    cut before removal, ``degenerate_shapes`` them as (needles, spindles, slivers, caps);
+    ``elements_cut_free`` the incollapsible ones that were cut free and removed. ``components``
+    is the number of pieces of the body afterwards; ``free_pieces`` those with no constraint,
+    ``pieces_fixed`` those of them fixed on one face (``fix_free_pieces``)."""
+
+    sweeps: int = 0
+    faces_selected: int = 0
+    faces_dissected: int = 0
+    vertices_split: int = 0
+    vertices_snapped: int = 0
+    snaps_refused: int = 0
+    degenerate_found: int = 0
+    degenerate_shapes: tuple = (0, 0, 0, 0)
+    edges_collapsed: int = 0
+    edges_split: int = 0
+    faces_split: int = 0
+    elements_cut_free: int = 0
+    components: int = 0
+    free_pieces: int = 0
+    pieces_fixed: int = 0
+    seconds: float = 0.0
+
+    @classmethod
+    def _from_engine(cls, r) -> "CutReport":
+        values = {f.name: getattr(r, f.name) for f in fields(cls)}
+        values["degenerate_shapes"] = tuple(values["degenerate_shapes"])
+        return cls(**values)
+
+    def __add__(self, other: "CutReport") -> "CutReport":
+        values = {}
+        for f in fields(self):
+            a, b = getattr(self, f.name), getattr(other, f.name)
+            if f.name == "components":
+                values[f.name] = b if other.sweeps or not self.sweeps else a
+            elif f.name == "degenerate_shapes":
+                values[f.name] = tuple(x + y for x, y in zip(a, b))
+            else:
+                values[f.name] = a + b
+        return CutReport(**values)
+
+    def __str__(self) -> str:
+        return (f"{self.faces_dissected} faces dissected ({self.vertices_snapped} vertices snapped, "
+                f"{self.snaps_refused} refused), {self.degenerate_found} degenerate: {self.edges_collapsed} collapses, "
+                f"{self.edges_split} splits, {self.elements_cut_free} cut free; {self.components} pieces "
+                f"in {self.seconds * 1e3:.2f} ms")
+
+
+def _points(value, shape: tuple, what: str) -> np.ndarray:
+    a = np.asarray(value, dtype=np.float64)
+    if a.shape != shape:
+        raise ValueError(f"{what} must have shape {shape}, got {a.shape}")
+    if not np.all(np.isfinite(a)):
+        raise ValueError(f"{what} has non-finite coordinates: {a.tolist()}")
+    return np.ascontiguousarray(a)
+
+
+class TetrahedralCutter:
+    """``TetrahedralCutter(body_or_mesh, *, snap=True, remove_degeneracies=True,
+    min_aspect_ratio=0.01, large_angle=0.99*pi, fix_free_pieces=True)``.
+
+    * ``body_or_mesh``: a 3D ``snede.Body`` (the scalpel then acts on the deformed body,
+      ``X + u``, as the user sees it) or a tetrahedral ``snede.Mesh`` (cut as it is).
+    * ``snap``: move the cut faces' vertices onto the sweep (§3.2.2); without it the incision
+      is jagged (Figure 3.5). Constrained vertices are never moved.
+    * ``remove_degeneracies``, ``min_aspect_ratio``, ``large_angle``: §3.2.3; elements around
+      the cut with aspect ratio (min height / max edge) below the threshold are collapsed by
+      shape, the rest cut free.
+    * ``fix_free_pieces``: a piece the cut separates from every constraint is fixed on one
+      face where it is (§3.3), so that the next static solve is well posed.
+
+    ``cut_triangle(corners)`` processes one sweep triangle ((3, 3), deformed coordinates);
+    ``move(scalpel)`` moves the scalpel ((2, 3): its two ends) and cuts along the sweep from
+    its previous position (the first call only places it). Both return a :class:`CutReport`.
+    Invalid input raises ``ValueError`` before anything changes.
+    """
+
+    def __init__(self, body_or_mesh, *, snap: bool = True, remove_degeneracies: bool = True,
+                 min_aspect_ratio: float = 0.01, large_angle: float = 0.99 * math.pi, fix_free_pieces: bool = True):
+        if isinstance(body_or_mesh, Mesh):
+            self.body, self.mesh, model = None, body_or_mesh, None
+        elif hasattr(body_or_mesh, "_model") and isinstance(getattr(body_or_mesh, "mesh", None), Mesh):
+            self.body, self.mesh, model = body_or_mesh, body_or_mesh.mesh, body_or_mesh._model
+        else:
+            raise TypeError(f"expected a snede.Body or snede.Mesh, got {type(body_or_mesh).__name__}")
+        if self.mesh.cell_dim != 3:
+            raise ValueError(f"TetrahedralCutter needs a tetrahedral mesh; this mesh has {self.mesh.cell_dim}-D cells")
+        if not (0 < min_aspect_ratio < 1):
+            raise ValueError(f"min_aspect_ratio must be in (0, 1), got {min_aspect_ratio}")
+        if not (0 < large_angle < math.pi):
+            raise ValueError(f"large_angle must be in (0, pi) radians, got {large_angle}")
+        self._impl = _snede.TetrahedralCutter(self.mesh._impl, model, bool(snap), bool(remove_degeneracies),
+                                              float(min_aspect_ratio), float(large_angle), bool(fix_free_pieces))
+
+    def cut_triangle(self, corners) -> CutReport:
+        return CutReport._from_engine(self._impl.cut_triangle(_points(corners, (3, 3), "corners")))
+
+    def move(self, scalpel) -> CutReport:
+        return CutReport._from_engine(self._impl.move(_points(scalpel, (2, 3), "scalpel")))
+
+    def cut(self, path, progress=None) -> CutReport:
+        """Move the scalpel through ``path``, an (n, 2, 3) sequence of scalpel positions; the
+        first places it. ``progress(done, total, report)`` is called after each move."""
+        path = np.asarray(path, dtype=np.float64)
+        if path.ndim != 3 or path.shape[1:] != (2, 3) or len(path) < 2:
+            raise ValueError(f"path must be (n, 2, 3) scalpel positions with n >= 2, got shape {path.shape}")
+        total = CutReport()
+        for k, scalpel in enumerate(path):
+            report = self.move(scalpel)
+            total = total + report
+            if progress is not None:
+                progress(k + 1, len(path), report)
+        return total
+
+    @property
+    def placed(self) -> bool:
+        return self._impl.placed
+
+    def incision_faces(self) -> np.ndarray:
+        """The boundary faces the cuts opened, (n, 3) vertex ids, oriented outward."""
+        return self._impl.incision_faces()
