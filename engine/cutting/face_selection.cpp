@@ -2,15 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <unordered_set>
 
 #include "mesh/element_quality.hpp"
 
 namespace snede {
-
-std::uint64_t FaceSelector::edge_key(VertexId a, VertexId b) {
-  if (a > b) std::swap(a, b);
-  return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(a)) << 32) | static_cast<std::uint32_t>(b);
-}
 
 std::vector<ElementId> FaceSelector::seeds(const Connectivity& c, const DeformedPositions& x,
                                            const SweepTriangle& sweep) const {
@@ -53,36 +49,54 @@ std::vector<ElementId> FaceSelector::walk(const Connectivity& c, const DeformedP
   return met;
 }
 
-FaceSelection FaceSelector::select(const Connectivity& c, const DeformedPositions& x, const SweepTriangle& sweep,
-                                   int sweep_index) {
+FaceSelection FaceSelector::select(const Connectivity& c, const DeformedPositions& x, const SweepTriangle& sweep) {
+  sweeps_.push_back(sweep);
+  if (sweeps_.size() > remembered_sweeps) sweeps_.pop_front();
   FaceSelection selection;
   selection.touched = walk(c, x, sweep, seeds(c, x, sweep));
-  for (ElementId e : selection.touched) {
-    const Simplex& tet = c.element(e).simplex;
-    for (const auto& [i, j] : tetrahedron_edges) {
-      const VertexId a = tet.vertex(i), b = tet.vertex(j);  // a < b: simplex vertices are sorted
-      if (marks_.count(edge_key(a, b))) continue;           // only the first crossing counts
-      const std::optional<double> t = sweep.crossing(x(a), x(b));
-      if (!t) continue;
-      const VertexId node = *t < 0.5 ? a : *t > 0.5 ? b : std::min(a, b);
-      marks_.emplace(edge_key(a, b), Mark{node, sweep_index});
-      node_sweep_.emplace(node, sweep_index);
-      ++selection.edges_crossed;
-    }
-  }
+
+  // The tetrahedra that may be completed now: those met by this sweep and the previous one.
+  std::vector<ElementId> candidates = selection.touched;
+  for (ElementId e : previous_touched_)
+    if (c.is_element(e)) candidates.push_back(e);
+  std::sort(candidates.begin(), candidates.end());
+  candidates.erase(std::unique(candidates.begin(), candidates.end()), candidates.end());
+
+  // The marked end of each edge of the candidates, from its first crossing among the
+  // remembered sweeps (−1: not crossed), and the sweep that marked it.
+  struct Mark {
+    VertexId node = no_id;
+    int sweep = -1;
+  };
+  std::unordered_map<std::uint64_t, Mark> marks;
+  auto mark_of = [&](VertexId a, VertexId b) {
+    const std::uint64_t key = (static_cast<std::uint64_t>(static_cast<std::uint32_t>(a)) << 32) | static_cast<std::uint32_t>(b);
+    auto [it, fresh] = marks.try_emplace(key);
+    if (fresh)
+      for (std::size_t s = 0; s < sweeps_.size(); ++s)
+        if (const std::optional<double> t = sweeps_[s].crossing(x(a), x(b))) {
+          it->second = {*t < 0.5 ? a : *t > 0.5 ? b : std::min(a, b), static_cast<int>(s)};
+          break;
+        }
+    return it->second;
+  };
+
   std::unordered_set<FaceId> chosen;
-  for (ElementId e : selection.touched) {
+  for (ElementId e : candidates) {
     const Simplex& tet = c.element(e).simplex;
-    std::array<bool, 4> marked{};
-    for (const auto& [i, j] : tetrahedron_edges)
-      if (const auto it = marks_.find(edge_key(tet.vertex(i), tet.vertex(j))); it != marks_.end())
-        marked[tet.index(it->second.node)] = true;
-    const int n_marked = static_cast<int>(std::count(marked.begin(), marked.end(), true));
+    std::array<int, 4> marked_by{-1, -1, -1, -1};
+    for (const auto& [i, j] : tetrahedron_edges) {
+      const Mark m = mark_of(tet.vertex(i), tet.vertex(j));  // a < b: simplex vertices are sorted
+      if (m.node == no_id) continue;
+      int& by = marked_by[tet.index(m.node)];
+      if (by < 0 || m.sweep < by) by = m.sweep;
+    }
+    const int n_marked = static_cast<int>(std::count_if(marked_by.begin(), marked_by.end(), [](int s) { return s >= 0; }));
     if (n_marked < 3) continue;
-    int left_out = static_cast<int>(std::find(marked.begin(), marked.end(), false) - marked.begin());
+    int left_out = static_cast<int>(std::find(marked_by.begin(), marked_by.end(), -1) - marked_by.begin());
     if (n_marked == 4) {
-      // Only when the sweep halves the edges exactly (§3.2.1): keep the three corners
-      // closest to this sweep's plane (the thesis picks a face at random).
+      // Only when a sweep halves the edges exactly (§3.2.1): keep the three corners closest
+      // to this sweep's plane (the thesis picks a face at random).
       ++selection.four_marked;
       double farthest = -1;
       for (int k = 0; k < 4; ++k)
@@ -91,63 +105,14 @@ FaceSelection FaceSelector::select(const Connectivity& c, const DeformedPosition
     const FaceId f = c.opposite_face(e, tet.vertex(left_out));
     const FaceId mate = c.face(f).mate;
     if (mate == no_id) continue;  // already on the surface: nothing to dissect
-    if (chosen.insert(std::min(f, mate)).second) selection.faces.push_back(std::min(f, mate));
+    if (!chosen.insert(std::min(f, mate)).second) continue;
+    selection.faces.push_back(std::min(f, mate));
+    for (int k = 0; k < 4; ++k)
+      if (k != left_out) selection.plane.try_emplace(tet.vertex(k), sweeps_[marked_by[k]]);
   }
   std::sort(selection.faces.begin(), selection.faces.end());
-  std::vector<ElementId> remembered = selection.touched;
-  for (ElementId e : previous_touched_)
-    if (c.is_element(e)) remembered.push_back(e);
-  keep_marks_of(c, remembered);
   previous_touched_ = selection.touched;
   return selection;
-}
-
-void FaceSelector::keep_marks_of(const Connectivity& c, const std::vector<ElementId>& elements) {
-  // Marks matter only for the tetrahedra the scalpel may still complete: those met by the
-  // last two sweeps. Dropping the rest keeps the memory (and every later update) local.
-  std::unordered_map<std::uint64_t, Mark> kept;
-  for (ElementId e : elements) {
-    const Simplex& tet = c.element(e).simplex;
-    for (const auto& [i, j] : tetrahedron_edges)
-      if (const auto it = marks_.find(edge_key(tet.vertex(i), tet.vertex(j))); it != marks_.end()) kept.insert(*it);
-  }
-  marks_ = std::move(kept);
-  std::unordered_map<VertexId, int> nodes;
-  for (const auto& [key, mark] : marks_)
-    if (const auto it = node_sweep_.find(mark.node); it != node_sweep_.end()) nodes.insert(*it);
-  node_sweep_ = std::move(nodes);
-}
-
-int FaceSelector::marking_sweep(VertexId v) const {
-  const auto it = node_sweep_.find(v);
-  return it == node_sweep_.end() ? -1 : it->second;
-}
-
-int FaceSelector::oldest_sweep() const {
-  int oldest = -1;
-  for (const auto& [v, sweep] : node_sweep_)
-    if (oldest < 0 || sweep < oldest) oldest = sweep;
-  return oldest;
-}
-
-void FaceSelector::forget_vertex(VertexId v) {
-  std::erase_if(marks_, [v](const auto& entry) {
-    return static_cast<VertexId>(entry.first >> 32) == v || static_cast<VertexId>(entry.first & 0xffffffffu) == v;
-  });
-  node_sweep_.erase(v);
-}
-
-void FaceSelector::copy_vertex(VertexId original, VertexId copy) {
-  // Edges of the copy that do not exist are never looked up, and the next selection drops them.
-  std::vector<std::pair<std::uint64_t, Mark>> added;
-  for (const auto& [key, mark] : marks_) {
-    const VertexId a = static_cast<VertexId>(key >> 32), b = static_cast<VertexId>(key & 0xffffffffu);
-    if (a != original && b != original) continue;
-    const VertexId other = a == original ? b : a;
-    added.push_back({edge_key(copy, other), Mark{mark.node == original ? copy : mark.node, mark.sweep}});
-  }
-  for (const auto& entry : added) marks_.insert(entry);
-  if (const auto it = node_sweep_.find(original); it != node_sweep_.end()) node_sweep_.emplace(copy, it->second);
 }
 
 }  // namespace snede

@@ -3,20 +3,25 @@
 // Every mesh edge that a sweep triangle crosses marks the end closest to the crossing (the
 // lower id when the edge is halved); only an edge's first crossing counts, so that sweeps
 // turning back cannot mark all four corners of a tetrahedron. A tetrahedron whose edges mark
-// exactly three of its corners selects the face they span (Figure 3.1). Marks persist from
-// one sweep triangle to the next for the tetrahedra the scalpel is still in (the incomplete
-// ones, Figure 3.2), so successive triangles give one connected cut surface, lagging behind
-// the scalpel (Figure 3.4).
+// exactly three of its corners selects the face they span (Figure 3.1).
 //
-// The search is local: the tetrahedra the sweep meets are found by a walk across faces from
+// Intersections of earlier sweep triangles count for the tetrahedra the scalpel is still in
+// (the incomplete ones, Figure 3.2), so successive triangles give one connected cut surface,
+// lagging behind the scalpel (Figure 3.4). The thesis stores those intersections; here the
+// selector keeps the last few sweep triangles instead and re-evaluates the crossings of the
+// tetrahedra met by the current and the previous sweep on the mesh as it is now: node
+// snapping has moved vertices since, and stored marks from before the move leave gaps in the
+// cut surface. Re-evaluated, a vertex snapped onto a sweep is marked by every edge that
+// touches it, and a planar sweep through the body always separates it.
+//
+// The search is local: the tetrahedra a sweep meets are found by a walk across faces from
 // those the previous sweep met; only the first contact (no previous sweep, or nothing met
 // near it) scans the boundary of the body, and a sweep entirely inside the body with no
 // previous contact scans the elements.
 #pragma once
 
-#include <cstdint>
+#include <deque>
 #include <unordered_map>
-#include <unordered_set>
 #include <vector>
 
 #include "cutting/deformed_positions.hpp"
@@ -28,37 +33,24 @@ namespace snede {
 struct FaceSelection {
   std::vector<FaceId> faces;       // interior faces to dissect, one of each mate pair
   std::vector<ElementId> touched;  // tetrahedra the sweep triangle meets
-  int edges_crossed = 0;           // edges crossed for the first time by this sweep
+  std::unordered_map<VertexId, SweepTriangle> plane;  // per vertex of `faces`: the sweep that marked it
   int four_marked = 0;             // tetrahedra with all four corners marked (one face chosen)
 };
 
 class FaceSelector {
  public:
-  // Processes sweep triangle number `sweep_index` against the deformed mesh.
-  FaceSelection select(const Connectivity& c, const DeformedPositions& x, const SweepTriangle& sweep, int sweep_index);
-  // The sweep that first marked v (its plane is where §3.2.2 snaps v), or −1.
-  int marking_sweep(VertexId v) const;
-  // Mesh edits the marks must follow: a vertex removed (its id may be reused), and a vertex
-  // copied by dissection (the copy's edges keep the original's marks).
-  void forget_vertex(VertexId v);
-  void copy_vertex(VertexId original, VertexId copy);
-  std::size_t n_marks() const { return marks_.size(); }
-  // The oldest sweep a remembered mark refers to (older planes are no longer needed), or −1.
-  int oldest_sweep() const;
+  // How many recent sweep triangles count for first crossings.
+  static constexpr std::size_t remembered_sweeps = 4;
+
+  // Processes the next sweep triangle against the deformed mesh.
+  FaceSelection select(const Connectivity& c, const DeformedPositions& x, const SweepTriangle& sweep);
 
  private:
-  struct Mark {
-    VertexId node;
-    int sweep;
-  };
-  static std::uint64_t edge_key(VertexId a, VertexId b);
   std::vector<ElementId> seeds(const Connectivity& c, const DeformedPositions& x, const SweepTriangle& sweep) const;
   std::vector<ElementId> walk(const Connectivity& c, const DeformedPositions& x, const SweepTriangle& sweep,
                               std::vector<ElementId> seeds) const;
-  void keep_marks_of(const Connectivity& c, const std::vector<ElementId>& elements);
 
-  std::unordered_map<std::uint64_t, Mark> marks_;
-  std::unordered_map<VertexId, int> node_sweep_;
+  std::deque<SweepTriangle> sweeps_;  // oldest first, the current one last
   std::vector<ElementId> previous_touched_;
 };
 

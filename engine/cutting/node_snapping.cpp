@@ -1,6 +1,8 @@
 #include "cutting/node_snapping.hpp"
 
 #include <Eigen/Dense>
+#include <algorithm>
+#include <array>
 #include <limits>
 #include <optional>
 
@@ -16,27 +18,47 @@ Eigen::Vector3d vec(const Point3& p) { return {p[0], p[1], p[2]}; }
 // Barycentric coordinates tolerance: a point on a shared face or edge belongs to both sides.
 constexpr double inside_tolerance = 1e-10;
 
-// The closest point to `from` on the line where the sweep plane meets the plane of boundary
-// face (a, b, c), if it lies in that face.
-std::optional<Eigen::Vector3d> on_boundary_face(const SweepTriangle& plane, const Eigen::Vector3d& from,
-                                                const Eigen::Vector3d& a, const Eigen::Vector3d& b,
-                                                const Eigen::Vector3d& c) {
-  const Eigen::Vector3d n1 = vec(plane.normal());
-  Eigen::Vector3d n2 = (b - a).cross(c - a);
-  const double area2 = n2.norm();
-  if (!(area2 > 0)) return std::nullopt;
-  n2 /= area2;
-  const double cosine = n1.dot(n2), det = 1 - cosine * cosine;
-  if (det < 1e-12) return std::nullopt;  // the face is parallel to the sweep plane
-  // y = from + α n1 + β n2 on both planes: the nearest point of their intersection line.
-  const double r1 = plane.offset() - n1.dot(from), r2 = n2.dot(a) - n2.dot(from);
-  const double alpha = (r1 - cosine * r2) / det, beta = (r2 - cosine * r1) / det;
-  const Eigen::Vector3d y = from + alpha * n1 + beta * n2;
-  // Inside the face: the sub-triangle areas against the face normal are all ≥ 0.
-  const double wa = (b - y).cross(c - y).dot(n2), wb = (c - y).cross(a - y).dot(n2), wc = (a - y).cross(b - y).dot(n2);
-  const double tolerance = -inside_tolerance * area2;
-  if (wa < tolerance || wb < tolerance || wc < tolerance) return std::nullopt;
-  return y;
+// Candidates for a boundary vertex in boundary face `corner`: where the sweep plane crosses
+// the face, a segment; its point closest to `from`, and its two ends (which lie on the face's
+// edges, and so on a crease of the body when the face borders one).
+std::vector<Eigen::Vector3d> on_boundary_face(const SweepTriangle& plane, const Eigen::Vector3d& from,
+                                              const std::array<Eigen::Vector3d, 3>& corner) {
+  std::array<double, 3> d;
+  for (int k = 0; k < 3; ++k) d[k] = plane.signed_distance({corner[k][0], corner[k][1], corner[k][2]});
+  std::vector<Eigen::Vector3d> ends;
+  for (int k = 0; k < 3; ++k) {
+    const int l = (k + 1) % 3;
+    if (d[k] == 0) ends.push_back(corner[k]);
+    if ((d[k] < 0 && d[l] > 0) || (d[k] > 0 && d[l] < 0)) ends.push_back(corner[k] + d[k] / (d[k] - d[l]) * (corner[l] - corner[k]));
+  }
+  if (ends.size() == 2) {
+    const Eigen::Vector3d p = ends[0], pq = ends[1] - ends[0];
+    const double length2 = pq.squaredNorm();
+    if (length2 > 0) ends.push_back(p + std::clamp((from - p).dot(pq) / length2, 0.0, 1.0) * pq);
+  }
+  return ends;
+}
+
+Eigen::Vector3d unit_normal(const std::array<Eigen::Vector3d, 3>& face) {
+  return (face[1] - face[0]).cross(face[2] - face[0]).normalized();
+}
+
+// Faces meeting at more than this angle form a crease (an edge or corner of the body) that a
+// snapped vertex must stay on; below it the surface counts as smooth.
+constexpr double crease_angle_cosine = 0.866;  // 30°
+
+// Whether moving the vertex to y, within boundary face `in`, leaves it on the plane of every
+// boundary face around it that meets `in` at a crease: the body keeps its edges and corners.
+bool keeps_features(const std::vector<std::array<Eigen::Vector3d, 3>>& boundary,
+                    const std::array<Eigen::Vector3d, 3>& in, const Eigen::Vector3d& y) {
+  const Eigen::Vector3d n_in = unit_normal(in);
+  for (const auto& face : boundary) {
+    const Eigen::Vector3d n = unit_normal(face);
+    if (n.dot(n_in) >= crease_angle_cosine) continue;
+    const double scale = (face[1] - face[0]).norm() + (face[2] - face[0]).norm();
+    if (std::abs(n.dot(y - face[0])) > 1e-9 * scale) return false;
+  }
+  return true;
 }
 
 }  // namespace
@@ -48,18 +70,19 @@ EditResult snap_to_sweep(Mesh& mesh, const DeformedPositions& x, VertexId v, con
   const std::string name = "vertex " + std::to_string(v);
 
   // Where v goes in deformed space.
-  bool on_boundary = false;
-  std::optional<Eigen::Vector3d> target;
+  std::vector<std::array<Eigen::Vector3d, 3>> boundary;
   for (ElementId e : star)
     for (FaceId f : c.element(e).faces) {
       const Face& face = c.face(f);
       if (face.mate != no_id || !face.simplex.contains(v)) continue;
-      on_boundary = true;
       const Simplex& s = face.simplex;
-      const auto y = on_boundary_face(plane, from, vec(x(s.vertex(0))), vec(x(s.vertex(1))), vec(x(s.vertex(2))));
-      if (y && (!target || (*y - from).norm() < (*target - from).norm())) target = y;
+      boundary.push_back({vec(x(s.vertex(0))), vec(x(s.vertex(1))), vec(x(s.vertex(2)))});
     }
-  if (!on_boundary) target = vec(plane.project(x(v)));
+  std::optional<Eigen::Vector3d> target;
+  if (boundary.empty()) target = vec(plane.project(x(v)));
+  for (const auto& face : boundary)
+    for (const Eigen::Vector3d& y : on_boundary_face(plane, from, face))
+      if (keeps_features(boundary, face, y) && (!target || (y - from).norm() < (*target - from).norm())) target = y;
   if (!target) return EditResult::refused(name + " is on the boundary and no boundary face around it meets the sweep plane");
 
   // The tetrahedron of the star containing it (deformed), and the point's barycentric

@@ -3,8 +3,13 @@
 //
 // In the deformed configuration an interior vertex is projected orthogonally onto the plane
 // of its sweep triangle; a boundary vertex, so as not to change the shape of a flat surface,
-// onto the line where that plane meets each boundary face around it, keeping the projection
-// closest to the vertex that lies in its face (Figure 3.6). The point is taken back to the
+// onto the segment where that plane crosses each boundary face around it (its point closest to
+// the vertex), keeping the candidate closest to the vertex (Figure 3.6). The thesis projects
+// onto the line and drops a projection outside the face, which fails at corners and edges of
+// the body where the line's nearest point lies beyond the face; the segment's nearest point
+// is always in the face. On a crease of the body (faces meeting at more than 30°: an edge or
+// a corner of a box) the vertex may only move along the crease, so that the body keeps its
+// shape; a corner does not move. The point is taken back to the
 // reference configuration through the tetrahedron around the vertex that contains it (the
 // barycentric coordinates of the point in the deformed tetrahedron, applied to its reference
 // corners), which carries the displacement with it: the vertex's deformed position becomes
@@ -17,8 +22,8 @@
 
 namespace snede {
 
-// Refused, leaving the mesh unchanged, when no boundary face around a boundary vertex meets
-// the plane within the face, when no tetrahedron around the vertex contains the point (the
+// Refused, leaving the mesh unchanged, when the plane crosses no boundary face around a
+// boundary vertex, when no tetrahedron around the vertex contains the point (the
 // thesis's failed repositioning), or when the move would make an element of the vertex's
 // star flat or inverted in the reference or the deformed configuration.
 EditResult snap_to_sweep(Mesh& mesh, const DeformedPositions& x, VertexId v, const SweepTriangle& plane);

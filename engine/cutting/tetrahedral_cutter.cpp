@@ -62,15 +62,13 @@ CutReport TetrahedralCutter::cut_triangle(std::span<const double> corners) {
   CutReport report;
   report.sweeps = 1;
   report.components = components_;
-  const int index = n_sweeps_++;
-  sweeps_.emplace(index, sweep);
 
   FaceSelection selection;
   {
     std::optional<ReadView> u;
     if (model_) u.emplace(model_->displacement());
     const DeformedPositions x(mesh_, u ? u->span().data() : nullptr);
-    selection = selector_.select(mesh_.connectivity(), x, sweep, index);
+    selection = selector_.select(mesh_.connectivity(), x, sweep);
   }
   // Faces selected earlier but left joined by their dissection are cut again with the new ones.
   for (const auto& [f, simplex] : joined_) {
@@ -82,11 +80,12 @@ CutReport TetrahedralCutter::cut_triangle(std::span<const double> corners) {
   report.faces_selected = static_cast<int>(selection.faces.size());
 
   if (!selection.faces.empty()) {
-    if (options_.snap) snap(selection, report);
     std::vector<VertexId> region;
+    if (options_.snap) region = snap(selection, report);
     {
       ChangeBatch batch(mesh_.connectivity());
-      region = dissect_selected(selection.faces, report);
+      const std::vector<VertexId> cut = dissect_selected(selection.faces, report);
+      region.insert(region.end(), cut.begin(), cut.end());
       if (options_.remove_degeneracies && !region.empty()) {
         const DegeneracyReport d = remove_degeneracies(mesh_, region, options_.degeneracy);
         report.degenerate_found = d.found;
@@ -99,13 +98,12 @@ CutReport TetrahedralCutter::cut_triangle(std::span<const double> corners) {
     }
     if (report.faces_dissected > 0 || report.elements_cut_free > 0) count_pieces(report);
   }
-  const int oldest = selector_.oldest_sweep();  // planes older than every remembered mark are not needed
-  sweeps_.erase(sweeps_.begin(), sweeps_.lower_bound(oldest >= 0 ? std::min(oldest, index) : index));
   report.seconds = wall_seconds() - start;
   return report;
 }
 
-void TetrahedralCutter::snap(const FaceSelection& selection, CutReport& report) {
+std::vector<VertexId> TetrahedralCutter::snap(const FaceSelection& selection, CutReport& report) {
+  std::vector<VertexId> snapped;
   std::vector<VertexId> vertices;
   for (FaceId f : selection.faces)
     for (VertexId v : mesh_.connectivity().face(f).simplex.vertices()) vertices.push_back(v);
@@ -117,9 +115,8 @@ void TetrahedralCutter::snap(const FaceSelection& selection, CutReport& report) 
       ++report.snaps_refused;
       continue;
     }
-    const int sweep = selector_.marking_sweep(v);
-    const auto plane = sweeps_.find(sweep);
-    if (plane == sweeps_.end()) continue;
+    const auto plane = selection.plane.find(v);
+    if (plane == selection.plane.end()) continue;  // a vertex of a face selected by an earlier sweep
     // Read again for every vertex: each snap moves the vertex before it, with its displacement.
     std::optional<ReadView> u;
     if (model_) u.emplace(model_->displacement());
@@ -128,10 +125,12 @@ void TetrahedralCutter::snap(const FaceSelection& selection, CutReport& report) 
     if (result.done) {
       ++report.vertices_snapped;
       placed_.insert(v);
+      snapped.push_back(v);
     } else {
       ++report.snaps_refused;
     }
   }
+  return snapped;
 }
 
 std::vector<VertexId> TetrahedralCutter::dissect_selected(std::vector<FaceId> faces, CutReport& report) {
@@ -154,7 +153,6 @@ std::vector<VertexId> TetrahedralCutter::dissect_selected(std::vector<FaceId> fa
     for (VertexId v : face.simplex.vertices()) region.push_back(v), placed_.insert(v);
   }
   for (const SplitVertex& s : split) {
-    selector_.copy_vertex(s.original, s.copy);
     placed_.insert(s.copy);
     region.push_back(s.copy);
   }
@@ -165,6 +163,7 @@ void TetrahedralCutter::count_pieces(CutReport& report) {
   const Connectivity& c = mesh_.connectivity();
   const auto [label, n] = connected_components(c);
   report.components = components_ = n;
+  if (!model_) return;  // a bare mesh has no supports to be free of
   std::vector<char> supported(n, 0);
   std::vector<ElementId> first(n, no_id);
   for (ElementId e = 0; e < c.element_capacity(); ++e) {
@@ -236,10 +235,7 @@ std::vector<VertexId> TetrahedralCutter::incision_faces() const {
 
 void TetrahedralCutter::on_change(const Connectivity& c, const ConnectivityChange& change) {
   for (const VertexEvent& event : change.vertex_events)
-    if (event.kind == VertexEventKind::removed) {
-      selector_.forget_vertex(event.vertex);
-      placed_.erase(event.vertex);
-    }
+    if (event.kind == VertexEventKind::removed) placed_.erase(event.vertex);
   // A face whose vertices were substituted (a collapse) leaves the boundary under its old
   // simplex and returns under its new one: the incision follows it.
   std::unordered_set<Simplex, SimplexHash> left(change.boundary_removed.begin(), change.boundary_removed.end());

@@ -15,7 +15,6 @@
 #pragma once
 
 #include <array>
-#include <map>
 #include <optional>
 #include <span>
 #include <unordered_map>
@@ -84,7 +83,8 @@ class TetrahedralCutter : public ConnectivityWatcher {
   void on_change(const Connectivity& connectivity, const ConnectivityChange& change) override;
 
  private:
-  void snap(const FaceSelection& selection, CutReport& report);
+  // Snaps the selected faces' vertices; returns those moved.
+  std::vector<VertexId> snap(const FaceSelection& selection, CutReport& report);
   std::vector<VertexId> dissect_selected(std::vector<FaceId> faces, CutReport& report);
   void count_pieces(CutReport& report);
   bool constrained(VertexId v) const;
@@ -93,8 +93,6 @@ class TetrahedralCutter : public ConnectivityWatcher {
   Model* model_;
   CutterOptions options_;
   FaceSelector selector_;
-  std::map<int, SweepTriangle> sweeps_;          // by index: those whose planes marked nodes still remembered
-  int n_sweeps_ = 0;
   std::unordered_set<VertexId> placed_;          // vertices already snapped or on the incision
   std::vector<std::pair<FaceId, Simplex>> joined_;  // selected faces the dissection left joined
   std::unordered_map<FaceId, Simplex> incision_;
