@@ -5,6 +5,7 @@
 #include <cmath>
 #include <stdexcept>
 #include <string>
+#include <tuple>
 #include <unordered_set>
 
 #include "topology/collapse_edge.hpp"
@@ -15,6 +16,10 @@
 
 namespace snede {
 namespace {
+
+// Passes stop when the list of degenerate elements did not shrink (§3.2.3), and after this many
+// at most.
+constexpr int max_passes = 8;
 
 // Keeps splits away from the ends of an edge: there a collapse alone does the job.
 constexpr double min_split_fraction = 0.05;
@@ -246,13 +251,22 @@ DegeneracyReport remove_degeneracies(Mesh& mesh, const std::vector<VertexId>& re
       if (mesh.is_vertex(v))
         for (ElementId e : local_star(c, v).elements)
           if (seen.insert(e).second && remover.degenerate(e)) found.push_back(e);
-    std::sort(found.begin(), found.end());
+    // Caps first, then slivers, spindles and needles, the flattest first within a class: a cap's
+    // neighbours are often slivers that its removal repairs, while their splits would cut the
+    // cap into degenerate pieces.
+    std::vector<std::tuple<int, double, ElementId>> order;
+    for (ElementId e : found) {
+      const std::vector<double> x = mesh.corners(e);
+      order.push_back({-static_cast<int>(degenerate_shape(x, options.large_angle)), element_quality(3, x).aspect_ratio, e});
+    }
+    std::sort(order.begin(), order.end());
+    for (std::size_t i = 0; i < found.size(); ++i) found[i] = std::get<2>(order[i]);
     return found;
   };
   std::vector<ElementId> degenerate = list();
   report.found = static_cast<int>(degenerate.size());
   for (ElementId e : degenerate) ++report.by_shape[static_cast<int>(degenerate_shape(mesh.corners(e), options.large_angle))];
-  while (!degenerate.empty()) {
+  while (!degenerate.empty() && report.passes < max_passes) {
     ++report.passes;
     for (ElementId e : degenerate) {
       if (!c.is_element(e) || !remover.degenerate(e)) continue;  // gone or repaired by an earlier collapse
@@ -262,11 +276,9 @@ DegeneracyReport remove_degeneracies(Mesh& mesh, const std::vector<VertexId>& re
     around.insert(remover.created.begin(), remover.created.end());
     remover.created.clear();
     std::vector<ElementId> next = list();
-    if (next.size() >= degenerate.size()) {
-      degenerate = std::move(next);
-      break;
-    }
+    const bool shorter = next.size() < degenerate.size();
     degenerate = std::move(next);
+    if (!shorter) break;
   }
   for (ElementId e : degenerate)
     if (c.is_element(e) && remover.degenerate(e)) remover.cut_free(e);

@@ -13,8 +13,9 @@
 //    and the short edge between them is collapsed.
 // Collapses keep a boundary vertex where they can (the body's shape and the cut surface stay
 // put) and are refused, never forced, when they would change the topology or invert an
-// element (Figure 3.10); a split whose collapse is refused is undone. After a pass the
-// degenerate elements are listed again; passes continue while the list shrinks. What remains
+// element (Figure 3.10); a split whose collapse is refused is undone. Within a pass, caps go
+// first, then slivers, spindles and needles, the flattest first. After a pass the degenerate
+// elements are listed again; passes continue while the list shrinks (at most 8). What remains
 // is cut free (dissected along its faces) and removed.
 #pragma once
 
