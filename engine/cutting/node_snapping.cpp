@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <array>
 #include <limits>
+#include <map>
 #include <optional>
 
 #include "core/predicates.hpp"
@@ -43,23 +44,9 @@ Eigen::Vector3d unit_normal(const std::array<Eigen::Vector3d, 3>& face) {
   return (face[1] - face[0]).cross(face[2] - face[0]).normalized();
 }
 
-// Faces meeting at more than this angle form a crease (an edge or corner of the body) that a
-// snapped vertex must stay on; below it the surface counts as smooth.
+// Boundary faces meeting at more than this angle form a crease (an edge or corner of the body)
+// that a snapped vertex must stay on; below it the surface counts as smooth.
 constexpr double crease_angle_cosine = 0.866;  // 30°
-
-// Whether moving the vertex to y, within boundary face `in`, leaves it on the plane of every
-// boundary face around it that meets `in` at a crease: the body keeps its edges and corners.
-bool keeps_features(const std::vector<std::array<Eigen::Vector3d, 3>>& boundary,
-                    const std::array<Eigen::Vector3d, 3>& in, const Eigen::Vector3d& y) {
-  const Eigen::Vector3d n_in = unit_normal(in);
-  for (const auto& face : boundary) {
-    const Eigen::Vector3d n = unit_normal(face);
-    if (n.dot(n_in) >= crease_angle_cosine) continue;
-    const double scale = (face[1] - face[0]).norm() + (face[2] - face[0]).norm();
-    if (std::abs(n.dot(y - face[0])) > 1e-9 * scale) return false;
-  }
-  return true;
-}
 
 }  // namespace
 
@@ -71,19 +58,37 @@ EditResult snap_to_sweep(Mesh& mesh, const DeformedPositions& x, VertexId v, con
 
   // Where v goes in deformed space.
   std::vector<std::array<Eigen::Vector3d, 3>> boundary;
+  std::map<VertexId, std::vector<Eigen::Vector3d>> edge_normals;  // boundary edges (v, w): their faces' normals
   for (ElementId e : star)
     for (FaceId f : c.element(e).faces) {
       const Face& face = c.face(f);
       if (face.mate != no_id || !face.simplex.contains(v)) continue;
-      const Simplex& s = face.simplex;
-      boundary.push_back({vec(x(s.vertex(0))), vec(x(s.vertex(1))), vec(x(s.vertex(2)))});
+      const auto corner = face.simplex.oriented_vertices();  // consistent normals across faces
+      boundary.push_back({vec(x(corner[0])), vec(x(corner[1])), vec(x(corner[2]))});
+      for (VertexId w : face.simplex.vertices())
+        if (w != v) edge_normals[w].push_back(unit_normal(boundary.back()));
     }
+  std::vector<VertexId> creases;
+  for (const auto& [w, normals] : edge_normals)
+    if (normals.size() == 2 && normals[0].dot(normals[1]) < crease_angle_cosine) creases.push_back(w);
+  auto consider = [&](const Eigen::Vector3d& y, std::optional<Eigen::Vector3d>& best) {
+    if (!best || (y - from).norm() < (*best - from).norm()) best = y;
+  };
   std::optional<Eigen::Vector3d> target;
-  if (boundary.empty()) target = vec(plane.project(x(v)));
-  for (const auto& face : boundary)
-    for (const Eigen::Vector3d& y : on_boundary_face(plane, from, face))
-      if (keeps_features(boundary, face, y) && (!target || (y - from).norm() < (*target - from).norm())) target = y;
-  if (!target) return EditResult::refused(name + " is on the boundary and no boundary face around it meets the sweep plane");
+  if (boundary.empty()) {
+    target = vec(plane.project(x(v)));
+  } else if (creases.empty()) {  // a smooth surface: anywhere the plane crosses a face around v
+    for (const auto& face : boundary)
+      for (const Eigen::Vector3d& y : on_boundary_face(plane, from, face)) consider(y, target);
+  } else if (creases.size() == 2) {  // on an edge of the body: only along it, so the body keeps its shape
+    for (VertexId w : creases) {
+      const double dv = plane.signed_distance(x(v)), dw = plane.signed_distance(x(w));
+      if ((dv <= 0 && dw >= 0) || (dv >= 0 && dw <= 0))
+        if (dv != dw) consider(from + dv / (dv - dw) * (vec(x(w)) - from), target);
+    }
+  }  // a corner of the body does not move
+  if (!target)
+    return EditResult::refused(name + " is on the boundary: a corner, or the sweep plane crosses no boundary face (or edge of the body) around it");
 
   // The tetrahedron of the star containing it (deformed), and the point's barycentric
   // coordinates there: the most interior choice when it lies on a shared face.
