@@ -72,9 +72,13 @@ FaceSelection FaceSelector::select(const Connectivity& c, const DeformedPosition
   auto mark_of = [&](VertexId a, VertexId b) {
     const std::uint64_t key = (static_cast<std::uint64_t>(static_cast<std::uint32_t>(a)) << 32) | static_cast<std::uint32_t>(b);
     auto [it, fresh] = marks.try_emplace(key);
-    if (fresh)
-      for (std::size_t s = 0; s < sweeps_.size(); ++s)
-        if (const std::optional<double> t = sweeps_[s].crossing(x(a), x(b))) {
+    if (!fresh) return it->second;
+    const Point3 pa = x(a), pb = x(b);
+    Point3 lo, hi;
+    for (int k = 0; k < 3; ++k) lo[k] = std::min(pa[k], pb[k]), hi[k] = std::max(pa[k], pb[k]);
+    for (std::size_t s = 0; s < sweeps_.size(); ++s)
+      if (sweeps_[s].box_overlaps(lo, hi))
+        if (const std::optional<double> t = sweeps_[s].crossing(pa, pb)) {
           it->second = {*t < 0.5 ? a : *t > 0.5 ? b : std::min(a, b), static_cast<int>(s)};
           break;
         }

@@ -39,8 +39,10 @@ struct FaceSelection {
 
 class FaceSelector {
  public:
-  // How many recent sweep triangles count for first crossings.
-  static constexpr std::size_t remembered_sweeps = 4;
+  // How many recent sweep triangles count for first crossings: a tetrahedron must be crossed
+  // completely within this many (32 scalpel moves), so steps shorter than about 1/30 of an
+  // element cut nothing. Each edge is tested only against sweeps whose boxes it meets.
+  static constexpr std::size_t remembered_sweeps = 64;
 
   // Processes the next sweep triangle against the deformed mesh.
   FaceSelection select(const Connectivity& c, const DeformedPositions& x, const SweepTriangle& sweep);

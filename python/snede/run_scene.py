@@ -92,7 +92,7 @@ def run(scene, method: str | None, rtol: float | None, out: Path, progress: bool
     writer = SeriesWriter(folder / scene.name)
     outcome = (scene.evolve or partial(solve_once, scene))(method, rtol, writer, folder, progress)
     picture = plot_body(body, folder / f"{scene.name}.png", title=f"{scene.name}: {type(body.material).__name__}, {method}",
-                        scale=scene.plot_scale, decorate=scene.decorate)
+                        scale=scene.plot_scale, decorate=scene.decorate, **(scene.picture() if scene.picture else {}))
     value = scene.probe(body)
     files = outcome.pop("files", {})
     summary = {

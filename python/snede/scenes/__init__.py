@@ -26,6 +26,7 @@ class Scene:
     # evolve(method, rtol, writer, folder, progress) -> summary entries (see run_scene.solve_once).
     evolve: Callable | None = None
     decorate: Callable | None = None  # decorate(ax): marks on the 2D picture
+    picture: Callable | None = None  # picture() -> more keyword arguments of plotting.plot_body, after the run
 
 
 def material(name: str, young: float, poisson: float, gamma: float = 8.0):
@@ -42,6 +43,6 @@ def material(name: str, young: float, poisson: float, gamma: float = 8.0):
 
 
 def builders() -> dict:
-    from snede.scenes import cantilever, cylinder, needle, slab
+    from snede.scenes import cantilever, cut, cylinder, needle, slab
 
-    return {"cantilever": cantilever, "cylinder": cylinder, "slab": slab, "needle": needle}
+    return {"cantilever": cantilever, "cylinder": cylinder, "slab": slab, "needle": needle, "cut": cut}

@@ -228,3 +228,16 @@ def test_bad_input_is_refused_before_anything_changes():
     report = cutter.move([[6, 5, 5], [6, 6, 5]])
     assert report.sweeps == 2 and report.faces_selected == 0 and report.faces_dissected == 0
     np.testing.assert_array_equal(mesh.points, points)
+
+
+@pytest.mark.parametrize("moves", [4, 16, 64])
+def test_small_scalpel_steps_cut_as_much_as_large_ones(moves):
+    """A tetrahedron crossed over many small moves still selects its face: crossings of the
+    earlier sweeps count (§3.2.1, Figure 3.2). 64 moves over 0.8 m are 1/13 of an element each."""
+    mesh = snede.meshing.box((1, 1, 1), (6, 6, 6))
+    cutter = snede.TetrahedralCutter(mesh)
+    cutter.cut([[[0.55, -0.5, z], [0.55, 1.5, z]] for z in np.linspace(1.1, 0.3, moves + 1)])
+    mesh._impl.validate()
+    # The plane x = 0.55 from the top down to z = 0.3: 6 columns × (rows fully passed) × 2 faces,
+    # the same whatever the step.
+    assert len(cutter.incision_faces()) == 96
