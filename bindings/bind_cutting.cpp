@@ -21,22 +21,25 @@ std::unique_ptr<TetrahedralCutter> make_cutter(Mesh& mesh, Model* model, bool sn
 
 void bind_cutting(py::module_& m) {
   py::class_<CutReport>(m, "CutReport")
-      .def_readonly("sweeps", &CutReport::sweeps)
-      .def_readonly("faces_selected", &CutReport::faces_selected)
-      .def_readonly("faces_dissected", &CutReport::faces_dissected)
-      .def_readonly("vertices_split", &CutReport::vertices_split)
-      .def_readonly("vertices_snapped", &CutReport::vertices_snapped)
-      .def_readonly("snaps_refused", &CutReport::snaps_refused)
-      .def_readonly("degenerate_found", &CutReport::degenerate_found)
-      .def_readonly("degenerate_shapes", &CutReport::degenerate_shapes)
-      .def_readonly("edges_collapsed", &CutReport::edges_collapsed)
-      .def_readonly("edges_split", &CutReport::edges_split)
-      .def_readonly("faces_split", &CutReport::faces_split)
-      .def_readonly("elements_cut_free", &CutReport::elements_cut_free)
-      .def_readonly("components", &CutReport::components)
-      .def_readonly("free_pieces", &CutReport::free_pieces)
-      .def_readonly("pieces_fixed", &CutReport::pieces_fixed)
-      .def_readonly("seconds", &CutReport::seconds);
+      .def(py::init<>())
+      .def("add", &CutReport::add, py::arg("other"))
+      .def_readwrite("sweeps", &CutReport::sweeps)
+      .def_readwrite("faces_selected", &CutReport::faces_selected)
+      .def_readwrite("faces_dissected", &CutReport::faces_dissected)
+      .def_readwrite("vertices_split", &CutReport::vertices_split)
+      .def_readwrite("vertices_snapped", &CutReport::vertices_snapped)
+      .def_readwrite("snaps_refused", &CutReport::snaps_refused)
+      .def_readwrite("degenerate_found", &CutReport::degenerate_found)
+      .def_readwrite("degenerate_shapes", &CutReport::degenerate_shapes)
+      .def_readwrite("edges_collapsed", &CutReport::edges_collapsed)
+      .def_readwrite("edges_split", &CutReport::edges_split)
+      .def_readwrite("faces_split", &CutReport::faces_split)
+      .def_readwrite("elements_cut_free", &CutReport::elements_cut_free)
+      .def_readwrite("components", &CutReport::components)
+      .def_readwrite("free_pieces", &CutReport::free_pieces)
+      .def_readwrite("pieces_fixed", &CutReport::pieces_fixed)
+      .def_readwrite("piece_search", &CutReport::piece_search)
+      .def_readwrite("seconds", &CutReport::seconds);
 
   py::class_<TetrahedralCutter>(m, "TetrahedralCutter")
       .def(py::init(&make_cutter), py::arg("mesh"), py::arg("model"), py::arg("snap"), py::arg("remove_degeneracies"),
@@ -46,6 +49,7 @@ void bind_cutting(py::module_& m) {
            py::arg("corners"))
       .def("move", [](TetrahedralCutter& c, const DoubleArray& scalpel) { return c.move(view(scalpel)); },
            py::arg("scalpel"))
+      .def("lift", &TetrahedralCutter::lift)
       .def_property_readonly("placed", &TetrahedralCutter::placed)
       .def("incision_faces", [](const TetrahedralCutter& c) { return to_array(c.incision_faces(), 3); });
 }

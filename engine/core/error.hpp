@@ -35,6 +35,19 @@ inline void require(bool ok, const std::string& what, const char* expectation, d
 
 inline bool positive_finite(double x) { return x > 0 && std::isfinite(x); }
 
+// Throws std::invalid_argument "<what>: <point_name> i coordinate k is x, not finite" for the
+// first non-finite number of `coordinates`, read as points of `dim` coordinates each.
+inline void require_finite_points(const double* coordinates, std::size_t size, int dim, const std::string& what,
+                                  const char* point_name) {
+  for (std::size_t i = 0; i < size; ++i) {
+    if (std::isfinite(coordinates[i])) continue;
+    std::ostringstream message;
+    message << what << ": " << point_name << " " << i / dim << " coordinate " << i % dim << " is "
+            << coordinates[i] << ", not finite";
+    throw std::invalid_argument(message.str());
+  }
+}
+
 // Runs `body` inside a callback that PETSc calls (MatMult of a shell, SNES function, ...):
 // a C++ exception becomes a PETSc error carrying its message, so it travels back through
 // PETSc to the caller instead of unwinding through C frames.

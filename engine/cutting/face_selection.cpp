@@ -101,7 +101,6 @@ FaceSelection FaceSelector::select(const Connectivity& c, const DeformedPosition
     if (n_marked == 4) {
       // Only when a sweep halves the edges exactly (§3.2.1): keep the three corners closest
       // to this sweep's plane (the thesis picks a face at random).
-      ++selection.four_marked;
       double farthest = -1;
       for (int k = 0; k < 4; ++k)
         if (const double d = std::abs(sweep.signed_distance(x(tet.vertex(k)))); d > farthest) farthest = d, left_out = k;

@@ -34,7 +34,6 @@ struct FaceSelection {
   std::vector<FaceId> faces;       // interior faces to dissect, one of each mate pair
   std::vector<ElementId> touched;  // tetrahedra the sweep triangle meets
   std::unordered_map<VertexId, SweepTriangle> plane;  // per vertex of `faces`: the sweep that marked it
-  int four_marked = 0;             // tetrahedra with all four corners marked (one face chosen)
 };
 
 class FaceSelector {
@@ -46,6 +45,11 @@ class FaceSelector {
 
   // Processes the next sweep triangle against the deformed mesh.
   FaceSelection select(const Connectivity& c, const DeformedPositions& x, const SweepTriangle& sweep);
+  // Forgets the earlier sweeps: the next one is a first contact.
+  void forget() {
+    sweeps_.clear();
+    previous_touched_.clear();
+  }
 
  private:
   std::vector<ElementId> seeds(const Connectivity& c, const DeformedPositions& x, const SweepTriangle& sweep) const;

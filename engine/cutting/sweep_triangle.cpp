@@ -5,6 +5,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "core/error.hpp"
 #include "core/predicates.hpp"
 
 namespace snede {
@@ -41,10 +42,7 @@ SweepTriangle::SweepTriangle(std::span<const double> corners) {
   if (corners.size() != 9)
     throw std::invalid_argument("sweep triangle: expected (3, 3) corner coordinates, got " +
                                 std::to_string(corners.size()) + " numbers");
-  for (std::size_t i = 0; i < 9; ++i)
-    if (!std::isfinite(corners[i]))
-      throw std::invalid_argument("sweep triangle: corner " + std::to_string(i / 3) + " coordinate " +
-                                  std::to_string(i % 3) + " is " + std::to_string(corners[i]) + ", not finite");
+  require_finite_points(corners.data(), corners.size(), 3, "sweep triangle", "corner");
   for (int i = 0; i < 3; ++i) corner_[i] = {corners[3 * i], corners[3 * i + 1], corners[3 * i + 2]};
   if (collinear_3d(corner_[0].data(), corner_[1].data(), corner_[2].data()))
     throw std::invalid_argument("sweep triangle: the three corners are collinear (the scalpel did not sweep an area)");

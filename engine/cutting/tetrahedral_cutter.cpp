@@ -5,10 +5,10 @@
 #include <stdexcept>
 #include <string>
 
+#include "core/error.hpp"
 #include "core/petsc_util.hpp"
 #include "core/predicates.hpp"
 #include "cutting/node_snapping.hpp"
-#include "mesh/traversal.hpp"
 #include "topology/dissect.hpp"
 
 namespace snede {
@@ -26,14 +26,15 @@ void CutReport::add(const CutReport& o) {
   edges_split += o.edges_split;
   faces_split += o.faces_split;
   elements_cut_free += o.elements_cut_free;
-  components = o.components;
+  if (o.sweeps > 0 || sweeps == 0) components = o.components;  // the later count, unless it swept nothing
   free_pieces += o.free_pieces;
   pieces_fixed += o.pieces_fixed;
+  piece_search += o.piece_search;
   seconds += o.seconds;
 }
 
 TetrahedralCutter::TetrahedralCutter(Mesh& mesh, Model* model, CutterOptions options)
-    : mesh_(mesh), model_(model), options_(options) {
+    : mesh_(mesh), model_(model), options_(options), pieces_(mesh.connectivity()) {
   if (mesh.cell_dim() != 3 || mesh.space_dim() != 3)
     throw std::invalid_argument("TetrahedralCutter: the mesh must be tetrahedral (3D cells in 3D), got cell_dim " +
                                 std::to_string(mesh.cell_dim()) + " in " + std::to_string(mesh.space_dim()) + "D");
@@ -44,7 +45,6 @@ TetrahedralCutter::TetrahedralCutter(Mesh& mesh, Model* model, CutterOptions opt
     throw std::invalid_argument("TetrahedralCutter: min_aspect_ratio must be in (0, 1), got " + std::to_string(d.min_aspect_ratio));
   if (!(d.large_angle > 0 && d.large_angle < std::acos(-1.0)))
     throw std::invalid_argument("TetrahedralCutter: large_angle must be in (0, π), got " + std::to_string(d.large_angle));
-  components_ = connected_components(mesh_.connectivity()).second;
   mesh_.connectivity().add_watcher(this);
 }
 
@@ -61,7 +61,7 @@ CutReport TetrahedralCutter::cut_triangle(std::span<const double> corners) {
   const double start = wall_seconds();
   CutReport report;
   report.sweeps = 1;
-  report.components = components_;
+  report.components = pieces_.pieces();
 
   FaceSelection selection;
   {
@@ -96,7 +96,7 @@ CutReport TetrahedralCutter::cut_triangle(std::span<const double> corners) {
         report.elements_cut_free = d.cut_free;
       }
     }
-    if (report.faces_dissected > 0 || report.elements_cut_free > 0) count_pieces(report);
+    count_pieces(report);
   }
   report.seconds = wall_seconds() - start;
   return report;
@@ -161,17 +161,21 @@ std::vector<VertexId> TetrahedralCutter::dissect_selected(std::vector<FaceId> fa
 
 void TetrahedralCutter::count_pieces(CutReport& report) {
   const Connectivity& c = mesh_.connectivity();
-  const auto [label, n] = connected_components(c);
-  report.components = components_ = n;
-  if (!model_) return;  // a bare mesh has no supports to be free of
+  const bool separated = pieces_.update(c);
+  report.piece_search = pieces_.last_search_size();
+  report.components = pieces_.pieces();
+  if (!separated || !model_) return;  // a bare mesh has no supports to be free of
+  const int n = pieces_.pieces();
+  auto label = [this](ElementId e) { return pieces_.label(e); };
   std::vector<char> supported(n, 0);
   std::vector<ElementId> first(n, no_id);
   for (ElementId e = 0; e < c.element_capacity(); ++e) {
-    if (label[e] < 0) continue;
-    if (first[label[e]] == no_id) first[label[e]] = e;
-    if (!supported[label[e]])
+    if (!c.is_element(e)) continue;
+    const int piece = label(e);
+    if (first[piece] == no_id) first[piece] = e;
+    if (!supported[piece])
       for (VertexId v : c.element(e).simplex.vertices())
-        if (constrained(v)) supported[label[e]] = 1;
+        if (constrained(v)) supported[piece] = 1;
   }
   for (int piece = 0; piece < n; ++piece) {
     if (supported[piece]) continue;
@@ -195,10 +199,7 @@ CutReport TetrahedralCutter::move(std::span<const double> scalpel) {
   if (scalpel.size() != 6)
     throw std::invalid_argument("TetrahedralCutter.move: the scalpel is a segment, (2, 3) coordinates; got " +
                                 std::to_string(scalpel.size()) + " numbers");
-  for (std::size_t i = 0; i < 6; ++i)
-    if (!std::isfinite(scalpel[i]))
-      throw std::invalid_argument("TetrahedralCutter.move: scalpel end " + std::to_string(i / 3) + " coordinate " +
-                                  std::to_string(i % 3) + " is " + std::to_string(scalpel[i]) + ", not finite");
+  require_finite_points(scalpel.data(), scalpel.size(), 3, "TetrahedralCutter.move", "scalpel end");
   std::array<double, 6> now;
   std::copy(scalpel.begin(), scalpel.end(), now.begin());
   if (now[0] == now[3] && now[1] == now[4] && now[2] == now[5])
@@ -218,8 +219,14 @@ CutReport TetrahedralCutter::move(std::span<const double> scalpel) {
     }
   }
   scalpel_ = now;
-  report.components = components_;
+  report.components = pieces_.pieces();
   return report;
+}
+
+void TetrahedralCutter::lift() {
+  scalpel_.reset();
+  selector_.forget();
+  joined_.clear();
 }
 
 std::vector<VertexId> TetrahedralCutter::incision_faces() const {
@@ -234,6 +241,7 @@ std::vector<VertexId> TetrahedralCutter::incision_faces() const {
 }
 
 void TetrahedralCutter::on_change(const Connectivity& c, const ConnectivityChange& change) {
+  pieces_.on_change(c, change);
   for (const VertexEvent& event : change.vertex_events)
     if (event.kind == VertexEventKind::removed) placed_.erase(event.vertex);
   // A face whose vertices were substituted (a collapse) leaves the boundary under its old

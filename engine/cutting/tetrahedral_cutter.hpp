@@ -7,8 +7,9 @@
 //  2. node snapping of the selected faces' vertices onto the sweep (§3.2.2, node_snapping.hpp),
 //  3. dissection along the selected faces (§7.3, dissect.hpp),
 //  4. degeneracy removal around the cut (§3.2.3, degeneracy_removal.hpp),
-//  5. the pieces (§3.3): a piece that the cut separates from every constraint is reported and,
-//     by option, fixed on one face so that the next static solve is well posed.
+//  5. the pieces (§3.3, piece_tracker.hpp, a search local to the cut): a piece that the cut
+//     separates from every constraint is reported and, by option, fixed on one face so that
+//     the next static solve is well posed.
 // Steps 3–5 are one change for the mesh's watchers, so a body (its displacement, velocity and
 // constraints carried to new and moved vertices by their parents) reissues its sizes once per
 // sweep triangle, and the solvers continue on the new mesh from the carried state.
@@ -22,6 +23,7 @@
 #include <vector>
 
 #include "cutting/face_selection.hpp"
+#include "mesh/piece_tracker.hpp"
 #include "solve/model.hpp"
 #include "topology/degeneracy_removal.hpp"
 
@@ -48,10 +50,13 @@ struct CutReport {
   int faces_split = 0;         // cap removals: a vertex inserted in a face
   int elements_cut_free = 0;
   int components = 0;          // pieces of the body after the cut
-  int free_pieces = 0;         // pieces without any constraint
+  int free_pieces = 0;         // after a sweep that separated a piece: pieces without any constraint
   int pieces_fixed = 0;        // of those, fixed on one face (fix_free_pieces)
+  std::size_t piece_search = 0;  // elements the local search for separated pieces visited
   double seconds = 0;
 
+  // Accumulates a later report: counts and times add up; components is the later report's
+  // unless that one swept nothing.
   void add(const CutReport& other);
 };
 
@@ -74,6 +79,10 @@ class TetrahedralCutter : public ConnectivityWatcher {
   // non-finite or zero-length segment; a move that sweeps no area gives an empty report.
   CutReport move(std::span<const double> scalpel);
   bool placed() const { return scalpel_.has_value(); }
+  // Lifts the scalpel out of the body: the next move only places it, and the next sweep
+  // starts a new incision (earlier sweeps no longer count for the tetrahedra they left
+  // incomplete, and faces left joined are not cut again).
+  void lift();
 
   // The incision: the boundary faces the cuts opened, (n, 3) vertex ids oriented outward.
   std::vector<VertexId> incision_faces() const;
@@ -97,7 +106,7 @@ class TetrahedralCutter : public ConnectivityWatcher {
   std::vector<std::pair<FaceId, Simplex>> joined_;  // selected faces the dissection left joined
   std::unordered_map<FaceId, Simplex> incision_;
   std::optional<std::array<double, 6>> scalpel_;
-  int components_ = 0;  // pieces of the body, counted at construction and after each cut
+  PieceTracker pieces_;
 };
 
 }  // namespace snede

@@ -27,8 +27,10 @@ class CutReport:
     ``degenerate_found`` counts the flat elements (aspect ratio below the threshold) around the
     cut before removal, ``degenerate_shapes`` them as (needles, spindles, slivers, caps);
     ``elements_cut_free`` the incollapsible ones that were cut free and removed. ``components``
-    is the number of pieces of the body afterwards; ``free_pieces`` those with no constraint,
-    ``pieces_fixed`` those of them fixed on one face (``fix_free_pieces``)."""
+    is the number of pieces of the body afterwards. On a sweep that separates a piece,
+    ``free_pieces`` counts the pieces with no constraint and ``pieces_fixed`` those of them
+    fixed on one face (``fix_free_pieces``). ``piece_search`` is the number of elements the
+    local search for separated pieces visited (it stays near the cut unless a piece separates)."""
 
     sweeps: int = 0
     faces_selected: int = 0
@@ -45,6 +47,7 @@ class CutReport:
     components: int = 0
     free_pieces: int = 0
     pieces_fixed: int = 0
+    piece_search: int = 0
     seconds: float = 0.0
 
     @classmethod
@@ -53,17 +56,18 @@ class CutReport:
         values["degenerate_shapes"] = tuple(values["degenerate_shapes"])
         return cls(**values)
 
-    def __add__(self, other: "CutReport") -> "CutReport":
-        values = {}
+    def _to_engine(self):
+        report = _snede.CutReport()
         for f in fields(self):
-            a, b = getattr(self, f.name), getattr(other, f.name)
-            if f.name == "components":
-                values[f.name] = b if other.sweeps or not self.sweeps else a
-            elif f.name == "degenerate_shapes":
-                values[f.name] = tuple(x + y for x, y in zip(a, b))
-            else:
-                values[f.name] = a + b
-        return CutReport(**values)
+            setattr(report, f.name, getattr(self, f.name))
+        return report
+
+    def __add__(self, other: "CutReport") -> "CutReport":
+        """Both reports together (counts and times add up; ``components`` is ``other``'s
+        unless it swept nothing), combined by the engine as ``move`` combines its halves."""
+        total = self._to_engine()
+        total.add(other._to_engine())
+        return CutReport._from_engine(total)
 
     def __str__(self) -> str:
         return (f"{self.faces_dissected} faces dissected ({self.vertices_snapped} vertices snapped, "
@@ -137,6 +141,11 @@ class TetrahedralCutter:
             if progress is not None:
                 progress(k + 1, len(path), report)
         return total
+
+    def lift(self) -> None:
+        """Lift the scalpel out of the body: the next ``move`` only places it, and the next
+        cut is a new incision (earlier sweeps no longer count, Figure 3.2)."""
+        self._impl.lift()
 
     @property
     def placed(self) -> bool:

@@ -241,3 +241,35 @@ def test_small_scalpel_steps_cut_as_much_as_large_ones(moves):
     # The plane x = 0.55 from the top down to z = 0.3: 6 columns × (rows fully passed) × 2 faces,
     # the same whatever the step.
     assert len(cutter.incision_faces()) == 96
+
+
+def test_lifting_the_scalpel_starts_a_new_incision_instead_of_sweeping_between_the_two():
+    mesh = snede.meshing.box((1, 1, 1), (8, 8, 8))
+    cutter = snede.TetrahedralCutter(mesh)
+    notch = [np.array([[0.3, -1.0, z], [0.3, 2.0, z]]) for z in (1.2, 0.6)]  # down to z = 0.6 at x = 0.3
+    first = cutter.cut(notch)
+    assert first.faces_dissected > 0 and cutter.placed
+    cutter.lift()
+    assert not cutter.placed
+    placing = cutter.move(np.array([[0.7, -1.0, 1.2], [0.7, 2.0, 1.2]]))
+    assert placing.sweeps == 0 and placing.faces_dissected == 0
+    second = cutter.move(np.array([[0.7, -1.0, 0.6], [0.7, 2.0, 0.6]]))
+    assert second.faces_dissected > 0 and second.components == 1
+    mesh._impl.validate()
+    # Two notches and nothing between them: every incision vertex lies on x = 0.3 or x = 0.7,
+    # where a scalpel that was not lifted would have swept the plane from one to the other.
+    x = mesh.points[np.unique(cutter.incision_faces()), 0]
+    assert np.all(np.isclose(x, 0.3, atol=1e-12) | np.isclose(x, 0.7, atol=1e-12))
+    assert np.any(np.isclose(x, 0.3, atol=1e-12)) and np.any(np.isclose(x, 0.7, atol=1e-12))
+
+
+def test_pieces_are_counted_by_a_search_near_the_cut_until_one_separates():
+    mesh = snede.meshing.box((1, 1, 1), (14, 14, 14))
+    n = mesh.n_cells
+    cutter = snede.TetrahedralCutter(mesh)
+    path = [np.array([[0.47, -1.0, z], [0.47, 2.0, z]]) for z in np.linspace(1.3, -0.3, 9)]
+    reports = [cutter.move(scalpel) for scalpel in path]
+    notching = [r for r in reports[1:] if r.faces_dissected > 0 and r.components == 1]
+    assert notching, "the path never cut without separating"
+    assert max(r.piece_search for r in notching) < n / 10
+    assert reports[-1].components == 2 == mesh.connected_components()[0]
