@@ -16,4 +16,5 @@ PYBIND11_MODULE(_snede, m) {
   snede::bindings::bind_edits(m);
   snede::bindings::bind_needle(m);
   snede::bindings::bind_cutting(m);
+  snede::bindings::bind_planar_cutting(m);
 }

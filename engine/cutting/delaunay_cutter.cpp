@@ -1,0 +1,551 @@
+#include "cutting/delaunay_cutter.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+#include "core/error.hpp"
+#include "core/petsc_util.hpp"
+#include "core/predicates.hpp"
+#include "needle/deformed_queries.hpp"
+#include "topology/collapse_edge.hpp"
+#include "topology/dissect.hpp"
+#include "topology/flip_edge.hpp"
+#include "topology/insert_vertex.hpp"
+#include "topology/local_star.hpp"
+#include "topology/remove_vertex.hpp"
+#include "topology/snap_vertex.hpp"
+#include "topology/split_edge.hpp"
+
+namespace snede {
+namespace {
+
+using Point = std::array<double, 2>;
+
+Point minus(const Point& a, const Point& b) { return {a[0] - b[0], a[1] - b[1]}; }
+double cross(const Point& a, const Point& b) { return a[0] * b[1] - a[1] * b[0]; }
+double distance(const Point& a, const Point& b) { return std::hypot(a[0] - b[0], a[1] - b[1]); }
+Point lerp(const Point& a, const Point& b, double t) { return {a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])}; }
+
+// Barycentric coordinates of x in triangle (a, b, c).
+std::array<double, 3> barycentric(const Point& a, const Point& b, const Point& c, const Point& x) {
+  const double area = cross(minus(b, a), minus(c, a));
+  const double lb = cross(minus(x, a), minus(c, a)) / area, lc = cross(minus(b, a), minus(x, a)) / area;
+  return {1 - lb - lc, lb, lc};
+}
+
+// Where segment p→q crosses segment a→b: (fraction along pq, fraction along ab), exact
+// about whether they meet (touching counts), or nothing.
+std::optional<std::pair<double, double>> segments_cross(const Point& p, const Point& q, const Point& a, const Point& b) {
+  const int sa = orientation_2d(p.data(), q.data(), a.data()), sb = orientation_2d(p.data(), q.data(), b.data());
+  if ((sa > 0 && sb > 0) || (sa < 0 && sb < 0) || (sa == 0 && sb == 0)) return std::nullopt;
+  const int sp = orientation_2d(a.data(), b.data(), p.data()), sq = orientation_2d(a.data(), b.data(), q.data());
+  if ((sp > 0 && sq > 0) || (sp < 0 && sq < 0)) return std::nullopt;
+  const Point d = minus(q, p), e = minus(b, a);
+  const double denominator = cross(d, e);
+  if (denominator == 0) return std::nullopt;
+  const double s = cross(minus(a, p), e) / denominator, t = cross(minus(a, p), d) / denominator;
+  return std::pair{std::clamp(s, 0.0, 1.0), std::clamp(t, 0.0, 1.0)};
+}
+
+// Interior angle at w of triangle (w, a, b).
+double angle_at(const Point& w, const Point& a, const Point& b) {
+  const Point u = minus(a, w), v = minus(b, w);
+  return std::atan2(std::abs(cross(u, v)), u[0] * v[0] + u[1] * v[1]);
+}
+
+}  // namespace
+
+void PlanarCutReport::add(const PlanarCutReport& later) {
+  if (moves == 0) triangles_before = later.triangles_before;
+  moves += later.moves;
+  flips += later.flips;
+  nodes_removed += later.nodes_removed;
+  nodes_inserted += later.nodes_inserted;
+  incision_splits += later.incision_splits;
+  edges_contracted += later.edges_contracted;
+  entries += later.entries;
+  exits += later.exits;
+  stuck += later.stuck;
+  triangles_after = later.triangles_after;
+  seconds += later.seconds;
+}
+
+DelaunayCutter::DelaunayCutter(Mesh& mesh, Model* model, DelaunayCutterOptions options)
+    : mesh_(mesh), model_(model), options_(options) {
+  if (mesh.cell_dim() != 2 || mesh.space_dim() != 2)
+    throw std::invalid_argument("DelaunayCutter: the mesh must be a 2D triangle mesh, got cell_dim " +
+                                std::to_string(mesh.cell_dim()) + " in " + std::to_string(mesh.space_dim()) + "D");
+  if (model && &model->body().mesh() != &mesh) throw std::invalid_argument("DelaunayCutter: the model's body is on another mesh");
+  for (const auto& [name, value] : {std::pair{"eps_edge", options.eps_edge}, std::pair{"eps_entry", options.eps_entry},
+                                    std::pair{"eps_exit", options.eps_exit}})
+    require(value >= 0 && std::isfinite(value), std::string("DelaunayCutter: ") + name, "finite and positive (0: the default)", value);
+  require(options.short_edge_angle >= 0 && options.short_edge_angle < std::acos(-1.0) / 2,
+          "DelaunayCutter: short_edge_angle", "in [0, π/2) radians", options.short_edge_angle);
+  // §5.4: thresholds as fractions of the mean edge length.
+  double total = 0;
+  std::size_t edges = 0;
+  const Connectivity& c = mesh.connectivity();
+  for (FaceId f = 0; f < c.face_capacity(); ++f) {
+    if (!c.is_face(f) || (c.face(f).mate != no_id && c.face(f).mate < f)) continue;
+    total += distance(reference(c.face(f).simplex.vertex(0)), reference(c.face(f).simplex.vertex(1)));
+    ++edges;
+  }
+  if (edges == 0) throw std::invalid_argument("DelaunayCutter: the mesh has no edges");
+  const double mean = total / static_cast<double>(edges);
+  if (options_.eps_edge == 0) options_.eps_edge = mean / 3;
+  if (options_.eps_entry == 0) options_.eps_entry = mean / 6;
+  if (options_.eps_exit == 0) options_.eps_exit = mean / 6;
+}
+
+DelaunayCutter::Point DelaunayCutter::reference(VertexId v) const {
+  const auto x = mesh_.point(v);
+  return {x[0], x[1]};
+}
+
+DelaunayCutter::Point DelaunayCutter::deformed(VertexId v, std::span<const double> u) const {
+  return u.empty() ? reference(v) : deformed_point(mesh_, u, v);
+}
+
+std::optional<DelaunayCutter::Point> DelaunayCutter::to_reference(const Point& x, std::span<const double> u) const {
+  if (!u.empty()) return reference_position(mesh_, u, x);
+  // A bare mesh: x itself, if some triangle contains it — walked to from the active node.
+  const Connectivity& c = mesh_.connectivity();
+  ElementId e = active_ >= 0 && mesh_.is_vertex(active_) && c.n_vertex_uses(active_) > 0 ? c.vertex_element(active_) : no_id;
+  for (int step = 0; e != no_id && step < 4096; ++step) {
+    const auto t = c.element(e).simplex.oriented_vertices();
+    const Point a = reference(t[0]), b = reference(t[1]), d = reference(t[2]);
+    const std::array<Point, 3> corner{a, b, d};
+    int out = -1;
+    for (int j = 0; j < 3 && out < 0; ++j)
+      if (orientation_2d(corner[(j + 1) % 3].data(), corner[(j + 2) % 3].data(), x.data()) < 0) out = j;
+    if (out < 0) return x;
+    e = c.neighbor(e, c.element(e).simplex.index(t[out]));
+  }
+  for (ElementId f = 0; f < c.element_capacity(); ++f) {  // walked out (a concave body) or no start: scan
+    if (!c.is_element(f)) continue;
+    const auto t = c.element(f).simplex.oriented_vertices();
+    const Point a = reference(t[0]), b = reference(t[1]), d = reference(t[2]);
+    if (orientation_2d(a.data(), b.data(), x.data()) >= 0 && orientation_2d(b.data(), d.data(), x.data()) >= 0 &&
+        orientation_2d(d.data(), a.data(), x.data()) >= 0)
+      return x;
+  }
+  return std::nullopt;
+}
+
+DelaunayCutter::Point DelaunayCutter::target_of(const Point& x, std::span<const double> u) const {
+  if (u.empty()) return x;
+  if (const auto inside = reference_position(mesh_, u, x)) return *inside;
+  // Outside the deformed body: extend the affine map of the active triangle that x faces.
+  const Point xb = deformed(active_, u);
+  std::optional<Wedge> facing;
+  for (const Wedge& w : wedges(active_)) {
+    const Point y = deformed(w.y, u), z = deformed(w.z, u);
+    if (cross(minus(y, xb), minus(x, xb)) >= 0 && cross(minus(x, xb), minus(z, xb)) >= 0) facing = w;
+  }
+  if (!facing) facing = wedges(active_).front();
+  const auto l = barycentric(xb, deformed(facing->y, u), deformed(facing->z, u), x);
+  const Point Xb = reference(active_), Y = reference(facing->y), Z = reference(facing->z);
+  return {l[0] * Xb[0] + l[1] * Y[0] + l[2] * Z[0], l[0] * Xb[1] + l[1] * Y[1] + l[2] * Z[1]};
+}
+
+std::vector<DelaunayCutter::Wedge> DelaunayCutter::wedges(VertexId b) const {
+  const Connectivity& c = mesh_.connectivity();
+  std::vector<Wedge> result;
+  for (ElementId e : local_star(c, b).elements) {
+    const auto t = c.element(e).simplex.oriented_vertices();
+    const int i = static_cast<int>(std::find(t.begin(), t.begin() + 3, b) - t.begin());
+    result.push_back({e, t[(i + 1) % 3], t[(i + 2) % 3]});
+  }
+  return result;
+}
+
+bool DelaunayCutter::on_boundary(VertexId v) const {
+  const Connectivity& c = mesh_.connectivity();
+  for (ElementId e : local_star(c, v).elements)
+    for (VertexId w : c.element(e).simplex.vertices())
+      if (w != v && c.face(c.opposite_face(e, w)).mate == no_id) return true;
+  return false;
+}
+
+std::optional<DelaunayCutter::Crossing> DelaunayCutter::first_boundary_crossing(const Point& from, const Point& to,
+                                                                               std::span<const double> u) const {
+  std::optional<Crossing> first;
+  for (const auto& [simplex, f] : mesh_.connectivity().boundary()) {
+    const VertexId y = simplex.oriented_vertices()[0], z = simplex.oriented_vertices()[1];
+    if (exit_point_ && (forbidden_.count(y) || forbidden_.count(z))) continue;
+    const auto hit = segments_cross(from, to, deformed(y, u), deformed(z, u));
+    if (hit && (!first || hit->first < first->s)) first = Crossing{y, z, hit->second, hit->first};
+  }
+  return first;
+}
+
+PlanarCutReport DelaunayCutter::move(std::span<const double> point) {
+  if (point.size() != 2)
+    throw std::invalid_argument("DelaunayCutter.move: the scalpel is a point, 2 coordinates; got " + std::to_string(point.size()));
+  require_finite_points(point.data(), point.size(), 2, "DelaunayCutter.move", "point");
+  const double start = wall_seconds();
+  PlanarCutReport report;
+  report.moves = 1;
+  report.triangles_before = mesh_.n_cells();
+  const Point now{point[0], point[1]};
+  if (phase_ != Phase::outside && !(mesh_.is_vertex(active_) && mesh_.connectivity().n_vertex_uses(active_) > 0))
+    phase_ = Phase::outside;  // the active node was removed by another edit
+  if (exit_point_ && distance(now, *exit_point_) > 2 * options_.eps_exit) {
+    exit_point_.reset();
+    forbidden_.clear();
+  }
+  // Deformed-space questions first: the edits below work in the reference configuration.
+  std::optional<Crossing> crossing;
+  std::optional<Point> inside;
+  Point target{};
+  {
+    std::optional<ReadView> view;
+    std::span<const double> u;
+    if (model_) {
+      view.emplace(model_->displacement());
+      u = view->span();
+    }
+    if (phase_ == Phase::outside && scalpel_) crossing = first_boundary_crossing(*scalpel_, now, u);
+    if (phase_ == Phase::cutting)
+      target = target_of(now, u);
+    else
+      inside = to_reference(now, u);
+  }
+  scalpel_ = now;
+
+  if (phase_ == Phase::outside && crossing) enter(*crossing, report);
+  if (phase_ == Phase::entering) {
+    if (!inside)
+      phase_ = Phase::outside;  // withdrawn before the incision began: the entry node stays
+    else if (distance(*inside, entry_) > options_.eps_entry && fix_up_entry(*inside, report))
+      last_target_ = *inside;
+  } else if (phase_ == Phase::cutting) {
+    const Point from = last_target_ ? *last_target_ : reference(active_);
+    if (!advance(target, report)) {
+      if (phase_ == Phase::cutting) ++report.stuck;
+    }
+    if (phase_ == Phase::cutting) {
+      last_target_ = target;
+      split_incision(report);
+      predict_exit(minus(target, from), report);
+    }
+  }
+  report.triangles_after = mesh_.n_cells();
+  report.seconds = wall_seconds() - start;
+  return report;
+}
+
+void DelaunayCutter::lift() {
+  phase_ = Phase::outside;
+  active_ = -1;
+  scalpel_.reset();
+  last_target_.reset();
+}
+
+void DelaunayCutter::enter(const Crossing& crossing, PlanarCutReport& report) {
+  const Point y = reference(crossing.y), z = reference(crossing.z);
+  const Point at = lerp(y, z, crossing.lambda);
+  VertexId a = -1;
+  if (distance(at, y) <= options_.eps_entry || crossing.lambda <= 0)
+    a = crossing.y;
+  else if (distance(at, z) <= options_.eps_entry || crossing.lambda >= 1)
+    a = crossing.z;
+  else if (const EditResult split = split_edge(mesh_, crossing.y, crossing.z, crossing.lambda); split.done) {
+    a = split.vertex;
+    ++report.nodes_inserted;
+  } else {
+    a = distance(at, y) < distance(at, z) ? crossing.y : crossing.z;
+  }
+  active_ = a;
+  entry_ = reference(a);
+  phase_ = Phase::entering;
+  ++report.entries;
+}
+
+bool DelaunayCutter::fix_up_entry(const Point& p, PlanarCutReport& report) {
+  const Connectivity& c = mesh_.connectivity();
+  const VertexId a = active_;
+  // The node at the scalpel: inserted in the triangle that holds p, or on its nearest edge.
+  ElementId host = no_id;
+  std::array<double, 3> weights{};
+  std::array<VertexId, 3> corners{};
+  for (ElementId e = 0; e < c.element_capacity() && host == no_id; ++e) {
+    if (!c.is_element(e)) continue;
+    const auto t = c.element(e).simplex.oriented_vertices();
+    const auto l = barycentric(reference(t[0]), reference(t[1]), reference(t[2]), p);
+    if (std::min({l[0], l[1], l[2]}) >= 0) host = e, weights = l, corners = {t[0], t[1], t[2]};
+  }
+  if (host == no_id) return false;
+  EditResult made = insert_vertex(mesh_, host, weights);
+  if (!made.done) {  // on or too near a side: split that side at p's projection
+    const int k = static_cast<int>(std::min_element(weights.begin(), weights.end()) - weights.begin());
+    const VertexId s = corners[(k + 1) % 3], t = corners[(k + 2) % 3];
+    const double along = weights[(k + 2) % 3] / (weights[(k + 1) % 3] + weights[(k + 2) % 3]);
+    made = split_edge(mesh_, s, t, std::clamp(along, 0.05, 0.95));
+  }
+  if (!made.done) return false;
+  const VertexId b = made.vertex;
+  ++report.nodes_inserted;
+  active_ = b;
+  remesh_around(b, report);
+  if (!mesh_.is_vertex(a) || !recover_edge(a, b, report)) {
+    if (remove_vertex_by_flips(mesh_, b).done) ++report.nodes_removed;
+    active_ = a;
+    return false;
+  }
+  for (VertexId v : dissect_edge(a, b)) incision_vertices_.insert(v);
+  incision_vertices_.insert(a);
+  incision_vertices_.insert(b);
+  phase_ = Phase::cutting;
+  return true;
+}
+
+bool DelaunayCutter::recover_edge(VertexId a, VertexId b, PlanarCutReport& report) {
+  const Point pa = reference(a), pb = reference(b);
+  for (int attempt = 0; attempt < 64; ++attempt) {
+    if (has_edge(mesh_.connectivity(), a, b)) return true;
+    std::optional<Wedge> through;
+    for (const Wedge& w : wedges(a))
+      if (orientation_2d(pa.data(), reference(w.y).data(), pb.data()) >= 0 &&
+          orientation_2d(pa.data(), pb.data(), reference(w.z).data()) >= 0)
+        through = w;
+    if (!through || !flip_edge(mesh_, through->y, through->z).done) return false;
+    ++report.flips;
+  }
+  return has_edge(mesh_.connectivity(), a, b);
+}
+
+std::vector<VertexId> DelaunayCutter::dissect_edge(VertexId a, VertexId b) {
+  Connectivity& c = mesh_.connectivity();
+  const std::vector<ElementId> sharing = elements_with_edge(c, a, b);
+  const Simplex& t = c.element(sharing.front()).simplex;
+  VertexId third = -1;
+  for (VertexId v : t.vertices())
+    if (v != a && v != b) third = v;
+  const FaceId face = c.opposite_face(sharing.front(), third);
+  const std::vector<SplitVertex> split =
+      dissect(c, std::span<const FaceId>(&face, 1), [this](VertexId v) { return mesh_.add_vertex(VertexParents::copy_of(v)); });
+  std::vector<VertexId> copies;
+  for (const SplitVertex& s : split) copies.push_back(s.copy);
+  return copies;
+}
+
+bool DelaunayCutter::move_active_to(const Point& x) {
+  // Parents from the star triangle holding x, so a body's fields are interpolated there.
+  std::optional<Wedge> best;
+  double best_min = -std::numeric_limits<double>::infinity();
+  std::array<double, 3> weights{};
+  const Point b = reference(active_);
+  for (const Wedge& w : wedges(active_)) {
+    const auto l = barycentric(b, reference(w.y), reference(w.z), x);
+    if (const double m = std::min({l[0], l[1], l[2]}); m > best_min) best_min = m, best = w, weights = l;
+  }
+  if (!best || best_min < -1e-9) return false;
+  for (double& w : weights) w = std::max(w, 0.0);
+  const double sum = weights[0] + weights[1] + weights[2];
+  for (double& w : weights) w /= sum;
+  const std::array<VertexId, 3> parents{active_, best->y, best->z};
+  return snap_vertex(mesh_, active_, VertexParents::barycentric(parents, weights)).done;
+}
+
+bool DelaunayCutter::advance(const Point& target, PlanarCutReport& report) {
+  for (int step = 0; step < 256; ++step) {
+    const Point x = reference(active_);
+    const Point d = minus(target, x);
+    if (d[0] == 0 && d[1] == 0) return true;
+    // The first active triangle the straight way to the target would invert.
+    double t_hit = std::numeric_limits<double>::infinity();
+    std::optional<Wedge> blocking;
+    for (const Wedge& w : wedges(active_)) {
+      const Point y = reference(w.y), z = reference(w.z);
+      const double now = cross(minus(y, x), minus(z, x)), then = cross(minus(y, target), minus(z, target));
+      if (then > 0) continue;
+      if (const double t = now / (now - then); t < t_hit) t_hit = t, blocking = w;
+    }
+    if (!blocking) {
+      if (move_active_to(target)) {
+        remesh_around(active_, report);
+        return true;
+      }
+      t_hit = 1;  // rounding at the target: step part of the way instead
+    }
+    if (!move_active_to({x[0] + 0.6 * t_hit * d[0], x[1] + 0.6 * t_hit * d[1]})) return false;
+    if (blocking) {
+      const Connectivity& c = mesh_.connectivity();
+      const FaceId ahead = c.opposite_face(blocking->element, active_);
+      if (c.is_face(ahead) && c.face(ahead).mate == no_id) {
+        // The way leaves the body through boundary edge (y, z): the cut exits there.
+        const auto hit = segments_cross(x, target, reference(blocking->y), reference(blocking->z));
+        exit_through(blocking->y, blocking->z, hit ? hit->second : 0.5, report);
+        return false;
+      }
+      if (c.is_face(ahead) && c.face(ahead).mate != no_id) {
+        if (flip_edge(mesh_, blocking->y, blocking->z).done) {
+          ++report.flips;
+        } else {
+          // A reflex corner ahead: remove the nearer interior end of the edge, if either is.
+          const Point here = reference(active_);
+          VertexId first = blocking->y, second = blocking->z;
+          if (distance(reference(second), here) < distance(reference(first), here)) std::swap(first, second);
+          bool removed = false;
+          for (VertexId v : {first, second})
+            if (!removed && !on_boundary(v) && remove_vertex_by_flips(mesh_, v).done) removed = true, ++report.nodes_removed;
+          if (!removed) return false;
+        }
+      }
+    }
+    remesh_around(active_, report);
+  }
+  return false;
+}
+
+void DelaunayCutter::remesh_around(VertexId b, PlanarCutReport& report) {
+  const Connectivity& c = mesh_.connectivity();
+  // Flips towards Delaunay: the edges of the active triangles (spokes and link edges).
+  for (int round = 0; round < 64; ++round) {
+    bool flipped = false;
+    for (const Wedge& w : wedges(b)) {
+      for (const auto& [p, q, opposite] : {std::tuple{w.y, w.z, b}, std::tuple{b, w.y, w.z}}) {
+        if (c.face(c.opposite_face(w.element, opposite)).mate == no_id) continue;
+        if (!is_locally_delaunay(mesh_, p, q) && flip_edge(mesh_, p, q).done) {
+          ++report.flips;
+          flipped = true;
+          break;
+        }
+      }
+      if (flipped) break;
+    }
+    if (!flipped) break;
+  }
+  // Interior nodes too close to the active node (§5.2.2), by distance or by angles (§5.5).
+  for (int round = 0; round < 16; ++round) {
+    const Point x = reference(b);
+    VertexId closest = -1;
+    double nearest = std::numeric_limits<double>::infinity();
+    for (const Wedge& w : wedges(b))
+      for (VertexId v : {w.y, w.z}) {
+        if (incision_vertices_.count(v) || on_boundary(v)) continue;
+        bool too_close = false;
+        if (options_.short_edge_angle > 0) {
+          too_close = true;
+          for (ElementId e : elements_with_edge(c, b, v)) {
+            VertexId third = -1;
+            for (VertexId t : c.element(e).simplex.vertices())
+              if (t != b && t != v) third = t;
+            if (angle_at(reference(third), x, reference(v)) >= options_.short_edge_angle) too_close = false;
+          }
+        } else {
+          too_close = distance(reference(v), x) < options_.eps_edge;
+        }
+        if (too_close && distance(reference(v), x) < nearest) nearest = distance(reference(v), x), closest = v;
+      }
+    if (closest < 0 || !remove_vertex_by_flips(mesh_, closest).done) break;
+    ++report.nodes_removed;
+  }
+}
+
+void DelaunayCutter::split_incision(PlanarCutReport& report) {
+  const Connectivity& c = mesh_.connectivity();
+  const VertexId b = active_;
+  // The cut edges: boundary edges b→c1 (in the wedge (b, c1, o1)) and c2→b (in (b, o2, c2)).
+  std::optional<Wedge> out, in;
+  for (const Wedge& w : wedges(b)) {
+    if (c.face(c.opposite_face(w.element, w.z)).mate == no_id) out = w;
+    if (c.face(c.opposite_face(w.element, w.y)).mate == no_id) in = w;
+  }
+  if (!out || !in || out->element == in->element) return;
+  const VertexId c1 = out->y, o1 = out->z, o2 = in->y, c2 = in->z;
+  if (o1 == o2 || !incision_vertices_.count(c1) || !incision_vertices_.count(c2)) return;
+  const Point pb = reference(b), pc = lerp(reference(c1), reference(c2), 0.5), p1 = reference(o1), p2 = reference(o2);
+  // Figure 5.5: is b–c, the cut edges seen as one edge, a Delaunay diagonal of (b, o2, c, o1)?
+  int orientation = orientation_2d(pb.data(), p2.data(), pc.data());
+  if (orientation == 0) return;
+  const int inside = orientation > 0 ? in_circle(pb.data(), p2.data(), pc.data(), p1.data())
+                                     : in_circle(pb.data(), pc.data(), p2.data(), p1.data());
+  if (inside <= 0) return;
+  // New nodes where the line o1 o2 crosses the cut edges: fraction s from b towards c.
+  const Point e = minus(p2, p1), bc = minus(pc, pb);
+  const double denominator = cross(bc, e);
+  if (denominator == 0) return;
+  const double s = cross(minus(p1, pb), e) / denominator;
+  const double length = distance(pb, pc);
+  if (!(s * length > 0.25 * options_.eps_edge && (1 - s) * length > 0.25 * options_.eps_edge)) return;
+  const EditResult first = split_edge(mesh_, b, c1, s);
+  if (!first.done) return;
+  const EditResult second = split_edge(mesh_, b, c2, s);
+  if (!second.done) {  // keep the lips alike: undo the first
+    collapse_edge(mesh_, c1, first.vertex, 0);
+    return;
+  }
+  incision_vertices_.insert(first.vertex);
+  incision_vertices_.insert(second.vertex);
+  report.nodes_inserted += 2;
+  ++report.incision_splits;
+  remesh_around(b, report);
+}
+
+void DelaunayCutter::predict_exit(const Point& direction, PlanarCutReport& report) {
+  const double length = std::hypot(direction[0], direction[1]);
+  if (length == 0 || phase_ != Phase::cutting) return;
+  const Point x = reference(active_);
+  const Point ahead{x[0] + options_.eps_exit * direction[0] / length, x[1] + options_.eps_exit * direction[1] / length};
+  const Connectivity& c = mesh_.connectivity();
+  for (const Wedge& w : wedges(active_)) {
+    if (c.face(c.opposite_face(w.element, active_)).mate != no_id) continue;
+    if (const auto hit = segments_cross(x, ahead, reference(w.y), reference(w.z))) {
+      exit_through(w.y, w.z, hit->second, report);
+      return;
+    }
+  }
+}
+
+void DelaunayCutter::exit_through(VertexId y, VertexId z, double lambda, PlanarCutReport& report) {
+  const Point py = reference(y), pz = reference(z), at = lerp(py, pz, lambda);
+  VertexId w = -1;
+  if (distance(at, py) <= options_.eps_exit)
+    w = y;
+  else if (distance(at, pz) <= options_.eps_exit)
+    w = z;
+  else if (const EditResult split = split_edge(mesh_, y, z, lambda); split.done) {
+    w = split.vertex;
+    ++report.nodes_inserted;
+  } else {
+    w = distance(at, py) < distance(at, pz) ? y : z;
+  }
+  const VertexId b = active_;
+  phase_ = Phase::outside;
+  active_ = -1;
+  last_target_.reset();
+  if (!has_edge(mesh_.connectivity(), b, w)) return;  // nothing to open: the tip stays a notch
+  const std::vector<VertexId> copies = dissect_edge(b, w);
+  ++report.exits;
+  // Contract the short edges the exit leaves (Figure 5.7): each copy of b into its copy of w.
+  std::vector<VertexId> tips{b}, ends{w};
+  for (VertexId v : copies) (mesh_.is_vertex(v) && mesh_.parents(v).vertex.front() == b ? tips : ends).push_back(v);
+  forbidden_.clear();
+  for (VertexId tip : tips)
+    for (VertexId end : ends)
+      if (has_edge(mesh_.connectivity(), tip, end) && distance(reference(tip), reference(end)) < options_.eps_edge &&
+          collapse_edge(mesh_, end, tip, 0).done) {
+        ++report.edges_contracted;
+        incision_vertices_.erase(tip);
+      }
+  for (VertexId v : ends) incision_vertices_.insert(v), forbidden_.insert(v);
+  for (VertexId v : tips)
+    if (mesh_.is_vertex(v)) incision_vertices_.insert(v), forbidden_.insert(v);
+  exit_point_ = scalpel_;
+}
+
+std::vector<VertexId> DelaunayCutter::incision_edges() const {
+  std::vector<VertexId> edges;
+  for (const auto& [simplex, f] : mesh_.connectivity().boundary()) {
+    const auto v = simplex.oriented_vertices();
+    if (incision_vertices_.count(v[0]) && incision_vertices_.count(v[1])) edges.insert(edges.end(), {v[0], v[1]});
+  }
+  return edges;
+}
+
+}  // namespace snede

@@ -1,0 +1,139 @@
+// Delaunay cutting of a 2D triangle mesh with a point scalpel (§5.2.2), on a body that may be
+// deformed: the scalpel moves in deformed coordinates and is followed in the reference
+// configuration, where the mesh is edited.
+//
+// The scalpel is attached to the active node, a boundary vertex at the tip of the incision
+// whose two boundary edges (the cut edges) are the incision's lips. Each move:
+//  * moves the active node towards the scalpel as far as its triangles stay positive; the
+//    edge ahead that would invert is flipped away (or, if the flip is not convex, its nearer
+//    interior end removed), so large moves are taken in steps and never invert a triangle;
+//  * flips the edges of the active triangles that are not locally Delaunay (exact in_circle);
+//  * removes interior nodes closer to the active node than ε_edge — or, scale free, those
+//    whose edge to it faces only angles below a threshold (§5.5);
+//  * splits the incision where the cut edges, seen as one edge, fail the empty-circle test
+//    (Figure 5.5): new nodes on both lips where the line through the opposite nodes crosses
+//    the cut edges.
+// Entry (Figure 5.6): the scalpel's path crossing the boundary makes (or, within ε_entry of a
+// vertex, picks) the entry node; the incision is postponed until the scalpel is ε_entry inside,
+// then a node is inserted at the scalpel, joined to the entry node by flips, and that edge is
+// dissected. Exit (Figure 5.7): when the active node's way crosses the boundary, or the move
+// extrapolated by ε_exit would, a node is made there (or picked within ε_exit), the edge to it
+// is dissected and the short edges it leaves are contracted; entries within ε_exit of an exit
+// are ignored until the scalpel has moved 2 ε_exit away from it (the forbidden edges).
+//
+// Departures from the thesis: the dent of a postponed entry is not drawn (the entry node stays
+// on the boundary until the fix-up); new incision nodes lie on the cut edges (chords of the
+// path between incision nodes) rather than on the path itself, and the two lips' nodes
+// coincide instead of being dilated.
+#pragma once
+
+#include <array>
+#include <optional>
+#include <span>
+#include <unordered_set>
+#include <vector>
+
+#include "solve/model.hpp"
+
+namespace snede {
+
+struct DelaunayCutterOptions {
+  // Distances in the reference configuration; 0 means the thesis's defaults from the mean
+  // edge length h̄ (§5.4): ε_edge = h̄/3, ε_entry = ε_exit = h̄/6.
+  double eps_edge = 0;
+  double eps_entry = 0;
+  double eps_exit = 0;
+  // > 0 (radians): an interior neighbour of the active node is removed when every angle
+  // facing their edge is below this, instead of the distance ε_edge (scale free, §5.5).
+  double short_edge_angle = 0;
+};
+
+// What one move (or several, added up) did to the mesh.
+struct PlanarCutReport {
+  int moves = 0;
+  int flips = 0;
+  int nodes_removed = 0;
+  int nodes_inserted = 0;
+  int incision_splits = 0;   // Figure 5.5: each inserts a node on both lips
+  int edges_contracted = 0;  // short edges left by an exit (Figure 5.7)
+  int entries = 0;
+  int exits = 0;
+  int stuck = 0;             // moves that left the active node short of the scalpel
+  std::size_t triangles_before = 0;
+  std::size_t triangles_after = 0;
+  double seconds = 0;
+
+  // Accumulates a later report: counts and times add, triangles_after is the later one's.
+  void add(const PlanarCutReport& later);
+};
+
+class DelaunayCutter {
+ public:
+  // Cuts `mesh` (triangles in 2D). With a model (whose body is on this mesh) the scalpel moves
+  // in deformed coordinates X + u. Throws std::invalid_argument for another kind of mesh,
+  // negative or non-finite thresholds.
+  DelaunayCutter(Mesh& mesh, Model* model, DelaunayCutterOptions options);
+
+  // Moves the scalpel to `point` (2 numbers, deformed coordinates). Throws
+  // std::invalid_argument, before changing anything, for a non-finite point.
+  PlanarCutReport move(std::span<const double> point);
+  // Lifts the scalpel: an incision in progress stays as it is, the next move only places it.
+  void lift();
+
+  // The active node, or -1 when no incision is in progress.
+  VertexId active_node() const { return phase_ == Phase::cutting ? active_ : -1; }
+  bool cutting() const { return phase_ == Phase::cutting; }
+  // Boundary edges made by the cuts (both lips), (n, 2) vertex ids.
+  std::vector<VertexId> incision_edges() const;
+  // The thresholds in use (defaults resolved from the mesh at construction).
+  const DelaunayCutterOptions& options() const { return options_; }
+
+ private:
+  enum class Phase { outside, entering, cutting };
+  using Point = std::array<double, 2>;
+  struct Wedge {  // triangle (b, y, z) of b's star, counter-clockwise
+    ElementId element;
+    VertexId y, z;
+  };
+  struct Crossing {  // where a segment meets boundary edge (y, z): y + lambda (z − y)
+    VertexId y, z;
+    double lambda, s;  // s: fraction along the segment
+  };
+
+  Point reference(VertexId v) const;
+  // u: the body's displacement (2 per point), empty for a bare mesh.
+  Point deformed(VertexId v, std::span<const double> u) const;
+  std::optional<Point> to_reference(const Point& x, std::span<const double> u) const;
+  // Where the active node should go for a scalpel at x (deformed): its reference position, or
+  // outside the body its image under the affine map of the active triangle facing it.
+  Point target_of(const Point& x, std::span<const double> u) const;
+  std::vector<Wedge> wedges(VertexId b) const;
+  bool on_boundary(VertexId v) const;
+  std::optional<Crossing> first_boundary_crossing(const Point& from, const Point& to, std::span<const double> u) const;
+
+  void enter(const Crossing& crossing, PlanarCutReport& report);
+  bool fix_up_entry(const Point& p, PlanarCutReport& report);
+  bool recover_edge(VertexId a, VertexId b, PlanarCutReport& report);
+  // Moves the active node towards T (reference): true if it got there; an exit ends the cut.
+  bool advance(const Point& target, PlanarCutReport& report);
+  bool move_active_to(const Point& x);
+  void remesh_around(VertexId b, PlanarCutReport& report);
+  void split_incision(PlanarCutReport& report);
+  void predict_exit(const Point& direction, PlanarCutReport& report);
+  void exit_through(VertexId y, VertexId z, double lambda, PlanarCutReport& report);
+  std::vector<VertexId> dissect_edge(VertexId a, VertexId b);
+
+  Mesh& mesh_;
+  Model* model_;
+  DelaunayCutterOptions options_;
+  Phase phase_ = Phase::outside;
+  VertexId active_ = -1;
+  Point entry_{};
+  std::optional<Point> scalpel_;       // last scalpel position (deformed)
+  std::optional<Point> last_target_;   // last reference position the active node was sent to
+  std::optional<Point> exit_point_;    // the scalpel (deformed) at the last exit
+  std::unordered_set<VertexId> forbidden_;  // boundary vertices of that exit: no entry near them
+  std::unordered_set<VertexId> incision_vertices_;
+};
+
+}  // namespace snede

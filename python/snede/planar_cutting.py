@@ -1,0 +1,169 @@
+"""Cutting 2D triangle meshes with a point scalpel (thesis §5.2): the Delaunay cut.
+
+The scalpel drags the active node, the tip of the incision, through the mesh; after every
+move the triangles around it are remeshed (Delaunay flips, removal of nodes closer than
+``eps_edge``, incision splits behind the scalpel), so the mesh stays small and well shaped.
+On a Body the scalpel moves in deformed coordinates and the mesh is edited in the reference
+configuration; the body keeps its state, so a stretched sheet opens as it is cut.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, fields
+
+import numpy as np
+
+from snede import _snede
+from snede.mesh import Mesh
+
+
+@dataclass(frozen=True)
+class PlanarCutReport:
+    """What one ``move`` (or a whole ``cut``) did: edge ``flips``, ``nodes_removed`` near the
+    active node, ``nodes_inserted`` (entry, exit and incision splits), ``incision_splits``
+    (Figure 5.5), ``edges_contracted`` after exits (Figure 5.7), ``entries``, ``exits``, moves
+    that left the active node short of the scalpel (``stuck``), the triangle counts before
+    and after, and the time in ``seconds``."""
+
+    moves: int = 0
+    flips: int = 0
+    nodes_removed: int = 0
+    nodes_inserted: int = 0
+    incision_splits: int = 0
+    edges_contracted: int = 0
+    entries: int = 0
+    exits: int = 0
+    stuck: int = 0
+    triangles_before: int = 0
+    triangles_after: int = 0
+    seconds: float = 0.0
+
+    @classmethod
+    def _from_engine(cls, r) -> "PlanarCutReport":
+        return cls(**{f.name: getattr(r, f.name) for f in fields(cls)})
+
+    def _to_engine(self):
+        report = _snede.PlanarCutReport()
+        for f in fields(self):
+            setattr(report, f.name, getattr(self, f.name))
+        return report
+
+    def __add__(self, later: "PlanarCutReport") -> "PlanarCutReport":
+        total = self._to_engine()
+        total.add(later._to_engine())
+        return PlanarCutReport._from_engine(total)
+
+    def __str__(self) -> str:
+        return (f"{self.moves} moves: {self.flips} flips, {self.nodes_removed} nodes removed, {self.nodes_inserted} "
+                f"inserted ({self.incision_splits} incision splits), {self.entries} entries, {self.exits} exits; "
+                f"{self.triangles_before} → {self.triangles_after} triangles in {self.seconds * 1e3:.2f} ms")
+
+
+def _target(body_or_mesh):
+    if isinstance(body_or_mesh, Mesh):
+        return None, body_or_mesh, None
+    if hasattr(body_or_mesh, "_model") and isinstance(getattr(body_or_mesh, "mesh", None), Mesh):
+        return body_or_mesh, body_or_mesh.mesh, body_or_mesh._model
+    raise TypeError(f"expected a snede.Body or snede.Mesh, got {type(body_or_mesh).__name__}")
+
+
+def _threshold(value, name: str) -> float:
+    if value is None:
+        return 0.0
+    value = float(value)
+    if not (value > 0 and math.isfinite(value)):
+        raise ValueError(f"{name} must be positive and finite (or None for the default), got {value}")
+    return value
+
+
+def _point(value) -> np.ndarray:
+    a = np.asarray(value, dtype=np.float64)
+    if a.shape != (2,):
+        raise ValueError(f"the scalpel is a point with 2 coordinates, got shape {a.shape}")
+    if not np.all(np.isfinite(a)):
+        raise ValueError(f"the scalpel point has non-finite coordinates: {a.tolist()}")
+    return a
+
+
+def sample_path(path, step: float) -> np.ndarray:
+    """The polyline ``path`` ((n, 2), n ≥ 2) sampled so that consecutive points are at most
+    ``step`` apart; its vertices are kept."""
+    path = np.asarray(path, dtype=np.float64)
+    if path.ndim != 2 or path.shape[1] != 2 or len(path) < 2:
+        raise ValueError(f"path must be an (n, 2) polyline with n >= 2 points, got shape {path.shape}")
+    if not np.all(np.isfinite(path)):
+        raise ValueError("path has non-finite coordinates")
+    points = [path[0]]
+    for a, b in zip(path[:-1], path[1:]):
+        pieces = max(1, int(math.ceil(np.linalg.norm(b - a) / step)))
+        points.extend(a + (b - a) * k / pieces for k in range(1, pieces + 1))
+    return np.array(points)
+
+
+class DelaunayCutter:
+    """Delaunay cutting of a 2D triangle mesh or plane-stress Body (§5.2.2, §5.4).
+
+    ``DelaunayCutter(body_or_mesh, *, eps_edge=None, eps_entry=None, eps_exit=None,
+    short_edge_angle=None)``: thresholds in the reference configuration; by default the
+    thesis's h̄/3, h̄/6 and h̄/6 with h̄ the mean edge length. ``short_edge_angle`` (radians)
+    replaces ``eps_edge`` by the scale-free criterion of §5.5: an interior neighbour of the
+    active node is removed when every angle facing their edge is smaller.
+
+    ``move(point)`` moves the scalpel ((2,), deformed coordinates): the first move from outside
+    the body that crosses its boundary enters, an incision follows the scalpel, and leaving
+    the body finishes the cut. ``cut(path)`` samples the polyline ``path`` ((n, 2)) and moves
+    along it. Both return a :class:`PlanarCutReport`. Invalid input raises ``ValueError``
+    before anything changes.
+    """
+
+    def __init__(self, body_or_mesh, *, eps_edge=None, eps_entry=None, eps_exit=None, short_edge_angle=None):
+        self.body, self.mesh, model = _target(body_or_mesh)
+        if self.mesh.cell_dim != 2 or self.mesh.space_dim != 2:
+            raise ValueError(f"{type(self).__name__} needs a 2D triangle mesh; this one has {self.mesh.cell_dim}-D cells "
+                             f"in {self.mesh.space_dim}-D")
+        angle = _threshold(short_edge_angle, "short_edge_angle")
+        if angle >= math.pi / 2:
+            raise ValueError(f"short_edge_angle must be below pi/2 radians, got {angle}")
+        self._impl = _snede.DelaunayCutter(self.mesh._impl, model, _threshold(eps_edge, "eps_edge"),
+                                           _threshold(eps_entry, "eps_entry"), _threshold(eps_exit, "eps_exit"), angle)
+
+    @property
+    def eps_edge(self) -> float:
+        return self._impl.eps_edge
+
+    @property
+    def eps_entry(self) -> float:
+        return self._impl.eps_entry
+
+    @property
+    def eps_exit(self) -> float:
+        return self._impl.eps_exit
+
+    def move(self, point) -> PlanarCutReport:
+        return PlanarCutReport._from_engine(self._impl.move(_point(point)))
+
+    def cut(self, path, step: float | None = None, progress=None) -> PlanarCutReport:
+        """Move along the polyline ``path`` ((n, 2)), sampled every ``step`` (default
+        ``eps_edge``); ``progress(done, total, report)`` is called after each move."""
+        points = sample_path(path, self.eps_edge if step is None else _threshold(step, "step"))
+        total = PlanarCutReport()
+        for k, point in enumerate(points):
+            report = self.move(point)
+            total = total + report
+            if progress is not None:
+                progress(k + 1, len(points), report)
+        return total
+
+    def lift(self) -> None:
+        """Lift the scalpel: an incision in progress stays as it is; the next move only places it."""
+        self._impl.lift()
+
+    @property
+    def active_node(self) -> int | None:
+        """The vertex at the tip of the incision in progress, or None."""
+        node = self._impl.active_node
+        return None if node < 0 else int(node)
+
+    def incision_edges(self) -> np.ndarray:
+        """The boundary edges the cuts made (both lips), (n, 2) vertex ids."""
+        return self._impl.incision_edges()
