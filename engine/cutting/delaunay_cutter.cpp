@@ -109,30 +109,33 @@ DelaunayCutter::Point DelaunayCutter::deformed(VertexId v, std::span<const doubl
   return u.empty() ? reference(v) : deformed_point(mesh_, u, v);
 }
 
-std::optional<DelaunayCutter::Point> DelaunayCutter::to_reference(const Point& x, std::span<const double> u) const {
-  if (!u.empty()) return reference_position(mesh_, u, x);
-  // A bare mesh: x itself, if some triangle contains it — walked to from the active node.
+ElementId DelaunayCutter::locate(const Point& x) const {
   const Connectivity& c = mesh_.connectivity();
+  auto contains = [&](ElementId e) {
+    const auto t = c.element(e).simplex.oriented_vertices();
+    const Point p0 = reference(t[0]), p1 = reference(t[1]), p2 = reference(t[2]);
+    return orientation_2d(p0.data(), p1.data(), x.data()) >= 0 && orientation_2d(p1.data(), p2.data(), x.data()) >= 0 &&
+           orientation_2d(p2.data(), p0.data(), x.data()) >= 0;
+  };
+  // Walk from the active node's triangles towards x, across the side x lies beyond.
   ElementId e = active_ >= 0 && mesh_.is_vertex(active_) && c.n_vertex_uses(active_) > 0 ? c.vertex_element(active_) : no_id;
   for (int step = 0; e != no_id && step < 4096; ++step) {
     const auto t = c.element(e).simplex.oriented_vertices();
-    const Point a = reference(t[0]), b = reference(t[1]), d = reference(t[2]);
-    const std::array<Point, 3> corner{a, b, d};
-    int out = -1;
-    for (int j = 0; j < 3 && out < 0; ++j)
-      if (orientation_2d(corner[(j + 1) % 3].data(), corner[(j + 2) % 3].data(), x.data()) < 0) out = j;
-    if (out < 0) return x;
-    e = c.neighbor(e, c.element(e).simplex.index(t[out]));
+    int beyond = -1;
+    for (int j = 0; j < 3 && beyond < 0; ++j)
+      if (orientation_2d(reference(t[(j + 1) % 3]).data(), reference(t[(j + 2) % 3]).data(), x.data()) < 0) beyond = j;
+    if (beyond < 0) return e;
+    e = c.neighbor(e, c.element(e).simplex.index(t[beyond]));
   }
-  for (ElementId f = 0; f < c.element_capacity(); ++f) {  // walked out (a concave body) or no start: scan
-    if (!c.is_element(f)) continue;
-    const auto t = c.element(f).simplex.oriented_vertices();
-    const Point a = reference(t[0]), b = reference(t[1]), d = reference(t[2]);
-    if (orientation_2d(a.data(), b.data(), x.data()) >= 0 && orientation_2d(b.data(), d.data(), x.data()) >= 0 &&
-        orientation_2d(d.data(), a.data(), x.data()) >= 0)
-      return x;
-  }
-  return std::nullopt;
+  for (ElementId f = 0; f < c.element_capacity(); ++f)  // walked out (a concave body) or no start: scan
+    if (c.is_element(f) && contains(f)) return f;
+  return no_id;
+}
+
+std::optional<DelaunayCutter::Point> DelaunayCutter::to_reference(const Point& x, std::span<const double> u) const {
+  if (!u.empty()) return reference_position(mesh_, u, x);
+  if (locate(x) == no_id) return std::nullopt;
+  return x;
 }
 
 DelaunayCutter::Point DelaunayCutter::target_of(const Point& x, std::span<const double> u) const {
@@ -215,6 +218,7 @@ PlanarCutReport DelaunayCutter::move(std::span<const double> point) {
       inside = to_reference(now, u);
   }
   scalpel_ = now;
+  touched_.clear();
 
   if (phase_ == Phase::outside && crossing) enter(*crossing, report);
   if (phase_ == Phase::entering) {
@@ -233,9 +237,34 @@ PlanarCutReport DelaunayCutter::move(std::span<const double> point) {
       predict_exit(minus(target, from), report);
     }
   }
+  if (phase_ == Phase::cutting) touched_.push_back(active_);
+  legalize(report);
   report.triangles_after = mesh_.n_cells();
   report.seconds = wall_seconds() - start;
   return report;
+}
+
+void DelaunayCutter::legalize(PlanarCutReport& report) {
+  const Connectivity& c = mesh_.connectivity();
+  std::vector<std::pair<VertexId, VertexId>> queue;
+  for (VertexId v : touched_)
+    if (mesh_.is_vertex(v) && c.n_vertex_uses(v) > 0)
+      for (const Wedge& w : wedges(v)) queue.insert(queue.end(), {{v, w.y}, {w.y, w.z}});
+  for (std::size_t done = 0; !queue.empty() && done < 64 * (touched_.size() + 16); ++done) {
+    const auto [p, q] = queue.back();
+    queue.pop_back();
+    if (!mesh_.is_vertex(p) || !mesh_.is_vertex(q)) continue;
+    const std::vector<ElementId> sharing = elements_with_edge(c, p, q);
+    if (sharing.size() != 2 || is_locally_delaunay(mesh_, p, q)) continue;
+    std::array<VertexId, 2> across{};
+    for (int k = 0; k < 2; ++k)
+      for (VertexId v : c.element(sharing[k]).simplex.vertices())
+        if (v != p && v != q) across[k] = v;
+    if (!flip_edge(mesh_, p, q).done) continue;
+    ++report.flips;
+    for (VertexId end : {p, q})
+      for (VertexId side : across) queue.push_back({end, side});
+  }
 }
 
 void DelaunayCutter::lift() {
@@ -262,6 +291,7 @@ void DelaunayCutter::enter(const Crossing& crossing, PlanarCutReport& report) {
   active_ = a;
   entry_ = reference(a);
   phase_ = Phase::entering;
+  touched_.push_back(a);
   ++report.entries;
 }
 
@@ -269,16 +299,14 @@ bool DelaunayCutter::fix_up_entry(const Point& p, PlanarCutReport& report) {
   const Connectivity& c = mesh_.connectivity();
   const VertexId a = active_;
   // The node at the scalpel: inserted in the triangle that holds p, or on its nearest edge.
-  ElementId host = no_id;
-  std::array<double, 3> weights{};
-  std::array<VertexId, 3> corners{};
-  for (ElementId e = 0; e < c.element_capacity() && host == no_id; ++e) {
-    if (!c.is_element(e)) continue;
-    const auto t = c.element(e).simplex.oriented_vertices();
-    const auto l = barycentric(reference(t[0]), reference(t[1]), reference(t[2]), p);
-    if (std::min({l[0], l[1], l[2]}) >= 0) host = e, weights = l, corners = {t[0], t[1], t[2]};
-  }
+  const ElementId host = locate(p);
   if (host == no_id) return false;
+  const auto t = c.element(host).simplex.oriented_vertices();
+  const std::array<VertexId, 3> corners{t[0], t[1], t[2]};
+  auto weights = barycentric(reference(t[0]), reference(t[1]), reference(t[2]), p);
+  for (double& w : weights) w = std::max(w, 0.0);
+  const double sum = weights[0] + weights[1] + weights[2];
+  for (double& w : weights) w /= sum;
   EditResult made = insert_vertex(mesh_, host, weights);
   if (!made.done) {  // on or too near a side: split that side at p's projection
     const int k = static_cast<int>(std::min_element(weights.begin(), weights.end()) - weights.begin());
@@ -292,11 +320,12 @@ bool DelaunayCutter::fix_up_entry(const Point& p, PlanarCutReport& report) {
   active_ = b;
   remesh_around(b, report);
   if (!mesh_.is_vertex(a) || !recover_edge(a, b, report)) {
-    if (remove_vertex_by_flips(mesh_, b).done) ++report.nodes_removed;
+    remove_node(b, report);
     active_ = a;
     return false;
   }
-  for (VertexId v : dissect_edge(a, b)) incision_vertices_.insert(v);
+  for (VertexId v : dissect_edge(a, b)) incision_vertices_.insert(v), touched_.push_back(v);
+  touched_.insert(touched_.end(), {a, b});
   incision_vertices_.insert(a);
   incision_vertices_.insert(b);
   phase_ = Phase::cutting;
@@ -312,8 +341,7 @@ bool DelaunayCutter::recover_edge(VertexId a, VertexId b, PlanarCutReport& repor
       if (orientation_2d(pa.data(), reference(w.y).data(), pb.data()) >= 0 &&
           orientation_2d(pa.data(), pb.data(), reference(w.z).data()) >= 0)
         through = w;
-    if (!through || !flip_edge(mesh_, through->y, through->z).done) return false;
-    ++report.flips;
+    if (!through || !flip(through->y, through->z, report)) return false;
   }
   return has_edge(mesh_.connectivity(), a, b);
 }
@@ -383,16 +411,14 @@ bool DelaunayCutter::advance(const Point& target, PlanarCutReport& report) {
         return false;
       }
       if (c.is_face(ahead) && c.face(ahead).mate != no_id) {
-        if (flip_edge(mesh_, blocking->y, blocking->z).done) {
-          ++report.flips;
-        } else {
+        if (!flip(blocking->y, blocking->z, report)) {
           // A reflex corner ahead: remove the nearer interior end of the edge, if either is.
           const Point here = reference(active_);
           VertexId first = blocking->y, second = blocking->z;
           if (distance(reference(second), here) < distance(reference(first), here)) std::swap(first, second);
           bool removed = false;
           for (VertexId v : {first, second})
-            if (!removed && !on_boundary(v) && remove_vertex_by_flips(mesh_, v).done) removed = true, ++report.nodes_removed;
+            if (!removed && !on_boundary(v)) removed = remove_node(v, report);
           if (!removed) return false;
         }
       }
@@ -410,8 +436,7 @@ void DelaunayCutter::remesh_around(VertexId b, PlanarCutReport& report) {
     for (const Wedge& w : wedges(b)) {
       for (const auto& [p, q, opposite] : {std::tuple{w.y, w.z, b}, std::tuple{b, w.y, w.z}}) {
         if (c.face(c.opposite_face(w.element, opposite)).mate == no_id) continue;
-        if (!is_locally_delaunay(mesh_, p, q) && flip_edge(mesh_, p, q).done) {
-          ++report.flips;
+        if (!is_locally_delaunay(mesh_, p, q) && flip(p, q, report)) {
           flipped = true;
           break;
         }
@@ -442,9 +467,27 @@ void DelaunayCutter::remesh_around(VertexId b, PlanarCutReport& report) {
         }
         if (too_close && distance(reference(v), x) < nearest) nearest = distance(reference(v), x), closest = v;
       }
-    if (closest < 0 || !remove_vertex_by_flips(mesh_, closest).done) break;
-    ++report.nodes_removed;
+    if (closest < 0 || !remove_node(closest, report)) break;
   }
+}
+
+bool DelaunayCutter::flip(VertexId p, VertexId q, PlanarCutReport& report) {
+  std::vector<VertexId> quad{p, q};
+  for (ElementId e : elements_with_edge(mesh_.connectivity(), p, q))
+    for (VertexId v : mesh_.connectivity().element(e).simplex.vertices()) quad.push_back(v);
+  if (!flip_edge(mesh_, p, q).done) return false;
+  ++report.flips;
+  touched_.insert(touched_.end(), quad.begin(), quad.end());
+  return true;
+}
+
+bool DelaunayCutter::remove_node(VertexId v, PlanarCutReport& report) {
+  std::vector<VertexId> link;
+  for (const Wedge& w : wedges(v)) link.insert(link.end(), {w.y, w.z});
+  if (!remove_vertex_by_flips(mesh_, v).done) return false;
+  ++report.nodes_removed;
+  touched_.insert(touched_.end(), link.begin(), link.end());
+  return true;
 }
 
 void DelaunayCutter::split_incision(PlanarCutReport& report) {
@@ -482,6 +525,7 @@ void DelaunayCutter::split_incision(PlanarCutReport& report) {
   }
   incision_vertices_.insert(first.vertex);
   incision_vertices_.insert(second.vertex);
+  touched_.insert(touched_.end(), {first.vertex, second.vertex});
   report.nodes_inserted += 2;
   ++report.incision_splits;
   remesh_around(b, report);
@@ -519,7 +563,9 @@ void DelaunayCutter::exit_through(VertexId y, VertexId z, double lambda, PlanarC
   phase_ = Phase::outside;
   active_ = -1;
   last_target_.reset();
-  if (!has_edge(mesh_.connectivity(), b, w)) return;  // nothing to open: the tip stays a notch
+  // An edge (b, w) that is missing, or already on the boundary (w next to b along it), has
+  // nothing to open: the incision ends where it is.
+  if (elements_with_edge(mesh_.connectivity(), b, w).size() != 2) return;
   const std::vector<VertexId> copies = dissect_edge(b, w);
   ++report.exits;
   // Contract the short edges the exit leaves (Figure 5.7): each copy of b into its copy of w.
@@ -533,9 +579,9 @@ void DelaunayCutter::exit_through(VertexId y, VertexId z, double lambda, PlanarC
         ++report.edges_contracted;
         incision_vertices_.erase(tip);
       }
-  for (VertexId v : ends) incision_vertices_.insert(v), forbidden_.insert(v);
+  for (VertexId v : ends) incision_vertices_.insert(v), forbidden_.insert(v), touched_.push_back(v);
   for (VertexId v : tips)
-    if (mesh_.is_vertex(v)) incision_vertices_.insert(v), forbidden_.insert(v);
+    if (mesh_.is_vertex(v)) incision_vertices_.insert(v), forbidden_.insert(v), touched_.push_back(v);
   exit_point_ = scalpel_;
 }
 

@@ -101,6 +101,8 @@ class DelaunayCutter {
   };
 
   Point reference(VertexId v) const;
+  // The triangle holding reference point x (walked to from the active node), or no_id.
+  ElementId locate(const Point& x) const;
   // u: the body's displacement (2 per point), empty for a bare mesh.
   Point deformed(VertexId v, std::span<const double> u) const;
   std::optional<Point> to_reference(const Point& x, std::span<const double> u) const;
@@ -118,6 +120,13 @@ class DelaunayCutter {
   bool advance(const Point& target, PlanarCutReport& report);
   bool move_active_to(const Point& x);
   void remesh_around(VertexId b, PlanarCutReport& report);
+  // Flips edge (p, q); the quadrilateral's corners count as touched.
+  bool flip(VertexId p, VertexId q, PlanarCutReport& report);
+  // Removes interior node v (retriangulating its star); its neighbours count as touched.
+  bool remove_node(VertexId v, PlanarCutReport& report);
+  // Lawson flips from the edges around the vertices this move touched until every interior
+  // edge there is locally Delaunay (the rest of the mesh was not changed).
+  void legalize(PlanarCutReport& report);
   void split_incision(PlanarCutReport& report);
   void predict_exit(const Point& direction, PlanarCutReport& report);
   void exit_through(VertexId y, VertexId z, double lambda, PlanarCutReport& report);
@@ -134,6 +143,7 @@ class DelaunayCutter {
   std::optional<Point> exit_point_;    // the scalpel (deformed) at the last exit
   std::unordered_set<VertexId> forbidden_;  // boundary vertices of that exit: no entry near them
   std::unordered_set<VertexId> incision_vertices_;
+  std::vector<VertexId> touched_;  // vertices whose stars this move changed
 };
 
 }  // namespace snede
