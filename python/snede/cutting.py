@@ -76,6 +76,26 @@ class CutReport:
                 f"in {self.seconds * 1e3:.2f} ms")
 
 
+def body_and_mesh(body_or_mesh):
+    """(body or None, mesh, the body's engine model or None) for a cutter's target."""
+    if isinstance(body_or_mesh, Mesh):
+        return None, body_or_mesh, None
+    if hasattr(body_or_mesh, "_model") and isinstance(getattr(body_or_mesh, "mesh", None), Mesh):
+        return body_or_mesh, body_or_mesh.mesh, body_or_mesh._model
+    raise TypeError(f"expected a snede.Body or snede.Mesh, got {type(body_or_mesh).__name__}")
+
+
+def move_along(move, positions, total, progress=None):
+    """Calls ``move`` at each of ``positions``, adding the reports to ``total``;
+    ``progress(done, count, report)`` after each."""
+    for k, position in enumerate(positions):
+        report = move(position)
+        total = total + report
+        if progress is not None:
+            progress(k + 1, len(positions), report)
+    return total
+
+
 def _points(value, shape: tuple, what: str) -> np.ndarray:
     a = np.asarray(value, dtype=np.float64)
     if a.shape != shape:
@@ -107,12 +127,7 @@ class TetrahedralCutter:
 
     def __init__(self, body_or_mesh, *, snap: bool = True, remove_degeneracies: bool = True,
                  min_aspect_ratio: float = 0.01, large_angle: float = 0.99 * math.pi, fix_free_pieces: bool = True):
-        if isinstance(body_or_mesh, Mesh):
-            self.body, self.mesh, model = None, body_or_mesh, None
-        elif hasattr(body_or_mesh, "_model") and isinstance(getattr(body_or_mesh, "mesh", None), Mesh):
-            self.body, self.mesh, model = body_or_mesh, body_or_mesh.mesh, body_or_mesh._model
-        else:
-            raise TypeError(f"expected a snede.Body or snede.Mesh, got {type(body_or_mesh).__name__}")
+        self.body, self.mesh, model = body_and_mesh(body_or_mesh)
         if self.mesh.cell_dim != 3:
             raise ValueError(f"TetrahedralCutter needs a tetrahedral mesh; this mesh has {self.mesh.cell_dim}-D cells")
         if not (0 < min_aspect_ratio < 1):
@@ -134,13 +149,7 @@ class TetrahedralCutter:
         path = np.asarray(path, dtype=np.float64)
         if path.ndim != 3 or path.shape[1:] != (2, 3) or len(path) < 2:
             raise ValueError(f"path must be (n, 2, 3) scalpel positions with n >= 2, got shape {path.shape}")
-        total = CutReport()
-        for k, scalpel in enumerate(path):
-            report = self.move(scalpel)
-            total = total + report
-            if progress is not None:
-                progress(k + 1, len(path), report)
-        return total
+        return move_along(self.move, path, CutReport(), progress)
 
     def lift(self) -> None:
         """Lift the scalpel out of the body: the next ``move`` only places it, and the next

@@ -14,7 +14,7 @@ from dataclasses import dataclass, fields
 import numpy as np
 
 from snede import _snede
-from snede.mesh import Mesh
+from snede.cutting import body_and_mesh, move_along
 
 
 @dataclass(frozen=True)
@@ -57,14 +57,6 @@ class PlanarCutReport:
         return (f"{self.moves} moves: {self.flips} flips, {self.nodes_removed} nodes removed, {self.nodes_inserted} "
                 f"inserted ({self.incision_splits} incision splits), {self.entries} entries, {self.exits} exits; "
                 f"{self.triangles_before} → {self.triangles_after} triangles in {self.seconds * 1e3:.2f} ms")
-
-
-def _target(body_or_mesh):
-    if isinstance(body_or_mesh, Mesh):
-        return None, body_or_mesh, None
-    if hasattr(body_or_mesh, "_model") and isinstance(getattr(body_or_mesh, "mesh", None), Mesh):
-        return body_or_mesh, body_or_mesh.mesh, body_or_mesh._model
-    raise TypeError(f"expected a snede.Body or snede.Mesh, got {type(body_or_mesh).__name__}")
 
 
 def _threshold(value, name: str) -> float:
@@ -117,7 +109,7 @@ class DelaunayCutter:
     """
 
     def __init__(self, body_or_mesh, *, eps_edge=None, eps_entry=None, eps_exit=None, short_edge_angle=None):
-        self.body, self.mesh, model = _target(body_or_mesh)
+        self.body, self.mesh, model = body_and_mesh(body_or_mesh)
         if self.mesh.cell_dim != 2 or self.mesh.space_dim != 2:
             raise ValueError(f"{type(self).__name__} needs a 2D triangle mesh; this one has {self.mesh.cell_dim}-D cells "
                              f"in {self.mesh.space_dim}-D")
@@ -146,13 +138,7 @@ class DelaunayCutter:
         """Move along the polyline ``path`` ((n, 2)), sampled every ``step`` (default
         ``eps_edge``); ``progress(done, total, report)`` is called after each move."""
         points = sample_path(path, self.eps_edge if step is None else _threshold(step, "step"))
-        total = PlanarCutReport()
-        for k, point in enumerate(points):
-            report = self.move(point)
-            total = total + report
-            if progress is not None:
-                progress(k + 1, len(points), report)
-        return total
+        return move_along(self.move, points, PlanarCutReport(), progress)
 
     def lift(self) -> None:
         """Lift the scalpel: an incision in progress stays as it is; the next move only places it."""

@@ -1,0 +1,77 @@
+"""Benchmark: the cost of one scalpel move of snede.DelaunayCutter (§5.2.2) against mesh size.
+
+    .venv/bin/python benchmarks/delaunay_cut_rates.py [--sizes 10 32 100 316 707] [--moves 40] [--quick]
+
+Unit squares of n × n × 2 triangles, from 200 (n = 10) to about 10⁶ (n = 707), all cut by the
+same path in units of the mesh spacing h = 1/n: the scalpel starts h outside the left side
+at mid-height and moves in steps of ε_edge = h̄/3 (the default threshold) along a line
+tilted 0.1 rad against the grid, ``--moves`` moves into the body (on the smallest mesh it
+leaves the body first: only the moves before the exit count). Columns (microseconds,
+CutReport.seconds):
+
+* entry: the move that crosses the boundary (a scan of the boundary edges, O(√n) here).
+* move: median and 90th percentile of the moves after the entry fix-up (remeshing around
+  the active node: flips, node removal, incision splits).
+* flips / splits per move: how much remeshing a move does (the same at every size if the
+  work is local).
+
+The issue's goal is a constant time per move, at most 50 µs at 10⁶ triangles; the last line
+says what was measured.
+"""
+import argparse
+import statistics
+import time
+
+import numpy as np
+
+import snede
+
+
+def measure(n: int, moves: int) -> dict:
+    start = time.perf_counter()
+    mesh = snede.meshing.rectangle((1.0, 1.0), (n, n))
+    build = time.perf_counter() - start
+    cutter = snede.DelaunayCutter(mesh)
+    h = 1.0 / n
+    direction = np.array([np.cos(0.1), np.sin(0.1)])
+    origin = np.array([-h, 0.5 + 0.37 * h])
+    reports = [cutter.move(origin + k * cutter.eps_edge * direction) for k in range(int(3 * h / cutter.eps_edge) + moves)]
+    entry = next(i for i, r in enumerate(reports) if r.entries)
+    cutting = []
+    for r in reports[entry + 1:]:
+        if r.exits:
+            break
+        cutting.append(r)
+    seconds = [r.seconds for r in cutting]
+    return {"n": n, "triangles": mesh.n_cells, "build_s": build, "entry_us": 1e6 * reports[entry].seconds,
+            "median_us": 1e6 * statistics.median(seconds), "p90_us": 1e6 * np.percentile(seconds, 90),
+            "flips": sum(r.flips for r in cutting) / len(cutting),
+            "splits": sum(r.incision_splits for r in cutting) / len(cutting), "moves": len(cutting)}
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--sizes", type=int, nargs="+", default=[10, 32, 100, 316, 707])
+    parser.add_argument("--moves", type=int, default=40)
+    parser.add_argument("--quick", action="store_true", help="sizes 10, 32, 100")
+    arguments = parser.parse_args()
+    sizes = (10, 32, 100) if arguments.quick else arguments.sizes
+    header = (f"{'triangles':>9} {'n':>4} {'build s':>7} | {'entry µs':>8} | {'move µs':>7} {'p90 µs':>7} | "
+              f"{'flips':>5} {'splits':>6} {'moves':>5}")
+    print(header)
+    print("-" * len(header))
+    rows = []
+    for n in sizes:
+        row = measure(n, arguments.moves)
+        rows.append(row)
+        print(f"{row['triangles']:>9} {n:>4} {row['build_s']:>7.2f} | {row['entry_us']:>8.0f} | {row['median_us']:>7.1f} "
+              f"{row['p90_us']:>7.1f} | {row['flips']:>5.2f} {row['splits']:>6.2f} {row['moves']:>5}", flush=True)
+    last, first = rows[-1], rows[0]
+    verdict = "met" if last["triangles"] >= 9e5 and last["median_us"] <= 50 else "NOT met (or not measured at 10⁶)"
+    print(f"\ngoal ≤ 50 µs per move at 10⁶ triangles: {last['median_us']:.1f} µs at {last['triangles']}: {verdict}. "
+          f"From {first['triangles']} to {last['triangles']} triangles a move costs ×"
+          f"{last['median_us'] / first['median_us']:.1f}; the entry ×{last['entry_us'] / first['entry_us']:.0f}.")
+
+
+if __name__ == "__main__":
+    main()
