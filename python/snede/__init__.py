@@ -21,11 +21,12 @@ from snede.dynamics import DynamicRelaxation  # noqa: F401
 from snede.needle import FrictionProfile, NeedleInsertion  # noqa: F401
 from snede.cutting import TetrahedralCutter, CutReport  # noqa: F401
 from snede.planar_cutting import DelaunayCutter, PlanarCutReport  # noqa: F401
+from snede.subdivision_cutting import SubdivisionCutter  # noqa: F401
 from snede import meshing  # noqa: F401
 
 __all__ = [
     "Mesh", "MeshQuality", "Body", "meshing", "StaticSolver", "DynamicRelaxation", "SolveResult",
-    "FrictionProfile", "NeedleInsertion", "TetrahedralCutter", "CutReport", "DelaunayCutter", "PlanarCutReport",
+    "FrictionProfile", "NeedleInsertion", "TetrahedralCutter", "CutReport", "DelaunayCutter", "PlanarCutReport", "SubdivisionCutter",
     "LinearElastic", "StVenantKirchhoff", "NeoHookean", "VerondaWestmann",
     "EditResult", "InvalidMesh", "PetscError", "DomainError", "LockingWarning", "PETSc",
 ]
