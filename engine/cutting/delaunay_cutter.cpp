@@ -177,7 +177,8 @@ std::optional<DelaunayCutter::Crossing> DelaunayCutter::first_boundary_crossing(
                                                                                std::span<const double> u) const {
   std::optional<Crossing> first;
   for (const auto& [simplex, f] : mesh_.connectivity().boundary()) {
-    const VertexId y = simplex.oriented_vertices()[0], z = simplex.oriented_vertices()[1];
+    const auto ends = simplex.oriented_vertices();
+    const VertexId y = ends[0], z = ends[1];
     if (exit_point_ && (forbidden_.count(y) || forbidden_.count(z))) continue;
     const auto hit = segments_cross(from, to, deformed(y, u), deformed(z, u));
     if (hit && (!first || hit->first < first->s)) first = Crossing{y, z, hit->second, hit->first};

@@ -56,24 +56,26 @@ class CutReport:
         values["degenerate_shapes"] = tuple(values["degenerate_shapes"])
         return cls(**values)
 
-    def _to_engine(self):
-        report = _snede.CutReport()
-        for f in fields(self):
-            setattr(report, f.name, getattr(self, f.name))
-        return report
-
     def __add__(self, other: "CutReport") -> "CutReport":
         """Both reports together (counts and times add up; ``components`` is ``other``'s
         unless it swept nothing), combined by the engine as ``move`` combines its halves."""
-        total = self._to_engine()
-        total.add(other._to_engine())
-        return CutReport._from_engine(total)
+        return CutReport._from_engine(engine_sum(self, other, _snede.CutReport))
 
     def __str__(self) -> str:
         return (f"{self.faces_dissected} faces dissected ({self.vertices_snapped} vertices snapped, "
                 f"{self.snaps_refused} refused), {self.degenerate_found} degenerate: {self.edges_collapsed} collapses, "
                 f"{self.edges_split} splits, {self.elements_cut_free} cut free; {self.components} pieces "
                 f"in {self.seconds * 1e3:.2f} ms")
+
+
+def engine_sum(earlier, later, engine_report):
+    """The engine's sum of two report dataclasses (its ``add``), as an ``engine_report``."""
+    total, other = engine_report(), engine_report()
+    for f in fields(earlier):
+        setattr(total, f.name, getattr(earlier, f.name))
+        setattr(other, f.name, getattr(later, f.name))
+    total.add(other)
+    return total
 
 
 def body_and_mesh(body_or_mesh):

@@ -14,7 +14,7 @@ from dataclasses import dataclass, fields
 import numpy as np
 
 from snede import _snede
-from snede.cutting import body_and_mesh, move_along
+from snede.cutting import body_and_mesh, engine_sum, move_along
 
 
 @dataclass(frozen=True)
@@ -42,16 +42,8 @@ class PlanarCutReport:
     def _from_engine(cls, r) -> "PlanarCutReport":
         return cls(**{f.name: getattr(r, f.name) for f in fields(cls)})
 
-    def _to_engine(self):
-        report = _snede.PlanarCutReport()
-        for f in fields(self):
-            setattr(report, f.name, getattr(self, f.name))
-        return report
-
     def __add__(self, later: "PlanarCutReport") -> "PlanarCutReport":
-        total = self._to_engine()
-        total.add(later._to_engine())
-        return PlanarCutReport._from_engine(total)
+        return PlanarCutReport._from_engine(engine_sum(self, later, _snede.PlanarCutReport))
 
     def __str__(self) -> str:
         return (f"{self.moves} moves: {self.flips} flips, {self.nodes_removed} nodes removed, {self.nodes_inserted} "
