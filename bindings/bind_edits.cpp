@@ -26,7 +26,7 @@ void bind_edits(py::module_& m) {
         return r.vertex < 0 ? std::string("EditResult(done)") : "EditResult(done, vertex=" + std::to_string(r.vertex) + ")";
       });
   m.def("flip_edge", &flip_edge, py::arg("mesh"), py::arg("a"), py::arg("b"));
-  m.def("is_locally_delaunay", &is_locally_delaunay, py::arg("mesh"), py::arg("a"), py::arg("b"));
+  m.def("is_locally_delaunay", py::overload_cast<const Mesh&, VertexId, VertexId>(&is_locally_delaunay), py::arg("mesh"), py::arg("a"), py::arg("b"));
   m.def("split_edge", &split_edge, py::arg("mesh"), py::arg("a"), py::arg("b"), py::arg("t"));
   m.def("insert_vertex",
         [](Mesh& mesh, ElementId e, const DoubleArray& weights) { return insert_vertex(mesh, e, view(weights)); },

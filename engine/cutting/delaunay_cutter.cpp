@@ -109,38 +109,59 @@ DelaunayCutter::Point DelaunayCutter::deformed(VertexId v, std::span<const doubl
   return u.empty() ? reference(v) : deformed_point(mesh_, u, v);
 }
 
-ElementId DelaunayCutter::locate(const Point& x) const {
+ElementId DelaunayCutter::locate(const Point& x, std::span<const double> u, VertexId from) const {
   const Connectivity& c = mesh_.connectivity();
-  auto contains = [&](ElementId e) {
-    const auto t = c.element(e).simplex.oriented_vertices();
-    const Point p0 = reference(t[0]), p1 = reference(t[1]), p2 = reference(t[2]);
-    return orientation_2d(p0.data(), p1.data(), x.data()) >= 0 && orientation_2d(p1.data(), p2.data(), x.data()) >= 0 &&
-           orientation_2d(p2.data(), p0.data(), x.data()) >= 0;
-  };
-  // Walk from the active node's triangles towards x, across the side x lies beyond.
-  ElementId e = active_ >= 0 && mesh_.is_vertex(active_) && c.n_vertex_uses(active_) > 0 ? c.vertex_element(active_) : no_id;
+  const auto at = [&](VertexId v) { return deformed(v, u); };
+  // Walk towards x, across the side x lies beyond, from the triangle of `from`'s star whose
+  // corner at `from` opens towards x: beside an incision (a slit in the body) a walk from
+  // another triangle of the star would run into the lips.
+  ElementId e = no_id;
+  if (from >= 0 && mesh_.is_vertex(from) && c.n_vertex_uses(from) > 0) {
+    e = c.vertex_element(from);
+    const Point o = at(from);
+    for (const Wedge& w : wedges(from))
+      if (orientation_2d(o.data(), at(w.y).data(), x.data()) >= 0 && orientation_2d(o.data(), x.data(), at(w.z).data()) >= 0) {
+        e = w.element;
+        break;
+      }
+  }
   for (int step = 0; e != no_id && step < 4096; ++step) {
     const auto t = c.element(e).simplex.oriented_vertices();
     int beyond = -1;
     for (int j = 0; j < 3 && beyond < 0; ++j)
-      if (orientation_2d(reference(t[(j + 1) % 3]).data(), reference(t[(j + 2) % 3]).data(), x.data()) < 0) beyond = j;
+      if (orientation_2d(at(t[(j + 1) % 3]).data(), at(t[(j + 2) % 3]).data(), x.data()) < 0) beyond = j;
     if (beyond < 0) return e;
     e = c.neighbor(e, c.element(e).simplex.index(t[beyond]));
   }
-  for (ElementId f = 0; f < c.element_capacity(); ++f)  // walked out (a concave body) or no start: scan
-    if (c.is_element(f) && contains(f)) return f;
+  // Walked out of the body (x outside, or a concave body in the way) or no start: scan.
+  for (ElementId f = 0; f < c.element_capacity(); ++f) {
+    if (!c.is_element(f)) continue;
+    const auto t = c.element(f).simplex.oriented_vertices();
+    const Point p0 = at(t[0]), p1 = at(t[1]), p2 = at(t[2]);
+    if (orientation_2d(p0.data(), p1.data(), x.data()) >= 0 && orientation_2d(p1.data(), p2.data(), x.data()) >= 0 &&
+        orientation_2d(p2.data(), p0.data(), x.data()) >= 0)
+      return f;
+  }
   return no_id;
 }
 
-std::optional<DelaunayCutter::Point> DelaunayCutter::to_reference(const Point& x, std::span<const double> u) const {
-  if (!u.empty()) return reference_position(mesh_, u, x);
-  if (locate(x) == no_id) return std::nullopt;
-  return x;
+std::optional<DelaunayCutter::Point> DelaunayCutter::to_reference(const Point& x, std::span<const double> u,
+                                                                 VertexId from) const {
+  const ElementId host = locate(x, u, from);
+  if (host == no_id) return std::nullopt;
+  if (u.empty()) return x;
+  // §5.5: the barycentric coordinates in the deformed triangle, applied to its reference corners.
+  const auto t = mesh_.connectivity().element(host).simplex.oriented_vertices();
+  const auto l = barycentric(deformed(t[0], u), deformed(t[1], u), deformed(t[2], u), x);
+  Point X{0, 0};
+  for (int k = 0; k < 3; ++k)
+    for (int d = 0; d < 2; ++d) X[d] += l[k] * reference(t[k])[d];
+  return X;
 }
 
 DelaunayCutter::Point DelaunayCutter::target_of(const Point& x, std::span<const double> u) const {
   if (u.empty()) return x;
-  if (const auto inside = reference_position(mesh_, u, x)) return *inside;
+  if (const auto inside = to_reference(x, u, active_)) return *inside;
   // Outside the deformed body: extend the affine map of the active triangle that x faces.
   const Point xb = deformed(active_, u);
   std::optional<Wedge> facing;
@@ -215,8 +236,10 @@ PlanarCutReport DelaunayCutter::move(std::span<const double> point) {
     if (phase_ == Phase::outside && scalpel_) crossing = first_boundary_crossing(*scalpel_, now, u);
     if (phase_ == Phase::cutting)
       target = target_of(now, u);
-    else
-      inside = to_reference(now, u);
+    else if (phase_ == Phase::entering)
+      inside = to_reference(now, u, active_);
+    else if (crossing)  // about to enter: walk from the boundary edge crossed
+      inside = to_reference(now, u, crossing->y);
   }
   scalpel_ = now;
   touched_.clear();
@@ -247,24 +270,36 @@ PlanarCutReport DelaunayCutter::move(std::span<const double> point) {
 
 void DelaunayCutter::legalize(PlanarCutReport& report) {
   const Connectivity& c = mesh_.connectivity();
-  std::vector<std::pair<VertexId, VertexId>> queue;
+  std::sort(touched_.begin(), touched_.end());
+  touched_.erase(std::unique(touched_.begin(), touched_.end()), touched_.end());
+  // An edge (p, q) waits with a triangle holding it, so that checking it costs one neighbour
+  // look-up; only when a flip or removal replaced that triangle is the edge searched again.
+  struct EdgeInTriangle {
+    ElementId triangle;
+    VertexId p, q;
+  };
+  std::vector<EdgeInTriangle> queue;
   for (VertexId v : touched_)
     if (mesh_.is_vertex(v) && c.n_vertex_uses(v) > 0)
-      for (const Wedge& w : wedges(v)) queue.insert(queue.end(), {{v, w.y}, {w.y, w.z}});
+      for (const Wedge& w : wedges(v)) queue.insert(queue.end(), {{w.element, v, w.y}, {w.element, w.y, w.z}});
   for (std::size_t done = 0; !queue.empty() && done < 64 * (touched_.size() + 16); ++done) {
-    const auto [p, q] = queue.back();
+    auto [e, p, q] = queue.back();
     queue.pop_back();
-    if (!mesh_.is_vertex(p) || !mesh_.is_vertex(q)) continue;
-    const std::vector<ElementId> sharing = elements_with_edge(c, p, q);
-    if (sharing.size() != 2 || is_locally_delaunay(mesh_, p, q)) continue;
-    std::array<VertexId, 2> across{};
-    for (int k = 0; k < 2; ++k)
-      for (VertexId v : c.element(sharing[k]).simplex.vertices())
-        if (v != p && v != q) across[k] = v;
+    if (!c.is_element(e) || !c.element(e).simplex.contains(p) || !c.element(e).simplex.contains(q)) {
+      if (!mesh_.is_vertex(p) || !mesh_.is_vertex(q)) continue;
+      const std::vector<ElementId> sharing = elements_with_edge(c, p, q);
+      if (sharing.empty()) continue;
+      e = sharing.front();
+    }
+    if (is_locally_delaunay(mesh_, e, p, q)) continue;
+    const VertexId r = third_vertex(c.element(e).simplex, p, q);
+    const VertexId s = third_vertex(c.element(c.neighbor(e, c.element(e).simplex.index(r))).simplex, p, q);
     if (!flip_edge(mesh_, p, q).done) continue;
     ++report.flips;
-    for (VertexId end : {p, q})
-      for (VertexId side : across) queue.push_back({end, side});
+    // The new edge (r, s) has the quadrilateral's four sides around it: check them again.
+    for (ElementId side : elements_with_edge(c, r, s))
+      for (VertexId end : {p, q})
+        if (c.element(side).simplex.contains(end)) queue.insert(queue.end(), {{side, end, r}, {side, end, s}});
   }
 }
 
@@ -300,7 +335,7 @@ bool DelaunayCutter::fix_up_entry(const Point& p, PlanarCutReport& report) {
   const Connectivity& c = mesh_.connectivity();
   const VertexId a = active_;
   // The node at the scalpel: inserted in the triangle that holds p, or on its nearest edge.
-  const ElementId host = locate(p);
+  const ElementId host = locate(p, {}, active_);
   if (host == no_id) return false;
   const auto t = c.element(host).simplex.oriented_vertices();
   const std::array<VertexId, 3> corners{t[0], t[1], t[2]};
@@ -435,9 +470,8 @@ void DelaunayCutter::remesh_around(VertexId b, PlanarCutReport& report) {
   for (int round = 0; round < 64; ++round) {
     bool flipped = false;
     for (const Wedge& w : wedges(b)) {
-      for (const auto& [p, q, opposite] : {std::tuple{w.y, w.z, b}, std::tuple{b, w.y, w.z}}) {
-        if (c.face(c.opposite_face(w.element, opposite)).mate == no_id) continue;
-        if (!is_locally_delaunay(mesh_, p, q) && flip(p, q, report)) {
+      for (const auto& [p, q] : {std::pair{w.y, w.z}, std::pair{b, w.y}}) {
+        if (!is_locally_delaunay(mesh_, w.element, p, q) && flip(p, q, report)) {
           flipped = true;
           break;
         }
@@ -453,7 +487,6 @@ void DelaunayCutter::remesh_around(VertexId b, PlanarCutReport& report) {
     double nearest = std::numeric_limits<double>::infinity();
     for (const Wedge& w : wedges(b))
       for (VertexId v : {w.y, w.z}) {
-        if (incision_vertices_.count(v) || on_boundary(v)) continue;
         bool too_close = false;
         if (options_.short_edge_angle > 0) {
           too_close = true;
@@ -466,7 +499,9 @@ void DelaunayCutter::remesh_around(VertexId b, PlanarCutReport& report) {
         } else {
           too_close = distance(reference(v), x) < options_.eps_edge;
         }
-        if (too_close && distance(reference(v), x) < nearest) nearest = distance(reference(v), x), closest = v;
+        // Only interior nodes go (the boundary's shape stays); the cheap tests first.
+        if (too_close && distance(reference(v), x) < nearest && !incision_vertices_.count(v) && !on_boundary(v))
+          nearest = distance(reference(v), x), closest = v;
       }
     if (closest < 0 || !remove_node(closest, report)) break;
   }

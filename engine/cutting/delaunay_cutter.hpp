@@ -101,11 +101,13 @@ class DelaunayCutter {
   };
 
   Point reference(VertexId v) const;
-  // The triangle holding reference point x (walked to from the active node), or no_id.
-  ElementId locate(const Point& x) const;
-  // u: the body's displacement (2 per point), empty for a bare mesh.
+  // u: the body's displacement (2 per point), empty for a bare mesh (then deformed = reference).
   Point deformed(VertexId v, std::span<const double> u) const;
-  std::optional<Point> to_reference(const Point& x, std::span<const double> u) const;
+  // The triangle holding x in deformed coordinates, walked to from vertex `from` (O(walk));
+  // the mesh is scanned only when the walk leaves the body. no_id if x is outside.
+  ElementId locate(const Point& x, std::span<const double> u, VertexId from) const;
+  // The reference position of the material point at deformed x, or nothing outside the body.
+  std::optional<Point> to_reference(const Point& x, std::span<const double> u, VertexId from) const;
   // Where the active node should go for a scalpel at x (deformed): its reference position, or
   // outside the body its image under the affine map of the active triangle facing it.
   Point target_of(const Point& x, std::span<const double> u) const;

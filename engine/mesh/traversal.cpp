@@ -43,14 +43,28 @@ std::vector<ElementId> elements_around(const Connectivity& c, const Simplex& s, 
   if (!c.is_element(start) || !c.element(start).simplex.contains_all(s))
     throw std::invalid_argument("elements_around: element " + std::to_string(start) + " does not contain " +
                                 s.to_string());
+  // Stars are small: a linear search of what was found beats hashing (and its allocations)
+  // until the star is large, when the hash set takes over.
+  constexpr std::size_t linear_search_limit = 64;
   std::vector<ElementId> found{start};
-  std::unordered_set<ElementId> seen{start};
+  std::unordered_set<ElementId> seen;
+  const auto first_visit = [&](ElementId e) {
+    if (found.size() < linear_search_limit) {
+      if (std::find(found.begin(), found.end(), e) != found.end()) return false;
+      found.push_back(e);
+      if (found.size() == linear_search_limit) seen.insert(found.begin(), found.end());
+      return true;
+    }
+    if (!seen.insert(e).second) return false;
+    found.push_back(e);
+    return true;
+  };
   for (std::size_t i = 0; i < found.size(); ++i) {
     const Element& element = c.element(found[i]);
     for (int j = 0; j <= c.dim(); ++j) {
       if (s.contains(element.simplex.vertex(j))) continue;  // this face does not contain s
       const ElementId next = c.neighbor(found[i], j);
-      if (next != no_id && seen.insert(next).second) found.push_back(next);
+      if (next != no_id) first_visit(next);
     }
   }
   return found;

@@ -1,5 +1,6 @@
 #include "topology/flip_edge.hpp"
 
+#include <algorithm>
 #include <optional>
 #include <stdexcept>
 
@@ -16,12 +17,6 @@ struct EdgeWings {
   ElementId left, right;
   VertexId c, d;
 };
-
-VertexId third_vertex(const Simplex& triangle, VertexId a, VertexId b) {
-  for (VertexId v : triangle.vertices())
-    if (v != a && v != b) return v;
-  throw std::logic_error("third_vertex: triangle " + triangle.to_string() + " is degenerate");
-}
 
 // The wings of (a, b), or the reason there are none.
 std::optional<EdgeWings> edge_wings(const Mesh& mesh, VertexId a, VertexId b, std::string& why_not) {
@@ -87,16 +82,39 @@ EditResult flip_edge(Mesh& mesh, VertexId a, VertexId b) {
   return EditResult::success();
 }
 
-bool is_locally_delaunay(const Mesh& mesh, VertexId a, VertexId b) {
+namespace {
+
+void require_planar_triangles(const Mesh& mesh) {
   if (mesh.cell_dim() != 2 || mesh.is_surface())
     throw std::invalid_argument("is_locally_delaunay: needs a 2D triangle mesh");
+}
+
+}  // namespace
+
+bool is_locally_delaunay(const Mesh& mesh, VertexId a, VertexId b) {
+  require_planar_triangles(mesh);
   const bool ends_are_vertices = a != b && mesh.is_vertex(a) && mesh.is_vertex(b);
   const std::vector<ElementId> sharing = ends_are_vertices ? elements_with_edge(mesh.connectivity(), a, b) : std::vector<ElementId>{};
   if (sharing.empty()) throw std::invalid_argument("is_locally_delaunay: edge " + vertex_list({a, b}) + " does not exist");
-  if (sharing.size() == 1) return true;
-  std::string why_not;
-  const EdgeWings wings = *edge_wings(mesh, a, b, why_not);
-  return in_circle(mesh.point(a).data(), mesh.point(b).data(), mesh.point(wings.c).data(), mesh.point(wings.d).data()) <= 0;
+  return is_locally_delaunay(mesh, sharing.front(), a, b);
+}
+
+bool is_locally_delaunay(const Mesh& mesh, ElementId triangle, VertexId a, VertexId b) {
+  require_planar_triangles(mesh);
+  const Connectivity& c = mesh.connectivity();
+  if (!c.is_element(triangle) || !c.element(triangle).simplex.contains(a) || !c.element(triangle).simplex.contains(b))
+    throw std::invalid_argument("is_locally_delaunay: element " + std::to_string(triangle) + " is not a triangle with edge " +
+                                vertex_list({a, b}));
+  const Simplex& near = c.element(triangle).simplex;
+  const VertexId r = third_vertex(near, a, b);
+  const ElementId across = c.neighbor(triangle, near.index(r));
+  if (across == no_id) return true;
+  const VertexId s = third_vertex(c.element(across).simplex, a, b);
+  // (p, q, r) counter-clockwise, as the triangle is positive.
+  const auto t = near.oriented_vertices();
+  const int k = static_cast<int>(std::find(t.begin(), t.begin() + 3, r) - t.begin());
+  const VertexId p = t[(k + 1) % 3], q = t[(k + 2) % 3];
+  return in_circle(mesh.point(p).data(), mesh.point(q).data(), mesh.point(r).data(), mesh.point(s).data()) <= 0;
 }
 
 }  // namespace snede

@@ -1,5 +1,8 @@
 #include "topology/local_star.hpp"
 
+#include <stdexcept>
+#include <string>
+
 #include "mesh/traversal.hpp"
 
 namespace snede {
@@ -20,6 +23,13 @@ std::vector<ElementId> elements_with_edge(const Connectivity& c, VertexId a, Ver
   for (ElementId e : local_star(c, a).elements)
     if (c.element(e).simplex.contains(b)) around.push_back(e);
   return around;
+}
+
+VertexId third_vertex(const Simplex& triangle, VertexId a, VertexId b) {
+  for (VertexId v : triangle.vertices())
+    if (v != a && v != b) return v;
+  throw std::logic_error("third_vertex: triangle " + triangle.to_string() + " has no vertex besides " +
+                         std::to_string(a) + " and " + std::to_string(b));
 }
 
 }  // namespace snede

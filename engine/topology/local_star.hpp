@@ -20,6 +20,9 @@ LocalStar local_star(const Connectivity& c, VertexId v);
 // The elements having both a and b as vertices (those around edge (a, b)).
 std::vector<ElementId> elements_with_edge(const Connectivity& c, VertexId a, VertexId b);
 
+// The vertex of a triangle other than a and b. Throws std::logic_error if there is none.
+VertexId third_vertex(const Simplex& triangle, VertexId a, VertexId b);
+
 // True if some element has both a and b as vertices.
 inline bool has_edge(const Connectivity& c, VertexId a, VertexId b) { return !elements_with_edge(c, a, b).empty(); }
 

@@ -106,5 +106,25 @@ TEST(FlipEdge, LocalDelaunayCriterionAgreesWithTheCircumcircle) {
   EXPECT_THROW(is_locally_delaunay(square, 0, 2), std::invalid_argument);
 }
 
+TEST(FlipEdge, LocalDelaunayCriterionFromEitherTriangleAgreesWithTheEdgeLookUp) {
+  for (const double depth : {-1.0, -1.3}) {
+    const Mesh mesh = quadrilateral({0.5, 0.2}, {0.5, depth});
+    const Connectivity& c = mesh.connectivity();
+    for (ElementId e = 0; e < c.element_capacity(); ++e) {
+      if (!c.is_element(e)) continue;
+      const auto v = c.element(e).simplex.vertices();
+      for (int j = 0; j < 3; ++j) {
+        const VertexId a = v[j], b = v[(j + 1) % 3];
+        EXPECT_EQ(is_locally_delaunay(mesh, e, a, b), is_locally_delaunay(mesh, a, b)) << "edge " << a << "-" << b;
+        EXPECT_EQ(is_locally_delaunay(mesh, e, b, a), is_locally_delaunay(mesh, a, b));
+      }
+    }
+    // The diagonal (0, 1) from both of its triangles: illegal for the deep-inside d only.
+    for (ElementId e : {0, 1}) EXPECT_EQ(is_locally_delaunay(mesh, e, 0, 1), depth < -1.2);
+    EXPECT_THROW(is_locally_delaunay(mesh, 0, 2, 3), std::invalid_argument);  // not an edge of element 0
+    EXPECT_THROW(is_locally_delaunay(mesh, 7, 0, 1), std::invalid_argument);  // no such element
+  }
+}
+
 }  // namespace
 }  // namespace snede
