@@ -6,7 +6,7 @@ from pathlib import Path
 
 import numpy as np
 
-HIGHLIGHT = (0.84, 0.15, 0.16, 1.0)  # faces picked out on a 3D surface (an incision): red, not in viridis
+HIGHLIGHT = (0.84, 0.15, 0.16, 1.0)  # faces or edges picked out (an incision): red, not in viridis
 
 
 def _figure():
@@ -18,30 +18,41 @@ def _figure():
     return plt
 
 
-def draw_2d(ax, points, cells, u, scale: float = 1.0, vmax: float | None = None):
-    """Reference wireframe (grey) and the deformed mesh coloured by |u|; returns the colour mapping."""
+def draw_2d(ax, points, cells, u, scale: float = 1.0, vmax: float | None = None, reference: bool = True,
+            highlight=None):
+    """The deformed mesh coloured by |u| over the reference wireframe (grey) or, with
+    ``reference=False``, under its own edges, so that an opened cut shows as a gap; the edges
+    of ``highlight`` ((m, 2) vertex ids, e.g. the lips of an incision) in red on the deformed
+    mesh. Returns the colour mapping."""
     deformed = points + scale * u
-    ax.triplot(points[:, 0], points[:, 1], cells, color="0.75", linewidth=0.4)
+    if reference:
+        ax.triplot(points[:, 0], points[:, 1], cells, color="0.75", linewidth=0.4)
     shaded = ax.tripcolor(deformed[:, 0], deformed[:, 1], cells, np.linalg.norm(u, axis=1), shading="gouraud",
                           cmap="viridis", vmin=0.0 if vmax is not None else None, vmax=vmax)
+    if not reference:
+        ax.triplot(deformed[:, 0], deformed[:, 1], cells, color="k", linewidth=0.25, alpha=0.5)
+    if highlight is not None and len(highlight):
+        lips = deformed[np.asarray(highlight)]  # (m, 2 ends, 2 coordinates)
+        ax.plot(lips[:, :, 0].T, lips[:, :, 1].T, color=HIGHLIGHT, linewidth=1.2, solid_capstyle="round")
     ax.set_aspect("equal")
     ax.set_xlabel("x [m]")
     ax.set_ylabel("y [m]")
     return shaded
 
 
-def _face_keys(faces) -> np.ndarray:
-    """One row per face, its vertex ids sorted: the same for both orientations."""
-    return np.sort(np.asarray(faces, dtype=np.int64).reshape(-1, 3), axis=1)
+def _face_keys(faces, corners: int) -> np.ndarray:
+    """One row per face (``corners`` vertex ids), its vertex ids sorted: the same for both orientations."""
+    return np.sort(np.asarray(faces, dtype=np.int64).reshape(-1, corners), axis=1)
 
 
 def highlighted(faces, highlight) -> np.ndarray:
-    """(len(faces),) bool: which of ``faces`` ((n, 3) vertex ids) are among ``highlight``
-    ((m, 3) vertex ids, in any order and orientation)."""
-    keys, wanted = _face_keys(faces), _face_keys(highlight)
+    """(len(faces),) bool: which of ``faces`` ((n, k) vertex ids: k = 3 for faces, 2 for edges)
+    are among ``highlight`` ((m, k) vertex ids, in any order and orientation)."""
+    corners = np.shape(faces)[-1]
+    keys, wanted = _face_keys(faces, corners), _face_keys(highlight, corners)
     if len(keys) == 0 or len(wanted) == 0:
         return np.zeros(len(keys), dtype=bool)
-    rows = np.dtype((np.void, keys.dtype.itemsize * 3))
+    rows = np.dtype((np.void, keys.dtype.itemsize * corners))
     return np.isin(np.ascontiguousarray(keys).view(rows).ravel(), np.ascontiguousarray(wanted).view(rows).ravel())
 
 
@@ -69,6 +80,12 @@ def draw_3d(ax, points, faces, u, scale: float = 1.0, norm=None, highlight=None,
     return int(marked.sum())
 
 
+def _incision_legend(ax, label: str) -> None:
+    from matplotlib.patches import Patch
+
+    ax.legend(handles=[Patch(color=HIGHLIGHT, label=label)], loc="upper right", fontsize=8)
+
+
 def _cube_limits(ax, coordinates) -> None:
     low, high = coordinates.min(axis=0), coordinates.max(axis=0)
     centre, radius = (low + high) / 2, (high - low).max() / 2
@@ -79,11 +96,13 @@ def _cube_limits(ax, coordinates) -> None:
 
 def plot_body(body, path, title: str = "", displacement=None, scale: float = 1.0, decorate=None,
               highlight=None, view: tuple | None = None, reference: bool = True) -> Path:
-    """Save a PNG of the body: reference wireframe (grey; ``reference=False``: none, in 3D) and
-    deformed surface coloured by |u| (metres). ``scale`` exaggerates the displacement (stated
-    in the title if ≠ 1); ``decorate(ax)`` draws on top of a 2D picture. In 3D, ``highlight``
-    ((m, 3) vertex ids of boundary faces, e.g. ``TetrahedralCutter.incision_faces()``) is drawn
-    in red and ``view`` is the camera's (elevation, azimuth) in degrees."""
+    """Save a PNG of the body: reference wireframe (grey; ``reference=False``: none in 3D, the
+    deformed mesh's edges in 2D) and deformed surface coloured by |u| (metres). ``scale``
+    exaggerates the displacement (stated in the title if ≠ 1); ``decorate(ax)`` draws on top of
+    a 2D picture. ``highlight``, boundary faces ((m, 3) vertex ids, e.g.
+    ``TetrahedralCutter.incision_faces()``) or in 2D boundary edges ((m, 2), e.g.
+    ``DelaunayCutter.incision_edges()``), is drawn in red; ``view`` is the 3D camera's
+    (elevation, azimuth) in degrees."""
     plt = _figure()
     u = body.displacement if displacement is None else np.asarray(displacement)
     magnitude = np.linalg.norm(u, axis=1)
@@ -93,7 +112,9 @@ def plot_body(body, path, title: str = "", displacement=None, scale: float = 1.0
         title = f"{title} (displacement ×{scale:g})"
     if mesh.dim == 2:
         fig, ax = plt.subplots(figsize=(6, 5))
-        shaded = draw_2d(ax, points, mesh.cells, u, scale)
+        shaded = draw_2d(ax, points, mesh.cells, u, scale, reference=reference, highlight=highlight)
+        if highlight is not None:
+            _incision_legend(ax, f"incision ({len(highlight)} edges)")
         if decorate is not None:
             decorate(ax)
     else:
@@ -110,10 +131,7 @@ def plot_body(body, path, title: str = "", displacement=None, scale: float = 1.0
         norm = colors.Normalize(vmin=magnitude.min(), vmax=max(magnitude.max(), 1e-300))
         marked = draw_3d(ax, points, faces, u, scale, norm, highlight)
         if highlight is not None:
-            from matplotlib.patches import Patch
-
-            ax.legend(handles=[Patch(color=HIGHLIGHT, label=f"incision ({marked} faces)")], loc="upper right",
-                      fontsize=8)
+            _incision_legend(ax, f"incision ({marked} faces)")
         _cube_limits(ax, np.concatenate([points, deformed]) if reference else deformed[np.unique(faces)])
         if view is not None:
             ax.view_init(*view)

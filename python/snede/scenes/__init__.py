@@ -42,7 +42,30 @@ def material(name: str, young: float, poisson: float, gamma: float = 8.0):
     return makers[name]()
 
 
-def builders() -> dict:
-    from snede.scenes import cantilever, cut, cylinder, needle, slab
+def briefly(result) -> str:
+    """The start of ``str(result)``, for a line of a scene's progress: converged or not,
+    PETSc's reason, iterations and the time."""
+    state = "converged" if result.converged else "NOT converged"
+    return f"{state} ({result.reason}) after {result.iterations} iterations, {result.seconds:.2f} s"
 
-    return {"cantilever": cantilever, "cylinder": cylinder, "slab": slab, "needle": needle, "cut": cut}
+
+def solve_entries(results) -> dict:
+    """Summary entries (those of ``run_scene.solve_once``) of a scene that solves many times:
+    converged only if every solve did, with the first failure's reason (else the last solve's);
+    iterations, solve seconds and MFLOP summed; the last residual norm."""
+    failed = [r for r in results if not r.converged]
+    return {
+        "converged": not failed, "reason": (failed[0] if failed else results[-1]).reason,
+        "iterations": sum(r.iterations for r in results),
+        "linear_iterations": sum(r.linear_iterations for r in results),
+        "residual_norm": results[-1].residual_norm,
+        "seconds": sum(r.seconds for r in results), "mflop": sum(r.flops for r in results) / 1e6,
+        "solves": len(results),
+    }
+
+
+def builders() -> dict:
+    from snede.scenes import cantilever, cut, cylinder, needle, sheet_cut, slab
+
+    return {"cantilever": cantilever, "cylinder": cylinder, "slab": slab, "needle": needle, "cut": cut,
+            "sheet-cut": sheet_cut}

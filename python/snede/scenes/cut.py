@@ -16,8 +16,9 @@ from dataclasses import dataclass
 import numpy as np
 
 import snede
-from snede.plotting import HIGHLIGHT, animate, draw_3d, highlighted
-from snede.scenes import Scene, material
+from snede.plotting import HIGHLIGHT, animate, draw_3d
+from snede.scenes import Scene, briefly, material, solve_entries
+from snede.scenes.incision import incision_cells, lips_gap
 
 LENGTH, WIDTH, HEIGHT = 0.2, 0.05, 0.05
 YOUNG, POISSON, DENSITY = 1e5, 0.3, 1000.0
@@ -43,36 +44,6 @@ class Frame:
     displacement: np.ndarray
     blade: np.ndarray | None  # (2, 3) its edge, deformed coordinates; None before it is placed
     label: str
-
-
-def incision_cells(mesh, faces) -> np.ndarray:
-    """(n_cells,) 1.0 on the tetrahedra with a face among ``faces`` ((m, 3) vertex ids)."""
-    cells = mesh.cells
-    sides = np.concatenate([cells[:, [1, 2, 3]], cells[:, [0, 2, 3]], cells[:, [0, 1, 3]], cells[:, [0, 1, 2]]])
-    return highlighted(sides, faces).reshape(4, -1).any(axis=0).astype(np.float64)
-
-
-def lips_gap(body, faces) -> float:
-    """The widest gap between the two lips of the cut (m): the largest deformed distance between
-    vertices of ``faces`` that the cut made from one (the same reference position); 0 if none."""
-    vertices = np.unique(np.asarray(faces).ravel())
-    if len(vertices) == 0:
-        return 0.0
-    reference = body.mesh.points[vertices]
-    deformed = reference + body.displacement[vertices]
-    _, group = np.unique(reference, axis=0, return_inverse=True)
-    group = group.ravel()
-    widest = 0.0
-    for g in np.flatnonzero(np.bincount(group) > 1):
-        x = deformed[group == g]
-        widest = max(widest, float(np.linalg.norm(x[:, None] - x[None], axis=2).max()))
-    return widest
-
-
-def _briefly(result) -> str:
-    """The start of ``str(result)``: converged or not, PETSc's reason, iterations, and the time."""
-    state = "converged" if result.converged else "NOT converged"
-    return f"{state} ({result.reason}) after {result.iterations} iterations, {result.seconds:.2f} s"
 
 
 class Cut:
@@ -148,7 +119,7 @@ class Cut:
             result = solver.solve()
             self.results.append(result)
             where = self._blade_depth(path[k])
-            say(f"cut: move {k:>2}/{moves}, blade {where}: {report}; relaxed: {_briefly(result)}", flush=True)
+            say(f"cut: move {k:>2}/{moves}, blade {where}: {report}; relaxed: {briefly(result)}", flush=True)
             self._record(writer, k + 1, path[k], f"blade {where}")
 
         # One colour scale and one box for all frames, over the vertices of the boundary.
@@ -157,16 +128,10 @@ class Cut:
         every = np.concatenate([f.points[v] + f.displacement[v] for f, v in zip(self.frames, surfaces)])
         self._box = every.min(axis=0), every.max(axis=0)
         gif = animate(self.frames, folder / "cut.gif", self._draw_frame, fps=2, projection="3d")
-        failed = [r for r in self.results if not r.converged]
         opening, incision = self.opening(), self.faces()
+        solves = solve_entries(self.results)
         return {
-            "converged": not failed, "reason": (failed[0] if failed else self.results[-1]).reason,
-            "iterations": sum(r.iterations for r in self.results),
-            "linear_iterations": sum(r.linear_iterations for r in self.results),
-            "residual_norm": self.results[-1].residual_norm,
-            "seconds": sum(r.seconds for r in self.results) + total.seconds,
-            "mflop": sum(r.flops for r in self.results) / 1e6,
-            "solves": len(self.results), "moves": done, "frames": len(self.frames),
+            **solves, "seconds": solves["seconds"] + total.seconds, "moves": done, "frames": len(self.frames),
             "faces_dissected": total.faces_dissected, "vertices_snapped": total.vertices_snapped,
             "snaps_refused": total.snaps_refused, "degenerate_found": total.degenerate_found,
             "edges_collapsed": total.edges_collapsed, "edges_split": total.edges_split,

@@ -17,7 +17,7 @@ from PIL import Image
 from snede import run_scene
 from snede.scenes import cut
 
-from test_scenes import ROOT, not_blank, run_cli
+from test_scenes import ROOT, not_blank, red_pixels, run_cli
 
 DIVISIONS = 12  # 12 × 3 × 3 cubes, 4 moves of the blade: about 2 seconds
 
@@ -39,13 +39,6 @@ def lips(scene):
         pairs.setdefault(tuple(mesh.points[v]), []).append(v)
     return [(key[2], (mesh.points[b] + u[b]) - (mesh.points[a] + u[a]))
             for key, group in pairs.items() if len(group) == 2 for a, b in [group]]
-
-
-def red_pixels(image) -> int:
-    """Pixels of the incision's red (shaded), which the viridis colours of |u| never give."""
-    rgb = np.asarray(image.convert("RGB"), dtype=float) / 255
-    r, g, b = rgb[..., 0], rgb[..., 1], rgb[..., 2]
-    return int(((r > 0.35) & (r > 2.5 * g) & (r > 2.5 * b)).sum())
 
 
 def test_every_relaxation_converges_and_the_notch_leaves_one_valid_piece(cut_beam):

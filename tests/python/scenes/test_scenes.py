@@ -99,6 +99,13 @@ def test_series_writes_point_fields_that_meshio_reads_and_refuses_a_wrong_length
         writer.write_mesh(mesh, 1.0, point_fields={"height": [1.0, 2.0, 3.0]})
 
 
+def red_pixels(image) -> int:
+    """Pixels of the incision's red (shaded), which the viridis colours of |u| never give."""
+    rgb = np.asarray(image.convert("RGB"), dtype=float) / 255
+    r, g, b = rgb[..., 0], rgb[..., 1], rgb[..., 2]
+    return int(((r > 0.35) & (r > 2.5 * g) & (r > 2.5 * b)).sum())
+
+
 def run_cli(*args, cwd=None):
     return subprocess.run([sys.executable, "-m", "snede", *args], capture_output=True, text=True,
                           cwd=cwd or ROOT, timeout=300)
