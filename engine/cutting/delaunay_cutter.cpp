@@ -243,6 +243,9 @@ PlanarCutReport DelaunayCutter::move(std::span<const double> point) {
   }
   scalpel_ = now;
   touched_.clear();
+  // A body hears of the move's edits at once: its vectors are reissued once per move.
+  std::optional<ChangeBatch> batch;
+  batch.emplace(mesh_.connectivity());
 
   if (phase_ == Phase::outside && crossing) enter(*crossing, report);
   if (phase_ == Phase::entering) {
@@ -263,6 +266,7 @@ PlanarCutReport DelaunayCutter::move(std::span<const double> point) {
   }
   if (phase_ == Phase::cutting) touched_.push_back(active_);
   legalize(report);
+  batch.reset();
   report.triangles_after = mesh_.n_cells();
   report.seconds = wall_seconds() - start;
   return report;
