@@ -50,6 +50,15 @@ std::optional<std::pair<double, double>> segments_cross(const Point& p, const Po
   return std::pair{std::clamp(s, 0.0, 1.0), std::clamp(t, 0.0, 1.0)};
 }
 
+// Where the line through p and q meets segment (a, b), as a fraction along it clamped to [0, 1]
+// (0.5 if they are parallel).
+double line_crossing(const Point& p, const Point& q, const Point& a, const Point& b) {
+  const Point d = minus(q, p), e = minus(b, a);
+  const double denominator = cross(d, e);
+  if (denominator == 0) return 0.5;
+  return std::clamp(cross(minus(a, p), d) / denominator, 0.0, 1.0);
+}
+
 // Interior angle at w of triangle (w, a, b).
 double angle_at(const Point& w, const Point& a, const Point& b) {
   const Point u = minus(a, w), v = minus(b, w);
@@ -445,9 +454,19 @@ bool DelaunayCutter::advance(const Point& target, PlanarCutReport& report) {
       const Connectivity& c = mesh_.connectivity();
       const FaceId ahead = c.opposite_face(blocking->element, active_);
       if (c.is_face(ahead) && c.face(ahead).mate == no_id) {
-        // The way leaves the body through boundary edge (y, z): the cut exits there.
-        const auto hit = segments_cross(x, target, reference(blocking->y), reference(blocking->z));
-        exit_through(blocking->y, blocking->z, hit ? hit->second : 0.5, report);
+        // The way leaves the body: the cut exits through the boundary edge of the star that
+        // the way crosses. Two collinear boundary edges tie for the first triangle to invert,
+        // so the blocking one need not be it.
+        VertexId y = blocking->y, z = blocking->z;
+        double lambda = line_crossing(x, target, reference(y), reference(z));
+        for (const Wedge& w : wedges(active_)) {
+          if (c.face(c.opposite_face(w.element, active_)).mate != no_id) continue;
+          if (const auto hit = segments_cross(x, target, reference(w.y), reference(w.z))) {
+            y = w.y, z = w.z, lambda = hit->second;
+            break;
+          }
+        }
+        exit_through(y, z, lambda, report);
         return false;
       }
       if (c.is_face(ahead) && c.face(ahead).mate != no_id) {
@@ -556,6 +575,16 @@ void DelaunayCutter::split_incision(PlanarCutReport& report) {
   const double s = cross(minus(p1, pb), e) / denominator;
   const double length = distance(pb, pc);
   if (!(s * length > 0.25 * options_.eps_edge && (1 - s) * length > 0.25 * options_.eps_edge)) return;
+  // A new incision node within ε_edge/2 of o1 or o2 would leave a sliver: the interior node
+  // goes instead, as one that near the active node does (§5.2.2), and the next move looks
+  // again; next to a boundary node the incision stays unsplit. (Removing within ε_edge gives
+  // larger angles still but an incision further from the path: docs/results/delaunay_cut.md.)
+  const Point at = lerp(pb, pc, s);
+  const VertexId nearer = distance(at, p1) < distance(at, p2) ? o1 : o2;
+  if (distance(at, reference(nearer)) < 0.5 * options_.eps_edge) {
+    if (!incision_vertices_.count(nearer) && !on_boundary(nearer) && remove_node(nearer, report)) remesh_around(b, report);
+    return;
+  }
   const EditResult first = split_edge(mesh_, b, c1, s);
   if (!first.done) return;
   const EditResult second = split_edge(mesh_, b, c2, s);

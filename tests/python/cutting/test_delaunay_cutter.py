@@ -90,6 +90,43 @@ def test_a_cut_across_separates_and_one_that_stops_leaves_one_piece():
     assert along.size > 0
 
 
+def test_a_straight_cut_enters_and_leaves_where_its_line_crosses_the_sides():
+    # The entry and exit nodes are made on the crossing or picked within ε_entry / ε_exit of
+    # it (Figures 5.6, 5.7); even when the exit sees two collinear boundary edges at once.
+    rng = np.random.default_rng(11)
+    paths = [np.array([[-0.1, 0.43], [1.1, 0.61]])] + [
+        np.array([[-0.2, rng.uniform(0.1, 0.9)], [1.2, rng.uniform(0.1, 0.9)]]) for _ in range(24)]
+    for path in paths:
+        n = 5 if path is paths[0] else int(rng.integers(4, 12))
+        mesh = snede.meshing.rectangle((1, 1), (n, n))
+        cutter = snede.DelaunayCutter(mesh)
+        report = cutter.cut(path)
+        assert report.entries == 1 and report.exits == 1, (path, report)
+        direction = (path[1] - path[0]) / np.linalg.norm(path[1] - path[0])
+        ends = mesh.points[np.unique(cutter.incision_edges())]
+        ends = ends[np.isclose(ends[:, 0], 0) | np.isclose(ends[:, 0], 1)]
+        assert len(ends) >= 3, (path, ends)  # the entry node, and the exit node on both lips
+        off_line = np.abs(np.cross(ends - path[0], direction))
+        assert off_line.max() <= max(cutter.eps_entry, cutter.eps_exit) * (1 + 1e-9), (path, ends)
+        assert mesh.connected_components()[0] == 2
+
+
+def test_no_incision_node_is_made_next_to_an_old_vertex():
+    # An S-shaped path (two half turns of radius 0.17) whose incision split once put a node
+    # 0.004 (0.018 h̄) from the grid vertex (0.6, 0.6), a 1.1° sliver: the interior vertex is
+    # removed instead. No two distinct vertices end up closer than ε_edge/4.
+    mesh = snede.meshing.rectangle((1, 1), (5, 5))
+    cutter = snede.DelaunayCutter(mesh)
+    turn = np.linspace(0.5 * math.pi, -0.5 * math.pi, 48)
+    back = np.linspace(0.5 * math.pi, 1.5 * math.pi, 48)
+    cutter.cut(np.r_[[[-0.1, 0.87]], np.c_[0.7 + 0.17 * np.cos(turn), 0.70 + 0.17 * np.sin(turn)],
+                     np.c_[0.3 + 0.17 * np.cos(back), 0.36 + 0.17 * np.sin(back)], [[1.1, 0.19]]])
+    points = mesh.points[np.unique(mesh.cells)]
+    gaps = np.linalg.norm(points[:, None] - points[None], axis=2)
+    distinct = gaps[gaps > 1e-12]
+    assert distinct.min() > cutter.eps_edge / 4, distinct.min()
+
+
 def test_triangles_added_grow_with_the_path_not_with_the_number_of_moves():
     # The thesis's 50-triangle mesh (Figure 5.16): +10 triangles at h/3 for its cut.
     added = {}
