@@ -47,7 +47,7 @@ class SubdivisionCutter:
         return np.unique(edges, axis=0, return_counts=True)
 
     def _first_crossing(self, p, q, after: float):
-        """The first edge crossing of segment p→q beyond fraction ``after``, ignoring edges at
+        """The first edge crossing of segment p→q strictly beyond fraction ``after``, ignoring edges at
         the incision's end: (fraction along pq, a, b, fraction along ab, on the boundary)."""
         edges, counts = self._edges()
         # Edges at the incision's end, and the lips (which lie along the path, so rounding
@@ -62,7 +62,7 @@ class SubdivisionCutter:
         with np.errstate(divide="ignore", invalid="ignore"):
             s = _cross(a - p, e) / denominator
             t = _cross(a - p, d) / denominator
-        hit = (denominator != 0) & (s > after + 1e-12) & (s <= 1) & (t >= -_END) & (t <= 1 + _END)
+        hit = (denominator != 0) & (s > after) & (s <= 1) & (t >= -_END) & (t <= 1 + _END)
         if not hit.any():
             return None
         k = np.flatnonzero(hit)[np.argmin(s[hit])]
@@ -78,9 +78,12 @@ class SubdivisionCutter:
         before = self.mesh.n_cells
         counts = dict(moves=1, nodes_inserted=0, entries=0, exits=0)
         if self._last is not None and not np.array_equal(p, self._last):
-            along = 0.0
-            while (crossing := self._first_crossing(self._last, p, along)) is not None:
+            # The first crossing may lie a rounding error behind the start: the last move then
+            # stopped just short of that edge. Later ones lie strictly beyond the one before.
+            after = -1e-12
+            while (crossing := self._first_crossing(self._last, p, after)) is not None:
                 along, a, b, t, boundary = crossing
+                after = along + 1e-12
                 if t <= _END or t >= 1 - _END:
                     vertex = a if t <= _END else b
                 else:

@@ -63,3 +63,13 @@ def test_subdivision_refuses_bodies_and_3d_meshes():
         SubdivisionCutter(snede.meshing.box((1, 1, 1), (2, 2, 2)))
     with pytest.raises(TypeError, match="snede.Mesh"):
         SubdivisionCutter(object())
+
+
+@pytest.mark.parametrize("nudge", [-2.0**-55, 0.0, 2.0**-55])
+def test_a_path_point_a_rounding_error_from_an_edge_still_crosses_it(nudge):
+    # The straight cut at y = 0.5 across 5 × 5 squares crosses the 11 edges at x = 0.2, 0.4 … and
+    # the diagonals whether or not the path has a point on (or just short of) the edge x = 0.2.
+    mesh = snede.meshing.rectangle((1, 1), (5, 5))
+    report = SubdivisionCutter(mesh).cut(np.array([[-0.1, 0.5], [0.2 + nudge, 0.5], [1.1, 0.5]]))
+    assert report.nodes_inserted == 11 and report.entries == 1 and report.exits == 1
+    assert mesh.connected_components()[0] == 2
