@@ -12,7 +12,8 @@
 //    whose edge to it faces only angles below a threshold (§5.5);
 //  * splits the incision where the cut edges, seen as one edge, fail the empty-circle test
 //    (Figure 5.5): new nodes on both lips where the line through the opposite nodes crosses
-//    the cut edges.
+//    the cut edges — unless one would fall within ε_edge/2 of an opposite node, which is then
+//    removed if it is interior (it would leave a sliver).
 // Entry (Figure 5.6): the scalpel's path crossing the boundary makes (or, within ε_entry of a
 // vertex, picks) the entry node; the incision is postponed until the scalpel is ε_entry inside,
 // then a node is inserted at the scalpel, joined to the entry node by flips, and that edge is
