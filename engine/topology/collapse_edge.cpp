@@ -80,15 +80,16 @@ std::optional<std::vector<VertexId>> link_condition_violation(const Connectivity
 }  // namespace
 
 EditResult collapse_edge(Mesh& mesh, VertexId keep, VertexId gone, double t) {
-  const std::string edge = "edge (" + std::to_string(keep) + ", " + std::to_string(gone) + ")";
+  // Part of a refusal message, built only when one is given.
+  const auto edge = [&] { return "edge (" + std::to_string(keep) + ", " + std::to_string(gone) + ")"; };
   if (!(t >= 0 && t <= 1)) return EditResult::refused("collapse_edge: t = " + std::to_string(t) + " is not in [0, 1]");
   if (keep == gone || !mesh.is_vertex(keep) || !mesh.is_vertex(gone))
-    return EditResult::refused("collapse_edge: " + edge + " is not an edge of the mesh");
+    return EditResult::refused("collapse_edge: " + edge() + " is not an edge of the mesh");
   const Connectivity& c = mesh.connectivity();
   const LocalStar star_keep = local_star(c, keep), star_gone = local_star(c, gone);
   std::vector<ElementId> around, survivors_gone, survivors_keep;
   for (ElementId e : star_gone.elements) (c.element(e).simplex.contains(keep) ? around : survivors_gone).push_back(e);
-  if (around.empty()) return EditResult::refused("collapse_edge: " + edge + " is not an edge of the mesh");
+  if (around.empty()) return EditResult::refused("collapse_edge: " + edge() + " is not an edge of the mesh");
   for (ElementId e : star_keep.elements)
     if (!c.element(e).simplex.contains(gone)) survivors_keep.push_back(e);
   for (const auto& [v, star] : {std::pair{keep, &star_keep}, std::pair{gone, &star_gone}})
@@ -97,7 +98,7 @@ EditResult collapse_edge(Mesh& mesh, VertexId keep, VertexId gone, double t) {
                                  " is pinched (its star is not face-connected)");
   // §3.2.3, Figure 3.10: the collapse must leave a manifold.
   if (auto s = link_condition_violation(c, keep, gone, star_keep.elements, star_gone.elements, around))
-    return EditResult::refused("collapse_edge: " + edge + " fails the link condition: " + simplex_text(*s) +
+    return EditResult::refused("collapse_edge: " + edge() + " fails the link condition: " + simplex_text(*s) +
                                " is in the links of both vertices but not in the edge's, so the collapse would "
                                "make the mesh non-manifold");
 
@@ -105,7 +106,7 @@ EditResult collapse_edge(Mesh& mesh, VertexId keep, VertexId gone, double t) {
   const std::vector<double> x = mesh.interpolated("collapse_edge", parents);  // exactly where move_vertex will put keep
   std::string why = spoiled_by_move(mesh, survivors_gone, gone, x);
   if (why.empty() && t != 0) why = spoiled_by_move(mesh, survivors_keep, keep, x);
-  if (!why.empty()) return EditResult::refused("collapse_edge: collapsing " + edge + ": " + why);
+  if (!why.empty()) return EditResult::refused("collapse_edge: collapsing " + edge() + ": " + why);
 
   ChangeBatch batch(mesh.connectivity());
   mesh.connectivity().replace_elements(around, {});

@@ -20,14 +20,15 @@ struct EdgeWings {
 
 // The wings of (a, b), or the reason there are none.
 std::optional<EdgeWings> edge_wings(const Mesh& mesh, VertexId a, VertexId b, std::string& why_not) {
-  const std::string edge = "edge " + vertex_list({a, b});
+  // Part of a refusal message, built only when one is given.
+  const auto edge = [&] { return "edge " + vertex_list({a, b}); };
   if (a == b || !mesh.is_vertex(a) || !mesh.is_vertex(b)) {
-    why_not = edge + " does not exist: " + (a == b ? "its ends coincide" : "an end is not a vertex of the mesh");
+    why_not = edge() + " does not exist: " + (a == b ? "its ends coincide" : "an end is not a vertex of the mesh");
     return std::nullopt;
   }
   const std::vector<ElementId> sharing = elements_with_edge(mesh.connectivity(), a, b);
   if (sharing.size() != 2) {
-    why_not = edge + (sharing.empty() ? " does not exist in the mesh" : " lies on the boundary");
+    why_not = edge() + (sharing.empty() ? " does not exist in the mesh" : " lies on the boundary");
     return std::nullopt;
   }
   const Connectivity& c = mesh.connectivity();
@@ -49,19 +50,20 @@ EditResult flip_edge(Mesh& mesh, VertexId a, VertexId b) {
   const std::optional<EdgeWings> wings = edge_wings(mesh, a, b, why_not);
   if (!wings) return EditResult::refused("flip_edge: " + why_not);
   const VertexId c = wings->c, d = wings->d;
-  const std::string flip = "flip_edge: flipping " + vertex_list({a, b}) + " to " + vertex_list({c, d});
-  if (c == d) return EditResult::refused(flip + ": both triangles have the same corners");
+  // Part of a refusal message, built only when one is given.
+  const auto flip = [&] { return "flip_edge: flipping " + vertex_list({a, b}) + " to " + vertex_list({c, d}); };
+  if (c == d) return EditResult::refused(flip() + ": both triangles have the same corners");
   if (has_edge(mesh.connectivity(), c, d))
-    return EditResult::refused(flip + ": edge " + vertex_list({c, d}) +
+    return EditResult::refused(flip() + ": edge " + vertex_list({c, d}) +
                                " already exists, the flip would duplicate it (Figure 5.9)");
   const std::array<VertexId, 4> quadrilateral{a, d, b, c};
   const RetriangulationPlane plane(mesh, quadrilateral);
-  if (!plane.has_normal()) return EditResult::refused(flip + ": the quadrilateral has no area");
+  if (!plane.has_normal()) return EditResult::refused(flip() + ": the quadrilateral has no area");
   for (const auto& [x, y, z] : {std::array<VertexId, 3>{a, d, c}, std::array<VertexId, 3>{b, c, d}}) {
     const std::string problem = plane.triangle_problem(x, y, z);
     if (!problem.empty()) {
       const std::string convexity = mesh.is_surface() ? "" : " (quadrilateral " + vertex_list({a, d, b, c}) + " is not strictly convex)";
-      return EditResult::refused(flip + ": " + problem + convexity);
+      return EditResult::refused(flip() + ": " + problem + convexity);
     }
   }
   if (mesh.is_surface()) {
@@ -72,7 +74,7 @@ EditResult flip_edge(Mesh& mesh, VertexId a, VertexId b) {
       const std::array<double, 3> normal = doubled_vector_area(mesh, x, y, z);
       for (const auto& old : old_normals)
         if (!(normal[0] * old[0] + normal[1] * old[1] + normal[2] * old[2] > 0))
-          return EditResult::refused(flip + ": triangle " + vertex_list({x, y, z}) +
+          return EditResult::refused(flip() + ": triangle " + vertex_list({x, y, z}) +
                                      " would fold over (its normal points against an old triangle's)");
     }
   }

@@ -55,11 +55,12 @@ EditResult insert_vertex(Mesh& mesh, ElementId e, std::span<const double> weight
       zero_weight.push_back(corners[i]);
     }
   }
-  const std::string where = "insert_vertex in element " + std::to_string(e) + ": ";
+  // Part of a refusal message, built only when one is given.
+  const auto where = [&] { return "insert_vertex in element " + std::to_string(e) + ": "; };
   if (parents.count() == 1)
-    return EditResult::refused(where + "the point is vertex " + std::to_string(parents.vertex[0]) + ", nothing to insert");
+    return EditResult::refused(where() + "the point is vertex " + std::to_string(parents.vertex[0]) + ", nothing to insert");
   if (parents.count() == 2)
-    return EditResult::refused(where + "the point lies on edge " + vertex_list({parents.vertex[0], parents.vertex[1]}) +
+    return EditResult::refused(where() + "the point lies on edge " + vertex_list({parents.vertex[0], parents.vertex[1]}) +
                                " (the other weights are 0): use split_edge");
 
   // The cells to split and, per cell, the corners the new vertex takes the place of: all of
@@ -73,7 +74,7 @@ EditResult insert_vertex(Mesh& mesh, ElementId e, std::span<const double> weight
   for (ElementId cell_id : split)
     for (VertexId corner : parents.vertex)
       if (!positive_with_corner_at(mesh, c.element(cell_id).simplex, corner, position.data()))
-        return EditResult::refused(where + "the point is too close to the side of element " + std::to_string(cell_id) +
+        return EditResult::refused(where() + "the point is too close to the side of element " + std::to_string(cell_id) +
                                    " opposite vertex " + std::to_string(corner) +
                                    ": the new cell would be degenerate or inverted (exact orientation)");
 

@@ -121,12 +121,13 @@ EditResult remove_vertex_by_flips(Mesh& mesh, VertexId v) {
     throw std::invalid_argument("remove_vertex_by_flips: needs a triangle mesh (2D or surface), not a tetrahedral mesh");
   if (!mesh.is_vertex(v))
     throw std::invalid_argument("remove_vertex_by_flips: " + std::to_string(v) + " is not a vertex of the mesh");
-  const std::string removing = "remove_vertex_by_flips of vertex " + std::to_string(v) + ": ";
+  // Part of a refusal message, built only when one is given.
+  const auto removing = [&] { return "remove_vertex_by_flips of vertex " + std::to_string(v) + ": "; };
   const std::vector<ElementId> star = local_star(mesh.connectivity(), v).elements;
-  if (star.empty()) return EditResult::refused(removing + "it is in no cell (Mesh::remove_vertex removes it)");
+  if (star.empty()) return EditResult::refused(removing() + "it is in no cell (Mesh::remove_vertex removes it)");
   std::string why_not;
   const std::optional<Link> link = link_of(mesh, v, star, why_not);
-  if (!link) return EditResult::refused(removing + why_not);
+  if (!link) return EditResult::refused(removing() + why_not);
   const std::vector<VertexId>& polygon = link->polygon;
   if (!link->closed) {
     const VertexId first = polygon.front(), last = polygon.back();
@@ -134,21 +135,21 @@ EditResult remove_vertex_by_flips(Mesh& mesh, VertexId v) {
     const bool collinear = mesh.is_surface() ? collinear_3d(x.data(), at.data(), y.data())
                                              : orientation_2d(x.data(), at.data(), y.data()) == 0;
     if (!collinear || !strictly_between(x, at, y))
-      return EditResult::refused(removing + "a boundary vertex is removed only when it lies straight between its "
+      return EditResult::refused(removing() + "a boundary vertex is removed only when it lies straight between its "
                                             "boundary neighbours, and " + vertex_list({last, v, first}) +
                                  " is not a straight segment");
     if (has_edge(mesh.connectivity(), last, first))
-      return EditResult::refused(removing + "the new boundary edge " + vertex_list({last, first}) + " already exists");
+      return EditResult::refused(removing() + "the new boundary edge " + vertex_list({last, first}) + " already exists");
   }
   const RetriangulationPlane plane(mesh, polygon);
-  if (!plane.has_normal()) return EditResult::refused(removing + "its star has no area");
+  if (!plane.has_normal()) return EditResult::refused(removing() + "its star has no area");
   const std::optional<std::vector<Simplex>> triangles = ear_triangulation(mesh, plane, polygon, why_not);
-  if (!triangles) return EditResult::refused(removing + why_not);
+  if (!triangles) return EditResult::refused(removing() + why_not);
   // A link of three vertices closes into one triangle; on a closed surface it may exist already.
   const Simplex& last_triangle = triangles->back();
   for (ElementId e : elements_with_edge(mesh.connectivity(), last_triangle.vertex(0), last_triangle.vertex(1)))
     if (mesh.connectivity().element(e).simplex.same_vertices(last_triangle))
-      return EditResult::refused(removing + "triangle " + last_triangle.to_string() + " already exists");
+      return EditResult::refused(removing() + "triangle " + last_triangle.to_string() + " already exists");
 
   ChangeBatch batch(mesh.connectivity());  // one change: the new triangles and the removed vertex
   mesh.connectivity().replace_elements(star, *triangles);

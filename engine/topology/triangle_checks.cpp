@@ -69,13 +69,14 @@ const double* RetriangulationPlane::in_plane(VertexId v) const {
 }
 
 std::string RetriangulationPlane::triangle_problem(VertexId a, VertexId b, VertexId c) const {
-  const std::string triangle = "triangle " + vertex_list({a, b, c});
+  // Part of a refusal message, built only when one is given.
+  const auto triangle = [&] { return "triangle " + vertex_list({a, b, c}); };
   if (mesh_.is_surface() && collinear_3d(mesh_.point(a).data(), mesh_.point(b).data(), mesh_.point(c).data()))
-    return triangle + " would be degenerate (its corners are collinear)";
+    return triangle() + " would be degenerate (its corners are collinear)";
   const int orientation = orientation_2d(in_plane(a), in_plane(b), in_plane(c));
   if (orientation > 0) return "";
-  if (mesh_.is_surface()) return triangle + " would fold over (its normal points against the region's)";
-  return triangle + (orientation == 0 ? " would be degenerate (its corners are collinear)" : " would be inverted (clockwise)");
+  if (mesh_.is_surface()) return triangle() + " would fold over (its normal points against the region's)";
+  return triangle() + (orientation == 0 ? " would be degenerate (its corners are collinear)" : " would be inverted (clockwise)");
 }
 
 bool RetriangulationPlane::closed_triangle_contains(VertexId a, VertexId b, VertexId c, VertexId q) const {
