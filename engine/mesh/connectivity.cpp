@@ -93,7 +93,7 @@ Connectivity Connectivity::from_cells(int dim, std::span<const VertexId> cells) 
   return c;
 }
 
-bool Connectivity::already_kept(const Simplex& sigma, const BoundaryMap& old_faces,
+bool Connectivity::already_kept(const Simplex& sigma, const LocalFaceMap& old_faces,
                                 const std::unordered_set<ElementId>& old_set) const {
   if (boundary_.count(sigma)) return true;
   // An interior face σ of a kept element is the mate of -σ; seen from -σ if that is an old face.
@@ -183,21 +183,21 @@ std::vector<ElementId> Connectivity::replace_elements(std::span<const ElementId>
                                                       std::span<const Simplex> new_simplexes) {
   // Checks first, so that a rejected call changes nothing.
   std::unordered_set<ElementId> old_set;
-  BoundaryMap old_faces;  // simplex -> Face of an old element
+  LocalFaceMap old_faces;  // simplex -> Face of an old element
   for (ElementId e : old_elements) {
     if (!is_element(e)) throw std::invalid_argument("replace_elements: " + element_text(e) + " does not exist");
     if (!old_set.insert(e).second)
       throw std::invalid_argument("replace_elements: " + element_text(e) + " is listed twice");
     for (int j = 0; j <= dim_; ++j) old_faces.emplace(faces_[elements_[e].faces[j]].simplex, elements_[e].faces[j]);
   }
-  BoundaryMap new_faces;  // simplex -> Face (reused or created); filled with no_id for now
+  LocalFaceMap new_faces;  // simplex -> Face (reused or created); filled with no_id for now
   for (const Simplex& tau : new_simplexes) {
     if (tau.dimension() != dim_)
       throw std::invalid_argument("replace_elements: simplex " + tau.to_string() + " has dimension " +
                                   std::to_string(tau.dimension()) + ", the mesh has " + std::to_string(dim_));
     for (int j = 0; j <= dim_; ++j) {
       const Simplex sigma = tau.subn(j);
-      if (!new_faces.emplace(sigma, no_id).second)
+      if (!new_faces.emplace(sigma, no_id))
         throw std::invalid_argument("replace_elements: face " + sigma.to_string() +
                                     " would belong to two new elements (7.4)");
       if (!old_faces.count(sigma) && already_kept(sigma, old_faces, old_set))
@@ -249,7 +249,7 @@ std::vector<ElementId> Connectivity::replace_elements(std::span<const ElementId>
       }
       faces_[f].element = e;
       elements_[e].faces[j] = f;
-      new_faces[sigma] = f;
+      new_faces.assign(sigma, f);
     }
   }
   // Pair created faces: first among the new faces (matched pairs never touch the boundary
@@ -318,7 +318,8 @@ void Connectivity::change_elements(std::span<const ElementSubstitution> substitu
   notify(change, orphans);
 }
 
-void Connectivity::pair_faces(std::span<const FaceId> unmatched, const BoundaryMap& local,
+template <class FaceMap>
+void Connectivity::pair_faces(std::span<const FaceId> unmatched, const FaceMap& local,
                               std::span<const FaceId> orphans, ConnectivityChange& change) {
   for (FaceId f : unmatched) {
     if (faces_[f].mate != no_id) continue;
@@ -413,6 +414,9 @@ namespace {
 
 // Live elements around the moved vertices that are not otherwise reported as new or changed.
 std::vector<ElementId> reshaped_by(const Connectivity& c, const ConnectivityChange& change) {
+  const bool moved = std::any_of(change.vertex_events.begin(), change.vertex_events.end(),
+                                 [](const VertexEvent& event) { return event.kind == VertexEventKind::moved; });
+  if (!moved) return {};  // the usual case: no sets to build
   std::unordered_set<ElementId> reported(change.added_elements.begin(), change.added_elements.end());
   for (const auto& entry : change.changed_elements) reported.insert(entry.first);
   std::unordered_set<ElementId> reshaped;

@@ -7,6 +7,7 @@
 // (the thesis's balanced trees cost O(log n) per lookup).
 #pragma once
 
+#include <algorithm>
 #include <span>
 #include <unordered_map>
 #include <unordered_set>
@@ -40,6 +41,34 @@ struct ElementSubstitution {
 };
 
 using BoundaryMap = std::unordered_map<Simplex, FaceId, SimplexHash>;
+
+// The faces of the few elements one replace_elements call swaps, by simplex: a flat vector
+// searched linearly, which at this size beats hashing and its allocations.
+class LocalFaceMap {
+ public:
+  using Entry = std::pair<Simplex, FaceId>;
+  using const_iterator = std::vector<Entry>::const_iterator;
+  const_iterator begin() const { return entries_.begin(); }
+  const_iterator end() const { return entries_.end(); }
+  const_iterator find(const Simplex& sigma) const {
+    return std::find_if(entries_.begin(), entries_.end(), [&](const Entry& e) { return e.first == sigma; });
+  }
+  bool count(const Simplex& sigma) const { return find(sigma) != end(); }
+  // Adds σ → f unless σ is present; true if added.
+  bool emplace(const Simplex& sigma, FaceId f) {
+    if (count(sigma)) return false;
+    entries_.emplace_back(sigma, f);
+    return true;
+  }
+  // σ must be present.
+  void assign(const Simplex& sigma, FaceId f) {
+    for (Entry& e : entries_)
+      if (e.first == sigma) e.second = f;
+  }
+
+ private:
+  std::vector<Entry> entries_;
+};
 
 class Connectivity {
  public:
@@ -121,10 +150,11 @@ class Connectivity {
   void link(FaceId a, FaceId b);
   // Links each unmatched face to its opposite, looked up among `local` faces first and then
   // in the boundary; the rest, and orphans left without a mate, join the boundary.
-  void pair_faces(std::span<const FaceId> unmatched, const BoundaryMap& local, std::span<const FaceId> orphans,
+  template <class FaceMap>  // BoundaryMap or LocalFaceMap
+  void pair_faces(std::span<const FaceId> unmatched, const FaceMap& local, std::span<const FaceId> orphans,
                   ConnectivityChange& change);
   // True if a face with simplex σ exists outside the elements being replaced.
-  bool already_kept(const Simplex& sigma, const BoundaryMap& old_faces,
+  bool already_kept(const Simplex& sigma, const LocalFaceMap& old_faces,
                     const std::unordered_set<ElementId>& old_set) const;
   // Completes `change` (staged vertex events, reshaped elements), updates the vertex
   // incidences and tells the watchers (or merges it into the open batch).
