@@ -269,6 +269,7 @@ PlanarCutReport DelaunayCutter::move(std::span<const double> point) {
     }
     if (phase_ == Phase::cutting) {
       last_target_ = target;
+      if (trail_.empty() || trail_.back() != reference(active_)) trail_.push_back(reference(active_));
       split_incision(report);
       predict_exit(minus(target, from), report);
     }
@@ -321,6 +322,7 @@ void DelaunayCutter::lift() {
   active_ = -1;
   scalpel_.reset();
   last_target_.reset();
+  trail_.clear();
 }
 
 void DelaunayCutter::enter(const Crossing& crossing, PlanarCutReport& report) {
@@ -378,6 +380,7 @@ bool DelaunayCutter::fix_up_entry(const Point& p, PlanarCutReport& report) {
   incision_vertices_.insert(a);
   incision_vertices_.insert(b);
   phase_ = Phase::cutting;
+  trail_ = {reference(a), reference(b)};
   return true;
 }
 
@@ -549,6 +552,39 @@ bool DelaunayCutter::remove_node(VertexId v, PlanarCutReport& report) {
   return true;
 }
 
+std::optional<DelaunayCutter::TrailCrossing> DelaunayCutter::trail_crossing(const Point& p, const Point& q,
+                                                                           const Point& near) const {
+  std::optional<TrailCrossing> best;
+  for (std::size_t k = 0; k + 1 < trail_.size(); ++k)
+    if (const auto hit = segments_cross(p, q, trail_[k], trail_[k + 1])) {
+      const Point x = lerp(p, q, hit->first);
+      if (!best || distance(x, near) < distance(best->point, near)) best = TrailCrossing{x, k};
+    }
+  return best;
+}
+
+bool DelaunayCutter::move_lips_to(const Point& x, std::array<VertexId, 2> copies,
+                                  std::array<std::array<VertexId, 3>, 2> own_triangles) {
+  // Each copy moves with the barycentric coordinates of x in its own lip's triangle (b, c, o),
+  // extrapolating for the copy on the far side, so a body's fields follow each lip's side.
+  const auto snap = [&](int k, const Point& to) {
+    const auto& [b, c, o] = own_triangles[k];
+    const auto weights = barycentric(reference(b), reference(c), reference(o), to);
+    return snap_vertex(mesh_, copies[k], VertexParents::barycentric(own_triangles[k], weights)).done;
+  };
+  const Point chord = reference(copies[0]);
+  if (!snap(0, x)) return false;
+  if (!snap(1, x)) {  // back to the chord, where the other copy still is
+    snap(0, chord);
+    mesh_.move_vertex(copies[0], reference(copies[1]));
+    return false;
+  }
+  // The two copies' weights differ: the second takes the first's coordinates, bit for bit.
+  const Point first = reference(copies[0]);
+  mesh_.move_vertex(copies[1], first);
+  return true;
+}
+
 void DelaunayCutter::split_incision(PlanarCutReport& report) {
   const Connectivity& c = mesh_.connectivity();
   const VertexId b = active_;
@@ -575,13 +611,18 @@ void DelaunayCutter::split_incision(PlanarCutReport& report) {
   const double s = cross(minus(p1, pb), e) / denominator;
   const double length = distance(pb, pc);
   if (!(s * length > 0.25 * options_.eps_edge && (1 - s) * length > 0.25 * options_.eps_edge)) return;
+  // §5.2.2: the new nodes go where o1 o2 crosses the scalpel's path (its trail since c);
+  // where it does not, on the chord.
+  const Point at = lerp(pb, pc, s);
+  const std::optional<TrailCrossing> on_path = trail_crossing(p1, p2, at);
+  const Point node = on_path ? on_path->point : at;
+  if (!(distance(node, pb) > 0.25 * options_.eps_edge && distance(node, pc) > 0.25 * options_.eps_edge)) return;
   // A new incision node within ε_edge/2 of o1 or o2 would leave a sliver: the interior node
   // goes instead, as one that near the active node does (§5.2.2), and the next move looks
   // again; next to a boundary node the incision stays unsplit. (Removing within ε_edge gives
   // larger angles still but an incision further from the path: docs/results/delaunay_cut.md.)
-  const Point at = lerp(pb, pc, s);
-  const VertexId nearer = distance(at, p1) < distance(at, p2) ? o1 : o2;
-  if (distance(at, reference(nearer)) < 0.5 * options_.eps_edge) {
+  const VertexId nearer = distance(node, p1) < distance(node, p2) ? o1 : o2;
+  if (distance(node, reference(nearer)) < 0.5 * options_.eps_edge) {
     if (!incision_vertices_.count(nearer) && !on_boundary(nearer) && remove_node(nearer, report)) remesh_around(b, report);
     return;
   }
@@ -591,6 +632,12 @@ void DelaunayCutter::split_incision(PlanarCutReport& report) {
   if (!second.done) {  // keep the lips alike: undo the first
     collapse_edge(mesh_, c1, first.vertex, 0);
     return;
+  }
+  if (on_path && move_lips_to(on_path->point, {first.vertex, second.vertex}, {{{b, c1, o1}, {b, c2, o2}}})) {
+    trail_.erase(trail_.begin(), trail_.begin() + static_cast<std::ptrdiff_t>(on_path->segment) + 1);
+    trail_.insert(trail_.begin(), on_path->point);
+  } else {
+    trail_ = {at, reference(b)};
   }
   incision_vertices_.insert(first.vertex);
   incision_vertices_.insert(second.vertex);
@@ -632,6 +679,7 @@ void DelaunayCutter::exit_through(VertexId y, VertexId z, double lambda, PlanarC
   phase_ = Phase::outside;
   active_ = -1;
   last_target_.reset();
+  trail_.clear();
   // An edge (b, w) that is missing, or already on the boundary (w next to b along it), has
   // nothing to open: the incision ends where it is.
   if (elements_with_edge(mesh_.connectivity(), b, w).size() != 2) return;

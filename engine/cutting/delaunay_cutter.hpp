@@ -12,8 +12,8 @@
 //    whose edge to it faces only angles below a threshold (§5.5);
 //  * splits the incision where the cut edges, seen as one edge, fail the empty-circle test
 //    (Figure 5.5): new nodes on both lips where the line through the opposite nodes crosses
-//    the cut edges — unless one would fall within ε_edge/2 of an opposite node, which is then
-//    removed if it is interior (it would leave a sliver).
+//    the scalpel's path — unless one would fall within ε_edge/2 of an opposite node, which is
+//    then removed if it is interior (it would leave a sliver).
 // Entry (Figure 5.6): the scalpel's path crossing the boundary makes (or, within ε_entry of a
 // vertex, picks) the entry node; the incision is postponed until the scalpel is ε_entry inside,
 // then a node is inserted at the scalpel, joined to the entry node by flips, and that edge is
@@ -23,9 +23,10 @@
 // are ignored until the scalpel has moved 2 ε_exit away from it (the forbidden edges).
 //
 // Departures from the thesis: the dent of a postponed entry is not drawn (the entry node stays
-// on the boundary until the fix-up); new incision nodes lie on the cut edges (chords of the
-// path between incision nodes) rather than on the path itself, and the two lips' nodes
-// coincide instead of being dilated.
+// on the boundary until the fix-up); a new incision node goes on the path (the active node's
+// trail) where the line through the opposite nodes crosses it, and on the cut edges' chord
+// only where that line misses the trail; the two lips' nodes coincide instead of being
+// dilated.
 #pragma once
 
 #include <array>
@@ -131,6 +132,14 @@ class DelaunayCutter {
   // edge there is locally Delaunay (the rest of the mesh was not changed).
   void legalize(PlanarCutReport& report);
   void split_incision(PlanarCutReport& report);
+  struct TrailCrossing {
+    Point point;
+    std::size_t segment;  // trail_[segment] → trail_[segment + 1]
+  };
+  // Where segment p→q crosses the trail, the crossing nearest to `near`.
+  std::optional<TrailCrossing> trail_crossing(const Point& p, const Point& q, const Point& near) const;
+  // Moves both copies of a new incision node to x; false (nothing moved) if either is refused.
+  bool move_lips_to(const Point& x, std::array<VertexId, 2> copies, std::array<std::array<VertexId, 3>, 2> own_triangles);
   void predict_exit(const Point& direction, PlanarCutReport& report);
   void exit_through(VertexId y, VertexId z, double lambda, PlanarCutReport& report);
   std::vector<VertexId> dissect_edge(VertexId a, VertexId b);
@@ -147,6 +156,8 @@ class DelaunayCutter {
   std::unordered_set<VertexId> forbidden_;  // boundary vertices of that exit: no entry near them
   std::unordered_set<VertexId> incision_vertices_;
   std::vector<VertexId> touched_;  // vertices whose stars this move changed
+  // Reference positions of the active node since the newest incision node behind it (first).
+  std::vector<Point> trail_;
 };
 
 }  // namespace snede

@@ -127,6 +127,38 @@ def test_no_incision_node_is_made_next_to_an_old_vertex():
     assert distinct.min() > cutter.eps_edge / 4, distinct.min()
 
 
+def distance_to_polyline(x, polyline) -> float:
+    a, b = polyline[:-1], polyline[1:]
+    d = b - a
+    t = np.clip(((x - a) * d).sum(axis=1) / np.maximum((d * d).sum(axis=1), 1e-300), 0, 1)
+    return float(np.linalg.norm(a + t[:, None] * d - x, axis=1).min())
+
+
+def test_incision_splits_put_their_nodes_on_the_scalpels_path():
+    # §5.2.2: the new nodes go where the line through the opposite nodes crosses the path (the
+    # active node's trail); only where that line misses the trail do they fall on the chord.
+    rng = np.random.default_rng(5)
+    made, on_path = 0, 0
+    for trial in range(12):
+        n = int(rng.integers(4, 12))
+        mesh = snede.meshing.rectangle((1, 1), (n, n))
+        cutter = snede.DelaunayCutter(mesh)
+        trail = []
+        for point in sample_path(random_path(rng, "curved"), cutter.eps_edge):
+            before = mesh.live_vertices.copy()
+            report = cutter.move(point)
+            if cutter.active_node is not None:
+                trail.append(mesh.points[cutter.active_node].copy())
+            if report.incision_splits:
+                after = mesh.live_vertices
+                new = np.flatnonzero(after & ~np.r_[before, np.zeros(len(after) - len(before), dtype=bool)])
+                for v in new:
+                    made += 1
+                    on_path += distance_to_polyline(mesh.points[v], np.array(trail)) < 1e-12
+    assert made > 50
+    assert on_path >= 0.9 * made, (on_path, made)
+
+
 def test_triangles_added_grow_with_the_path_not_with_the_number_of_moves():
     # The thesis's 50-triangle mesh (Figure 5.16): +10 triangles at h/3 for its cut.
     added = {}
