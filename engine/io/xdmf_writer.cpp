@@ -138,6 +138,7 @@ void XdmfWriter::write_step(double time, const Mesh& mesh, std::span<const doubl
 void XdmfWriter::write_xdmf() const {
   std::ofstream out(xdmf_path());
   if (!out) throw std::runtime_error("cannot write " + xdmf_path());
+  out.precision(17);  // times read back exactly (a double's round-trip precision)
   const std::string h5 = xml_escaped(file_name(h5_path()));
   out << "<?xml version=\"1.0\"?>\n<Xdmf Version=\"3.0\">\n<Domain>\n"
       << "<Grid Name=\"series\" GridType=\"Collection\" CollectionType=\"Temporal\">\n";

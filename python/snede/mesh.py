@@ -280,13 +280,26 @@ class Mesh(MeshEdits):
     def read(cls, path) -> "Mesh":
         """Read a mesh with meshio (gmsh .msh, VTK/VTU, XDMF, and every format meshio reads).
         Tetrahedra are taken if present, else triangles: a 2D mesh when every z is 0, otherwise
-        a surface mesh in 3D."""
-        import io
+        a surface mesh in 3D.
 
-        import meshio
+        An ``.xdmf`` time series written by ``snede.output.SeriesWriter`` (which meshio cannot
+        read) gives the mesh of its last step; use ``snede.output.read_series`` for every step
+        with its own mesh and fields."""
+        import io
 
         if not Path(path).exists():
             raise FileNotFoundError(f"no mesh file {path}")
+        if Path(path).suffix.lower() in (".xdmf", ".xmf"):
+            from snede import output
+
+            if output._is_series(path):
+                steps = output._read(path, last_only=True)
+                if not steps:
+                    raise ValueError(f"{path}: the series has no steps (yet): no mesh to read")
+                return steps[-1].mesh
+
+        import meshio
+
         # meshio tries its ANSYS reader on .msh first, printing blank lines, and calls
         # sys.exit on a file it cannot parse: silence the one and turn the other into an error.
         try:
