@@ -1,5 +1,6 @@
 #include "bindings.hpp"
 #include "core/error.hpp"
+#include "core/interrupt.hpp"
 #include "core/options.hpp"
 #include "core/petsc_util.hpp"
 
@@ -9,19 +10,22 @@ namespace snede::bindings {
 
 void bind_core(py::module_& m) {
   py::register_exception<PetscException>(m, "PetscError", PyExc_RuntimeError);
-  // A Python callback run by PETSc (a petsc4py monitor) that raised makes PETSc fail with
-  // petsc4py's PETSC_ERR_PYTHON while that exception is still set: it, with its type and
-  // message (a KeyboardInterrupt too), is what the caller gets, not "PETSc error -1".
+  // A solve stopped by Python — a petsc4py monitor that raised (PETSc then fails with
+  // petsc4py's PETSC_ERR_PYTHON), or a Ctrl-C seen by the interrupt check below — comes back
+  // as a PetscError while Python's exception is still set: that exception, with its type and
+  // message (KeyboardInterrupt for Ctrl-C), is what the caller gets, not "PETSc error -1".
   // (Translators registered later are tried first; rethrowing passes to the next one.)
   py::register_exception_translator([](std::exception_ptr thrown) {
-    constexpr PetscErrorCode petsc4py_python_error = -1;  // PETSC_ERR_PYTHON in petsc4py.h
     try {
       std::rethrow_exception(thrown);
-    } catch (const PetscException& e) {
-      if (e.code() == petsc4py_python_error && PyErr_Occurred()) return;
+    } catch (const PetscException&) {
+      if (PyErr_Occurred()) return;
       throw;
     }
   });
+  // The solvers ask between iterations whether to stop: Python's signal handlers run here (the
+  // GIL is held during solves), and a SIGINT leaves a KeyboardInterrupt set and stops the solve.
+  set_interrupt_check([] { return PyErr_CheckSignals() != 0; });
   m.def("petsc_allocated_bytes", &petsc_allocated_bytes,
         "Bytes currently allocated by PETSc (tracked only with -malloc_debug or -malloc_view).");
   m.def("option_real", &option_real, py::arg("name"),

@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "core/error.hpp"
+#include "core/interrupt.hpp"
 #include "core/norms.hpp"
 #include "core/petsc_util.hpp"
 
@@ -386,6 +387,7 @@ PetscErrorCode DynamicRelaxation::post_step_callback(TS ts) {
     void* context = nullptr;
     SNEDE_PETSC(TSGetApplicationContext(ts, &context));
     callback_owner<DynamicRelaxation>(context, "DynamicRelaxation").after_step();
+    stop_if_interrupted();
   });
 }
 

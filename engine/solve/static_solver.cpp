@@ -7,6 +7,7 @@
 #include <limits>
 
 #include "core/error.hpp"
+#include "core/interrupt.hpp"
 #include "core/norms.hpp"
 #include "core/petsc_util.hpp"
 
@@ -346,6 +347,7 @@ PetscErrorCode StaticSolver::snes_converged_callback(SNES snes, PetscInt it, Pet
                                                      PetscReal fnorm, SNESConvergedReason* reason, void* context) {
   return petsc_callback("snede stopping criterion", [&] {
     auto* self = &callback_owner<StaticSolver>(context, "StaticSolver");
+    stop_if_interrupted();
     // PETSc's default test catches NaN norms and the iteration limit.
     SNEDE_PETSC(SNESConvergedDefault(snes, it, xnorm, snorm, fnorm, reason, nullptr));
     self->history_.push_back(fnorm);
@@ -358,11 +360,12 @@ PetscErrorCode StaticSolver::snes_converged_callback(SNES snes, PetscInt it, Pet
   });
 }
 
-PetscErrorCode StaticSolver::ksp_converged_callback(KSP ksp, PetscInt it, PetscReal rnorm, KSPConvergedReason* reason,
+PetscErrorCode StaticSolver::ksp_converged_callback(KSP ksp, PetscInt /*iteration*/, PetscReal rnorm, KSPConvergedReason* reason,
                                                     void* context) {
   return petsc_callback("snede stopping criterion", [&] {
     auto* self = &callback_owner<StaticSolver>(context, "StaticSolver");
     (void)ksp;
+    stop_if_interrupted();
     rnorm *= self->system_scale_;  // the residual in newtons
     self->history_.push_back(rnorm);
     if (!std::isfinite(rnorm) || !std::isfinite(self->current_tolerance())) {

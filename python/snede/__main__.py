@@ -130,6 +130,11 @@ def main(argv: list[str] | None = None) -> int:
     except (snede.PetscError, ValueError, OSError) as error:  # a bad PETSc option value, bad input
         print(f"error: {error}", file=sys.stderr)
         return 2
+    except KeyboardInterrupt:  # Ctrl-C: solves stop between iterations (engine/core/interrupt.hpp)
+        where = f" (the files written so far in {args.out} are complete up to the last step)" \
+            if args.command in ("run", "demo") else ""
+        print(f"interrupted{where}", file=sys.stderr)
+        return 130
     if args.command != "list":
         _warn_unused(logger)
     return code

@@ -79,7 +79,9 @@ def cylinder(length=0.1, radius=0.03, h=0.01, seed: int | None = None) -> Mesh:
             raise ValueError(f"{name} must be positive and finite, got {value}")
     initialized_here = not gmsh.isInitialized()
     if initialized_here:
-        gmsh.initialize(readConfigFiles=False)
+        # interruptible=False: gmsh would otherwise take over SIGINT for good, and Ctrl-C
+        # would kill the process without a word instead of raising KeyboardInterrupt.
+        gmsh.initialize(readConfigFiles=False, interruptible=False)
     try:
         gmsh.option.setNumber("General.Terminal", 0)
         gmsh.model.add("snede-cylinder")
