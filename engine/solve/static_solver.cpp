@@ -141,6 +141,11 @@ void StaticSolver::create_objects() {
     SNEDE_PETSC(SNESKSPSetUseEW(snes_, PETSC_TRUE));
     SNEDE_PETSC(SNESSetMaxLinearSolveFailures(snes_, options_.max_iterations));
   }
+  // A line search's absolute tolerance depends on the units (cp declares CONVERGED_FNORM_ABS
+  // once the slope F·y falls below it, and F is in scaled units here): convergence is decided
+  // by snede's own criterion alone.
+  SNEDE_PETSC(SNESLineSearchSetTolerances(line_search, PETSC_DEFAULT, PETSC_DEFAULT, PETSC_DEFAULT, 0.0, PETSC_DEFAULT,
+                                          PETSC_DEFAULT));
   SNEDE_PETSC(SNESSetFromOptions(snes_));
   option_database_.mark_read_options_used();
 }
@@ -183,10 +188,10 @@ SolveResult StaticSolver::solve() {
   rule_ = options_.stopping;
   rule_.force_scale = model_.force_scale();
   rule_.n_dofs = static_cast<double>(model_.n_dofs());
-  // Linear CG solves the system divided by the force scale E·t·H (E·H² in 3D), so that its
-  // dot products stay in range whatever the units (E = 1e155 Pa overflows p·Ap otherwise);
-  // the iterate keeps its units and the stopping test multiplies back. (The same scaling of
-  // the SNES function, objective and tangent upset the cp line search; not done yet.)
+  // Every method solves the system divided by the force scale E·t·H (E·H² in 3D), so that its
+  // dot products stay in range whatever the units (E = 1e155 Pa overflows p·Ap otherwise):
+  // linear CG its right-hand side and operator, SNES its function, objective (energy) and
+  // tangent. The iterate keeps its units and the stopping tests multiply back.
   system_scale_ = std::isfinite(rule_.force_scale) && rule_.force_scale > 0 ? rule_.force_scale : 1.0;
   model_.enforce_constraints(model_.displacement());
   // A free body has rigid motions: the static problem has no unique solution.
@@ -244,6 +249,7 @@ SolveResult StaticSolver::solve_nonlinear() {
   result.initial_residual_norm = vec_norm(residual_);
   SNESConvergedReason reason;
   PetscInt iterations = 0, linear = 0;
+  const ScaledOperator scaled(model_, system_scale_);
   auto run = [&] {
     SNEDE_PETSC(SNESSolve(snes_, nullptr, u));
     PetscInt its = 0, lits = 0;
@@ -318,6 +324,7 @@ PetscErrorCode StaticSolver::residual_callback(SNES snes, Vec x, Vec F, void* co
     auto* self = &callback_owner<StaticSolver>(context, "StaticSolver");
     EvaluationReport report;
     self->model_.residual(x, F, report);
+    SNEDE_PETSC(VecScale(F, 1.0 / self->system_scale_));
     const bool inverted = !report.inverted.empty() && forbids_inversion(self->model_.body().material());
     if (!report.domain_errors.empty() || inverted) SNEDE_PETSC(SNESSetFunctionDomainError(snes));
   });
@@ -327,7 +334,7 @@ PetscErrorCode StaticSolver::objective_callback(SNES snes, Vec x, PetscReal* val
   return petsc_callback("snede static objective", [&] {
     auto* self = &callback_owner<StaticSolver>(context, "StaticSolver");
     EvaluationReport report;
-    *value = self->model_.potential_energy(x, report);
+    *value = self->model_.potential_energy(x, report) / self->system_scale_;
     if (!report.domain_errors.empty()) {
       *value = std::numeric_limits<double>::infinity();
       SNEDE_PETSC(SNESSetFunctionDomainError(snes));
@@ -350,6 +357,7 @@ PetscErrorCode StaticSolver::snes_converged_callback(SNES snes, PetscInt it, Pet
     stop_if_interrupted();
     // PETSc's default test catches NaN norms and the iteration limit.
     SNEDE_PETSC(SNESConvergedDefault(snes, it, xnorm, snorm, fnorm, reason, nullptr));
+    fnorm *= self->system_scale_;  // the residual in newtons
     self->history_.push_back(fnorm);
     if (*reason < 0) return;
     if (!std::isfinite(self->current_tolerance())) {

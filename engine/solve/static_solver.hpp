@@ -69,7 +69,7 @@ class StaticSolver {
   std::uint64_t generation_ = 0;
   StoppingRule rule_;  // the stopping rule of the current solve, scaled to the model
   double external_norm_ = 0;
-  double system_scale_ = 1;  // linear CG sees J and F divided by it (the force scale)
+  double system_scale_ = 1;  // CG and SNES see J, F and the energy divided by it (the force scale)
   double reaction_norm_ = 0;  // reactions used by the KSP test (at the start of a linear solve)
   std::vector<double> history_;
 };
