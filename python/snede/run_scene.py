@@ -81,6 +81,15 @@ def fitting_method(scene) -> str:
     return scene.default_method
 
 
+def picture_arguments(scene, method: str) -> dict:
+    """The keyword arguments of ``plotting.plot_body`` for the scene's picture (after its run):
+    title, displacement scale, the fixed vertices, the scene's decoration and its own."""
+    mesh = scene.body.mesh
+    fixed = None if scene.fixed is None else np.asarray(scene.fixed(mesh.points), dtype=bool) & mesh.live_vertices
+    return {"title": f"{scene.name}: {type(scene.body.material).__name__}, {method}", "scale": scene.plot_scale,
+            "decorate": scene.decorate, "fixed": fixed, **(scene.picture() if scene.picture else {})}
+
+
 def run(scene, method: str | None, rtol: float | None, out: Path, progress: bool = True) -> dict:
     """Solve (or evolve) the scene with ``method`` (None: ``fitting_method(scene)``), write the
     series, the picture and summary.json; the summary."""
@@ -91,8 +100,7 @@ def run(scene, method: str | None, rtol: float | None, out: Path, progress: bool
     folder.mkdir(parents=True, exist_ok=True)
     writer = SeriesWriter(folder / scene.name)
     outcome = (scene.evolve or partial(solve_once, scene))(method, rtol, writer, folder, progress)
-    picture = plot_body(body, folder / f"{scene.name}.png", title=f"{scene.name}: {type(body.material).__name__}, {method}",
-                        scale=scene.plot_scale, decorate=scene.decorate, **(scene.picture() if scene.picture else {}))
+    picture = plot_body(body, folder / f"{scene.name}.png", **picture_arguments(scene, method))
     value = scene.probe(body)
     files = outcome.pop("files", {})
     summary = {

@@ -19,7 +19,7 @@ class Scene:
     probe: Callable[["snede.Body"], float]
     analytic: float | None = None  # the probe's analytic value, where one exists
     damping: float = 20.0  # η for dynamic relaxation (1/s)
-    plot_scale: float = 1.0  # displacement exaggeration in the picture
+    plot_scale: float = 1.0  # displacement exaggeration in the picture (stated in its title)
     details: dict = field(default_factory=dict)
     default_rtol: float = 1e-6
     # A scene that is not one static solve (the needle insertion) runs itself:
@@ -27,6 +27,9 @@ class Scene:
     evolve: Callable | None = None
     decorate: Callable | None = None  # decorate(ax): marks on the 2D picture
     picture: Callable | None = None  # picture() -> more keyword arguments of plotting.plot_body, after the run
+    # fixed(points) -> (n_points,) bool: the vertices the scene holds (of the mesh after the
+    # run), marked on the picture; the scene's loads are drawn from the body.
+    fixed: Callable | None = None
 
 
 def material(name: str, young: float, poisson: float, gamma: float = 8.0):

@@ -6,8 +6,14 @@ import snede
 from snede.scenes import Scene, material
 
 LENGTH, HEIGHT, DEPTH, YOUNG, LOAD = 1.2, 0.2, 0.3, 1e6, 3.0
+VIEW = (20.0, 30.0, 0.0, "y")  # the picture's camera: y up, the beam bending down across the picture
 OPTIONS = ("divisions",)  # the scene options it uses (the command line refuses the others)
 DESCRIPTION = "§3.3 cantilever beam, 3 N tip load, analytic tip deflection 8.64 mm"
+
+
+def held(points) -> np.ndarray:
+    """The vertices the beam is held at: its end x = 0."""
+    return np.isclose(points[:, 0], 0.0)
 
 
 def build(options) -> Scene:
@@ -19,11 +25,11 @@ def build(options) -> Scene:
     mesh = snede.meshing.box((LENGTH, HEIGHT, DEPTH), (n, n // 4, n // 4))
     body = snede.Body(mesh, material(options.material or "linear", YOUNG, 0.0), density=1000.0)
     x = mesh.points
-    body.fix(np.isclose(x[:, 0], 0.0))
+    body.fix(held(x))
     tip = np.flatnonzero(np.isclose(x[:, 0], LENGTH))
     body.add_nodal_force(tip, (0.0, -LOAD / len(tip), 0.0))
     return Scene(
         name="cantilever", description=DESCRIPTION, body=body, default_method="cg",
         probe_name="tip deflection [m]", probe=lambda b: float(-b.displacement[tip, 1].mean()),
         analytic=4 * LOAD / (YOUNG * DEPTH) * (LENGTH / HEIGHT) ** 3, damping=17.0, plot_scale=10.0,
-        details={"divisions": [n, n // 4, n // 4]})
+        fixed=held, picture=lambda: {"view": VIEW}, details={"divisions": [n, n // 4, n // 4]})

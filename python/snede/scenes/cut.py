@@ -168,6 +168,11 @@ class Cut:
                       color=HIGHLIGHT)
 
 
+def held(points) -> np.ndarray:
+    """The vertices the beam is held at: its end x = 0."""
+    return np.isclose(points[:, 0], 0.0)
+
+
 def build(options) -> Scene:
     n = 24 if options.divisions is None else options.divisions
     if n <= 0:
@@ -176,12 +181,12 @@ def build(options) -> Scene:
         raise ValueError(f"--divisions for the cut must be a multiple of 4 (n × n/4 × n/4 cubes), got {n}")
     mesh = snede.meshing.box((LENGTH, WIDTH, HEIGHT), (n, n // 4, n // 4))
     body = snede.Body(mesh, material(options.material or "neohookean", YOUNG, POISSON), density=DENSITY)
-    body.fix(np.isclose(mesh.points[:, 0], 0.0))
+    body.fix(held(mesh.points))
     body.add_gravity((0.0, 0.0, -9.81))
     cut = Cut(body, n)
     return Scene(
         name="cut", description=DESCRIPTION, body=body, default_method="newton",
         probe_name="widest gap between the lips [m]", probe=lambda b: cut.opening(),
-        evolve=cut.evolve, picture=lambda: {"highlight": cut.faces(), "view": VIEW, "reference": False},
+        evolve=cut.evolve, fixed=held, picture=lambda: {"highlight": cut.faces(), "view": VIEW, "reference": False},
         details={"divisions": [n, n // 4, n // 4], "blade_at_reference_x_m": (round(AT * n) + OFFSET) * LENGTH / n,
                  "depth_fraction": DEPTH, "blade_step_elements": STEP})

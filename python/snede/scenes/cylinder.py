@@ -20,10 +20,16 @@ def build(options) -> Scene:
         mesh = snede.Mesh.read(MESHES / "cylinder_small.msh")
     name = options.material or "neohookean"
     body = snede.Body(mesh, material(name, 1e4, 0.3, 8.0), density=1000.0)
-    body.fix(np.isclose(mesh.points[:, 0], mesh.points[:, 0].min()))
+    x0 = mesh.points[:, 0].min()
+
+    def held(points) -> np.ndarray:  # the end x = x0
+        return np.isclose(points[:, 0], x0)
+
+    body.fix(held(mesh.points))
     body.add_gravity((0.0, 0.0, -9.8))
     tip = np.flatnonzero(np.isclose(mesh.points[:, 0], mesh.points[:, 0].max()))
     return Scene(
         name="cylinder", description=DESCRIPTION, body=body, default_method="newton",
         probe_name="tip sag [m]", probe=lambda b: float(-b.displacement[tip, 2].mean()),
-        damping=ETA_CRIT[name], details={"mesh": "cylinder_small.msh" if not options.mesh_size else f"h={options.mesh_size}"})
+        damping=ETA_CRIT[name], fixed=held,
+        details={"mesh": "cylinder_small.msh" if not options.mesh_size else f"h={options.mesh_size}"})

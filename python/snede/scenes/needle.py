@@ -13,7 +13,7 @@ import numpy as np
 import snede
 from snede.plotting import animate, draw_2d
 from snede.scenes import Scene, material
-from snede.scenes.needle_slab import DEPTH, DIRECTION, ENTRY, POISSON, YOUNG, h, needle_for, slab_body
+from snede.scenes.needle_slab import DEPTH, DIRECTION, ENTRY, POISSON, YOUNG, h, held, needle_for, slab_body
 
 OPTIONS = ("divisions", "speed")  # the scene options it uses (the command line refuses the others)
 DESCRIPTION = "§6.8.1 needle inserted 70 mm into the slab: stick-slip friction, bisection at the tip"
@@ -34,10 +34,9 @@ class Frame:
 
 
 def draw_needle(ax, frame: Frame, legend: bool = True) -> None:
-    """The deformed mesh's edges, the needle (from 1 cm outside the entry to the tip) and its
-    nodes coloured by state."""
+    """The needle (from 1 cm outside the entry to the tip) and its nodes coloured by state (on a
+    picture of the deformed mesh, ``plotting.draw_2d``, which draws the mesh's edges)."""
     x = frame.points + frame.displacement
-    ax.triplot(x[:, 0], x[:, 1], frame.cells, color="w", linewidth=0.3, alpha=0.6)
     entry, direction = np.asarray(ENTRY), np.asarray(DIRECTION)
     ends = np.array([entry - 0.01 * direction, entry + frame.depth * direction])
     ax.plot(ends[:, 0], ends[:, 1], color="k", linewidth=1.2)
@@ -134,5 +133,6 @@ def build(options) -> Scene:
     return Scene(
         name="needle", description=DESCRIPTION, body=body, default_method="cg" if name == "linear" else "newton",
         probe_name="needle force along shaft [N]", probe=lambda b: insertion.shaft_force(), default_rtol=1e-3,
-        evolve=insertion.evolve, decorate=insertion.decorate,
+        evolve=insertion.evolve, decorate=insertion.decorate, fixed=held,
+        picture=lambda: {"loads": False},  # the needle and its nodes' states show the friction
         details={"h_start": h_start, "h_ref": H_REF, "speed_h_ref_per_update": speed, "depth_m": DEPTH})

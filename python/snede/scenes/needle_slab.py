@@ -21,19 +21,22 @@ def h(k: int) -> float:
     return SIZE * 2.0 ** -k
 
 
+def held(points, fixed: str = "right") -> np.ndarray:
+    """(n,) bool: the vertices the slab is held at, its right side (``fixed="right"``) or bottom."""
+    if fixed == "right":
+        return np.isclose(points[:, 0], SIZE)
+    if fixed == "bottom":
+        return np.isclose(points[:, 1], 0.0)
+    raise ValueError(f"fixed must be 'right' or 'bottom', got {fixed!r}")
+
+
 def slab_body(h_start: int, material=None, *, fixed: str = "right") -> "snede.Body":
     """The slab meshed with right triangles of leg h_{h_start} (2·4^h_start cells), held on the
     right side (``fixed="right"``, §6.8.1) or at the bottom (``"bottom"``, Figure 6.12)."""
     n = 2 ** h_start
     mesh = snede.meshing.rectangle((SIZE, SIZE), (n, n))
     body = snede.Body(mesh, material or snede.LinearElastic(YOUNG, POISSON), density=1000.0, thickness=THICKNESS)
-    x = mesh.points
-    if fixed == "right":
-        body.fix(np.isclose(x[:, 0], SIZE))
-    elif fixed == "bottom":
-        body.fix(np.isclose(x[:, 1], 0.0))
-    else:
-        raise ValueError(f"fixed must be 'right' or 'bottom', got {fixed!r}")
+    body.fix(held(mesh.points, fixed))
     return body
 
 

@@ -153,6 +153,11 @@ class SheetCut:
         self._draw_scalpel(ax, self.frames[-1].scalpel)
 
 
+def held(points) -> np.ndarray:
+    """The vertices the grips hold: the short edges x = 0 and x = LENGTH (reference)."""
+    return np.isclose(points[:, 0], 0.0) | np.isclose(points[:, 0], LENGTH)
+
+
 def build(options) -> Scene:
     n = 40 if options.divisions is None else options.divisions
     if n <= 0:
@@ -171,6 +176,6 @@ def build(options) -> Scene:
         name="sheet-cut", description=DESCRIPTION, body=body,
         default_method="cg" if name == "linear" else "newton",
         probe_name="widest gap between the lips [m]", probe=lambda b: sheet.opening(),
-        evolve=sheet.evolve, decorate=sheet.decorate,
+        evolve=sheet.evolve, decorate=sheet.decorate, fixed=held,
         picture=lambda: {"reference": False, "highlight": sheet.incision()},
         details={"divisions": [n, 3 * n // 5], "stretch": STRETCH, "depth_fraction": DEPTH, "sway_fraction": SWAY})

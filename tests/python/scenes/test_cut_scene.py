@@ -160,3 +160,29 @@ def test_example_script_cuts_and_relaxes_in_turn(tmp_path):
     assert not_blank(folder / "scalpel_cut.png")
     with h5py.File(folder / "scalpel_cut.h5", "r") as f:
         assert len(f["/mesh"]) > 1
+
+
+def test_picture_shows_the_cut_the_supports_and_gravity(cut_beam, request):
+    """Issue 14 item 9: the incision's faces in red on the deformed beam, the held end marked,
+    gravity's arrow, axes to scale."""
+    import numpy.testing as npt
+
+    from snede.plotting import draw_body, highlighted
+    import matplotlib.pyplot as plt
+    from test_pictures import one, to_scale
+
+    scene, summary, _ = cut_beam
+    body = scene.body
+    arguments = run_scene.picture_arguments(scene, summary["method"])
+    fig, ax = draw_body(body, **arguments)
+    request.addfinalizer(lambda: plt.close(fig))
+    faces = body.mesh.boundary_faces()
+    surface = one(ax, "surface")
+    r, g, b = surface.get_facecolor()[:, :3].T  # the incision's red, shaded by the light
+    red = (r > 2.5 * g) & (r > 2.5 * b)
+    assert red.sum() == highlighted(faces, scene.evolve.__self__.faces()).sum() == summary["incision_faces"]
+    assert f"incision ({summary['incision_faces']} faces)" in [t.get_text() for t in ax.get_legend().get_texts()]
+    assert len(one(ax, "fixed")._offsets3d[0]) == arguments["fixed"].sum() == body._model.n_constrained
+    assert one(ax, "gravity-label").get_text().strip() == "g = 9.81 m/s²"
+    assert "to scale" in ax.get_title()
+    npt.assert_allclose(to_scale(ax), np.eye(2), atol=2e-3)

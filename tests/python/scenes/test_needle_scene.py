@@ -79,3 +79,24 @@ def test_cli_runs_the_needle(tmp_path):
 def test_bad_needle_options_give_a_message(args, message, tmp_path):
     out = run_cli("run", "needle", *args, "--out", str(tmp_path))
     assert out.returncode != 0 and message in out.stderr and "Traceback" not in out.stderr
+
+
+def test_picture_shows_the_refined_mesh_the_supports_and_the_needle(inserted, request):
+    """Issue 14 item 9: the mesh's edges (the refined mesh's), the held side marked, to scale."""
+    from snede.plotting import draw_body, mesh_edges
+    import matplotlib.pyplot as plt
+    from test_pictures import by_gid, one
+
+    scene, summary, _ = inserted
+    body = scene.body
+    arguments = run_scene.picture_arguments(scene, summary["method"])
+    fig, ax = draw_body(body, **arguments)
+    request.addfinalizer(lambda: plt.close(fig))
+    assert "to scale" in ax.get_title() and ax.get_aspect() == 1.0
+    assert len(one(ax, "mesh-edges").get_segments()) == len(mesh_edges(body.mesh.cells))
+    # The engine counts the needle's nodes too (held or sliding along the needle).
+    assert len(one(ax, "fixed").get_xdata()) == arguments["fixed"].sum() == 2 ** 2 + 1
+    assert arguments["fixed"].sum() + summary["needle_nodes"] == body._model.n_constrained
+    assert not by_gid(ax, "loads")  # the needle and its nodes show the friction
+    labels = [t.get_text() for t in ax.get_legend().get_texts()]
+    assert f"stick ({summary['stick']})" in labels and f"slip ({summary['slip']})" in labels

@@ -213,3 +213,24 @@ def test_neo_hookean_sheet_is_cut_with_newton(tmp_path):
 def test_bad_sheet_cut_options_give_a_message(args, message, tmp_path):
     out = run_cli("run", "sheet-cut", *args, "--out", str(tmp_path))
     assert out.returncode == 2 and message in out.stderr and "Traceback" not in out.stderr
+
+
+def test_picture_marks_the_grips(sheet, request):
+    """Issue 14 item 9: the vertices the grips hold, where they pulled them."""
+    from snede.plotting import draw_body
+    import matplotlib.pyplot as plt
+    from test_pictures import one
+
+    scene, summary = sheet
+    body = scene.body
+    arguments = run_scene.picture_arguments(scene, summary["method"])
+    fig, ax = draw_body(body, **arguments)
+    request.addfinalizer(lambda: plt.close(fig))
+    fixed = one(ax, "fixed")
+    held = np.flatnonzero(arguments["fixed"])
+    assert len(held) == body._model.n_constrained
+    x = body.mesh.points[held] + body.displacement[held]
+    np.testing.assert_allclose(np.c_[fixed.get_xdata(), fixed.get_ydata()], x)
+    pull = 0.5 * sheet_cut.STRETCH * sheet_cut.LENGTH
+    np.testing.assert_allclose(np.abs(x[:, 0] - 0.5 * sheet_cut.LENGTH), 0.5 * sheet_cut.LENGTH + pull)
+    assert "to scale" in ax.get_title() and ax.get_aspect() == 1.0
