@@ -9,7 +9,7 @@ import warnings
 
 import numpy as np
 
-from snede import _snede
+from snede import _checks, _snede
 from snede.mesh import Mesh
 
 # Above this Poisson's ratio linear tetrahedra visibly lock (docs/results/extremes.md: at
@@ -96,6 +96,7 @@ class Body:
     def element_stiffness(self, row: int, u) -> np.ndarray:
         """Stiffness matrix of cell ``row`` at u: ((dim+1)·dim)², ordered by the cell's
         vertices (``mesh.cells[row]``) then components. For checks and preconditioners."""
+        row = _checks.index(row, "row", self.mesh.n_cells, "rows of mesh.cells")
         return self._impl.element_stiffness(int(self.mesh.cell_ids[row]), self._field("u", u))
 
     def lumped_mass(self) -> np.ndarray:
@@ -118,10 +119,7 @@ class Body:
             array = np.flatnonzero(array)
         if array.dtype.kind not in "iu" or array.ndim != 1:
             raise ValueError(f"vertices must be a 1-D array of vertex indices or a boolean mask, got {array.dtype} {array.shape}")
-        bad = array[(array < 0) | (array >= self.mesh.n_points)]
-        if len(bad):
-            raise ValueError(f"vertex {bad[0]} does not exist (the mesh has {self.mesh.n_points} points)")
-        return np.ascontiguousarray(array, dtype=np.int64)
+        return _checks.index_array(array, "vertices", self.mesh.n_points, "a vertex of the mesh")
 
     def fix(self, vertices, value=None) -> None:
         """Fix vertices (indices or a boolean mask) at displacement ``value``: None for zero,

@@ -11,7 +11,7 @@ import math
 
 import numpy as np
 
-from snede import _snede
+from snede import _checks, _snede
 from snede._petsc import option_list
 from snede.result import SolveResult
 
@@ -43,12 +43,12 @@ class DynamicRelaxation:
     def step(self, n: int = 1) -> SolveResult:
         """Take ``n`` time steps. ``converged`` is False only on divergence (blow-up, NaN,
         inverted elements); ``residual_norm`` is ‖F(u)‖ at the final state."""
-        return SolveResult._from_engine(self._impl.step(int(n)))
+        return SolveResult._from_engine(self._impl.step(_checks.count(n, "n")))
 
     def run(self, rtol: float = 1e-3, max_steps: int = 100000) -> SolveResult:
         """Step until ‖F(u)‖ ≤ rtol·√(‖f_ext‖² + ‖f_react‖²) (criterion (6.9)), or
         ``max_steps`` (``reason == "DIVERGED_MAX_IT"``)."""
-        return SolveResult._from_engine(self._impl.run(float(rtol), int(max_steps)))
+        return SolveResult._from_engine(self._impl.run(float(rtol), _checks.count(max_steps, "max_steps")))
 
     def critical_time_step(self, flop_budget: float = 50e6, initial: float | None = None,
                            reduction: float = 0.15, min_steps: int = 200) -> float:
@@ -57,7 +57,7 @@ class DynamicRelaxation:
         steps, which large meshes need), searched from ``initial`` (None: the CFL estimate) in
         factors of (1 − ``reduction``). The state is restored."""
         return self._impl.critical_time_step(float(flop_budget), float(initial or 0.0), float(reduction),
-                                             int(min_steps))
+                                             _checks.count(min_steps, "min_steps", 1))
 
     @property
     def cfl_time_step(self) -> float:

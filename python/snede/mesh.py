@@ -8,7 +8,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from snede import _snede
+from snede import _checks, _snede
 from snede.mesh_edits import MeshEdits
 
 
@@ -42,9 +42,8 @@ def _as_cells(cells, space_dim: int) -> np.ndarray:
         raise ValueError(f"cells must have shape {expected} for {space_dim}-D points, got {array.shape}")
     if array.shape[0] == 0:
         raise ValueError("cells is empty: a mesh needs at least one cell")
-    if array.dtype.kind == "u" and array.max() > np.iinfo(np.int64).max:
-        raise ValueError("cells holds vertex indices beyond int64")
-    return np.ascontiguousarray(array, dtype=np.int64)
+    # The engine checks the range (naming the cell); here only that the ids survive the cast.
+    return _checks.index_array(array, "cells", what="a vertex of the mesh")
 
 
 class Mesh(MeshEdits):
@@ -67,6 +66,7 @@ class Mesh(MeshEdits):
     def __init__(self, points, cells):
         points = _as_points(points)
         cells = _as_cells(cells, points.shape[1])
+        _checks.size(len(points), len(cells), f"points ({len(points)} rows) and cells ({len(cells)} rows)")
         self._impl = _snede.Mesh(points, cells)
 
     @classmethod
@@ -158,13 +158,12 @@ class Mesh(MeshEdits):
     def element_vertices(self, element: int) -> np.ndarray:
         """The vertices of the cell with element id ``element`` (stable across edits, unlike
         row numbers), in its row order of ``cells``."""
-        return np.asarray(self._impl.element_vertices(int(element)), dtype=np.int64)
+        element = _checks.index(element, "element", _checks.ID_LIMIT, "element ids")
+        return np.asarray(self._impl.element_vertices(element), dtype=np.int64)
 
     def star(self, vertex: int) -> np.ndarray:
         """Element ids of all cells containing ``vertex`` (a scan, O(n))."""
-        if not 0 <= int(vertex) < self.n_points:
-            raise ValueError(f"vertex {vertex} does not exist (the mesh has {self.n_points} points)")
-        return np.asarray(self._impl.star(int(vertex)), dtype=np.int64)
+        return np.asarray(self._impl.star(self._vertex(vertex)), dtype=np.int64)
 
     def connected_components(self) -> tuple[int, np.ndarray]:
         """(number of components, (n_cells,) component label per row of ``cells``)."""
@@ -200,7 +199,7 @@ class Mesh(MeshEdits):
         faces = np.asarray(faces)
         if faces.dtype.kind not in "iu" or faces.ndim != 2 or faces.shape[1] != self.cell_dim:
             raise ValueError(f"faces must be (n, {self.cell_dim}) integer vertex indices, got {faces.shape} {faces.dtype}")
-        return _snede.dissect(self._impl, np.ascontiguousarray(faces, dtype=np.int64))
+        return _snede.dissect(self._impl, _checks.index_array(faces, "faces", self.n_points, "a vertex of the mesh"))
 
     @contextlib.contextmanager
     def batch(self):
@@ -220,7 +219,8 @@ class Mesh(MeshEdits):
         if parents.dtype.kind not in "iu" or parents.ndim != 1 or weights.shape != parents.shape:
             raise ValueError(f"parents must be 1-D vertex indices with one weight each, got {parents.shape} "
                              f"{parents.dtype} and weights {weights.shape}")
-        return np.ascontiguousarray(parents, dtype=np.int64), np.ascontiguousarray(weights)
+        parents = _checks.index_array(parents, "parents", self.n_points, "a vertex of the mesh")
+        return parents, np.ascontiguousarray(weights)
 
     def add_vertex(self, parents, weights) -> int:
         """Add a vertex at ``Σ weights[i]·x[parents[i]]`` (barycentric: weights sum to 1) and
@@ -236,13 +236,13 @@ class Mesh(MeshEdits):
         if (point is None) == (parents is None):
             raise ValueError("give either parents and weights, or point")
         if point is not None:
-            self._impl.move_vertex_to(int(vertex), np.ascontiguousarray(point, dtype=np.float64))
+            self._impl.move_vertex_to(self._vertex(vertex), np.ascontiguousarray(point, dtype=np.float64))
         else:
-            self._impl.move_vertex(int(vertex), *self._parents(parents, weights))
+            self._impl.move_vertex(self._vertex(vertex), *self._parents(parents, weights))
 
     def remove_vertex(self, vertex: int) -> None:
         """Remove a vertex that no cell uses any more (its id is reused by a later addition)."""
-        self._impl.remove_vertex(int(vertex))
+        self._impl.remove_vertex(self._vertex(vertex))
 
     # -- refinement (§6.5) -------------------------------------------------------------
     def _bisection(self):
@@ -256,10 +256,14 @@ class Mesh(MeshEdits):
     def refine_uniform(self, levels: int = 1) -> int:
         """Bisect every cell ``levels`` times by conforming bisection (§6.5: newest-vertex in
         2D, Maubach's in 3D). On ``meshing.rectangle`` and ``meshing.box`` each level doubles
-        the cell count exactly. Returns how many cells were split."""
-        if isinstance(levels, bool) or not isinstance(levels, (int, np.integer)) or levels < 0:
-            raise ValueError(f"levels must be a non-negative integer, got {levels!r}")
-        return self._bisection().refine_uniform(int(levels))
+        the cell count exactly. Returns how many cells were split. ``levels`` is at most what
+        keeps the cell count within the engine's 32-bit ids (each level at least doubles it)."""
+        cells = max(self.n_cells, 1)
+        most = (_checks.INT32_MAX // cells).bit_length() - 1  # n_cells · 2**most ≤ 2**31 − 1
+        levels = _checks.count(levels, "levels", 0, most,
+                               f": each level at least doubles the {self.n_cells} cells, and the engine numbers "
+                               f"at most 2**31 − 1")
+        return self._bisection().refine_uniform(levels)
 
     def refine_around(self, point, h: float) -> int:
         """Bisect (§6.5 refine-around) until every cell containing ``point`` (shape (dim,))

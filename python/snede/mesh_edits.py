@@ -7,17 +7,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from snede import _snede
+from snede import _checks, _snede
 
 EditResult = _snede.EditResult
-
-
-def _index(value, what: str, limit: int) -> int:
-    if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
-        raise ValueError(f"{what} must be an integer index, got {value!r}")
-    if not 0 <= int(value) < limit:
-        raise ValueError(f"{what} {value} does not exist (there are {limit})")
-    return int(value)
 
 
 def _fraction(value, what: str) -> float:
@@ -31,7 +23,7 @@ class MeshEdits:
     """Mixed into ``snede.Mesh``; every method takes vertex ids (rows of ``points``)."""
 
     def _vertex(self, value, what: str = "vertex") -> int:
-        return _index(value, what, self.n_points)
+        return _checks.index(value, what, self.n_points, "vertex ids")
 
     def flip_edge(self, a: int, b: int) -> EditResult:
         """Replace the two triangles sharing edge (a, b) by the two sharing the other diagonal
@@ -55,12 +47,11 @@ class MeshEdits:
         (``cell_ids[row]`` for a row of ``cells``; ids, unlike rows, survive edits), splitting it
         into 3 triangles or 4 tetrahedra; in 3D one zero weight puts it on a face, whose one or
         two tetrahedra are split. Refused on an edge (use ``split_edge``) or too close to a side."""
-        if isinstance(element, bool) or not isinstance(element, (int, np.integer)):
-            raise ValueError(f"element must be an integer element id, got {element!r}")
+        element = _checks.index(element, "element", _checks.ID_LIMIT, "element ids")
         weights = np.ascontiguousarray(weights, dtype=np.float64)
         if weights.shape != (self.cell_dim + 1,):
             raise ValueError(f"weights must have shape ({self.cell_dim + 1},), got {weights.shape}")
-        return _snede.insert_vertex(self._impl, int(element), weights)
+        return _snede.insert_vertex(self._impl, element, weights)
 
     def collapse_edge(self, keep: int, gone: int, t: float = 0.0) -> EditResult:
         """Merge ``gone`` into ``keep`` (§3.2.3, Figure 3.10): the cells around the edge

@@ -2,9 +2,11 @@
 from __future__ import annotations
 
 import itertools
+import math
 
 import numpy as np
 
+from snede import _checks
 from snede.mesh import Mesh
 
 
@@ -13,15 +15,15 @@ def _grid_points(size, divisions) -> np.ndarray:
     return np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, len(size))
 
 
-def _check(size, divisions, dim: int):
+def _check(size, divisions, dim: int, cells_per_box: int):
     size = tuple(float(s) for s in size)
-    divisions = tuple(int(n) for n in divisions)
+    divisions = tuple(divisions)
     if len(size) != dim or len(divisions) != dim:
         raise ValueError(f"size and divisions must have {dim} entries, got {size} and {divisions}")
     if not all(np.isfinite(s) and s > 0 for s in size):
         raise ValueError(f"size must be positive and finite, got {size}")
-    if not all(n >= 1 for n in divisions):
-        raise ValueError(f"divisions must be at least 1, got {divisions}")
+    divisions = tuple(_checks.count(n, f"divisions[{k}]", 1, None) for k, n in enumerate(divisions))
+    _checks.size(math.prod(n + 1 for n in divisions), cells_per_box * math.prod(divisions), f"divisions {divisions}")
     return size, divisions
 
 
@@ -29,7 +31,7 @@ def box(size=(1.0, 1.0, 1.0), divisions=(10, 10, 10)) -> Mesh:
     """Structured tetrahedra on [0, size]: each of the nx·ny·nz cubes split into six
     tetrahedra around its main diagonal (the Kuhn split, which conforming bisection needs).
     Gives 6·nx·ny·nz cells and (nx+1)(ny+1)(nz+1) points."""
-    size, divisions = _check(size, divisions, 3)
+    size, divisions = _check(size, divisions, 3, 6)
     nx, ny, nz = divisions
     points = _grid_points(size, divisions)
 
@@ -55,7 +57,7 @@ def box(size=(1.0, 1.0, 1.0), divisions=(10, 10, 10)) -> Mesh:
 def rectangle(size=(1.0, 1.0), divisions=(10, 10)) -> Mesh:
     """Structured right triangles on [0, size]: each square split along its diagonal from
     (x, y) to (x + hx, y + hy). Gives 2·nx·ny cells and (nx+1)(ny+1) points."""
-    size, divisions = _check(size, divisions, 2)
+    size, divisions = _check(size, divisions, 2, 2)
     nx, ny = divisions
     points = _grid_points(size, divisions)
     i, j = (a.ravel() for a in np.meshgrid(np.arange(nx), np.arange(ny), indexing="ij"))
@@ -77,6 +79,8 @@ def cylinder(length=0.1, radius=0.03, h=0.01, seed: int | None = None) -> Mesh:
     for name, value in (("length", length), ("radius", radius), ("h", h)):
         if not (np.isfinite(value) and value > 0):
             raise ValueError(f"{name} must be positive and finite, got {value}")
+    if seed is not None:
+        seed = _checks.count(seed, "seed", 0)  # gmsh's Mesh.RandomSeed is a C int
     initialized_here = not gmsh.isInitialized()
     if initialized_here:
         # interruptible=False: gmsh would otherwise take over SIGINT for good, and Ctrl-C

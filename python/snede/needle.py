@@ -17,7 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from snede import _snede
+from snede import _checks, _snede
 from snede._petsc import option_list
 
 
@@ -153,13 +153,17 @@ class NeedleInsertion:
             raise TypeError(f"friction must be a snede.FrictionProfile, got {type(friction).__name__}")
         if not (rtol > 0):
             raise ValueError(f"rtol must be positive, got {rtol}")
+        max_rearrangements = _checks.count(max_rearrangements, "max_rearrangements", 1)
+        # None (or 0, as the engine has it) relaxes until no node changes state.
+        solves_per_update = 0 if solves_per_update is None else _checks.count(solves_per_update, "solves_per_update")
+        max_iterations = _checks.count(max_iterations, "max_iterations", 1)
         self.body = body
         self.friction_profile = friction
         bisection = body.mesh._bisection() if h_ref is not None else None
         self._impl = _snede.NeedleInsertion(
             body._model, bisection, np.asarray(entry, dtype=np.float64), np.asarray(direction, dtype=np.float64),
-            friction._impl, float(static_factor), None if h_ref is None else float(h_ref), int(max_rearrangements),
-            int(solves_per_update or 0), bool(extrapolate), method, float(rtol), criterion, float(round_tolerance), int(max_iterations), options_prefix,
+            friction._impl, float(static_factor), None if h_ref is None else float(h_ref), max_rearrangements,
+            solves_per_update, bool(extrapolate), method, float(rtol), criterion, float(round_tolerance), max_iterations, options_prefix,
             option_list(petsc_options))
 
     def advance(self, distance: float) -> NeedleStepReport:

@@ -5,7 +5,7 @@ line tunes it: ``-static_snes_monitor``, ``-static_snes_ncg_type fr``,
 """
 from __future__ import annotations
 
-from snede import _snede
+from snede import _checks, _snede
 from snede._petsc import option_list
 from snede.result import SolveResult
 
@@ -46,6 +46,7 @@ class StaticSolver:
             raise ValueError(f"method must be one of {METHODS}, got {method!r}")
         if not (rtol > 0):
             raise ValueError(f"rtol must be positive, got {rtol}")
+        max_iterations = _checks.count(max_iterations, "max_iterations", 1)
         options = dict(petsc_options or {})
         if line_search is not None:
             if method != "ncg":
@@ -60,7 +61,7 @@ class StaticSolver:
         self.body = body
         self.method = method
         self._impl = _snede.StaticSolver(body._model, method, float(rtol), criterion, float(round_tolerance),
-                                         int(max_iterations), options_prefix, option_list(options))
+                                         max_iterations, options_prefix, option_list(options))
 
     def solve(self) -> SolveResult:
         return SolveResult._from_engine(self._impl.solve())
