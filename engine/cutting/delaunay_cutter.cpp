@@ -361,6 +361,9 @@ bool DelaunayCutter::fix_up_entry(const Point& p, PlanarCutReport& report) {
   EditResult made = insert_vertex(mesh_, host, weights);
   if (!made.done) {  // on or too near a side: split that side at p's projection
     const int k = static_cast<int>(std::min_element(weights.begin(), weights.end()) - weights.begin());
+    // On a boundary side (an incision's lip, most often) the new incision would run along
+    // the boundary: the entry stays postponed until the scalpel is in the material.
+    if (c.face(c.opposite_face(host, corners[k])).mate == no_id) return false;
     const VertexId s = corners[(k + 1) % 3], t = corners[(k + 2) % 3];
     const double along = weights[(k + 2) % 3] / (weights[(k + 1) % 3] + weights[(k + 2) % 3]);
     made = split_edge(mesh_, s, t, std::clamp(along, 0.05, 0.95));
