@@ -3,6 +3,10 @@
 
 #include <pybind11/stl.h>
 
+#include <cstdio>
+#include <cstdlib>
+#include <optional>
+
 namespace snede::bindings {
 namespace {
 
@@ -69,6 +73,23 @@ py::dict flops_of(const ElasticBody& body) {
   return out;
 }
 
+// x as Python prints it after rounding to 15 significant digits: E and ν come back from the
+// Lamé parameters with round-off (0.30000000000000004), which a repr should not show.
+std::string rounded_repr(double x) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.15g", x);
+  return py::repr(py::float_(std::strtod(text, nullptr))).cast<std::string>();
+}
+
+// VerondaWestmann(E, nu, gamma) with a message, not pybind11's list of signatures, for a
+// missing ν or γ.
+VerondaWestmann make_veronda_westmann(double E, std::optional<double> nu, std::optional<double> gamma) {
+  if (!nu || !gamma)
+    throw std::invalid_argument(std::string("VerondaWestmann(E, nu, gamma) needs ") + (nu ? "" : "nu, Poisson's ratio, and ") +
+                                "gamma, its exponential stiffening (dimensionless, > 0; e.g. 8 as in §4.3)");
+  return VerondaWestmann(E, *nu, *gamma);
+}
+
 // A material's class with what every material shows: Lamé parameters, E, ν and a repr
 // naming them (γ too where there is one).
 template <class M>
@@ -78,9 +99,9 @@ py::class_<M> bind_material(py::module_& m, const char* name) {
       .def_property_readonly("E", [](const M& s) { return young_modulus(s.lame); })
       .def_property_readonly("nu", [](const M& s) { return poisson_ratio(s.lame); })
       .def("__repr__", [name](const M& s) {
-        std::string text = std::string(name) + "(E=" + py::repr(py::float_(young_modulus(s.lame))).cast<std::string>() +
-                           ", nu=" + py::repr(py::float_(poisson_ratio(s.lame))).cast<std::string>();
-        if constexpr (requires { s.gamma; }) text += ", gamma=" + py::repr(py::float_(s.gamma)).cast<std::string>();
+        std::string text =
+            std::string(name) + "(E=" + rounded_repr(young_modulus(s.lame)) + ", nu=" + rounded_repr(poisson_ratio(s.lame));
+        if constexpr (requires { s.gamma; }) text += ", gamma=" + rounded_repr(s.gamma);
         return text + ")";
       });
   return material;
@@ -97,13 +118,7 @@ void bind_fem(py::module_& m) {
   auto neo = bind_material<NeoHookean>(m, "NeoHookean");
   neo.def(py::init<double, double>(), py::arg("E"), py::arg("nu"));
   auto veronda = bind_material<VerondaWestmann>(m, "VerondaWestmann");
-  veronda.def(py::init<double, double, double>(), py::arg("E"), py::arg("nu"), py::arg("gamma"))
-      .def(py::init([](double, double) -> VerondaWestmann {
-             throw std::invalid_argument(
-                 "VerondaWestmann(E, nu, gamma) needs gamma, its exponential stiffening (dimensionless, > 0; "
-                 "e.g. 8 as in §4.3)");
-           }),
-           py::arg("E"), py::arg("nu"))
+  veronda.def(py::init(&make_veronda_westmann), py::arg("E"), py::arg("nu") = py::none(), py::arg("gamma") = py::none())
       .def_readonly("gamma", &VerondaWestmann::gamma);
 
   py::class_<ElasticBody>(m, "ElasticBody")

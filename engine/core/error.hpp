@@ -22,6 +22,12 @@ class PetscException : public std::runtime_error {
   PetscErrorCode code_;
 };
 
+// A file could not be created, opened or written (a folder deleted or read-only, a full disk);
+// Python sees it as snede.FileError, an OSError.
+class FileError : public std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
 // Throws PetscException with PETSc's text for `code` if it is non-zero; `call` names the call.
 void check_petsc(PetscErrorCode code, const char* call, const char* file, int line);
 

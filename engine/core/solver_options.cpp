@@ -26,7 +26,7 @@ PetscErrorCode destroy_database(void* database) {
 SolverOptions::SolverOptions(const std::string& prefix, const OptionList& options) {
   OptionList own;
   for (const auto& [name, value] : options) own.emplace_back("-" + prefix + bare_option_name(name), value);
-  SNEDE_PETSC(PetscContainerCreate(PETSC_COMM_SELF, &holder_));
+  SNEDE_PETSC(PetscContainerCreate(PETSC_COMM_SELF, holder_.out()));
   try {
     SNEDE_PETSC(PetscContainerSetUserDestroy(holder_, destroy_database));
     SNEDE_PETSC(PetscOptionsCreate(&database_));
@@ -46,16 +46,16 @@ SolverOptions::SolverOptions(const std::string& prefix, const OptionList& option
       if (is_name) global_names_.push_back(token.substr(1));
     }
   } catch (...) {
-    PetscContainerDestroy(&holder_);
+    holder_.reset();
     throw;
   }
 }
 
-SolverOptions::~SolverOptions() { PetscContainerDestroy(&holder_); }
+SolverOptions::~SolverOptions() = default;
 
 void SolverOptions::use_for(PetscObject object) const {
   SNEDE_PETSC(PetscObjectSetOptions(object, database_));
-  SNEDE_PETSC(PetscObjectCompose(object, "snede_solver_options", reinterpret_cast<PetscObject>(holder_)));
+  SNEDE_PETSC(PetscObjectCompose(object, "snede_solver_options", reinterpret_cast<PetscObject>(holder_.get())));
 }
 
 void SolverOptions::mark_read_options_used() const {

@@ -12,6 +12,8 @@
 #include <utility>
 #include <vector>
 
+#include "core/petsc_handle.hpp"
+
 namespace snede {
 
 // PETSc options as (name, value): the name without the solver's prefix (leading '-' are
@@ -36,13 +38,17 @@ class SolverOptions {
   void use_for(Object object) const {
     use_for(reinterpret_cast<PetscObject>(object));
   }
+  template <class Object, PetscErrorCode (*destroy)(Object*)>
+  void use_for(const PetscHandle<Object, destroy>& handle) const {
+    use_for(handle.get());
+  }
 
   // Marks the global options this solver has read as used in the global database, so that
   // -options_left lists only the options that no solver read.
   void mark_read_options_used() const;
 
  private:
-  PetscContainer holder_ = nullptr;  // owns the database; every object using it holds a reference
+  ContainerHandle holder_;  // owns the database; every object using it holds a reference
   PetscOptions database_ = nullptr;
   std::vector<std::string> global_names_;  // the copied global options, without '-'
 };

@@ -3,11 +3,13 @@
 #include <fstream>
 #include <stdexcept>
 
+#include "core/error.hpp"
+
 namespace snede {
 namespace {
 
 void check_hdf5(herr_t status, const std::string& what) {
-  if (status < 0) throw std::runtime_error("HDF5 failed to " + what);
+  if (status < 0) throw FileError("HDF5 failed to " + what);
 }
 
 // Text as it may stand in an XML attribute value or element.
@@ -54,7 +56,7 @@ std::string file_name(const std::string& path) {
 XdmfWriter::XdmfWriter(std::string base) : base_(std::move(base)) {
   H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);  // errors are reported as exceptions, not printed
   const hid_t file = H5Fcreate(h5_path().c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
-  if (file < 0) throw std::runtime_error("cannot create " + h5_path() + " (does the folder exist and is it writable?)");
+  if (file < 0) throw FileError("cannot create " + h5_path() + " (does the folder exist and is it writable?)");
   H5Fclose(file);
   write_xdmf();
 }
@@ -70,7 +72,7 @@ void XdmfWriter::write_dataset(const std::string& path, const void* data, hid_t 
   if (set < 0) {
     H5Sclose(space);
     H5Pclose(lcpl);
-    throw std::runtime_error("HDF5 failed to create " + path + " in " + h5_path());
+    throw FileError("HDF5 failed to create " + path + " in " + h5_path());
   }
   const herr_t status = H5Dwrite(set, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data);
   H5Dclose(set);
@@ -93,7 +95,7 @@ void XdmfWriter::write_step(double time, const Mesh& mesh, std::span<const doubl
   // The file is open only while a step is written, so readers (ParaView, h5py) can open it
   // between steps.
   file_ = H5Fopen(h5_path().c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
-  if (file_ < 0) throw std::runtime_error("cannot open " + h5_path() + " for writing");
+  if (file_ < 0) throw FileError("cannot open " + h5_path() + " for writing (was its folder removed?)");
   struct CloseOnExit {
     hid_t& file;
     ~CloseOnExit() {
@@ -137,7 +139,7 @@ void XdmfWriter::write_step(double time, const Mesh& mesh, std::span<const doubl
 
 void XdmfWriter::write_xdmf() const {
   std::ofstream out(xdmf_path());
-  if (!out) throw std::runtime_error("cannot write " + xdmf_path());
+  if (!out) throw FileError("cannot write " + xdmf_path());
   out.precision(17);  // times read back exactly (a double's round-trip precision)
   const std::string h5 = xml_escaped(file_name(h5_path()));
   out << "<?xml version=\"1.0\"?>\n<Xdmf Version=\"3.0\">\n<Domain>\n"

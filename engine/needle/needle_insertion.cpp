@@ -68,18 +68,16 @@ NeedleInsertion::NeedleInsertion(Model& model, Bisection* bisection, const Point
 
 NeedleInsertion::~NeedleInsertion() {
   model_.body().mesh().connectivity().remove_watcher(this);
-  model_.remove_carried_field(&rate_);
-  model_.remove_carried_field(&start_);
-  VecDestroy(&rate_);
-  VecDestroy(&start_);
+  model_.remove_carried_field(rate_.slot());
+  model_.remove_carried_field(start_.slot());
 }
 
 void NeedleInsertion::create_predictor_vectors() {
-  SNEDE_PETSC(VecDuplicate(model_.displacement(), &rate_));
-  SNEDE_PETSC(VecDuplicate(model_.displacement(), &start_));
+  SNEDE_PETSC(VecDuplicate(model_.displacement(), rate_.out()));
+  SNEDE_PETSC(VecDuplicate(model_.displacement(), start_.out()));
   SNEDE_PETSC(VecZeroEntries(rate_));
-  model_.add_carried_field(&rate_);
-  model_.add_carried_field(&start_);
+  model_.add_carried_field(rate_.slot());
+  model_.add_carried_field(start_.slot());
 }
 
 void NeedleInsertion::predict(double distance) {

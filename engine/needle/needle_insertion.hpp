@@ -144,8 +144,8 @@ class NeedleInsertion : public ConnectivityWatcher {
   double last_tolerance_ = 0;
   // Predictor (a warm start better than the last state): the displacement change per unit of
   // needle travel in the last update, carried through mesh changes like the state.
-  Vec rate_ = nullptr;
-  Vec start_ = nullptr;  // the state at the start of the current update
+  VecHandle rate_;
+  VecHandle start_;  // the state at the start of the current update
   bool have_rate_ = false;
   void predict(double distance);
   void record_rate(double distance);

@@ -60,12 +60,12 @@ DynamicRelaxation::DynamicRelaxation(Model& model, double damping_eta, double dt
   try {
     generation_ = model_.generation();
     Vec u = model_.displacement();
-    SNEDE_PETSC(VecDuplicate(u, &velocity_));
+    SNEDE_PETSC(VecDuplicate(u, velocity_.out()));
     SNEDE_PETSC(VecZeroEntries(velocity_));
-    model_.add_carried_field(&velocity_);  // follows cuts and refinements like the state
-    SNEDE_PETSC(VecDuplicate(u, &inverse_mass_));
-    SNEDE_PETSC(VecDuplicate(u, &residual_));
-    SNEDE_PETSC(TSCreate(PETSC_COMM_SELF, &ts_));
+    model_.add_carried_field(velocity_.slot());  // follows cuts and refinements like the state
+    SNEDE_PETSC(VecDuplicate(u, inverse_mass_.out()));
+    SNEDE_PETSC(VecDuplicate(u, residual_.out()));
+    SNEDE_PETSC(TSCreate(PETSC_COMM_SELF, ts_.out()));
     option_database_.use_for(ts_);
     TSAdapt adapt = nullptr;
     SNEDE_PETSC(TSGetAdapt(ts_, &adapt));
@@ -89,31 +89,23 @@ DynamicRelaxation::DynamicRelaxation(Model& model, double damping_eta, double dt
     SNEDE_PETSC(TSSetFromOptions(ts_));
     option_database_.mark_read_options_used();
     PetscBool is_ss22 = PETSC_FALSE;
-    SNEDE_PETSC(PetscObjectTypeCompare(reinterpret_cast<PetscObject>(ts_), ts_ss22, &is_ss22));
+    SNEDE_PETSC(PetscObjectTypeCompare(reinterpret_cast<PetscObject>(ts_.get()), ts_ss22, &is_ss22));
     if (!is_ss22)
       throw std::invalid_argument("dynamic relaxation integrates with the TS type " + std::string(ts_ss22) + "; -" +
                                   options_prefix + "ts_type must not change it");
     require(positive_finite(time_step()), "-" + options_prefix + "ts_dt", "positive and finite", time_step());
     follows_cfl_ = dt == 0 && time_step() == default_dt;
   } catch (...) {
-    model_.remove_carried_field(&velocity_);
-    TSDestroy(&ts_);
-    VecDestroy(&velocity_);
-    VecDestroy(&inverse_mass_);
-    VecDestroy(&residual_);
+    model_.remove_carried_field(velocity_.slot());  // the handles release the PETSc objects
     throw;
   }
 }
 
 DynamicRelaxation::~DynamicRelaxation() {
-  model_.remove_carried_field(&velocity_);
+  model_.remove_carried_field(velocity_.slot());
   TSSetApplicationContext(ts_, nullptr);  // a petsc4py handle may outlive this solver
   TSSetRHSFunction(ts_, nullptr,
                    [](TS, PetscReal, Vec, Vec, void*) { return orphaned_callback_error("DynamicRelaxation"); }, nullptr);
-  TSDestroy(&ts_);
-  VecDestroy(&velocity_);
-  VecDestroy(&inverse_mass_);
-  VecDestroy(&residual_);
 }
 
 // h: with the shortest edge (the h of the text around (2.61)) the estimate exceeded the
@@ -158,11 +150,11 @@ void DynamicRelaxation::reissue_sizes_if_mesh_changed() {
   // The mesh changed size (a cut or a refinement): the model has carried the velocity over
   // like the displacement (a copy moves with its original, a midpoint with its edge); the
   // same TS takes the new vectors, so a user's handle and options survive.
-  SNEDE_PETSC(VecDestroy(&inverse_mass_));
-  SNEDE_PETSC(VecDestroy(&residual_));
+  inverse_mass_.reset();
+  residual_.reset();
   Vec u = model_.displacement();
-  SNEDE_PETSC(VecDuplicate(u, &inverse_mass_));
-  SNEDE_PETSC(VecDuplicate(u, &residual_));
+  SNEDE_PETSC(VecDuplicate(u, inverse_mass_.out()));
+  SNEDE_PETSC(VecDuplicate(u, residual_.out()));
   SNEDE_PETSC(TSReset(ts_));
   SNEDE_PETSC(TS2SetSolution(ts_, u, velocity_));
   generation_ = model_.generation();

@@ -86,10 +86,10 @@ class DynamicRelaxation {
 
   Model& model_;
   SolverOptions option_database_;  // read by the PETSc objects below
-  TS ts_ = nullptr;
-  Vec velocity_ = nullptr;
-  Vec inverse_mass_ = nullptr;  // 1/m per dof (0 for a vertex without mass)
-  Vec residual_ = nullptr;
+  TsHandle ts_;
+  VecHandle velocity_;
+  VecHandle inverse_mass_;  // 1/m per dof (0 for a vertex without mass)
+  VecHandle residual_;
   std::uint64_t generation_ = 0;
   bool follows_cfl_ = false;
 

@@ -35,9 +35,9 @@ void apply_line_search(SNESLineSearch ls, Slope slope_kind) {
   PetscInt max_its;
   SNEDE_PETSC(SNESLineSearchGetTolerances(ls, &steptol, &maxstep, &rtol, &atol, &ltol, &max_its));
 
-  Vec d = nullptr, Kd = nullptr;
-  SNEDE_PETSC(VecDuplicate(Y, &d));
-  SNEDE_PETSC(VecDuplicate(Y, &Kd));
+  VecHandle d, Kd;
+  SNEDE_PETSC(VecDuplicate(Y, d.out()));
+  SNEDE_PETSC(VecDuplicate(Y, Kd.out()));
   SNEDE_PETSC(VecCopy(Y, d));
   SNEDE_PETSC(VecScale(d, -1.0));
 
@@ -92,8 +92,8 @@ void apply_line_search(SNESLineSearch ls, Slope slope_kind) {
     alpha -= update;
     evaluated_at_alpha = false;
   }
-  SNEDE_PETSC(VecDestroy(&d));
-  SNEDE_PETSC(VecDestroy(&Kd));
+  d.reset();
+  Kd.reset();
   if (domain_error || alpha <= 0 || !std::isfinite(alpha)) {
     SNEDE_PETSC(SNESLineSearchSetReason(ls, domain_error ? SNES_LINESEARCH_FAILED_DOMAIN : SNES_LINESEARCH_FAILED_REDUCT));
     return;

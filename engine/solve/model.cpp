@@ -19,18 +19,15 @@ Model::Model(ElasticBody& body) : body_(body), constraints_(body.dim()) {
 
 Model::~Model() {
   body_.mesh().connectivity().remove_watcher(this);
-  MatShellSetContext(tangent_, nullptr);  // a petsc4py handle may outlive the model
-  VecDestroy(&u_);
-  VecDestroy(&u_linearization_);
-  MatDestroy(&tangent_);
+  if (tangent_) MatShellSetContext(tangent_, nullptr);  // a petsc4py handle may outlive the model
 }
 
 void Model::create_vectors() {
   const PetscInt n = n_dofs();
-  SNEDE_PETSC(VecCreateSeq(PETSC_COMM_SELF, n, &u_));
+  SNEDE_PETSC(VecCreateSeq(PETSC_COMM_SELF, n, u_.out()));
   SNEDE_PETSC(VecSetBlockSize(u_, dim()));
-  SNEDE_PETSC(VecDuplicate(u_, &u_linearization_));
-  SNEDE_PETSC(MatCreateShell(PETSC_COMM_SELF, n, n, n, n, this, &tangent_));
+  SNEDE_PETSC(VecDuplicate(u_, u_linearization_.out()));
+  SNEDE_PETSC(MatCreateShell(PETSC_COMM_SELF, n, n, n, n, this, tangent_.out()));
   SNEDE_PETSC(MatShellSetOperation(tangent_, MATOP_MULT, reinterpret_cast<void (*)(void)>(tangent_mult_callback)));
   SNEDE_PETSC(MatSetOption(tangent_, MAT_SYMMETRIC, PETSC_TRUE));
   SNEDE_PETSC(MatSetOption(tangent_, MAT_SPD, PETSC_TRUE));
@@ -275,7 +272,7 @@ void Model::on_change(const Connectivity&, const ConnectivityChange& change) {
       if (event.kind != VertexEventKind::moved)
         std::fill_n(entry.second.begin() + static_cast<std::ptrdiff_t>(event.vertex) * dim(), dim(), 0.0);
   }
-  std::vector<Vec*> fields{&u_};
+  std::vector<Vec*> fields{u_.slot()};
   fields.insert(fields.end(), carried_fields_.begin(), carried_fields_.end());
   if (n_new == n_points_) {  // same rows (moves, removals, reused ids): in place, O(events)
     for (Vec* field : fields) replay(WriteView(*field).span(), change);
@@ -287,9 +284,9 @@ void Model::on_change(const Connectivity&, const ConnectivityChange& change) {
     v.resize(body_.n_dofs(), 0.0);
     replay(v, change);
   }
-  for (Vec* field : fields) VecDestroy(field);
-  VecDestroy(&u_linearization_);
-  MatDestroy(&tangent_);
+  for (Vec* field : fields) SNEDE_PETSC(VecDestroy(field));
+  u_linearization_.reset();
+  tangent_.reset();
   n_points_ = n_new;
   create_vectors();
   for (std::size_t i = 1; i < fields.size(); ++i) SNEDE_PETSC(VecDuplicate(u_, fields[i]));

@@ -23,6 +23,7 @@
 #include <string>
 #include <vector>
 
+#include "core/petsc_handle.hpp"
 #include "fem/elastic_body.hpp"
 #include "solve/constraints.hpp"
 
@@ -114,9 +115,9 @@ class Model : public ConnectivityWatcher {
   std::vector<double> external_;       // cached f_ext
   bool external_valid_ = false;
   VertexId n_points_ = 0;
-  Vec u_ = nullptr;
-  Vec u_linearization_ = nullptr;
-  Mat tangent_ = nullptr;
+  VecHandle u_;
+  VecHandle u_linearization_;
+  MatHandle tangent_;
   std::uint64_t generation_ = 0;
   double last_reaction_norm_ = 0;
   double operator_scale_ = 1;

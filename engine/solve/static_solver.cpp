@@ -52,14 +52,7 @@ StaticSolver::StaticSolver(Model& model, StaticOptions options)
         "method 'cg' (linear CG) solves the linear problem and needs LinearElastic; use 'ncg' or 'newton' for "
         "nonlinear materials");
   register_line_searches();
-  try {
-    create_objects();
-  } catch (...) {  // a bad option: release what was made (the destructor will not run)
-    KSPDestroy(&ksp_);
-    SNESDestroy(&snes_);
-    VecDestroy(&residual_);
-    throw;
-  }
+  create_objects();  // on a bad option the handles release what was made
 }
 
 StaticSolver::~StaticSolver() {
@@ -75,9 +68,6 @@ StaticSolver::~StaticSolver() {
     SNESSetConvergenceTest(snes_, snes_converged_callback, nullptr, nullptr);
   }
   if (ksp_) KSPSetConvergenceTest(ksp_, ksp_converged_callback, nullptr, nullptr);
-  KSPDestroy(&ksp_);
-  SNESDestroy(&snes_);
-  VecDestroy(&residual_);
 }
 
 KSP StaticSolver::ksp() const {
@@ -89,10 +79,10 @@ KSP StaticSolver::ksp() const {
 
 void StaticSolver::create_objects() {
   generation_ = model_.generation();
-  SNEDE_PETSC(VecDuplicate(model_.displacement(), &residual_));
+  SNEDE_PETSC(VecDuplicate(model_.displacement(), residual_.out()));
   const char* prefix = options_.options_prefix.c_str();
   if (options_.method == StaticMethod::linear_cg) {
-    SNEDE_PETSC(KSPCreate(PETSC_COMM_SELF, &ksp_));
+    SNEDE_PETSC(KSPCreate(PETSC_COMM_SELF, ksp_.out()));
     option_database_.use_for(ksp_);
     SNEDE_PETSC(KSPSetOptionsPrefix(ksp_, prefix));
     SNEDE_PETSC(KSPSetType(ksp_, KSPCG));
@@ -107,7 +97,7 @@ void StaticSolver::create_objects() {
     option_database_.mark_read_options_used();
     return;
   }
-  SNEDE_PETSC(SNESCreate(PETSC_COMM_SELF, &snes_));
+  SNEDE_PETSC(SNESCreate(PETSC_COMM_SELF, snes_.out()));
   option_database_.use_for(snes_);
   SNEDE_PETSC(SNESSetOptionsPrefix(snes_, prefix));  // also creates the KSP
   KSP inner = nullptr;
@@ -155,8 +145,7 @@ void StaticSolver::reissue_sizes_if_mesh_changed() {
   // The mesh changed size (a cut or a refinement): new vectors and a new shell, same
   // solver objects (so a user's handle and options survive).
   generation_ = model_.generation();
-  SNEDE_PETSC(VecDestroy(&residual_));
-  SNEDE_PETSC(VecDuplicate(model_.displacement(), &residual_));
+  SNEDE_PETSC(VecDuplicate(model_.displacement(), residual_.out()));
   if (ksp_) {
     SNEDE_PETSC(KSPReset(ksp_));
     SNEDE_PETSC(KSPSetOperators(ksp_, model_.tangent(), model_.tangent()));
@@ -164,11 +153,10 @@ void StaticSolver::reissue_sizes_if_mesh_changed() {
     SNEDE_PETSC(SNESReset(snes_));
     // SNESReset keeps the SNES's DM, whose global vector still has the old size (NCG
     // duplicates it): a fresh shell DM, then the callbacks it carries set again.
-    DM dm = nullptr;
-    SNEDE_PETSC(DMShellCreate(PETSC_COMM_SELF, &dm));
+    DmHandle dm;
+    SNEDE_PETSC(DMShellCreate(PETSC_COMM_SELF, dm.out()));
     SNEDE_PETSC(DMShellSetGlobalVector(dm, residual_));
-    SNEDE_PETSC(SNESSetDM(snes_, dm));
-    SNEDE_PETSC(DMDestroy(&dm));
+    SNEDE_PETSC(SNESSetDM(snes_, dm));  // the SNES holds its own reference
     SNEDE_PETSC(SNESSetObjective(snes_, objective_callback, this));
     SNEDE_PETSC(SNESSetFunction(snes_, residual_, residual_callback, this));
     if (options_.method == StaticMethod::newton)
@@ -210,9 +198,10 @@ SolveResult StaticSolver::solve_linear() {
   SolveResult result;
   const double start = wall_seconds();
   const double start_flops = logged_flops();
-  Vec u = model_.displacement(), rhs = nullptr, step = nullptr;
-  SNEDE_PETSC(VecDuplicate(u, &rhs));
-  SNEDE_PETSC(VecDuplicate(u, &step));
+  Vec u = model_.displacement();
+  VecHandle rhs, step;
+  SNEDE_PETSC(VecDuplicate(u, rhs.out()));
+  SNEDE_PETSC(VecDuplicate(u, step.out()));
   EvaluationReport report;
   model_.residual(u, residual_, report);
   throw_if_domain_error(report);
@@ -233,8 +222,6 @@ SolveResult StaticSolver::solve_linear() {
   result.iterations = static_cast<int>(iterations);
   result.reason = std::string(KSPConvergedReasons[reason]);
   result.converged = reason > 0;
-  SNEDE_PETSC(VecDestroy(&rhs));
-  SNEDE_PETSC(VecDestroy(&step));
   finish(result, start, start_flops);
   return result;
 }

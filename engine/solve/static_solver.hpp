@@ -63,9 +63,9 @@ class StaticSolver {
   Model& model_;
   StaticOptions options_;
   SolverOptions option_database_;  // read by the PETSc objects below
-  KSP ksp_ = nullptr;    // linear CG only
-  SNES snes_ = nullptr;  // nonlinear methods only
-  Vec residual_ = nullptr;
+  KspHandle ksp_;    // linear CG only
+  SnesHandle snes_;  // nonlinear methods only
+  VecHandle residual_;
   std::uint64_t generation_ = 0;
   StoppingRule rule_;  // the stopping rule of the current solve, scaled to the model
   double external_norm_ = 0;

@@ -6,6 +6,7 @@ from snede._petsc import PETSc  # noqa: F401  (initialises PETSc before the engi
 from snede._snede import (  # noqa: F401
     DomainError,
     EditResult,
+    FileError,
     InvalidMesh,
     LinearElastic,
     NeoHookean,
@@ -28,6 +29,6 @@ __all__ = [
     "Mesh", "MeshQuality", "Body", "meshing", "StaticSolver", "DynamicRelaxation", "SolveResult",
     "FrictionProfile", "NeedleInsertion", "TetrahedralCutter", "CutReport", "DelaunayCutter", "PlanarCutReport", "SubdivisionCutter",
     "LinearElastic", "StVenantKirchhoff", "NeoHookean", "VerondaWestmann",
-    "EditResult", "InvalidMesh", "PetscError", "DomainError", "LockingWarning", "PETSc",
+    "EditResult", "FileError", "InvalidMesh", "PetscError", "DomainError", "LockingWarning", "PETSc",
 ]
 __version__ = "0.1.0"

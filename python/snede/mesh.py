@@ -309,8 +309,11 @@ class Mesh(MeshEdits):
         try:
             with contextlib.redirect_stdout(io.StringIO()):
                 data = meshio.read(str(path))
-        except SystemExit:
-            raise ValueError(f"{path}: meshio could not read this file") from None
+        except OSError:  # unreadable (permissions, a folder): the system's own error says why
+            raise
+        except (SystemExit, Exception) as error:  # meshio's parsers fail in many ways on a damaged file
+            reason = "" if isinstance(error, SystemExit) else f" ({type(error).__name__}: {error})"
+            raise ValueError(f"{path}: meshio could not read this file{reason}") from None
         blocks = {block.type: block.data for block in data.cells}
         if "tetra" in blocks:
             cells = np.concatenate([b.data for b in data.cells if b.type == "tetra"])

@@ -186,12 +186,20 @@ def test_write_msh_is_a_gmsh_file(tmp_path):
     assert path.read_bytes().startswith(b"$MeshFormat")
 
 
-def test_read_of_a_corrupt_file_raises_a_value_error_naming_the_file(tmp_path):
-    """meshio calls sys.exit on this file; Mesh.read turns that into a ValueError that names
-    the file. (This test used to accept any Exception at all, so a NameError inside
-    Mesh.read, or meshio's own internals, passed it.)"""
-    path = tmp_path / "corrupt.msh"
-    path.write_text("this is not a mesh\n")
+def damaged_file(kind: str, path):
+    canonical = (MESHES / "cylinder_small.msh").read_bytes()
+    contents = {"text": b"this is not a mesh\n", "binary": bytes(range(256)) * 8, "empty": b"",
+                "truncated": canonical[: len(canonical) // 2], "header only": canonical[:40]}[kind]
+    path.write_bytes(contents)
+    return path
+
+
+@pytest.mark.parametrize("kind", ["text", "binary", "empty", "truncated", "header only"])
+def test_read_of_a_damaged_file_raises_a_value_error_naming_the_file(tmp_path, kind):
+    """meshio fails on these in several ways (sys.exit, UnicodeDecodeError, IndexError,
+    ReadError); Mesh.read turns each into a ValueError that names the file. (This test used to
+    accept any Exception at all, so a NameError inside Mesh.read passed it.)"""
+    path = damaged_file(kind, tmp_path / "damaged.msh")
     with pytest.raises(ValueError, match=re.escape(str(path))):
         read_quietly(path)
 

@@ -32,12 +32,27 @@ def test_the_displacement_does_not_depend_on_the_units_from_1e_minus3_to_1e155(m
                                    atol=1e-9 * np.abs(reference.displacement).max())
 
 
-@pytest.mark.parametrize("method", ["cg", "ncg", "newton"])
+@pytest.mark.parametrize("method", ["cg", "ncg", "newton", "dynamic"])
 def test_loads_beyond_double_range_are_never_converged(method):
     body = sagging_sheet(1e5)
     body.add_gravity((0.0, -1e300))
-    result = snede.StaticSolver(body, method, rtol=1e-6).solve()
+    if method == "dynamic":
+        result = snede.DynamicRelaxation(body, 20.0).run(rtol=1e-6, max_steps=200)
+    else:
+        result = snede.StaticSolver(body, method, rtol=1e-6).solve()
     assert not result.converged
+
+
+def test_dynamic_relaxation_reaches_the_same_displacement_whatever_the_units():
+    reference = sagging_sheet(1e5)
+    assert snede.StaticSolver(reference, "cg", rtol=1e-10).solve().converged
+    for young in (1e-3, 1e5, 1e150):
+        body = sagging_sheet(young)
+        dynamics = snede.DynamicRelaxation(body, 2.0 * np.sqrt(young / 1e5) * 20.0)
+        result = dynamics.run(rtol=1e-8, max_steps=200000)
+        assert result.converged and np.isfinite(result.residual_norm), (young, result)
+        np.testing.assert_allclose(body.displacement, reference.displacement, rtol=1e-5,
+                                   atol=1e-6 * np.abs(reference.displacement).max())
 
 
 @pytest.mark.parametrize("kwargs, fragment", [
@@ -57,6 +72,12 @@ def test_materials_show_their_parameters():
     assert veronda.E == pytest.approx(3e3) and veronda.nu == pytest.approx(0.3)
     with pytest.raises(ValueError, match="needs gamma"):
         snede.VerondaWestmann(3e3, 0.3)
+    with pytest.raises(ValueError, match="needs nu, Poisson's ratio, and gamma"):
+        snede.VerondaWestmann(3e3)
+    # E and ν come back from the Lamé parameters; the repr does not show their round-off.
+    assert repr(snede.LinearElastic(1e3, 0.3)) == "LinearElastic(E=1000.0, nu=0.3)"
+    assert repr(snede.StVenantKirchhoff(2.5e-3, 0.1)) == "StVenantKirchhoff(E=0.0025, nu=0.1)"
+    assert repr(snede.VerondaWestmann(3e3, 0.3, 8.0)) == "VerondaWestmann(E=3000.0, nu=0.3, gamma=8.0)"
 
 
 def test_xdmf_field_names_are_escaped_and_bad_ones_refused(tmp_path):
@@ -155,21 +176,31 @@ from snede import _snede
 mesh = snede.meshing.rectangle((1.0, 0.2), (6, 2))
 body = snede.Body(mesh, snede.LinearElastic(1e3, 0.3), thickness=0.01)
 body.fix(np.isclose(mesh.points[:, 0], 0.0))
+friction = snede.FrictionProfile.uniform(1.0)
 
-def fail(method):
+FAILURES = {  # each construction fails on an option, after it has made some PETSc objects
+    "cg": lambda: snede.StaticSolver(body, "cg", petsc_options={"ksp_type": "nosuchtype"}),
+    "ncg": lambda: snede.StaticSolver(body, "ncg", petsc_options={"snes_type": "nosuchtype"}),
+    "newton": lambda: snede.StaticSolver(body, "newton", petsc_options={"snes_type": "nosuchtype"}),
+    "dynamic, unknown TS": lambda: snede.DynamicRelaxation(body, 10.0, petsc_options={"ts_type": "nosuchtype"}),
+    "dynamic, other TS": lambda: snede.DynamicRelaxation(body, 10.0, petsc_options={"ts_type": "euler"}),
+    "needle": lambda: snede.NeedleInsertion(body, (0.0, 0.1), (1.0, 0.0), friction, method="newton",
+                                            petsc_options={"snes_type": "nosuchtype"}),
+}
+
+def fail(make):
     try:
-        snede.StaticSolver(body, method, petsc_options={"snes_type" if method != "cg" else "ksp_type": "nosuchtype"})
-    except snede.PetscError:
+        make()
+    except (snede.PetscError, ValueError):
         return
-    raise SystemExit("a bad type was accepted")
+    raise SystemExit("a bad option was accepted")
 
-for method in ("cg", "ncg", "newton"):
-    for _ in range(20):
-        fail(method)  # warm-up: PETSc's registries and caches
+for make in FAILURES.values():
+    for _ in range(10):
+        fail(make)  # warm-up: PETSc's registries and caches
 before = _snede.petsc_allocated_bytes()
-for method in ("cg", "ncg", "newton"):
-    for _ in range(300):
-        fail(method)
+for k in range(1002):
+    fail(list(FAILURES.values())[k % len(FAILURES)])
 print(before, _snede.petsc_allocated_bytes())
 """
 
@@ -186,8 +217,8 @@ def test_failed_solver_constructions_leave_petsc_memory_flat():
     # The first line; PETSc's -malloc_debug report of what is still allocated at exit follows.
     before, after = map(float, result.stdout.splitlines()[0].split())
     assert before > 0  # -malloc_debug tracks PETSc's allocations
-    # 900 failed constructions: the ~25 kB each they used to leak would be over 20 MB; about
-    # 50 bytes each remain (option strings, PetscStrallocpy).
+    # 1002 failed constructions (static, dynamic, needle): the ~25 kB each used to leak would be
+    # over 20 MB; PETSc keeps about 50 bytes per failure (option strings, PetscStrallocpy).
     assert after - before < 100e3, (before, after)
 
 
@@ -220,3 +251,63 @@ def test_an_exception_inside_a_petsc_monitor_keeps_its_type_and_message(handle, 
     assert str(raised.value) == str(exception)
     petsc_object.cancelMonitor()
     assert run().converged
+
+
+DELETED_FOLDER_SCRIPT = """
+import shutil
+import sys
+from pathlib import Path
+
+import snede
+from snede.output import SeriesWriter
+
+out = Path(sys.argv[1])
+mesh = snede.meshing.rectangle((1.0, 1.0), (2, 2))
+body = snede.Body(mesh, snede.LinearElastic(1e4, 0.3), thickness=0.01)
+writer = SeriesWriter(out / "series")
+writer.write(body, 0.0)
+shutil.rmtree(out)  # the output folder goes away mid-run
+writer.write(body, 1.0)
+print("NOT REACHED")
+"""
+
+
+def test_an_output_folder_deleted_mid_run_stops_the_command_line_with_one_line(tmp_path):
+    # Item 8: the writer's failure is a snede.FileError (an OSError) naming the file; the
+    # command line prints it on one line and exits 2 instead of showing a traceback.
+    import subprocess
+    import sys
+
+    script = tmp_path / "deleting.py"
+    script.write_text(DELETED_FOLDER_SCRIPT)
+    out = tmp_path / "out"
+    result = subprocess.run([sys.executable, "-m", "snede", "run", str(script), str(out)], capture_output=True,
+                            text=True, timeout=120)
+    assert result.returncode == 2, (result.stdout, result.stderr)
+    assert "NOT REACHED" not in result.stdout and "Traceback" not in result.stderr
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("error: cannot open") and "series.h5" in lines[0], lines
+    assert issubclass(snede.FileError, OSError)
+
+
+@pytest.mark.parametrize("method", ["cg", "ncg", "newton"])
+def test_every_method_continues_after_a_dissection_and_agrees_with_a_new_solver(method):
+    # Item 3 (ncg raised "Incompatible vector local lengths" after a mesh change): a cut that
+    # adds vertices, then the same solver object solves again, from the carried-over state.
+    mesh = snede.meshing.rectangle((1.0, 0.2), (10, 2))
+    material = snede.LinearElastic(1e5, 0.3) if method == "cg" else snede.NeoHookean(1e5, 0.3)
+    body = snede.Body(mesh, material, thickness=0.01, density=1.0)
+    body.fix(np.isclose(mesh.points[:, 0], 0.0))
+    body.add_gravity((0.0, -9.81))
+    solver = snede.StaticSolver(body, method, rtol=1e-9)
+    assert solver.solve().converged
+    n_before = mesh.n_points
+    faces = mesh.faces_where(lambda x: np.isclose(x[:, 0], 0.5) & (x[:, 1] < 0.15))
+    assert len(mesh.dissect(faces)) > 0 and mesh.n_points > n_before
+    after = solver.solve()
+    assert after.converged, after
+    carried = body.displacement.copy()
+    body.displacement = np.zeros_like(carried)
+    fresh = snede.StaticSolver(body, method, rtol=1e-9, options_prefix="fresh_").solve()
+    assert fresh.converged, fresh
+    np.testing.assert_allclose(carried, body.displacement, atol=1e-6 * np.abs(carried).max())
