@@ -5,6 +5,7 @@
 #include "solve/model.hpp"
 #include "solve/solve_result.hpp"
 #include "solve/static_solver.hpp"
+#include "solve/tangent_assembly.hpp"
 
 #include <pybind11/stl.h>
 
@@ -27,9 +28,28 @@ py::array_t<double> reactions_of(Model& model) {
 std::unique_ptr<StaticSolver> make_static_solver(Model& model, const std::string& method, double rtol,
                                                  const std::string& criterion, double round_tolerance,
                                                  int max_iterations, const std::string& prefix,
-                                                 const OptionList& petsc_options) {
-  return std::make_unique<StaticSolver>(
-      model, static_options(method, rtol, criterion, round_tolerance, max_iterations, prefix, petsc_options));
+                                                 const OptionList& petsc_options, const std::string& preconditioner) {
+  StaticOptions options = static_options(method, rtol, criterion, round_tolerance, max_iterations, prefix, petsc_options);
+  options.preconditioner = preconditioner;
+  return std::make_unique<StaticSolver>(model, std::move(options));
+}
+
+// The shell at u: a petsc4py Mat sharing the model's (it applies J at the last point set).
+py::object tangent_operator_at(Model& model, const DoubleArray& u) {
+  set_vec_values(model.linearization_point(), view(u));
+  return to_petsc4py(model.tangent());
+}
+
+// A new assembled J at u, owned by the petsc4py Mat returned.
+py::object assembled_tangent_at(Model& model, const DoubleArray& u, const std::string& format) {
+  if (format != "aij" && format != "baij")
+    throw std::invalid_argument("format must be 'aij' or 'baij', got '" + format + "'");
+  VecHandle x;
+  SNEDE_PETSC(VecDuplicate(model.displacement(), x.out()));
+  set_vec_values(x, view(u));
+  MatHandle A = create_tangent_matrix(model, format == "baij" ? MatrixFormat::baij : MatrixFormat::aij);
+  assemble_tangent(model, x, A);
+  return to_petsc4py(A.get());  // petsc4py takes a reference; the handle drops ours
 }
 
 }  // namespace
@@ -91,12 +111,15 @@ void bind_solve(py::module_& m) {
       .def_property("displacement", [](const Model& s) { return vec_to_array(s.displacement(), s.dim()); },
                     [](Model& s, const DoubleArray& u) { array_to_vec(u, s.displacement()); })
       .def_property_readonly("displacement_vec", [](const Model& s) { return to_petsc4py(s.displacement()); })
-      .def_property_readonly("tangent_mat", [](const Model& s) { return to_petsc4py(s.tangent()); });
+      .def_property_readonly("tangent_mat", [](const Model& s) { return to_petsc4py(s.tangent()); })
+      .def("tangent_operator", &tangent_operator_at, py::arg("u"))
+      .def("assemble_tangent", &assembled_tangent_at, py::arg("u"), py::arg("format"));
 
   py::class_<StaticSolver>(m, "StaticSolver")
       .def(py::init(&make_static_solver), py::arg("model"), py::arg("method"), py::arg("rtol"), py::arg("criterion"),
            py::arg("round_tolerance"), py::arg("max_iterations"), py::arg("options_prefix"), py::arg("petsc_options"),
-           py::keep_alive<1, 2>())
+           py::arg("preconditioner"), py::keep_alive<1, 2>())
+      .def_property_readonly("preconditioner", &StaticSolver::preconditioner)
       .def("solve", &StaticSolver::solve)
       .def_property_readonly("ksp", [](const StaticSolver& s) { return to_petsc4py(s.ksp()); })
       .def_property_readonly("snes", [](const StaticSolver& s) {

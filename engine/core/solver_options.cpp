@@ -58,6 +58,14 @@ void SolverOptions::use_for(PetscObject object) const {
   SNEDE_PETSC(PetscObjectCompose(object, "snede_solver_options", reinterpret_cast<PetscObject>(holder_.get())));
 }
 
+std::optional<std::string> SolverOptions::string_option(const std::string& name) const {
+  char value[256] = {};
+  PetscBool set = PETSC_FALSE;
+  SNEDE_PETSC(PetscOptionsGetString(database_, nullptr, ("-" + name).c_str(), value, sizeof value, &set));
+  if (!set) return std::nullopt;
+  return std::string(value);
+}
+
 void SolverOptions::mark_read_options_used() const {
   for (const std::string& name : global_names_) {
     PetscBool read = PETSC_FALSE, set = PETSC_FALSE;

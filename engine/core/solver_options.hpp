@@ -8,6 +8,7 @@
 
 #include <petscsys.h>
 
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -42,6 +43,9 @@ class SolverOptions {
   void use_for(const PetscHandle<Object, destroy>& handle) const {
     use_for(handle.get());
   }
+
+  // The value of option `name` (with its prefix, without '-') in this database, if set.
+  std::optional<std::string> string_option(const std::string& name) const;
 
   // Marks the global options this solver has read as used in the global database, so that
   // -options_left lists only the options that no solver read.

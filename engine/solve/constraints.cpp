@@ -92,6 +92,18 @@ void Constraints::project(std::span<double> v) const {
   }
 }
 
+void Constraints::projection_block(VertexId v, std::span<double> block) const {
+  check_vertex(v);
+  const VertexConstraint& c = vertices_[v];
+  for (int i = 0; i < dim_; ++i)
+    for (int j = 0; j < dim_; ++j) {
+      double& p = block[static_cast<std::size_t>(i * dim_ + j)];
+      if (c.kind == ConstraintKind::free) p = i == j ? 1.0 : 0.0;
+      else if (c.kind == ConstraintKind::slide) p = c.direction[i] * c.direction[j];
+      else p = 0.0;  // fixed or absent
+    }
+}
+
 void Constraints::project_complement(std::span<double> v) const {
   for (std::size_t i = 0; i < vertices_.size(); ++i) {
     const VertexConstraint& c = vertices_[i];

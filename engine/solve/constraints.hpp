@@ -41,6 +41,8 @@ class Constraints {
 
   // v ← P v
   void project(std::span<double> v) const;
+  // Vertex v's block of P (dim × dim, row-major) into `block`.
+  void projection_block(VertexId v, std::span<double> block) const;
   // v ← (I − P) v
   void project_complement(std::span<double> v) const;
   // u ← P u + (I − P) anchor: the nearest displacement that satisfies the constraints.

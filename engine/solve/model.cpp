@@ -7,6 +7,7 @@
 #include "core/error.hpp"
 #include "core/norms.hpp"
 #include "core/petsc_util.hpp"
+#include "solve/tangent_assembly.hpp"
 
 namespace snede {
 
@@ -29,6 +30,8 @@ void Model::create_vectors() {
   SNEDE_PETSC(VecDuplicate(u_, u_linearization_.out()));
   SNEDE_PETSC(MatCreateShell(PETSC_COMM_SELF, n, n, n, n, this, tangent_.out()));
   SNEDE_PETSC(MatShellSetOperation(tangent_, MATOP_MULT, reinterpret_cast<void (*)(void)>(tangent_mult_callback)));
+  SNEDE_PETSC(MatShellSetOperation(tangent_, MATOP_GET_DIAGONAL,
+                                   reinterpret_cast<void (*)(void)>(tangent_diagonal_callback)));
   SNEDE_PETSC(MatSetOption(tangent_, MAT_SYMMETRIC, PETSC_TRUE));
   SNEDE_PETSC(MatSetOption(tangent_, MAT_SPD, PETSC_TRUE));
 }
@@ -237,6 +240,15 @@ PetscErrorCode Model::tangent_mult_callback(Mat A, Vec d, Vec out) {
     void* context = nullptr;
     SNEDE_PETSC(MatShellGetContext(A, &context));
     callback_owner<Model>(context, "Body").tangent_mult(d, out);
+  });
+}
+
+PetscErrorCode Model::tangent_diagonal_callback(Mat A, Vec diagonal) {
+  return petsc_callback("snede tangent shell MatGetDiagonal", [&] {
+    void* context = nullptr;
+    SNEDE_PETSC(MatShellGetContext(A, &context));
+    const Model& model = callback_owner<Model>(context, "Body");
+    tangent_diagonal(model, model.u_linearization_, diagonal);
   });
 }
 

@@ -75,6 +75,8 @@ class Model : public ConnectivityWatcher {
   // The shell applies scale·J: a solver may divide a whole linear system by a force scale
   // to keep CG's dot products in range; 1 otherwise.
   void set_operator_scale(double scale) { operator_scale_ = scale; }
+  double operator_scale() const { return operator_scale_; }
+  Vec linearization_point() const { return u_linearization_; }
   void set_linearization_point(Vec u);
 
   // Π(u) = Π_int(u) − f_extᵀu (+∞ for an inverted element of a material forbidding it).
@@ -101,6 +103,8 @@ class Model : public ConnectivityWatcher {
   void create_vectors();
   void tangent_mult(Vec d, Vec out);
   static PetscErrorCode tangent_mult_callback(Mat A, Vec d, Vec out);
+  // The shell's MatGetDiagonal (for PCJACOBI): the diagonal of J without forming J.
+  static PetscErrorCode tangent_diagonal_callback(Mat A, Vec diagonal);
 
   // The vertex events of `change` applied, in order, to one nodal field already sized for the
   // mesh's rows.

@@ -27,6 +27,11 @@ struct StaticOptions {
   StoppingRule stopping;  // force_scale and n_dofs are filled from the model
   int max_iterations = 10000;
   std::string options_prefix = "static_";
+  // The PETSc PC type of the CG (linear, or Newton's inner one): "none", "jacobi" (from the
+  // shell's diagonal, no matrix), "gamg" (on an assembled tangent with the rigid-body near null
+  // space) or any PETSc PC that works on an assembled matrix ("ilu", "icc", "sor", ...).
+  // Empty: -<prefix>pc_type if given, else "none". -<prefix>pc_type on the command line wins.
+  std::string preconditioner;
   OptionList petsc_options;  // this solver's PETSc options, without the prefix
 };
 
@@ -42,11 +47,19 @@ class StaticSolver {
   KSP ksp() const;  // linear CG's KSP, or Newton's inner KSP
   SNES snes() const { return snes_; }
   const StaticOptions& options() const { return options_; }
+  // The PC type in use, and the assembled matrix it is built from (null without one).
+  const std::string& preconditioner() const { return pc_type_; }
+  Mat preconditioner_matrix() const { return preconditioner_matrix_; }
   Model& model() { return model_; }
 
  private:
   void create_objects();
   void reissue_sizes_if_mesh_changed();
+  // The matrix the PC is built from: the shell, or an assembled tangent for the current mesh.
+  Mat preconditioning_matrix();
+  // Newton's Jacobian callback: the assembled tangent is refilled unless the SNES lags the
+  // preconditioner at this iteration (-<prefix>snes_lag_preconditioner).
+  void refill_preconditioner(SNES snes, Vec x);
   double current_tolerance() const;
   SolveResult solve_linear();
   SolveResult solve_nonlinear();
@@ -66,6 +79,10 @@ class StaticSolver {
   KspHandle ksp_;    // linear CG only
   SnesHandle snes_;  // nonlinear methods only
   VecHandle residual_;
+  std::string pc_type_;
+  bool needs_matrix_ = false;          // the PC needs entries: an assembled tangent
+  MatHandle preconditioner_matrix_;    // that tangent, for the current mesh
+  bool preconditioner_filled_ = false;  // filled since it was made (for lagging)
   std::uint64_t generation_ = 0;
   StoppingRule rule_;  // the stopping rule of the current solve, scaled to the model
   double external_norm_ = 0;

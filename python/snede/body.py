@@ -99,6 +99,21 @@ class Body:
         row = _checks.index(row, "row", self.mesh.n_cells, "rows of mesh.cells")
         return self._impl.element_stiffness(int(self.mesh.cell_ids[row]), self._field("u", u))
 
+    def tangent_operator(self, u=None):
+        """The tangent J = P K(u) P + (I − P) as a petsc4py ``Mat`` applied matrix-free (a
+        ``MatShell`` over the element kernels; P projects out the constrained motions, so a
+        fixed vertex's rows are the identity). ``u``: (n_points, dim), default the current
+        displacement. The shell is the body's own: a later solve moves its linearisation point,
+        and after a cut or refinement the body makes a new one (ask again). It also gives its
+        diagonal (``getDiagonal``)."""
+        return self._model.tangent_operator(self._field("u", self.displacement if u is None else u))
+
+    def assemble_tangent(self, u=None, format: str = "baij"):
+        """J at ``u`` (default the current displacement) assembled from the same element kernels
+        into a new petsc4py ``Mat``: ``format`` "baij" (blocks of dim × dim) or "aij". For
+        preconditioners and comparison; it does not follow later mesh changes."""
+        return self._model.assemble_tangent(self._field("u", self.displacement if u is None else u), str(format))
+
     def lumped_mass(self) -> np.ndarray:
         """Mass per vertex (kg): 1/(dim+1) of each incident cell's mass (§2.5); (n_points,)."""
         return np.asarray(self._impl.lumped_mass())

@@ -32,16 +32,25 @@ class StaticSolver:
       apply to this solver only, not to later solvers with the same prefix; the command line
       (PETSc's global options, as they are when the solver is made) still wins.
 
-    Linear CG solves the system divided by the force scale E·t·H (E·H² in 3D), so that the
+    * ``preconditioner`` (cg and newton): the PETSc PC of the CG. ``"none"``; ``"jacobi"``
+      (the diagonal of the tangent, computed element by element: no matrix); ``"gamg"``
+      (algebraic multigrid on a tangent assembled from the same element kernels, with the
+      rigid-body modes as near null space; refilled at every Newton iteration unless
+      ``-static_snes_lag_preconditioner k`` lags it, rebuilt after a cut or refinement); or any
+      PETSc PC that works on an assembled matrix (``"ilu"``, ``"icc"``, ``"sor"``, ``"lu"``).
+      None (default): ``-static_pc_type`` if given, else ``"none"``. ``-static_pc_type`` on the
+      command line wins over the argument. The shell stays the operator in every case.
+
+    Every method solves the system divided by the force scale E·t·H (E·H² in 3D), so that the
     answer does not depend on the units (E from 1e-3 to 1e155 Pa give the same displacement);
-    ``-static_ksp_monitor`` prints its residual norms divided by it, while ``SolveResult``
-    reports them in newtons. ncg and newton are not scaled yet: they stay accurate to about
-    E = 1e100 and report non-convergence beyond.
+    ``-static_ksp_monitor`` prints residual norms divided by it, while ``SolveResult``
+    reports them in newtons.
     """
 
     def __init__(self, body, method: str = "newton", rtol: float = 1e-6, *, criterion: str = "6.9",
                  round_tolerance: float = 1e-12, max_iterations: int = 10000, line_search: str | None = None,
-                 ncg_type: str | None = None, options_prefix: str = "static_", petsc_options: dict | None = None):
+                 ncg_type: str | None = None, options_prefix: str = "static_", petsc_options: dict | None = None,
+                 preconditioner: str | None = None):
         if method not in METHODS:
             raise ValueError(f"method must be one of {METHODS}, got {method!r}")
         if not (rtol > 0):
@@ -58,13 +67,21 @@ class StaticSolver:
             if ncg_type not in ("prp", "fr", "hs", "dy", "cd"):
                 raise ValueError(f"ncg_type must be 'prp' or 'fr' (or hs, dy, cd), got {ncg_type!r}")
             options.setdefault("snes_ncg_type", ncg_type)
+        if preconditioner is not None and (not isinstance(preconditioner, str) or not preconditioner.strip()):
+            raise ValueError(f"preconditioner must be a PETSc PC type name such as 'none', 'jacobi' or 'gamg', "
+                             f"got {preconditioner!r}")
         self.body = body
         self.method = method
         self._impl = _snede.StaticSolver(body._model, method, float(rtol), criterion, float(round_tolerance),
-                                         max_iterations, options_prefix, option_list(options))
+                                         max_iterations, options_prefix, option_list(options), preconditioner or "")
 
     def solve(self) -> SolveResult:
         return SolveResult._from_engine(self._impl.solve())
+
+    @property
+    def preconditioner(self) -> str:
+        """The PETSc PC type the CG uses ("none" for ncg)."""
+        return self._impl.preconditioner
 
     @property
     def ksp(self):
