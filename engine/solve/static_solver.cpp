@@ -304,7 +304,10 @@ SolveResult StaticSolver::solve_nonlinear() {
   // residual is still far above it. Full Newton steps converge quadratically there: a few
   // are tried, and kept only if they meet the criterion — otherwise the state goes back to
   // where the line search stopped, so the attempt never makes a result worse.
-  if (options_.method == StaticMethod::newton && reason == SNES_DIVERGED_LINE_SEARCH) {
+  // (PETSc reports some of these failures as DIVERGED_LOCAL_MIN when ‖Jᵀ F‖ is small.)
+  const SNESConvergedReason stopped_by = reason;
+  if (options_.method == StaticMethod::newton &&
+      (reason == SNES_DIVERGED_LINE_SEARCH || reason == SNES_DIVERGED_LOCAL_MIN)) {
     VecHandle stopped;
     SNEDE_PETSC(VecDuplicate(u, stopped.out()));
     SNEDE_PETSC(VecCopy(u, stopped));
@@ -321,7 +324,7 @@ SolveResult StaticSolver::solve_nonlinear() {
     SNEDE_PETSC(SNESLineSearchSetType(line_search, previous.c_str()));
     if (left == 0 || reason <= 0) {
       SNEDE_PETSC(VecCopy(stopped, u));
-      reason = SNES_DIVERGED_LINE_SEARCH;
+      reason = stopped_by;
     }
   }
   result.iterations = static_cast<int>(iterations);
