@@ -47,9 +47,9 @@ py::object assembled_tangent_at(Model& model, const DoubleArray& u, const std::s
   VecHandle x;
   SNEDE_PETSC(VecDuplicate(model.displacement(), x.out()));
   set_vec_values(x, view(u));
-  MatHandle A = create_tangent_matrix(model, format == "baij" ? MatrixFormat::baij : MatrixFormat::aij);
-  assemble_tangent(model, x, A);
-  return to_petsc4py(A.get());  // petsc4py takes a reference; the handle drops ours
+  AssembledTangent tangent(model, format == "baij" ? MatrixFormat::baij : MatrixFormat::aij);
+  tangent.assemble(model, x);
+  return to_petsc4py(tangent.mat());  // petsc4py takes a reference; the handle drops ours
 }
 
 }  // namespace

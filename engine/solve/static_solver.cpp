@@ -159,13 +159,13 @@ void StaticSolver::create_objects() {
   option_database_.mark_read_options_used();
 }
 
-void StaticSolver::reissue_sizes_if_mesh_changed() {
-  if (generation_ == model_.generation()) return;
-  // The mesh changed size (a cut or a refinement): new vectors and a new shell, same
-  // solver objects (so a user's handle and options survive).
+void StaticSolver::follow_mesh_changes() {
+  const bool resized = generation_ != model_.generation();
+  const bool stale_matrix = needs_matrix_ && (!assembled_ || !assembled_->matches(model_));
+  if (!resized && !stale_matrix) return;
   generation_ = model_.generation();
-  SNEDE_PETSC(VecDuplicate(model_.displacement(), residual_.out()));
-  preconditioner_matrix_.reset();  // its sparsity was the old mesh's
+  if (resized) SNEDE_PETSC(VecDuplicate(model_.displacement(), residual_.out()));
+  assembled_.reset();  // its sparsity was the old mesh's (a flip or a cut changes it)
   if (ksp_) {
     SNEDE_PETSC(KSPReset(ksp_));
     SNEDE_PETSC(KSPSetOperators(ksp_, model_.tangent(), preconditioning_matrix()));
@@ -195,12 +195,12 @@ void StaticSolver::reissue_sizes_if_mesh_changed() {
 
 Mat StaticSolver::preconditioning_matrix() {
   if (!needs_matrix_) return model_.tangent();
-  if (!preconditioner_matrix_) {
-    preconditioner_matrix_ = create_tangent_matrix(model_, MatrixFormat::aij);  // GAMG works on AIJ
-    set_rigid_body_near_null_space(model_, preconditioner_matrix_);
+  if (!assembled_) {
+    assembled_ = std::make_unique<AssembledTangent>(model_, MatrixFormat::aij);  // GAMG works on AIJ
+    set_rigid_body_near_null_space(model_, assembled_->mat());
     preconditioner_filled_ = false;
   }
-  return preconditioner_matrix_;
+  return assembled_->mat();
 }
 
 void StaticSolver::refill_preconditioner(SNES snes, Vec x) {
@@ -210,7 +210,7 @@ void StaticSolver::refill_preconditioner(SNES snes, Vec x) {
   // As SNES decides whether to rebuild the PC: -1 never again, k > 1 every k-th iteration.
   const bool lagged = (lag == -1 || (lag > 1 && iteration % lag != 0)) && preconditioner_filled_;
   if (lagged) return;
-  assemble_tangent(model_, x, preconditioner_matrix_);
+  assembled_->assemble(model_, x);
   preconditioner_filled_ = true;
 }
 
@@ -219,7 +219,7 @@ double StaticSolver::current_tolerance() const {
 }
 
 SolveResult StaticSolver::solve() {
-  reissue_sizes_if_mesh_changed();
+  follow_mesh_changes();
   history_.clear();
   external_norm_ = euclidean_norm(model_.external_forces());
   // The force scale is a scan of the mesh: once per solve, not once per iteration.
@@ -263,7 +263,7 @@ SolveResult StaticSolver::solve_linear() {
   SNEDE_PETSC(VecScale(rhs, -1.0 / system_scale_));
   SNEDE_PETSC(VecSet(step, 0.0));
   const ScaledOperator scaled(model_, system_scale_);
-  if (needs_matrix_) assemble_tangent(model_, u, preconditioning_matrix());
+  if (needs_matrix_) assembled_->assemble(model_, u);
   SNEDE_PETSC(KSPSolve(ksp_, rhs, step));
   SNEDE_PETSC(VecAXPY(u, 1.0, step));
   KSPConvergedReason reason;

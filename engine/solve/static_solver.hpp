@@ -14,7 +14,10 @@
 #include <vector>
 
 #include "core/solver_options.hpp"
+#include <memory>
+
 #include "solve/model.hpp"
+#include "solve/tangent_assembly.hpp"
 #include "solve/solve_result.hpp"
 #include "solve/stopping.hpp"
 
@@ -49,12 +52,14 @@ class StaticSolver {
   const StaticOptions& options() const { return options_; }
   // The PC type in use, and the assembled matrix it is built from (null without one).
   const std::string& preconditioner() const { return pc_type_; }
-  Mat preconditioner_matrix() const { return preconditioner_matrix_; }
+  Mat preconditioner_matrix() const { return assembled_ ? assembled_->mat() : nullptr; }
   Model& model() { return model_; }
 
  private:
   void create_objects();
-  void reissue_sizes_if_mesh_changed();
+  // After a mesh change: new vectors if the size changed (same solver objects, so a user's
+  // handle and options survive), a new assembled tangent if its sparsity is out of date.
+  void follow_mesh_changes();
   // The matrix the PC is built from: the shell, or an assembled tangent for the current mesh.
   Mat preconditioning_matrix();
   // Newton's Jacobian callback: the assembled tangent is refilled unless the SNES lags the
@@ -81,7 +86,7 @@ class StaticSolver {
   VecHandle residual_;
   std::string pc_type_;
   bool needs_matrix_ = false;          // the PC needs entries: an assembled tangent
-  MatHandle preconditioner_matrix_;    // that tangent, for the current mesh
+  std::unique_ptr<AssembledTangent> assembled_;  // that tangent, for the current mesh
   bool preconditioner_filled_ = false;  // filled since it was made (for lagging)
   std::uint64_t generation_ = 0;
   StoppingRule rule_;  // the stopping rule of the current solve, scaled to the model

@@ -29,95 +29,158 @@ void for_each_projected_element_matrix(const Model& model, std::span<const doubl
   const Connectivity& c = body.mesh().connectivity();
   const int d = model.dim(), n = (d + 1) * d;
   const std::vector<double> P = projection_blocks(model);
+  std::vector<bool> free(model.body().mesh().n_points());
+  for (VertexId v = 0; v < static_cast<VertexId>(free.size()); ++v)
+    free[v] = model.constraints()[v].kind == ConstraintKind::free;
   std::vector<double> left(static_cast<std::size_t>(n) * n);
   std::vector<bool> skipped(c.element_capacity(), false);
   if (forbids_inversion(body.material()))
     for (ElementId e : body.inverted_elements(u)) skipped[e] = true;
+  std::size_t k = 0;
   for (ElementId e : body.mesh().cell_ids()) {
+    const std::size_t index = k++;
     if (skipped[e]) continue;
     const auto vertices = c.element(e).simplex.oriented_vertices();
     std::vector<double> K = body.element_stiffness(e, u);
-    // left = diag(P_a) K, then K = left diag(P_b): block by block, dim × dim each.
-    for (int a = 0; a <= d; ++a)
-      for (int col = 0; col < n; ++col)
-        for (int i = 0; i < d; ++i) {
-          double sum = 0;
-          for (int k = 0; k < d; ++k)
-            sum += P[(static_cast<std::size_t>(vertices[a]) * d + i) * d + k] * K[static_cast<std::size_t>(a * d + k) * n + col];
-          left[static_cast<std::size_t>(a * d + i) * n + col] = sum;
-        }
-    for (int row = 0; row < n; ++row)
-      for (int b = 0; b <= d; ++b)
-        for (int j = 0; j < d; ++j) {
-          double sum = 0;
-          for (int k = 0; k < d; ++k)
-            sum += left[static_cast<std::size_t>(row) * n + b * d + k] * P[(static_cast<std::size_t>(vertices[b]) * d + k) * d + j];
-          K[static_cast<std::size_t>(row) * n + b * d + j] = sum;
-        }
-    visit(std::span<const VertexId>(vertices.data(), d + 1), std::span<const double>(K));
+    const bool all_free = std::all_of(vertices.begin(), vertices.begin() + d + 1, [&](VertexId v) { return free[v]; });
+    if (!all_free) {
+      // left = diag(P_a) K, then K = left diag(P_b): block by block, dim × dim each.
+      for (int a = 0; a <= d; ++a)
+        for (int col = 0; col < n; ++col)
+          for (int i = 0; i < d; ++i) {
+            double sum = 0;
+            for (int m = 0; m < d; ++m)
+              sum += P[(static_cast<std::size_t>(vertices[a]) * d + i) * d + m] * K[static_cast<std::size_t>(a * d + m) * n + col];
+            left[static_cast<std::size_t>(a * d + i) * n + col] = sum;
+          }
+      for (int row = 0; row < n; ++row)
+        for (int b = 0; b <= d; ++b)
+          for (int j = 0; j < d; ++j) {
+            double sum = 0;
+            for (int m = 0; m < d; ++m)
+              sum += left[static_cast<std::size_t>(row) * n + b * d + m] * P[(static_cast<std::size_t>(vertices[b]) * d + m) * d + j];
+            K[static_cast<std::size_t>(row) * n + b * d + j] = sum;
+          }
+    }
+    visit(index, std::span<const VertexId>(vertices.data(), d + 1), std::span<const double>(K));
   }
+}
+
+// The (I − P) block of every vertex, one after another (dim × dim, row-major).
+std::vector<double> complement_blocks(const Model& model) {
+  const int d = model.dim();
+  std::vector<double> blocks = projection_blocks(model);
+  for (std::size_t i = 0; i < blocks.size(); ++i) blocks[i] = ((i % (d * d)) % (d + 1) == 0 ? 1.0 : 0.0) - blocks[i];
+  return blocks;
 }
 
 }  // namespace
 
-MatHandle create_tangent_matrix(const Model& model, MatrixFormat format) {
+AssembledTangent::AssembledTangent(const Model& model, MatrixFormat format)
+    : format_(format), revision_(model.body().mesh().connectivity().revision()) {
   const Mesh& mesh = model.body().mesh();
   const Connectivity& c = mesh.connectivity();
   const int d = model.dim();
   const VertexId n = mesh.n_points();
   std::vector<std::vector<VertexId>> neighbours(n);
   for (VertexId v = 0; v < n; ++v) neighbours[v].push_back(v);
-  for (ElementId e : mesh.cell_ids()) {
+  const std::vector<ElementId> elements = mesh.cell_ids();
+  for (ElementId e : elements) {
     const auto vertices = c.element(e).simplex.oriented_vertices();
     for (int a = 0; a <= d; ++a)
       for (int b = 0; b <= d; ++b)
         if (a != b) neighbours[vertices[a]].push_back(vertices[b]);
   }
-  std::vector<PetscInt> blocks_per_row(n);
-  for (VertexId v = 0; v < n; ++v) {
-    auto& list = neighbours[v];
+  for (auto& list : neighbours) {
     std::sort(list.begin(), list.end());
-    blocks_per_row[v] = static_cast<PetscInt>(std::unique(list.begin(), list.end()) - list.begin());
+    list.erase(std::unique(list.begin(), list.end()), list.end());
   }
-  MatHandle A;
+  auto rank = [&](VertexId a, VertexId b) {
+    const auto& list = neighbours[a];
+    return static_cast<std::int32_t>(std::lower_bound(list.begin(), list.end(), b) - list.begin());
+  };
+  block_rank_.reserve(elements.size() * (d + 1) * (d + 1));
+  for (ElementId e : elements) {
+    const auto vertices = c.element(e).simplex.oriented_vertices();
+    for (int a = 0; a <= d; ++a)
+      for (int b = 0; b <= d; ++b) block_rank_.push_back(rank(vertices[a], vertices[b]));
+  }
+  self_rank_.resize(n);
+  for (VertexId v = 0; v < n; ++v) self_rank_[v] = rank(v, v);
+
   const PetscInt rows = static_cast<PetscInt>(n) * d;
-  SNEDE_PETSC(MatCreate(PETSC_COMM_SELF, A.out()));
-  SNEDE_PETSC(MatSetSizes(A, rows, rows, rows, rows));
-  SNEDE_PETSC(MatSetType(A, format == MatrixFormat::baij ? MATSEQBAIJ : MATSEQAIJ));
-  SNEDE_PETSC(MatSetBlockSize(A, d));
-  SNEDE_PETSC(MatXAIJSetPreallocation(A, d, blocks_per_row.data(), nullptr, nullptr, nullptr));
-  SNEDE_PETSC(MatSetOption(A, MAT_SYMMETRIC, PETSC_TRUE));
-  return A;
+  SNEDE_PETSC(MatCreate(PETSC_COMM_SELF, A_.out()));
+  SNEDE_PETSC(MatSetSizes(A_, rows, rows, rows, rows));
+  SNEDE_PETSC(MatSetType(A_, format == MatrixFormat::baij ? MATSEQBAIJ : MATSEQAIJ));
+  SNEDE_PETSC(MatSetBlockSize(A_, d));
+  if (format == MatrixFormat::baij) {
+    std::vector<PetscInt> blocks_per_row(n);
+    for (VertexId v = 0; v < n; ++v) blocks_per_row[v] = static_cast<PetscInt>(neighbours[v].size());
+    SNEDE_PETSC(MatXAIJSetPreallocation(A_, d, blocks_per_row.data(), nullptr, nullptr, nullptr));
+  } else {
+    // Scalar CSR with each row's columns sorted: PETSc keeps them in this order, so the value
+    // of (row 3a + i, column 3b + j) lies at row_start[3a + i] + 3·rank(a, b) + j.
+    row_start_.resize(static_cast<std::size_t>(rows) + 1);
+    std::vector<PetscInt> columns;
+    for (VertexId v = 0; v < n; ++v)
+      for (int i = 0; i < d; ++i) {
+        row_start_[static_cast<std::size_t>(v) * d + i] = static_cast<PetscInt>(columns.size());
+        for (VertexId w : neighbours[v])
+          for (int j = 0; j < d; ++j) columns.push_back(static_cast<PetscInt>(w) * d + j);
+      }
+    row_start_.back() = static_cast<PetscInt>(columns.size());
+    SNEDE_PETSC(MatSeqAIJSetPreallocationCSR(A_, row_start_.data(), columns.data(), nullptr));
+  }
+  SNEDE_PETSC(MatSetOption(A_, MAT_SYMMETRIC, PETSC_TRUE));
+  SNEDE_PETSC(MatSetOption(A_, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_TRUE));
 }
 
-void assemble_tangent(const Model& model, Vec u, Mat A) {
-  const int d = model.dim();
-  const VertexId n = model.body().mesh().n_points();
-  PetscInt rows = 0;
-  SNEDE_PETSC(MatGetSize(A, &rows, nullptr));
-  if (rows != static_cast<PetscInt>(n) * d)
-    throw std::invalid_argument("the tangent matrix has " + std::to_string(rows) + " rows, the body " +
-                                std::to_string(static_cast<PetscInt>(n) * d) + " dofs: make it for the current mesh");
-  SNEDE_PETSC(MatZeroEntries(A));
+bool AssembledTangent::matches(const Model& model) const {
+  return model.body().mesh().connectivity().revision() == revision_;
+}
+
+void AssembledTangent::assemble(const Model& model, Vec u) {
+  if (!matches(model))
+    throw std::logic_error("the assembled tangent was made for another mesh: the mesh changed since");
+  const int d = model.dim(), n = (d + 1) * d;
+  const std::vector<double> complement = complement_blocks(model);
   ReadView x(u);
-  std::vector<PetscInt> block_rows;
-  for_each_projected_element_matrix(model, x.span(), [&](std::span<const VertexId> vertices, std::span<const double> K) {
-    block_rows.assign(vertices.begin(), vertices.end());
-    const auto count = static_cast<PetscInt>(block_rows.size());
-    SNEDE_PETSC(MatSetValuesBlocked(A, count, block_rows.data(), count, block_rows.data(), K.data(), ADD_VALUES));
-  });
-  // + (I − P): the constrained directions keep a unit diagonal, as in the shell.
-  const std::vector<double> P = projection_blocks(model);
-  std::vector<double> complement(static_cast<std::size_t>(d) * d);
-  for (VertexId v = 0; v < n; ++v) {
-    for (int i = 0; i < d * d; ++i)
-      complement[i] = (i % (d + 1) == 0 ? 1.0 : 0.0) - P[static_cast<std::size_t>(v) * d * d + i];
-    const PetscInt row = v;
-    SNEDE_PETSC(MatSetValuesBlocked(A, 1, &row, 1, &row, complement.data(), ADD_VALUES));
+  if (format_ == MatrixFormat::aij) {
+    PetscScalar* values = nullptr;
+    SNEDE_PETSC(MatSeqAIJGetArray(A_, &values));
+    std::fill(values, values + row_start_.back(), 0.0);
+    for_each_projected_element_matrix(model, x.span(), [&](std::size_t k, std::span<const VertexId> vertices,
+                                                           std::span<const double> K) {
+      const std::int32_t* ranks = block_rank_.data() + k * (d + 1) * (d + 1);
+      for (int a = 0; a <= d; ++a)
+        for (int i = 0; i < d; ++i) {
+          PetscScalar* row = values + row_start_[static_cast<std::size_t>(vertices[a]) * d + i];
+          const double* K_row = K.data() + static_cast<std::size_t>(a * d + i) * n;
+          for (int b = 0; b <= d; ++b)
+            for (int j = 0; j < d; ++j) row[d * ranks[a * (d + 1) + b] + j] += K_row[b * d + j];
+        }
+    });
+    // + (I − P): the constrained directions keep a unit diagonal, as in the shell.
+    for (std::size_t v = 0; v < self_rank_.size(); ++v)
+      for (int i = 0; i < d; ++i)
+        for (int j = 0; j < d; ++j)
+          values[row_start_[v * d + i] + d * self_rank_[v] + j] += complement[(v * d + i) * d + j];
+    SNEDE_PETSC(MatSeqAIJRestoreArray(A_, &values));
+  } else {
+    SNEDE_PETSC(MatZeroEntries(A_));
+    std::vector<PetscInt> block_rows;
+    for_each_projected_element_matrix(model, x.span(), [&](std::size_t, std::span<const VertexId> vertices,
+                                                           std::span<const double> K) {
+      block_rows.assign(vertices.begin(), vertices.end());
+      const auto count = static_cast<PetscInt>(block_rows.size());
+      SNEDE_PETSC(MatSetValuesBlocked(A_, count, block_rows.data(), count, block_rows.data(), K.data(), ADD_VALUES));
+    });
+    for (PetscInt v = 0; v < static_cast<PetscInt>(self_rank_.size()); ++v)
+      SNEDE_PETSC(MatSetValuesBlocked(A_, 1, &v, 1, &v, complement.data() + v * d * d, ADD_VALUES));
   }
-  SNEDE_PETSC(MatAssemblyBegin(A, MAT_FINAL_ASSEMBLY));
-  SNEDE_PETSC(MatAssemblyEnd(A, MAT_FINAL_ASSEMBLY));
-  if (model.operator_scale() != 1) SNEDE_PETSC(MatScale(A, model.operator_scale()));
+  SNEDE_PETSC(MatAssemblyBegin(A_, MAT_FINAL_ASSEMBLY));
+  SNEDE_PETSC(MatAssemblyEnd(A_, MAT_FINAL_ASSEMBLY));
+  if (model.operator_scale() != 1) SNEDE_PETSC(MatScale(A_, model.operator_scale()));
 }
 
 void set_rigid_body_near_null_space(const Model& model, Mat A) {
@@ -138,15 +201,16 @@ void tangent_diagonal(const Model& model, Vec u, Vec diagonal) {
   std::vector<double> values(model.body().n_dofs(), 0.0);
   {
     ReadView x(u);
-    for_each_projected_element_matrix(model, x.span(), [&](std::span<const VertexId> vertices, std::span<const double> K) {
+    for_each_projected_element_matrix(model, x.span(), [&](std::size_t, std::span<const VertexId> vertices,
+                                                           std::span<const double> K) {
       for (int row = 0; row < n; ++row)
         values[static_cast<std::size_t>(vertices[row / d]) * d + row % d] += K[static_cast<std::size_t>(row) * n + row];
     });
   }
-  const std::vector<double> P = projection_blocks(model);
+  const std::vector<double> complement = complement_blocks(model);
   for (std::size_t dof = 0; dof < values.size(); ++dof) {
     const std::size_t v = dof / d, k = dof % d;
-    values[dof] = model.operator_scale() * (values[dof] + 1.0 - P[(v * d + k) * d + k]);
+    values[dof] = model.operator_scale() * (values[dof] + complement[(v * d + k) * d + k]);
   }
   set_vec_values(diagonal, values);
 }

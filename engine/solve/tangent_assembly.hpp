@@ -7,6 +7,9 @@
 
 #include <petscmat.h>
 
+#include <cstdint>
+#include <vector>
+
 #include "core/petsc_handle.hpp"
 #include "solve/model.hpp"
 
@@ -14,13 +17,27 @@ namespace snede {
 
 enum class MatrixFormat { aij, baij };
 
-// A matrix with the block sparsity of the current mesh: a dim × dim block for every pair of
+// J with the block sparsity of the mesh it was made for: a dim × dim block for every pair of
 // vertices that share an element, and a diagonal block for every vertex (removed ones too).
-MatHandle create_tangent_matrix(const Model& model, MatrixFormat format);
+class AssembledTangent {
+ public:
+  AssembledTangent(const Model& model, MatrixFormat format);
+  // Whether the mesh is still the one this matrix was made for (no edit since).
+  bool matches(const Model& model) const;
+  // Fills the matrix with J at u, scaled by the model's operator scale s as the shell is.
+  // AIJ values are added straight into PETSc's value array at offsets found once per mesh.
+  void assemble(const Model& model, Vec u);
+  Mat mat() const { return A_; }
 
-// Fills A (from create_tangent_matrix, for the current mesh) with J at u, scaled by the
-// model's operator scale s as the shell is.
-void assemble_tangent(const Model& model, Vec u, Mat A);
+ private:
+  MatrixFormat format_;
+  std::uint64_t revision_;
+  MatHandle A_;
+  std::vector<PetscInt> row_start_;       // AIJ: offset of each scalar row's first value
+  std::vector<std::int32_t> block_rank_;  // per element (in cell_ids order) and block (a, b):
+                                          // b's place among a's sorted neighbours
+  std::vector<std::int32_t> self_rank_;   // per vertex: its own place among its neighbours
+};
 
 // The rigid-body motions of the reference configuration as A's near null space (what GAMG
 // needs to coarsen elasticity well).

@@ -147,3 +147,36 @@ def test_bad_preconditioners_are_refused():
         snede.StaticSolver(body, "cg", preconditioner="nosuchpc")
     with pytest.raises(ValueError, match="format must be"):
         body.assemble_tangent(format="dense")
+
+
+def test_an_edit_that_keeps_the_vertex_count_still_rebuilds_the_assembled_tangent():
+    # A flip changes the sparsity without changing the sizes: the solver must notice it.
+    mesh = snede.meshing.rectangle((1.0, 0.2), (10, 2))
+    body = snede.Body(mesh, snede.LinearElastic(1e5, 0.3), thickness=0.01)
+    body.fix(np.isclose(mesh.points[:, 0], 0.0))
+    body.add_gravity((0.0, -9.81))
+    solver = snede.StaticSolver(body, "cg", rtol=1e-10, preconditioner="gamg")
+    assert solver.solve().converged
+    cells = mesh.cells.copy()
+    assert mesh.flip_edge(*interior_edge(mesh))
+    assert not np.array_equal(np.sort(mesh.cells, axis=1), np.sort(cells, axis=1))
+    after = solver.solve()
+    assert after.converged, after
+    carried = body.displacement.copy()
+    body.displacement = np.zeros_like(carried)
+    assert snede.StaticSolver(body, "cg", rtol=1e-10, options_prefix="plain_").solve().converged
+    np.testing.assert_allclose(carried, body.displacement, atol=1e-7 * np.abs(carried).max())
+
+
+def interior_edge(mesh):
+    """An edge shared by two triangles whose flip is allowed (a convex quadrilateral)."""
+    count = {}
+    for t in mesh.cells:
+        for k in range(3):
+            edge = tuple(sorted((int(t[k]), int(t[(k + 1) % 3]))))
+            count[edge] = count.get(edge, 0) + 1
+    x = mesh.points
+    for (a, b), n in count.items():
+        if n == 2 and 0.3 < x[a, 0] < 0.7 and x[a, 0] != x[b, 0] and x[a, 1] != x[b, 1]:
+            return a, b  # a diagonal of a grid square
+    raise AssertionError("no interior diagonal")
