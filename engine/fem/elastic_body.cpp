@@ -116,15 +116,19 @@ LaneMask inverted_lanes(const ElementBlock<D>& block, const Tensor<Batch, D>& U)
 //
 // Adds every block's columns into `out` (zeroed first). kernel(block, U) gives the columns;
 // U is gathered from u, and inversion checked, only if reads_state; each block's results are
-// checked for non-finite values only if checks_results.
+// checked for non-finite values only if checks_results. The kernel (with the material it
+// holds) and the block range are local copies: stores into `out` cannot change them, so they
+// stay in registers.
 template <bool reads_state, bool checks_results, int D, class Kernel>
 [[gnu::flatten]] std::size_t accumulate_blocks(const ElementStream<D>& stream, bool forbids_inversion,
                                                std::span<const double> u, std::span<double> out,
-                                               EvaluationReport& report, Kernel&& kernel) {
+                                               EvaluationReport& report, const Kernel& kernel) {
   std::fill(out.begin(), out.end(), 0.0);
   std::size_t n_evaluated = 0;
-  const std::vector<ElementBlock<D>>& blocks = stream.blocks();
+  const Kernel evaluate = kernel;
+  const std::span<const ElementBlock<D>> blocks = stream.blocks();
   for (std::size_t b = 0; b < blocks.size(); ++b) {
+    prefetch_ahead<D>(blocks, b);
     const ElementBlock<D>& block = blocks[b];
     Tensor<Batch, D> U;
     LaneMask inverted = 0;
@@ -132,7 +136,7 @@ template <bool reads_state, bool checks_results, int D, class Kernel>
       U = gather_differences<D>(u, block);
       inverted = inverted_lanes<D>(block, U);
     }
-    const Tensor<Batch, D> G = kernel(block, U);
+    const Tensor<Batch, D> G = evaluate(block, U);
     const LaneMask finite = checks_results ? finite_lanes(G) : all_lanes;
     const CountedLanes lanes = count_lanes(ElementStream<D>::live_lanes(block), inverted, finite, forbids_inversion,
                                            static_cast<ElementId>(b * batch_width), report);
@@ -148,7 +152,7 @@ template <bool reads_state, bool checks_results, int D, class Kernel>
 // out the non-finite elements as an element-by-element loop does.
 template <bool reads_state, int D, class Kernel>
 std::size_t accumulate(const ElementStream<D>& stream, bool forbids_inversion, std::span<const double> u,
-                       std::span<double> out, EvaluationReport& report, Kernel&& kernel) {
+                       std::span<double> out, EvaluationReport& report, const Kernel& kernel) {
   EvaluationReport first_pass;
   const std::size_t n = accumulate_blocks<reads_state, false, D>(stream, forbids_inversion, u, out, first_pass, kernel);
   if (!all_finite(out)) return accumulate_blocks<reads_state, true, D>(stream, forbids_inversion, u, out, report, kernel);
@@ -158,12 +162,14 @@ std::size_t accumulate(const ElementStream<D>& stream, bool forbids_inversion, s
 
 // Π_int: the energies of the blocks' lanes that count, summed lane by lane and then across.
 template <int D, class M>
-[[gnu::flatten]] double sum_energy(const ElementStream<D>& stream, const M& m, std::span<const double> u,
+[[gnu::flatten]] double sum_energy(const ElementStream<D>& stream, const M& material, std::span<const double> u,
                                    EvaluationReport& report, std::size_t& n_evaluated) {
-  const std::vector<ElementBlock<D>>& blocks = stream.blocks();
+  const M m = material;  // a local copy, as in accumulate_blocks
+  const std::span<const ElementBlock<D>> blocks = stream.blocks();
   Batch sums = 0.0;
   bool infinite = false;
   for (std::size_t b = 0; b < blocks.size(); ++b) {
+    prefetch_ahead<D>(blocks, b);
     const ElementBlock<D>& block = blocks[b];
     const Tensor<Batch, D> U = gather_differences<D>(u, block);
     const LaneMask live = ElementStream<D>::live_lanes(block), inverted = inverted_lanes<D>(block, U);
@@ -183,8 +189,9 @@ template <int D, class M>
 template <int D>
 [[gnu::flatten]] std::vector<ElementId> find_inverted(const ElementStream<D>& stream, std::span<const double> u) {
   std::vector<ElementId> inverted;
-  const std::vector<ElementBlock<D>>& blocks = stream.blocks();
+  const std::span<const ElementBlock<D>> blocks = stream.blocks();
   for (std::size_t b = 0; b < blocks.size(); ++b) {
+    prefetch_ahead<D>(blocks, b);
     const ElementBlock<D>& block = blocks[b];
     const LaneMask lanes = ElementStream<D>::live_lanes(block) & inverted_lanes<D>(block, gather_differences<D>(u, block));
     for (int lane = 0; lane < batch_width; ++lane)
@@ -328,7 +335,7 @@ void ElasticBody::internal_forces(std::span<const double> u, std::span<double> f
   check_size("force", f);
   with_material_and_dimension(material_, dim(), [&](const auto& m, auto dimension) {
     constexpr int D = decltype(dimension)::value;
-    const std::size_t n = accumulate<true, D>(stream<D>(), forbids_inversion(material_), u, f, report, [&](const ElementBlock<D>& block, const Tensor<Batch, D>& U) {
+    const std::size_t n = accumulate<true, D>(stream<D>(), forbids_inversion(material_), u, f, report, [m](const ElementBlock<D>& block, const Tensor<Batch, D>& U) {
       return force_kernel<Batch, D>(m, block.reference, U);
     });
     log_flops(flops_.force, n);
@@ -345,7 +352,7 @@ void ElasticBody::tangent_apply(std::span<const double> u, std::span<const doubl
   with_material_and_dimension(material_, dim(), [&](const auto& m, auto dimension) {
     constexpr int D = decltype(dimension)::value;
     constexpr bool reads_state = !is_linear<std::decay_t<decltype(m)>>;
-    const std::size_t n = accumulate<reads_state, D>(stream<D>(), forbids_inversion(material_), u, out, report, [&](const ElementBlock<D>& block, const Tensor<Batch, D>& U) {
+    const std::size_t n = accumulate<reads_state, D>(stream<D>(), forbids_inversion(material_), u, out, report, [m, d](const ElementBlock<D>& block, const Tensor<Batch, D>& U) {
       return tangent_kernel<Batch, D>(m, block.reference, U, gather_differences<D>(d, block));
     });
     log_flops(flops_.tangent, n);

@@ -6,6 +6,8 @@
 // scalar S is double for one element, or Batch for batch_width elements side by side.
 #pragma once
 
+#include <type_traits>
+
 #include "fem/constitutive.hpp"
 #include "fem/tensor.hpp"
 
@@ -16,6 +18,15 @@ struct ElementReference {
   Tensor<S, D> Z_inv;
   S measure = 0;  // volume (3D) or area × thickness (2D)
 };
+
+// ref's Z⁻¹ as a tensor of T: the stored one itself when S is T (no copy), else cast.
+template <class T, int D, class S>
+decltype(auto) inverse_shape(const ElementReference<D, S>& ref) {
+  if constexpr (std::is_same_v<T, S>)
+    return (ref.Z_inv);
+  else
+    return Tensor<T, D>(ref.Z_inv.template cast<T>());
+}
 
 template <class T, int D, class S>
 Tensor<T, D> deformation_gradient(const ElementReference<D, S>& ref, const Tensor<T, D>& U) {
@@ -38,7 +49,7 @@ Tensor<T, D> element_force_columns(const M& m, const ElementReference<D, S>& ref
 template <class T, int D, class M, class S>
 Tensor<T, D> element_tangent_columns(const M& m, const ElementReference<D, S>& ref, const Tensor<T, D>& U,
                                      const Tensor<T, D>& dU) {
-  const Tensor<T, D> Z_inv = ref.Z_inv.template cast<T>();
+  const auto& Z_inv = inverse_shape<T>(ref);
   const Tensor<T, D> dP = first_piola_derivative<T, D>(m, deformation_gradient<T, D>(ref, U), Tensor<T, D>(dU * Z_inv));
   return T(ref.measure) * dP * Z_inv.transpose();
 }

@@ -68,6 +68,20 @@ class ElementStream {
   std::vector<ElementBlock<D>> blocks_;
 };
 
+// How many blocks ahead the loops ask for the next blocks' data. The hardware prefetcher
+// alone keeps too few of these sequential misses in flight once a block's gathers fill the
+// reorder window: at 10⁶ tetrahedra a block loop ran 3× slower than its data's bandwidth
+// allows; 8 blocks (32 elements, ~3 KB) ahead brings it back (measured 4–32: all alike).
+inline constexpr std::size_t prefetch_distance = 8;
+
+// Asks for block b + prefetch_distance of `blocks` (if there is one), every cache line of it.
+template <int D>
+void prefetch_ahead(std::span<const ElementBlock<D>> blocks, std::size_t b) {
+  if (b + prefetch_distance >= blocks.size()) return;
+  const char* start = reinterpret_cast<const char*>(&blocks[b + prefetch_distance]);
+  for (std::size_t offset = 0; offset < sizeof(ElementBlock<D>); offset += 64) __builtin_prefetch(start + offset);
+}
+
 // D·vertex for corner j of every lane: where the corner's row starts in a nodal array.
 template <int D>
 LaneIndices corner_rows(const ElementBlock<D>& block, int j) {

@@ -15,7 +15,7 @@ namespace snede {
 template <class T, int D, class S>
 Tensor<T, D> linear_stiffness_columns(const LinearElastic& m, const ElementReference<D, S>& ref,
                                       const Tensor<T, D>& dU) {
-  const Tensor<T, D> Z_inv = ref.Z_inv.template cast<T>();
+  const auto& Z_inv = inverse_shape<T>(ref);
   return T(ref.measure) * m.stress_of_gradient<T, D>(dU * Z_inv) * Z_inv.transpose();
 }
 
