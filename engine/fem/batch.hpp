@@ -65,8 +65,8 @@ class Batch {
     return Batch(v);
   }
 
-  // Lane l is values[indices[l]].
-  static Batch gather(const double* values, LaneIndices indices) {
+  // Lane l is values[indices[l]] (batch_width indices).
+  static Batch gather(const double* values, const std::int32_t* indices) {
     return from_lanes([&](int lane) { return values[indices[lane]]; });
   }
 

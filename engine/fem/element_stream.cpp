@@ -8,7 +8,7 @@ ElementBlock<D> free_block() {
   ElementBlock<D> block;
   block.reference.Z_inv = Tensor<Batch, D>::Identity();
   block.reference.measure = 0.0;
-  for (auto& corner : block.vertices) corner.fill(0);
+  for (auto& corner : block.rows) corner.fill(0);
   return block;
 }
 
@@ -30,7 +30,7 @@ void ElementStream<D>::store(ElementId e, const Vertices& vertices, const Elemen
   for (int i = 0; i < D; ++i)
     for (int j = 0; j < D; ++j) set_lane(block.reference.Z_inv(i, j), reference.Z_inv(i, j));
   set_lane(block.reference.measure, reference.measure);
-  for (int j = 0; j <= D; ++j) block.vertices[j][lane] = vertices[j];
+  for (int j = 0; j <= D; ++j) block.rows[j][lane] = D * vertices[j];
 }
 
 template <int D>
@@ -42,7 +42,7 @@ void ElementStream<D>::release(ElementId e) {
 template <int D>
 typename ElementStream<D>::Vertices ElementStream<D>::vertices(ElementId e) const {
   Vertices v;
-  for (int j = 0; j <= D; ++j) v[j] = block_of(e).vertices[j][e % batch_width];
+  for (int j = 0; j <= D; ++j) v[j] = block_of(e).rows[j][e % batch_width] / D;
   return v;
 }
 

@@ -1,6 +1,9 @@
 // The per-element data the element loops stream through (§2.3; §7.4 for how it follows the
-// mesh): each element's oriented vertex ids (int32) and reference data Z⁻¹, |τ|, in element-id
-// order, in blocks of batch_width elements. Inside a block each quantity is stored entry by
+// mesh): each element's oriented vertices (int32) and reference data Z⁻¹, |τ|, in element-id
+// order, in blocks of batch_width elements. A vertex v is stored as D·v, where its row starts
+// in a (n_points, D) nodal array: a gather or scatter is then one load of the index and one
+// of the values (storing v cost two more instructions per node and lane, ~20% of the linear
+// tangent's). Inside a block each quantity is stored entry by
 // entry with the block's elements side by side, so one entry of batch_width elements is one
 // Batch: a loop reads memory once, front to back, and loads Z⁻¹ and |τ| with aligned vector
 // loads (96 bytes per tetrahedron, no pointer chasing through Element records).
@@ -11,7 +14,7 @@
 // hands its id to the next element added, so slots refill, the capacity never exceeds the
 // largest element count the mesh had, and the id order (the mesh's locality) is kept, where
 // compaction would need a map on every access and would scatter the order. A free slot has
-// vertices all 0 (a live element's are distinct), Z⁻¹ = I and |τ| = 0: evaluating it is
+// rows all 0 (a live element's vertices are distinct), Z⁻¹ = I and |τ| = 0: evaluating it is
 // harmless (F = I), and the loops leave it out of sums and reports.
 #pragma once
 
@@ -32,7 +35,7 @@ namespace snede {
 template <int D>
 struct ElementBlock {
   ElementReference<D, Batch> reference;
-  std::array<std::array<VertexId, batch_width>, D + 1> vertices;  // [corner][lane], positively oriented
+  std::array<std::array<std::int32_t, batch_width>, D + 1> rows;  // D·vertex, [corner][lane], positively oriented
 };
 
 template <int D>
@@ -52,12 +55,11 @@ class ElementStream {
   ElementReference<D> reference(ElementId e) const;
   std::size_t memory_bytes() const { return blocks_.capacity() * sizeof(ElementBlock<D>); }
 
-  // The lanes of `block` that hold live elements (those whose first two vertices differ).
+  // The lanes of `block` that hold live elements (those whose first two rows differ).
   static LaneMask live_lanes(const ElementBlock<D>& block) {
-    using Ids = VertexId __attribute__((vector_size(batch_width * sizeof(VertexId))));
-    Ids first, second;
-    std::memcpy(&first, block.vertices[0].data(), sizeof first);
-    std::memcpy(&second, block.vertices[1].data(), sizeof second);
+    LaneIndices first, second;
+    std::memcpy(&first, block.rows[0].data(), sizeof first);
+    std::memcpy(&second, block.rows[1].data(), sizeof second);
     return true_lanes(first != second);
   }
 
@@ -82,22 +84,14 @@ void prefetch_ahead(std::span<const ElementBlock<D>> blocks, std::size_t b) {
   for (std::size_t offset = 0; offset < sizeof(ElementBlock<D>); offset += 64) __builtin_prefetch(start + offset);
 }
 
-// D·vertex for corner j of every lane: where the corner's row starts in a nodal array.
-template <int D>
-LaneIndices corner_rows(const ElementBlock<D>& block, int j) {
-  LaneIndices rows;
-  std::memcpy(&rows, block.vertices[j].data(), sizeof rows);
-  return rows * D;
-}
-
 // U (D×D) of every lane: column j − 1 holds x_j − x_0 of the element's nodes' values in
 // `nodal` ((n_points, D) row-major).
 template <int D>
 Tensor<Batch, D> gather_differences(std::span<const double> nodal, const ElementBlock<D>& block) {
-  const std::array<Batch, D> x0 = load_nodes<D>(nodal.data(), corner_rows<D>(block, 0));
+  const std::array<Batch, D> x0 = load_nodes<D>(nodal.data(), block.rows[0].data());
   Tensor<Batch, D> U;
   for (int j = 1; j <= D; ++j) {
-    const std::array<Batch, D> xj = load_nodes<D>(nodal.data(), corner_rows<D>(block, j));
+    const std::array<Batch, D> xj = load_nodes<D>(nodal.data(), block.rows[j].data());
     for (int k = 0; k < D; ++k) U(k, j - 1) = xj[k] - x0[k];
   }
   return U;
@@ -113,11 +107,11 @@ void scatter_columns(std::span<double> out, const ElementBlock<D>& block, const 
     for (int j = 2; j <= D; ++j) sum += G(k, j - 1);
     node0[k] = -sum;
   }
-  add_to_nodes<D>(out.data(), corner_rows<D>(block, 0), node0, lanes);
+  add_to_nodes<D>(out.data(), block.rows[0].data(), node0, lanes);
   for (int j = 1; j <= D; ++j) {
     std::array<Batch, D> column;
     for (int k = 0; k < D; ++k) column[k] = G(k, j - 1);
-    add_to_nodes<D>(out.data(), corner_rows<D>(block, j), column, lanes);
+    add_to_nodes<D>(out.data(), block.rows[j].data(), column, lanes);
   }
 }
 

@@ -37,11 +37,19 @@ struct LinearElastic {
   Tensor<T, D> second_piola(const Tensor<T, D>& F) const {
     return first_piola<T, D>(F);
   }
-  // σ and W of a displacement gradient H = F − I given as such: small strains lose no digits
-  // to the identity (the specialised kernels, fem/linear_elastic_kernel.hpp).
+  // s·σ(sym H) and W(sym H) of a displacement gradient H = F − I given as such: small
+  // strains lose no digits to the identity (the specialised kernels,
+  // fem/linear_elastic_kernel.hpp). The factor s (an element's measure) scales the two Lamé
+  // coefficients rather than the D² entries; σ's symmetry is written out.
   template <class T, int D>
-  Tensor<T, D> stress_of_gradient(const Tensor<T, D>& H) const {
-    return stress_of<T, D>(symmetric_part<T, D>(H));
+  Tensor<T, D> stress_of_gradient(const Tensor<T, D>& H, const T& s = T(1)) const {
+    const T mu = T(lame.mu) * s, lambda_trace = T(effective_lambda<D>()) * s * H.trace();
+    Tensor<T, D> sigma;
+    for (int i = 0; i < D; ++i) {
+      sigma(i, i) = T(2) * mu * H(i, i) + lambda_trace;
+      for (int j = i + 1; j < D; ++j) sigma(i, j) = sigma(j, i) = mu * (H(i, j) + H(j, i));
+    }
+    return sigma;
   }
   template <class T, int D>
   T energy_of_gradient(const Tensor<T, D>& H) const {

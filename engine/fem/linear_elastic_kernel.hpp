@@ -16,7 +16,7 @@ template <class T, int D, class S>
 Tensor<T, D> linear_stiffness_columns(const LinearElastic& m, const ElementReference<D, S>& ref,
                                       const Tensor<T, D>& dU) {
   const auto& Z_inv = inverse_shape<T>(ref);
-  return T(ref.measure) * m.stress_of_gradient<T, D>(dU * Z_inv) * Z_inv.transpose();
+  return m.stress_of_gradient<T, D>(dU * Z_inv, T(ref.measure)) * Z_inv.transpose();
 }
 
 template <class T, int D, class S>
