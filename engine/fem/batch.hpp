@@ -17,6 +17,8 @@
 #include <immintrin.h>
 #endif
 
+#include "core/double_like_scalar.hpp"
+
 namespace snede {
 
 // Doubles per register on the target: 4 with AVX (256 bits), else 2 (SSE2, the portable
@@ -155,11 +157,5 @@ inline bool all_finite(std::span<const double> x) {
 
 namespace Eigen {
 template <>
-struct NumTraits<snede::Batch> : NumTraits<double> {
-  using Real = snede::Batch;
-  using NonInteger = snede::Batch;
-  using Nested = snede::Batch;
-  using Literal = snede::Batch;
-  enum { IsComplex = 0, IsInteger = 0, IsSigned = 1, RequireInitialization = 1, ReadCost = 1, AddCost = 1, MulCost = 1 };
-};
+struct NumTraits<snede::Batch> : snede::DoubleLikeNumTraits<snede::Batch> {};
 }  // namespace Eigen
