@@ -7,6 +7,8 @@
 #include <cmath>
 #include <cstdint>
 
+#include "core/double_like_scalar.hpp"
+
 namespace snede {
 
 struct FlopTally {
@@ -66,11 +68,5 @@ inline double value_of(Counted x) { return x.value(); }
 
 namespace Eigen {
 template <>
-struct NumTraits<snede::Counted> : NumTraits<double> {
-  using Real = snede::Counted;
-  using NonInteger = snede::Counted;
-  using Nested = snede::Counted;
-  using Literal = snede::Counted;
-  enum { IsComplex = 0, IsInteger = 0, IsSigned = 1, RequireInitialization = 1, ReadCost = 1, AddCost = 1, MulCost = 1 };
-};
+struct NumTraits<snede::Counted> : snede::DoubleLikeNumTraits<snede::Counted> {};
 }  // namespace Eigen

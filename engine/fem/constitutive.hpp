@@ -11,7 +11,9 @@
 #pragma once
 
 #include <concepts>
+#include <type_traits>
 
+#include "fem/batch.hpp"
 #include "fem/tensor.hpp"
 
 namespace snede {
@@ -21,6 +23,16 @@ concept WrittenInC = requires(const M& m, const Tensor<double, 3>& C) {
   { m.stress(C) };
 };
 
+// C₃₃ in plane stress. On a Batch, a material that finds it by iteration (Newton steps that
+// branch element by element) is run lane by lane; closed forms run on all lanes at once.
+template <class T, class M>
+T plane_stress_c33(const M& m, const Tensor<T, 2>& C2) {
+  if constexpr (std::is_same_v<T, Batch> && !M::plane_stress_c33_closed_form)
+    return Batch::from_lanes([&](int lane) { return m.plane_stress_c33(lane_of(C2, lane)); });
+  else
+    return m.plane_stress_c33(C2);
+}
+
 template <class T, int D, class M>
 Tensor<T, 3> right_cauchy_green_3d(const M& m, const Tensor<T, D>& F) {
   if constexpr (D == 3) {
@@ -29,7 +41,7 @@ Tensor<T, 3> right_cauchy_green_3d(const M& m, const Tensor<T, D>& F) {
     Tensor<T, 3> C = Tensor<T, 3>::Zero();
     const Tensor<T, 2> C2 = F.transpose() * F;
     C.template topLeftCorner<2, 2>() = C2;
-    C(2, 2) = m.plane_stress_c33(C2);
+    C(2, 2) = plane_stress_c33<T>(m, C2);
     return C;
   }
 }

@@ -2,6 +2,7 @@
 
 #include <petsclog.h>
 
+#include <bit>
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -9,14 +10,52 @@
 #include "core/counted.hpp"
 #include "core/error.hpp"
 #include "core/log_event.hpp"
+#include "fem/linear_elastic_kernel.hpp"
 
 namespace snede {
 namespace {
 
-using Vertices = std::array<VertexId, max_dimension + 1>;
+template <class M>
+constexpr bool is_linear = std::is_same_v<M, LinearElastic>;
+
+// The kernels the loops run, on double, Counted or Batch: §3.1's for LinearElastic (no F, a
+// tangent independent of the state), the general F/P/dP ones (§2.3, §4.3) otherwise.
+template <class T, int D, class M, class S>
+T energy_kernel(const M& m, const ElementReference<D, S>& ref, const Tensor<T, D>& U) {
+  if constexpr (is_linear<M>)
+    return linear_energy<T, D>(m, ref, U);
+  else
+    return element_energy<T, D>(m, ref, U);
+}
+
+template <class T, int D, class M, class S>
+Tensor<T, D> force_kernel(const M& m, const ElementReference<D, S>& ref, const Tensor<T, D>& U) {
+  if constexpr (is_linear<M>)
+    return -linear_stiffness_columns<T, D>(m, ref, U);
+  else
+    return element_force_columns<T, D>(m, ref, U);
+}
+
+template <class T, int D, class M, class S>
+Tensor<T, D> tangent_kernel(const M& m, const ElementReference<D, S>& ref, const Tensor<T, D>& U, const Tensor<T, D>& dU) {
+  if constexpr (is_linear<M>)
+    return linear_stiffness_columns<T, D>(m, ref, dU);
+  else
+    return element_tangent_columns<T, D>(m, ref, U, dU);
+}
+
+// Calls function(material alternative, std::integral_constant<int, D>).
+template <class Function>
+decltype(auto) with_material_and_dimension(const Material& material, int dim, Function&& function) {
+  return std::visit(
+      [&](const auto& m) {
+        return dim == 2 ? function(m, std::integral_constant<int, 2>{}) : function(m, std::integral_constant<int, 3>{});
+      },
+      material);
+}
 
 template <int D>
-Tensor<double, D> gather_differences(std::span<const double> u, const Vertices& v) {
+Tensor<double, D> gather_differences(std::span<const double> u, const typename ElementStream<D>::Vertices& v) {
   Tensor<double, D> U;
   for (int j = 1; j <= D; ++j)
     for (int k = 0; k < D; ++k)
@@ -24,28 +63,141 @@ Tensor<double, D> gather_differences(std::span<const double> u, const Vertices& 
   return U;
 }
 
-// Adds columns to nodes 1..D and minus their sum to node 0.
-template <int D>
-void scatter_columns(std::span<double> out, const Vertices& v, const Tensor<double, D>& G) {
-  for (int j = 1; j <= D; ++j)
-    for (int k = 0; k < D; ++k) {
-      out[static_cast<std::size_t>(v[j]) * D + k] += G(k, j - 1);
-      out[static_cast<std::size_t>(v[0]) * D + k] -= G(k, j - 1);
-    }
-}
-
-// Calls visit(e, oriented vertices, reference) for every live element.
+// Calls visit(e, vertices, reference) for every live element, one at a time (the loops that
+// are not hot: stresses, masses).
 template <int D, class Visit>
-void for_each_element(const Connectivity& c, const std::vector<ElementReference<D>>& refs, Visit&& visit) {
-  for (ElementId e = 0; e < c.element_capacity(); ++e) {
-    if (!c.is_element(e)) continue;
-    visit(e, c.element(e).simplex.oriented_vertices(), refs[e]);
-  }
+void for_each_live_element(const ElementStream<D>& stream, Visit&& visit) {
+  for (ElementId e = 0; e < stream.capacity(); ++e)
+    if (stream.is_live(e)) visit(e, stream.vertices(e), stream.reference(e));
 }
 
-template <class Function>
-decltype(auto) with_material(const Material& material, Function&& function) {
-  return std::visit(std::forward<Function>(function), material);
+// The lanes of one block that count, as the element-by-element loop always decided: a live
+// element with det F ≤ 0 is reported as inverted and left out if the material forbids
+// inversion; the others are evaluated, and a non-finite result is reported and left out.
+struct CountedLanes {
+  LaneMask evaluated = 0, kept = 0;
+};
+
+// Lane by lane, for the blocks with a free slot, an inverted element or a non-finite result.
+[[gnu::noinline]] CountedLanes count_exceptional_lanes(LaneMask live, LaneMask inverted, LaneMask finite,
+                                                       bool forbids_inversion, ElementId first, EvaluationReport& report) {
+  CountedLanes lanes;
+  for (int lane = 0; lane < batch_width; ++lane) {
+    const LaneMask bit = LaneMask{1} << lane;
+    if (!(live & bit)) continue;
+    if (inverted & bit) {
+      report.inverted.push_back(first + lane);
+      if (forbids_inversion) continue;
+    }
+    lanes.evaluated |= bit;
+    if (!(finite & bit)) {
+      report.domain_errors.push_back(first + lane);
+      continue;
+    }
+    lanes.kept |= bit;
+  }
+  return lanes;
+}
+
+CountedLanes count_lanes(LaneMask live, LaneMask inverted, LaneMask finite, bool forbids_inversion, ElementId first,
+                         EvaluationReport& report) {
+  if (live == all_lanes && inverted == 0 && finite == all_lanes) return {all_lanes, all_lanes};
+  return count_exceptional_lanes(live, inverted, finite, forbids_inversion, first, report);
+}
+
+template <int D>
+LaneMask inverted_lanes(const ElementBlock<D>& block, const Tensor<Batch, D>& U) {
+  return non_positive_lanes(deformation_gradient<Batch, D>(block.reference, U).determinant());
+}
+
+// The block loops are flattened: every kernel, Eigen expression and Batch operation inlined
+// into one loop body, so batches stay in registers (GCC's inliner, left alone, calls Eigen's
+// per-coefficient assignments on a custom scalar out of line).
+//
+// Adds every block's columns into `out` (zeroed first). kernel(block, U) gives the columns;
+// U is gathered from u, and inversion checked, only if reads_state; each block's results are
+// checked for non-finite values only if checks_results. The kernel (with the material it
+// holds) and the block range are local copies: stores into `out` cannot change them, so they
+// stay in registers.
+template <bool reads_state, bool checks_results, int D, class Kernel>
+[[gnu::flatten]] std::size_t accumulate_blocks(const ElementStream<D>& stream, bool forbids_inversion,
+                                               std::span<const double> u, std::span<double> out,
+                                               EvaluationReport& report, const Kernel& kernel) {
+  std::fill(out.begin(), out.end(), 0.0);
+  std::size_t n_evaluated = 0;
+  const Kernel evaluate = kernel;
+  const std::span<const ElementBlock<D>> blocks = stream.blocks();
+  for (std::size_t b = 0; b < blocks.size(); ++b) {
+    prefetch_ahead<D>(blocks, b);
+    const ElementBlock<D>& block = blocks[b];
+    Tensor<Batch, D> U;
+    LaneMask inverted = 0;
+    if constexpr (reads_state) {
+      U = gather_differences<D>(u, block);
+      inverted = inverted_lanes<D>(block, U);
+    }
+    const Tensor<Batch, D> G = evaluate(block, U);
+    const LaneMask finite = checks_results ? finite_lanes(G) : all_lanes;
+    const CountedLanes lanes = count_lanes(ElementStream<D>::live_lanes(block), inverted, finite, forbids_inversion,
+                                           static_cast<ElementId>(b * batch_width), report);
+    n_evaluated += std::popcount(lanes.evaluated);
+    scatter_columns<D>(out, block, G, lanes.kept);
+  }
+  return n_evaluated;
+}
+
+// accumulate_blocks with its results checked once, on `out`: a non-finite element result
+// makes `out` non-finite (so does a sum that overflows, for which the second pass then finds
+// no element). Only then does the loop run again, checking every block, to report and leave
+// out the non-finite elements as an element-by-element loop does.
+template <bool reads_state, int D, class Kernel>
+std::size_t accumulate(const ElementStream<D>& stream, bool forbids_inversion, std::span<const double> u,
+                       std::span<double> out, EvaluationReport& report, const Kernel& kernel) {
+  EvaluationReport first_pass;
+  const std::size_t n = accumulate_blocks<reads_state, false, D>(stream, forbids_inversion, u, out, first_pass, kernel);
+  if (!all_finite(out)) return accumulate_blocks<reads_state, true, D>(stream, forbids_inversion, u, out, report, kernel);
+  report.inverted.insert(report.inverted.end(), first_pass.inverted.begin(), first_pass.inverted.end());
+  return n;
+}
+
+// Π_int: the energies of the blocks' lanes that count, summed lane by lane and then across.
+template <int D, class M>
+[[gnu::flatten]] double sum_energy(const ElementStream<D>& stream, const M& material, std::span<const double> u,
+                                   EvaluationReport& report, std::size_t& n_evaluated) {
+  const M m = material;  // a local copy, as in accumulate_blocks
+  const std::span<const ElementBlock<D>> blocks = stream.blocks();
+  Batch sums = 0.0;
+  bool infinite = false;
+  for (std::size_t b = 0; b < blocks.size(); ++b) {
+    prefetch_ahead<D>(blocks, b);
+    const ElementBlock<D>& block = blocks[b];
+    const Tensor<Batch, D> U = gather_differences<D>(u, block);
+    const LaneMask live = ElementStream<D>::live_lanes(block), inverted = inverted_lanes<D>(block, U);
+    const Batch values = energy_kernel<Batch, D>(m, block.reference, U);
+    const CountedLanes lanes = count_lanes(live, inverted, finite_lanes(values), M::forbids_inversion,
+                                           static_cast<ElementId>(b * batch_width), report);
+    // +∞ for an inverted element of a material that forbids inversion.
+    if (M::forbids_inversion && (live & inverted)) infinite = true;
+    n_evaluated += std::popcount(lanes.evaluated);
+    sums += lanes.kept == all_lanes ? values : Batch::from_lanes([&](int lane) { return lanes.kept >> lane & 1 ? values[lane] : 0.0; });
+  }
+  double total = 0;
+  for (int lane = 0; lane < batch_width; ++lane) total += sums[lane];
+  return infinite ? std::numeric_limits<double>::infinity() : total;
+}
+
+template <int D>
+[[gnu::flatten]] std::vector<ElementId> find_inverted(const ElementStream<D>& stream, std::span<const double> u) {
+  std::vector<ElementId> inverted;
+  const std::span<const ElementBlock<D>> blocks = stream.blocks();
+  for (std::size_t b = 0; b < blocks.size(); ++b) {
+    prefetch_ahead<D>(blocks, b);
+    const ElementBlock<D>& block = blocks[b];
+    const LaneMask lanes = ElementStream<D>::live_lanes(block) & inverted_lanes<D>(block, gather_differences<D>(u, block));
+    for (int lane = 0; lane < batch_width; ++lane)
+      if (lanes >> lane & 1) inverted.push_back(static_cast<ElementId>(b * batch_width + lane));
+  }
+  return inverted;
 }
 
 template <int D, class M>
@@ -65,21 +217,16 @@ KernelFlops count_flops(const M& m) {
     kernel();
     return flop_tally();
   };
-  flops.energy = run([&] { element_energy<Counted, D>(m, ref, U); }).arithmetic;
-  const FlopTally force = run([&] { element_force_columns<Counted, D>(m, ref, U); });
+  flops.energy = run([&] { energy_kernel<Counted, D>(m, ref, U); }).arithmetic;
+  const FlopTally force = run([&] { force_kernel<Counted, D>(m, ref, U); });
   flops.force = force.arithmetic;
   flops.functions = force.functions;
-  flops.tangent = run([&] { element_tangent_columns<Counted, D>(m, ref, U, dU); }).arithmetic;
+  flops.tangent = run([&] { tangent_kernel<Counted, D>(m, ref, U, dU); }).arithmetic;
   return flops;
 }
 
 void log_flops(std::int64_t per_element, std::size_t n_elements) {
   SNEDE_PETSC(PetscLogFlops(static_cast<PetscLogDouble>(per_element) * static_cast<PetscLogDouble>(n_elements)));
-}
-
-template <class M>
-constexpr bool forbids_inversion(const M&) {
-  return M::forbids_inversion;
 }
 
 }  // namespace
@@ -105,8 +252,8 @@ ElasticBody::ElasticBody(Mesh& mesh, Material material, double density, double t
   } else if (thickness != 0) {
     throw std::invalid_argument("thickness is only for 2D (plane-stress) bodies; this mesh is 3D");
   }
-  flops_ = with_material(material_, [&](const auto& m) {
-    return mesh.dim() == 2 ? count_flops<2>(m) : count_flops<3>(m);
+  flops_ = with_material_and_dimension(material_, mesh.dim(), [](const auto& m, auto dimension) {
+    return count_flops<decltype(dimension)::value>(m);
   });
   mesh_.connectivity().add_watcher(this);
 }
@@ -114,42 +261,52 @@ ElasticBody::ElasticBody(Mesh& mesh, Material material, double density, double t
 ElasticBody::~ElasticBody() { mesh_.connectivity().remove_watcher(this); }
 
 template <>
-const std::vector<ElementReference<2>>& ElasticBody::references<2>() const {
-  return references_2d_;
+const ElementStream<2>& ElasticBody::stream<2>() const {
+  return stream_2d_;
 }
 template <>
-const std::vector<ElementReference<3>>& ElasticBody::references<3>() const {
-  return references_3d_;
+const ElementStream<3>& ElasticBody::stream<3>() const {
+  return stream_3d_;
 }
 
-void ElasticBody::compute_reference(ElementId e) {
-  const std::vector<double> x = mesh_.corners(e);  // positively oriented
-  auto fill = [&](auto& refs, auto dimension) {
+void ElasticBody::reserve_ids(ElementId capacity) {
+  dim() == 2 ? stream_2d_.reserve_ids(capacity) : stream_3d_.reserve_ids(capacity);
+}
+
+void ElasticBody::release(ElementId e) { dim() == 2 ? stream_2d_.release(e) : stream_3d_.release(e); }
+
+void ElasticBody::compute_reference(const Connectivity& connectivity, ElementId e) {
+  const auto oriented = connectivity.element(e).simplex.oriented_vertices();
+  auto fill = [&](auto& stream, auto dimension) {
     constexpr int D = decltype(dimension)::value;
-    if (refs.size() <= static_cast<std::size_t>(e)) refs.resize(mesh_.connectivity().element_capacity());
+    typename ElementStream<D>::Vertices v;
+    std::copy_n(oriented.begin(), D + 1, v.begin());
     Tensor<double, D> Z;
     for (int j = 1; j <= D; ++j)
-      for (int k = 0; k < D; ++k) Z(k, j - 1) = x[j * D + k] - x[k];
-    refs[e].Z_inv = Z.inverse();
-    refs[e].measure = Z.determinant() / (D == 2 ? 2.0 : 6.0) * (D == 2 ? thickness_ : 1.0);
+      for (int k = 0; k < D; ++k) Z(k, j - 1) = mesh_.point(v[j])[k] - mesh_.point(v[0])[k];
+    const ElementReference<D> reference{Z.inverse(), Z.determinant() / (D == 2 ? 2.0 : 6.0) * (D == 2 ? thickness_ : 1.0)};
+    stream.store(e, v, reference);
   };
   if (dim() == 2)
-    fill(references_2d_, std::integral_constant<int, 2>{});
+    fill(stream_2d_, std::integral_constant<int, 2>{});
   else
-    fill(references_3d_, std::integral_constant<int, 3>{});
+    fill(stream_3d_, std::integral_constant<int, 3>{});
 }
 
 void ElasticBody::init(const Connectivity& connectivity) {
-  references_2d_.assign(dim() == 2 ? connectivity.element_capacity() : 0, {});
-  references_3d_.assign(dim() == 3 ? connectivity.element_capacity() : 0, {});
-  for (ElementId e : connectivity.element_ids()) compute_reference(e);
+  reserve_ids(connectivity.element_capacity());
+  for (ElementId e : connectivity.element_ids()) compute_reference(connectivity, e);
 }
 
-void ElasticBody::on_change(const Connectivity&, const ConnectivityChange& change) {
-  // Only the elements that changed get new reference data (§7.4).
-  for (ElementId e : change.added_elements) compute_reference(e);
-  for (const auto& entry : change.changed_elements) compute_reference(entry.first);
-  for (ElementId e : change.reshaped_elements) compute_reference(e);  // a corner moved
+void ElasticBody::on_change(const Connectivity& connectivity, const ConnectivityChange& change) {
+  // Only the slots of the elements that changed are touched (§7.4): O(size of the change).
+  // A removed id may come back among the added ones (the free list reuses it).
+  reserve_ids(connectivity.element_capacity());
+  for (const auto& entry : change.removed_elements)
+    if (!connectivity.is_element(entry.first)) release(entry.first);
+  for (ElementId e : change.added_elements) compute_reference(connectivity, e);
+  for (const auto& entry : change.changed_elements) compute_reference(connectivity, entry.first);
+  for (ElementId e : change.reshaped_elements) compute_reference(connectivity, e);  // a corner moved
 }
 
 void ElasticBody::check_size(const char* what, std::span<const double> a) const {
@@ -162,62 +319,12 @@ double ElasticBody::energy(std::span<const double> u, EvaluationReport& report) 
   static const PetscLogEvent event = log_event("SnedeEnergy");
   ScopedEvent logged(event);
   check_size("displacement", u);
-  return with_material(material_, [&](const auto& m) {
-    auto loop = [&](auto dimension) {
-      constexpr int D = decltype(dimension)::value;
-      double total = 0;
-      std::size_t n = 0;
-      for_each_element<D>(mesh_.connectivity(), references<D>(), [&](ElementId e, const Vertices& v, const auto& ref) {
-        const Tensor<double, D> U = gather_differences<D>(u, v);
-        if (deformation_gradient<double, D>(ref, U).determinant() <= 0) {
-          report.inverted.push_back(e);
-          if (forbids_inversion(m)) {
-            total = std::numeric_limits<double>::infinity();
-            return;
-          }
-        }
-        const double value = element_energy<double, D>(m, ref, U);
-        ++n;
-        if (!std::isfinite(value)) {
-          report.domain_errors.push_back(e);
-          return;
-        }
-        total += value;
-      });
-      log_flops(flops_.energy, n);
-      return total;
-    };
-    return dim() == 2 ? loop(std::integral_constant<int, 2>{}) : loop(std::integral_constant<int, 3>{});
-  });
-}
-
-// Adds each element's columns (from `kernel`) into `out`, skipping and reporting inverted
-// elements of materials that forbid inversion and non-finite results.
-template <class Kernel>
-void ElasticBody::accumulate(std::span<const double> u, std::span<double> out, EvaluationReport& report,
-                             std::int64_t flops_per_element, Kernel&& kernel) const {
-  std::fill(out.begin(), out.end(), 0.0);
-  with_material(material_, [&](const auto& m) {
-    auto loop = [&](auto dimension) {
-      constexpr int D = decltype(dimension)::value;
-      std::size_t n = 0;
-      for_each_element<D>(mesh_.connectivity(), references<D>(), [&](ElementId e, const Vertices& v, const auto& ref) {
-        const Tensor<double, D> U = gather_differences<D>(u, v);
-        if (deformation_gradient<double, D>(ref, U).determinant() <= 0) {
-          report.inverted.push_back(e);
-          if (forbids_inversion(m)) return;
-        }
-        const Tensor<double, D> G = kernel(m, ref, U, v);
-        ++n;
-        if (!G.allFinite()) {
-          report.domain_errors.push_back(e);
-          return;
-        }
-        scatter_columns<D>(out, v, G);
-      });
-      log_flops(flops_per_element, n);
-    };
-    dim() == 2 ? loop(std::integral_constant<int, 2>{}) : loop(std::integral_constant<int, 3>{});
+  return with_material_and_dimension(material_, dim(), [&](const auto& m, auto dimension) {
+    constexpr int D = decltype(dimension)::value;
+    std::size_t n_evaluated = 0;
+    const double total = sum_energy<D>(stream<D>(), m, u, report, n_evaluated);
+    log_flops(flops_.energy, n_evaluated);
+    return total;
   });
 }
 
@@ -226,9 +333,12 @@ void ElasticBody::internal_forces(std::span<const double> u, std::span<double> f
   ScopedEvent logged(event);
   check_size("displacement", u);
   check_size("force", f);
-  accumulate(u, f, report, flops_.force, [](const auto& m, const auto& ref, const auto& U, const Vertices&) {
-    constexpr int D = std::decay_t<decltype(U)>::RowsAtCompileTime;
-    return element_force_columns<double, D>(m, ref, U);
+  with_material_and_dimension(material_, dim(), [&](const auto& m, auto dimension) {
+    constexpr int D = decltype(dimension)::value;
+    const std::size_t n = accumulate<true, D>(stream<D>(), forbids_inversion(material_), u, f, report, [m](const ElementBlock<D>& block, const Tensor<Batch, D>& U) {
+      return force_kernel<Batch, D>(m, block.reference, U);
+    });
+    log_flops(flops_.force, n);
   });
 }
 
@@ -239,38 +349,31 @@ void ElasticBody::tangent_apply(std::span<const double> u, std::span<const doubl
   check_size("displacement", u);
   check_size("direction", d);
   check_size("result", out);
-  accumulate(u, out, report, flops_.tangent, [d](const auto& m, const auto& ref, const auto& U, const Vertices& v) {
-    constexpr int D = std::decay_t<decltype(U)>::RowsAtCompileTime;
-    return element_tangent_columns<double, D>(m, ref, U, gather_differences<D>(d, v));
+  with_material_and_dimension(material_, dim(), [&](const auto& m, auto dimension) {
+    constexpr int D = decltype(dimension)::value;
+    constexpr bool reads_state = !is_linear<std::decay_t<decltype(m)>>;
+    const std::size_t n = accumulate<reads_state, D>(stream<D>(), forbids_inversion(material_), u, out, report, [m, d](const ElementBlock<D>& block, const Tensor<Batch, D>& U) {
+      return tangent_kernel<Batch, D>(m, block.reference, U, gather_differences<D>(d, block));
+    });
+    log_flops(flops_.tangent, n);
   });
 }
 
 std::vector<ElementId> ElasticBody::inverted_elements(std::span<const double> u) const {
   check_size("displacement", u);
-  std::vector<ElementId> inverted;
-  auto loop = [&](auto dimension) {
-    constexpr int D = decltype(dimension)::value;
-    for_each_element<D>(mesh_.connectivity(), references<D>(), [&](ElementId e, const Vertices& v, const auto& ref) {
-      if (deformation_gradient<double, D>(ref, gather_differences<D>(u, v)).determinant() <= 0) inverted.push_back(e);
-    });
-  };
-  dim() == 2 ? loop(std::integral_constant<int, 2>{}) : loop(std::integral_constant<int, 3>{});
-  return inverted;
+  return dim() == 2 ? find_inverted<2>(stream<2>(), u) : find_inverted<3>(stream<3>(), u);
 }
 
 std::vector<double> ElasticBody::element_stress(std::span<const double> u) const {
   check_size("displacement", u);
   std::vector<double> stress;
-  with_material(material_, [&](const auto& m) {
-    auto loop = [&](auto dimension) {
-      constexpr int D = decltype(dimension)::value;
-      for_each_element<D>(mesh_.connectivity(), references<D>(), [&](ElementId, const Vertices& v, const auto& ref) {
-        const Tensor<double, D> S = second_piola<double, D>(m, deformation_gradient<double, D>(ref, gather_differences<D>(u, v)));
-        for (int i = 0; i < D; ++i)
-          for (int j = 0; j < D; ++j) stress.push_back(S(i, j));
-      });
-    };
-    dim() == 2 ? loop(std::integral_constant<int, 2>{}) : loop(std::integral_constant<int, 3>{});
+  with_material_and_dimension(material_, dim(), [&](const auto& m, auto dimension) {
+    constexpr int D = decltype(dimension)::value;
+    for_each_live_element<D>(stream<D>(), [&](ElementId, const auto& v, const ElementReference<D>& ref) {
+      const Tensor<double, D> S = second_piola<double, D>(m, deformation_gradient<double, D>(ref, gather_differences<D>(u, v)));
+      for (int i = 0; i < D; ++i)
+        for (int j = 0; j < D; ++j) stress.push_back(S(i, j));
+    });
   });
   return stress;
 }
@@ -278,31 +381,27 @@ std::vector<double> ElasticBody::element_stress(std::span<const double> u) const
 std::vector<double> ElasticBody::element_stiffness(ElementId e, std::span<const double> u) const {
   check_size("displacement", u);
   if (!mesh_.connectivity().is_element(e)) throw std::invalid_argument("element " + std::to_string(e) + " does not exist");
-  const Vertices v = mesh_.connectivity().element(e).simplex.oriented_vertices();
   const int n = (dim() + 1) * dim();
   std::vector<double> K(static_cast<std::size_t>(n) * n);
-  with_material(material_, [&](const auto& m) {
-    auto columns = [&](auto dimension) {
-      constexpr int D = decltype(dimension)::value;
-      const auto& ref = references<D>()[e];
-      const Tensor<double, D> U = gather_differences<D>(u, v);
-      for (int column = 0; column < n; ++column) {
-        // unit direction on (node column / D, component column % D), as local differences
-        Tensor<double, D> dU = Tensor<double, D>::Zero();
-        const int node = column / D, component = column % D;
-        if (node == 0)
-          dU.row(component).setConstant(-1.0);
-        else
-          dU(component, node - 1) = 1.0;
-        const Tensor<double, D> G = element_tangent_columns<double, D>(m, ref, U, dU);
-        for (int j = 1; j <= D; ++j)
-          for (int k = 0; k < D; ++k) {
-            K[static_cast<std::size_t>(j * D + k) * n + column] = G(k, j - 1);
-            K[static_cast<std::size_t>(k) * n + column] -= G(k, j - 1);
-          }
-      }
-    };
-    dim() == 2 ? columns(std::integral_constant<int, 2>{}) : columns(std::integral_constant<int, 3>{});
+  with_material_and_dimension(material_, dim(), [&](const auto& m, auto dimension) {
+    constexpr int D = decltype(dimension)::value;
+    const ElementReference<D> ref = stream<D>().reference(e);
+    const Tensor<double, D> U = gather_differences<D>(u, stream<D>().vertices(e));
+    for (int column = 0; column < n; ++column) {
+      // unit direction on (node column / D, component column % D), as local differences
+      Tensor<double, D> dU = Tensor<double, D>::Zero();
+      const int node = column / D, component = column % D;
+      if (node == 0)
+        dU.row(component).setConstant(-1.0);
+      else
+        dU(component, node - 1) = 1.0;
+      const Tensor<double, D> G = element_tangent_columns<double, D>(m, ref, U, dU);
+      for (int j = 1; j <= D; ++j)
+        for (int k = 0; k < D; ++k) {
+          K[static_cast<std::size_t>(j * D + k) * n + column] = G(k, j - 1);
+          K[static_cast<std::size_t>(k) * n + column] -= G(k, j - 1);
+        }
+    }
   });
   return K;
 }
@@ -311,7 +410,7 @@ std::vector<double> ElasticBody::lumped_mass() const {
   std::vector<double> mass(mesh_.n_points(), 0.0);
   auto loop = [&](auto dimension) {
     constexpr int D = decltype(dimension)::value;
-    for_each_element<D>(mesh_.connectivity(), references<D>(), [&](ElementId, const Vertices& v, const auto& ref) {
+    for_each_live_element<D>(stream<D>(), [&](ElementId, const auto& v, const ElementReference<D>& ref) {
       for (int j = 0; j <= D; ++j) mass[v[j]] += density_ * ref.measure / (D + 1);
     });
   };

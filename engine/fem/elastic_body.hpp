@@ -1,6 +1,7 @@
 // Matrix-free evaluation over a whole mesh (§2.3, §4.3): total energy, internal forces,
 // tangent action, lumped mass and gravity, for one material. It is a connectivity watcher:
-// per-element reference data (Z⁻¹, |τ|) is recomputed only for elements a change reports.
+// per-element reference data (Z⁻¹, |τ|) is recomputed only for elements a change reports,
+// in an ElementStream the loops read batch_width elements at a time (fem/element_stream.hpp).
 //
 // Conventions: displacement and force arrays are (n_points, dim) row-major; internal forces
 // are −∂Π_int/∂u; the tangent action is ∂²Π_int/∂u² · d.
@@ -11,7 +12,7 @@
 #include <stdexcept>
 #include <vector>
 
-#include "fem/element_kernel.hpp"
+#include "fem/element_stream.hpp"
 #include "fem/material.hpp"
 #include "mesh/mesh.hpp"
 
@@ -56,7 +57,9 @@ class ElasticBody : public ConnectivityWatcher {
   double energy(std::span<const double> u, EvaluationReport& report) const;
   // f = −∂Π_int/∂u; inverted elements of a material that forbids inversion contribute nothing.
   void internal_forces(std::span<const double> u, std::span<double> f, EvaluationReport& report) const;
-  // out = K(u) d, K = ∂²Π_int/∂u²; inverted elements as for the forces.
+  // out = K(u) d, K = ∂²Π_int/∂u²; inverted elements as for the forces. LinearElastic's K
+  // does not depend on u, which it does not read: report.inverted stays empty (inversion is
+  // reported by energy, internal_forces and inverted_elements, which the solvers consult).
   void tangent_apply(std::span<const double> u, std::span<const double> d, std::span<double> out,
                      EvaluationReport& report) const;
   // Ids of the elements with det F ≤ 0 at u.
@@ -77,19 +80,18 @@ class ElasticBody : public ConnectivityWatcher {
 
  private:
   template <int D>
-  const std::vector<ElementReference<D>>& references() const;
-  void compute_reference(ElementId e);
+  const ElementStream<D>& stream() const;
+  void reserve_ids(ElementId capacity);
+  void compute_reference(const Connectivity& connectivity, ElementId e);
+  void release(ElementId e);
   void check_size(const char* what, std::span<const double> a) const;
-  template <class Kernel>
-  void accumulate(std::span<const double> u, std::span<double> out, EvaluationReport& report,
-                  std::int64_t flops_per_element, Kernel&& kernel) const;
 
   Mesh& mesh_;
   Material material_;
   double density_;
   double thickness_;
-  std::vector<ElementReference<2>> references_2d_;
-  std::vector<ElementReference<3>> references_3d_;
+  ElementStream<2> stream_2d_;
+  ElementStream<3> stream_3d_;
   KernelFlops flops_;
 };
 

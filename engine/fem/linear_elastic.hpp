@@ -22,9 +22,7 @@ struct LinearElastic {
   }
   template <class T, int D>
   T energy(const Tensor<T, D>& F) const {
-    const Tensor<T, D> eps = strain<T, D>(F);
-    const T trace = eps.trace();
-    return T(lame.mu) * double_dot<T, D>(eps, eps) + T(0.5 * effective_lambda<D>()) * trace * trace;
+    return energy_of_strain<T, D>(strain<T, D>(F));
   }
   template <class T, int D>
   Tensor<T, D> first_piola(const Tensor<T, D>& F) const {
@@ -32,18 +30,45 @@ struct LinearElastic {
   }
   template <class T, int D>
   Tensor<T, D> first_piola_derivative(const Tensor<T, D>&, const Tensor<T, D>& dF) const {
-    return stress_of<T, D>(T(0.5) * (dF + dF.transpose()));
+    return stress_of_gradient<T, D>(dF);
   }
   // The stress reported per element: σ (the linear theory does not tell S from σ).
   template <class T, int D>
   Tensor<T, D> second_piola(const Tensor<T, D>& F) const {
     return first_piola<T, D>(F);
   }
+  // s·σ(sym H) and W(sym H) of a displacement gradient H = F − I given as such: small
+  // strains lose no digits to the identity (the specialised kernels,
+  // fem/linear_elastic_kernel.hpp). The factor s (an element's measure) scales the two Lamé
+  // coefficients rather than the D² entries; σ's symmetry is written out.
+  template <class T, int D>
+  Tensor<T, D> stress_of_gradient(const Tensor<T, D>& H, const T& s = T(1)) const {
+    const T mu = T(lame.mu) * s, lambda_trace = T(effective_lambda<D>()) * s * H.trace();
+    Tensor<T, D> sigma;
+    for (int i = 0; i < D; ++i) {
+      sigma(i, i) = T(2) * mu * H(i, i) + lambda_trace;
+      for (int j = i + 1; j < D; ++j) sigma(i, j) = sigma(j, i) = mu * (H(i, j) + H(j, i));
+    }
+    return sigma;
+  }
+  template <class T, int D>
+  T energy_of_gradient(const Tensor<T, D>& H) const {
+    return energy_of_strain<T, D>(symmetric_part<T, D>(H));
+  }
 
  private:
   template <class T, int D>
+  static Tensor<T, D> symmetric_part(const Tensor<T, D>& H) {
+    return T(0.5) * (H + H.transpose());
+  }
+  template <class T, int D>
   static Tensor<T, D> strain(const Tensor<T, D>& F) {
-    return T(0.5) * (F + F.transpose()) - identity<T, D>();
+    return symmetric_part<T, D>(F) - identity<T, D>();
+  }
+  template <class T, int D>
+  T energy_of_strain(const Tensor<T, D>& eps) const {
+    const T trace = eps.trace();
+    return T(lame.mu) * double_dot<T, D>(eps, eps) + T(0.5 * effective_lambda<D>()) * trace * trace;
   }
   template <class T, int D>
   Tensor<T, D> stress_of(const Tensor<T, D>& eps) const {

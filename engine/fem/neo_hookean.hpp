@@ -12,6 +12,7 @@ namespace snede {
 
 struct NeoHookean {
   Lame lame;
+  static constexpr bool plane_stress_c33_closed_form = true;
   static constexpr bool forbids_inversion = true;
   static constexpr const char* name = "NeoHookean";
 

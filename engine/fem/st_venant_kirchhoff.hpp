@@ -9,6 +9,7 @@ namespace snede {
 
 struct StVenantKirchhoff {
   Lame lame;
+  static constexpr bool plane_stress_c33_closed_form = true;
   static constexpr bool forbids_inversion = false;
   static constexpr const char* name = "StVenantKirchhoff";
 

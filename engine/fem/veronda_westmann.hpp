@@ -19,6 +19,7 @@ namespace snede {
 struct VerondaWestmann {
   Lame lame;
   double gamma;
+  static constexpr bool plane_stress_c33_closed_form = false;
   static constexpr bool forbids_inversion = true;
   static constexpr const char* name = "VerondaWestmann";
 

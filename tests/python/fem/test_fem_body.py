@@ -21,7 +21,8 @@ def test_lumped_mass_and_gravity_add_up(dim):
 
 def test_flops_are_counted_per_kernel(material_name):
     flops = body_of(small_mesh(3), all_materials()[material_name]).flops_per_element()
-    assert 50 < flops["energy"] < flops["force"] < flops["tangent"] < 2000
+    # ≤: the linear force −K u and tangent K d are one kernel (§3.1), equal in cost.
+    assert 50 < flops["energy"] < flops["force"] <= flops["tangent"] < 2000
 
 
 def test_reference_data_follow_a_dissection(material_name):

@@ -1,0 +1,139 @@
+// Benchmark (not a test): element-loop throughput of ElasticBody per material (§2.3, §4.3),
+// and the linear tangent product against an assembled BAIJ(3) product in the same run.
+//
+//     build/cpp/kernel_throughput [n ...]        (default: 26 55, Kuhn boxes of 6n³ tetrahedra)
+//
+// For each box and material prints million tetrahedra per second (one core, best of several
+// calls) for the energy, the internal forces and the tangent action, then ns per tetrahedron
+// for the linear tangent and for MatMult on the BAIJ(3) matrix assembled from the same
+// element stiffness matrices. The state is the one benchmarks/fem_throughput.py uses: a
+// 0.1 m cube, u = 1e-4·N(0, 1) per component, d = N(0, 1).
+#include <petscmat.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <random>
+#include <set>
+#include <vector>
+
+#include "core/error.hpp"
+#include "core/petsc_handle.hpp"
+#include "core/petsc_session.hpp"
+#include "fem/elastic_body.hpp"
+#include "topology/refinement_checks.hpp"
+
+namespace {
+
+using namespace snede;
+
+// Seconds of the fastest of `repeats` calls (after one warm-up call).
+template <class Work>
+double best_seconds(int repeats, Work&& work) {
+  work();
+  double best = 1e300;
+  for (int r = 0; r < repeats; ++r) {
+    const auto start = std::chrono::steady_clock::now();
+    work();
+    best = std::min(best, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+  }
+  return best;
+}
+
+Mesh box_of_side(double side, int n) {
+  Mesh unit = testing::kuhn_cube(n);
+  std::vector<double> points = unit.points();
+  for (double& x : points) x *= side;
+  std::vector<std::int64_t> cells;
+  for (VertexId v : unit.cells()) cells.push_back(v);
+  return Mesh(3, std::move(points), cells);
+}
+
+// The BAIJ(3) matrix Σ_e K_e, preallocated exactly from the vertex graph.
+Mat assembled_baij(const ElasticBody& body, std::span<const double> u) {
+  const Mesh& mesh = body.mesh();
+  const VertexId n_points = mesh.n_points();
+  std::vector<std::set<VertexId>> neighbours(n_points);
+  const std::vector<VertexId> cells = mesh.cells();
+  for (std::size_t c = 0; c < cells.size(); c += 4)
+    for (int i = 0; i < 4; ++i)
+      for (int j = 0; j < 4; ++j) neighbours[cells[c + i]].insert(cells[c + j]);
+  std::vector<PetscInt> blocks_per_row(n_points);
+  for (VertexId v = 0; v < n_points; ++v) blocks_per_row[v] = static_cast<PetscInt>(neighbours[v].size());
+  Mat K;
+  SNEDE_PETSC(MatCreateSeqBAIJ(PETSC_COMM_SELF, 3, 3 * n_points, 3 * n_points, 0, blocks_per_row.data(), &K));
+  for (ElementId e : mesh.cell_ids()) {
+    const auto v = mesh.connectivity().element(e).simplex.oriented_vertices();
+    const std::vector<double> Ke = body.element_stiffness(e, u);
+    const PetscInt rows[4] = {v[0], v[1], v[2], v[3]};
+    SNEDE_PETSC(MatSetValuesBlocked(K, 4, rows, 4, rows, Ke.data(), ADD_VALUES));
+  }
+  SNEDE_PETSC(MatAssemblyBegin(K, MAT_FINAL_ASSEMBLY));
+  SNEDE_PETSC(MatAssemblyEnd(K, MAT_FINAL_ASSEMBLY));
+  return K;
+}
+
+double baij_product_seconds(const ElasticBody& body, std::span<const double> u, std::span<const double> d,
+                            int repeats) {
+  PetscHandle<Mat, MatDestroy> K(assembled_baij(body, u));
+  PetscHandle<Vec, VecDestroy> x, y;
+  SNEDE_PETSC(MatCreateVecs(K, x.out(), y.out()));
+  PetscScalar* values = nullptr;
+  SNEDE_PETSC(VecGetArray(x, &values));
+  std::copy(d.begin(), d.end(), values);
+  SNEDE_PETSC(VecRestoreArray(x, &values));
+  return best_seconds(repeats, [&] { SNEDE_PETSC(MatMult(K, x, y)); });
+}
+
+struct LinearAgainstBaij {
+  double n_cells, shell_ns, baij_ns;
+};
+
+LinearAgainstBaij run_box(int n) {
+  Mesh mesh = box_of_side(0.1, n);
+  const double n_cells = static_cast<double>(mesh.n_cells());
+  std::mt19937 rng(0);
+  std::normal_distribution<double> normal;
+  std::vector<double> u(3 * static_cast<std::size_t>(mesh.n_points())), d(u.size()), out(u.size());
+  for (double& x : u) x = 1e-4 * normal(rng);
+  for (double& x : d) x = normal(rng);
+  const int repeats = n_cells > 5e5 ? 5 : 10;
+  const std::vector<Material> materials = {LinearElastic(3e3, 0.3), StVenantKirchhoff(3e3, 0.3),
+                                           NeoHookean(3e3, 0.3), VerondaWestmann(3e3, 0.3, 2.0)};
+  double linear_tangent_seconds = 0;
+  for (const Material& material : materials) {
+    ElasticBody body(mesh, material, 1000.0, 0.0);
+    EvaluationReport report;
+    const double t_energy = best_seconds(repeats, [&] { body.energy(u, report); });
+    const double t_force = best_seconds(repeats, [&] { body.internal_forces(u, out, report); });
+    const double t_tangent = best_seconds(repeats, [&] { body.tangent_apply(u, d, out, report); });
+    if (std::holds_alternative<LinearElastic>(material)) linear_tangent_seconds = t_tangent;
+    const char* name = std::visit([](const auto& m) { return std::decay_t<decltype(m)>::name; }, material);
+    std::printf("| %9.0f | %-17s | %8.1f | %8.1f | %8.1f | %8.1f | %6zu |\n", n_cells, name, n_cells / t_energy * 1e-6,
+                n_cells / t_force * 1e-6, n_cells / t_tangent * 1e-6, t_tangent / n_cells * 1e9,
+                report.inverted.size() + report.domain_errors.size());
+    std::fflush(stdout);
+  }
+  ElasticBody linear(mesh, LinearElastic(3e3, 0.3), 1000.0, 0.0);
+  const double t_baij = baij_product_seconds(linear, u, d, repeats);
+  return {n_cells, linear_tangent_seconds / n_cells * 1e9, t_baij / n_cells * 1e9};
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::vector<int> divisions;
+  for (int i = 1; i < argc; ++i) divisions.push_back(std::atoi(argv[i]));
+  if (divisions.empty()) divisions = {26, 55};
+  int petsc_argc = 1;
+  snede::PetscSession petsc(&petsc_argc, &argv);
+  std::printf("| tetrahedra | material | energy M/s | force M/s | tangent M/s | tangent ns/tet | flagged |\n");
+  std::printf("|---|---|---|---|---|---|---|\n");
+  std::vector<LinearAgainstBaij> linear;
+  for (int n : divisions) linear.push_back(run_box(n));
+  std::printf("\n| tetrahedra | linear tangent ns/tet | BAIJ(3) MatMult ns/tet | tangent / BAIJ |\n|---|---|---|---|\n");
+  for (const LinearAgainstBaij& row : linear)
+    std::printf("| %9.0f | %8.2f | %8.2f | %5.2f |\n", row.n_cells, row.shell_ns, row.baij_ns, row.shell_ns / row.baij_ns);
+  return 0;
+}
