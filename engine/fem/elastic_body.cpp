@@ -294,6 +294,8 @@ void ElasticBody::compute_reference(const Connectivity& connectivity, ElementId 
 }
 
 void ElasticBody::init(const Connectivity& connectivity) {
+  stream_2d_ = {};
+  stream_3d_ = {};
   reserve_ids(connectivity.element_capacity());
   for (ElementId e : connectivity.element_ids()) compute_reference(connectivity, e);
 }

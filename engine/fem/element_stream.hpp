@@ -1,12 +1,13 @@
 // The per-element data the element loops stream through (§2.3; §7.4 for how it follows the
 // mesh): each element's oriented vertices (int32) and reference data Z⁻¹, |τ|, in element-id
-// order, in blocks of batch_width elements. A vertex v is stored as D·v, where its row starts
-// in a (n_points, D) nodal array: a gather or scatter is then one load of the index and one
-// of the values (storing v cost two more instructions per node and lane, ~20% of the linear
-// tangent's). Inside a block each quantity is stored entry by
+// order, in blocks of batch_width elements. Inside a block each quantity is stored entry by
 // entry with the block's elements side by side, so one entry of batch_width elements is one
 // Batch: a loop reads memory once, front to back, and loads Z⁻¹ and |τ| with aligned vector
-// loads (96 bytes per tetrahedron, no pointer chasing through Element records).
+// loads (96 bytes per tetrahedron, no pointer chasing through Element records). A vertex v is
+// stored as D·v, where its row starts in a (n_points, D) nodal array, so that a gather or
+// scatter is one load of the index and one of the values (storing v cost two more
+// instructions per node and lane, ~20% of the linear tangent's); int32 then holds vertex ids
+// below 2³¹/D (715 million in 3D).
 //
 // Element e lives in block e / batch_width, lane e % batch_width: no id → slot map. The
 // owner keeps it in step with the watcher's changes, O(1) per element changed. A removed
@@ -53,7 +54,6 @@ class ElementStream {
   bool is_live(ElementId e) const { return live_lanes(block_of(e)) >> (e % batch_width) & 1; }
   Vertices vertices(ElementId e) const;
   ElementReference<D> reference(ElementId e) const;
-  std::size_t memory_bytes() const { return blocks_.capacity() * sizeof(ElementBlock<D>); }
 
   // The lanes of `block` that hold live elements (those whose first two rows differ).
   static LaneMask live_lanes(const ElementBlock<D>& block) {
