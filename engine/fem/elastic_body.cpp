@@ -229,6 +229,19 @@ void log_flops(std::int64_t per_element, std::size_t n_elements) {
   SNEDE_PETSC(PetscLogFlops(static_cast<PetscLogDouble>(per_element) * static_cast<PetscLogDouble>(n_elements)));
 }
 
+// The unit direction on local dof `column` (node column / D, component column % D) as the
+// differences dU that the kernels take (node 0 moves every column the other way).
+template <class T, int D>
+Tensor<T, D> unit_differences(int column) {
+  Tensor<T, D> dU = Tensor<T, D>::Zero();
+  const int node = column / D, component = column % D;
+  if (node == 0)
+    dU.row(component).setConstant(T(-1.0));
+  else
+    dU(component, node - 1) = T(1.0);
+  return dU;
+}
+
 }  // namespace
 
 void throw_if_domain_error(const EvaluationReport& report) {
@@ -390,14 +403,7 @@ std::vector<double> ElasticBody::element_stiffness(ElementId e, std::span<const 
     const ElementReference<D> ref = stream<D>().reference(e);
     const Tensor<double, D> U = gather_differences<D>(u, stream<D>().vertices(e));
     for (int column = 0; column < n; ++column) {
-      // unit direction on (node column / D, component column % D), as local differences
-      Tensor<double, D> dU = Tensor<double, D>::Zero();
-      const int node = column / D, component = column % D;
-      if (node == 0)
-        dU.row(component).setConstant(-1.0);
-      else
-        dU(component, node - 1) = 1.0;
-      const Tensor<double, D> G = element_tangent_columns<double, D>(m, ref, U, dU);
+      const Tensor<double, D> G = element_tangent_columns<double, D>(m, ref, U, unit_differences<double, D>(column));
       for (int j = 1; j <= D; ++j)
         for (int k = 0; k < D; ++k) {
           K[static_cast<std::size_t>(j * D + k) * n + column] = G(k, j - 1);
@@ -406,6 +412,41 @@ std::vector<double> ElasticBody::element_stiffness(ElementId e, std::span<const 
     }
   });
   return K;
+}
+
+void ElasticBody::for_each_element_stiffness(std::span<const double> u, const StiffnessVisitor& visit) const {
+  check_size("displacement", u);
+  with_material_and_dimension(material_, dim(), [&](const auto& m, auto dimension) {
+    constexpr int D = decltype(dimension)::value, n = (D + 1) * D;
+    using Material = std::decay_t<decltype(m)>;
+    const std::span<const ElementBlock<D>> blocks = stream<D>().blocks();
+    std::array<std::array<double, n * n>, batch_width> K;
+    for (std::size_t b = 0; b < blocks.size(); ++b) {
+      const ElementBlock<D>& block = blocks[b];
+      LaneMask lanes = ElementStream<D>::live_lanes(block);
+      const Tensor<Batch, D> U = gather_differences<D>(u, block);
+      if (Material::forbids_inversion) lanes &= ~inverted_lanes<D>(block, U);
+      if (!lanes) continue;
+      for (int column = 0; column < n; ++column) {
+        const Tensor<Batch, D> G = tangent_kernel<Batch, D>(m, block.reference, U, unit_differences<Batch, D>(column));
+        for (int lane = 0; lane < batch_width; ++lane)
+          for (int k = 0; k < D; ++k) {
+            double node_0 = 0;
+            for (int j = 1; j <= D; ++j) {
+              K[lane][static_cast<std::size_t>(j * D + k) * n + column] = G(k, j - 1)[lane];
+              node_0 -= G(k, j - 1)[lane];
+            }
+            K[lane][static_cast<std::size_t>(k) * n + column] = node_0;
+          }
+      }
+      for (int lane = 0; lane < batch_width; ++lane) {
+        if (!(lanes >> lane & 1)) continue;
+        const ElementId e = static_cast<ElementId>(b * batch_width + lane);
+        const auto vertices = stream<D>().vertices(e);
+        visit(e, std::span<const VertexId>(vertices.data(), D + 1), std::span<const double>(K[lane]));
+      }
+    }
+  });
 }
 
 std::vector<double> ElasticBody::lumped_mass() const {

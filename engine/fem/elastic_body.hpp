@@ -8,6 +8,7 @@
 #pragma once
 
 #include <array>
+#include <functional>
 #include <span>
 #include <stdexcept>
 #include <vector>
@@ -69,6 +70,12 @@ class ElasticBody : public ConnectivityWatcher {
   // Stiffness matrix of element e at u: ((dim+1)·dim)², rows and columns ordered by the
   // element's oriented vertices, then by component. For comparison and preconditioning only.
   std::vector<double> element_stiffness(ElementId e, std::span<const double> u) const;
+  // Calls visit(e, vertices, K) for every live element with its stiffness at u, as
+  // element_stiffness gives it, computed for a block of elements per kernel call (for
+  // assembling J and its diagonal). Inverted elements of a material that forbids inversion
+  // are left out, as the tangent action leaves them out.
+  using StiffnessVisitor = std::function<void(ElementId, std::span<const VertexId>, std::span<const double>)>;
+  void for_each_element_stiffness(std::span<const double> u, const StiffnessVisitor& visit) const;
   // Lumped mass per vertex: a share 1/(dim+1) of each incident element's mass (§2.5).
   std::vector<double> lumped_mass() const;
   // Consistent gravity load for linear elements: ρ|τ|g/(dim+1) per vertex and element.

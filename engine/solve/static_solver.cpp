@@ -33,6 +33,8 @@ bool is_linear(const Material& material) { return std::holds_alternative<LinearE
 // After a line-search failure Newton tries at most this many full steps, and keeps them only
 // if they meet the stopping criterion (quadratic convergence needs a handful).
 constexpr PetscInt newton_finish_steps = 10;
+// ‖F‖ changed by less than this fraction over a Newton iteration: a stalled line search.
+constexpr double newton_stall = 1e-6;
 
 }  // namespace
 
@@ -418,6 +420,14 @@ PetscErrorCode StaticSolver::snes_converged_callback(SNES snes, PetscInt it, Pet
       return;
     }
     *reason = fnorm <= self->current_tolerance() ? SNES_CONVERGED_FNORM_ABS : SNES_CONVERGED_ITERATING;
+    // A Newton iteration that leaves ‖F‖ as it was made no progress: the line search took a
+    // vanishing step, which near the solution means the energy cannot show the decrease any
+    // more (its round-off). Stop as a line-search failure, so that the full-step finish in
+    // solve_nonlinear takes over now rather than after more stalled iterations.
+    const std::size_t n = self->history_.size();
+    if (*reason == SNES_CONVERGED_ITERATING && self->options_.method == StaticMethod::newton && it > 0 && n >= 2 &&
+        std::abs(fnorm - self->history_[n - 2]) <= newton_stall * self->history_[n - 2])
+      *reason = SNES_DIVERGED_LINE_SEARCH;
   });
 }
 

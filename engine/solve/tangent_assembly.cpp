@@ -19,51 +19,43 @@ std::vector<double> projection_blocks(const Model& model) {
   return blocks;
 }
 
-// Calls visit(vertices, K_e) for every element with its stiffness at u projected on both
-// sides, P_a K_ab P_b, rows and columns ordered by the element's oriented vertices, then
-// by component (ElasticBody::element_stiffness's order). Inverted elements of a material
-// that forbids inversion are left out, as the shell leaves them out.
+// Calls visit(e, vertices, K_e) for every element with its stiffness at u projected on both
+// sides, P_a K_ab P_b, rows and columns ordered by the element's oriented vertices, then by
+// component (ElasticBody::element_stiffness's order). Inverted elements of a material that
+// forbids inversion are left out, as the shell leaves them out.
 template <class Visit>
 void for_each_projected_element_matrix(const Model& model, std::span<const double> u, Visit&& visit) {
-  const ElasticBody& body = model.body();
-  const Connectivity& c = body.mesh().connectivity();
   const int d = model.dim(), n = (d + 1) * d;
   const std::vector<double> P = projection_blocks(model);
   std::vector<bool> free(model.body().mesh().n_points());
   for (VertexId v = 0; v < static_cast<VertexId>(free.size()); ++v)
     free[v] = model.constraints()[v].kind == ConstraintKind::free;
-  std::vector<double> left(static_cast<std::size_t>(n) * n);
-  std::vector<bool> skipped(c.element_capacity(), false);
-  if (forbids_inversion(body.material()))
-    for (ElementId e : body.inverted_elements(u)) skipped[e] = true;
-  std::size_t k = 0;
-  for (ElementId e : body.mesh().cell_ids()) {
-    const std::size_t index = k++;
-    if (skipped[e]) continue;
-    const auto vertices = c.element(e).simplex.oriented_vertices();
-    std::vector<double> K = body.element_stiffness(e, u);
-    const bool all_free = std::all_of(vertices.begin(), vertices.begin() + d + 1, [&](VertexId v) { return free[v]; });
-    if (!all_free) {
-      // left = diag(P_a) K, then K = left diag(P_b): block by block, dim × dim each.
-      for (int a = 0; a <= d; ++a)
-        for (int col = 0; col < n; ++col)
-          for (int i = 0; i < d; ++i) {
-            double sum = 0;
-            for (int m = 0; m < d; ++m)
-              sum += P[(static_cast<std::size_t>(vertices[a]) * d + i) * d + m] * K[static_cast<std::size_t>(a * d + m) * n + col];
-            left[static_cast<std::size_t>(a * d + i) * n + col] = sum;
-          }
-      for (int row = 0; row < n; ++row)
-        for (int b = 0; b <= d; ++b)
-          for (int j = 0; j < d; ++j) {
-            double sum = 0;
-            for (int m = 0; m < d; ++m)
-              sum += left[static_cast<std::size_t>(row) * n + b * d + m] * P[(static_cast<std::size_t>(vertices[b]) * d + m) * d + j];
-            K[static_cast<std::size_t>(row) * n + b * d + j] = sum;
-          }
+  std::vector<double> left(static_cast<std::size_t>(n) * n), projected(static_cast<std::size_t>(n) * n);
+  model.body().for_each_element_stiffness(u, [&](ElementId e, std::span<const VertexId> vertices,
+                                                 std::span<const double> K) {
+    if (std::all_of(vertices.begin(), vertices.end(), [&](VertexId v) { return free[v]; })) {
+      visit(e, vertices, K);
+      return;
     }
-    visit(index, std::span<const VertexId>(vertices.data(), d + 1), std::span<const double>(K));
-  }
+    // left = diag(P_a) K, then projected = left diag(P_b): block by block, dim × dim each.
+    for (int a = 0; a <= d; ++a)
+      for (int col = 0; col < n; ++col)
+        for (int i = 0; i < d; ++i) {
+          double sum = 0;
+          for (int m = 0; m < d; ++m)
+            sum += P[(static_cast<std::size_t>(vertices[a]) * d + i) * d + m] * K[static_cast<std::size_t>(a * d + m) * n + col];
+          left[static_cast<std::size_t>(a * d + i) * n + col] = sum;
+        }
+    for (int row = 0; row < n; ++row)
+      for (int b = 0; b <= d; ++b)
+        for (int j = 0; j < d; ++j) {
+          double sum = 0;
+          for (int m = 0; m < d; ++m)
+            sum += left[static_cast<std::size_t>(row) * n + b * d + m] * P[(static_cast<std::size_t>(vertices[b]) * d + m) * d + j];
+          projected[static_cast<std::size_t>(row) * n + b * d + j] = sum;
+        }
+    visit(e, vertices, std::span<const double>(projected));
+  });
 }
 
 // The (I − P) block of every vertex, one after another (dim × dim, row-major).
@@ -99,11 +91,12 @@ AssembledTangent::AssembledTangent(const Model& model, MatrixFormat format)
     const auto& list = neighbours[a];
     return static_cast<std::int32_t>(std::lower_bound(list.begin(), list.end(), b) - list.begin());
   };
-  block_rank_.reserve(elements.size() * (d + 1) * (d + 1));
+  block_rank_.assign(static_cast<std::size_t>(c.element_capacity()) * (d + 1) * (d + 1), 0);
   for (ElementId e : elements) {
     const auto vertices = c.element(e).simplex.oriented_vertices();
     for (int a = 0; a <= d; ++a)
-      for (int b = 0; b <= d; ++b) block_rank_.push_back(rank(vertices[a], vertices[b]));
+      for (int b = 0; b <= d; ++b)
+        block_rank_[(static_cast<std::size_t>(e) * (d + 1) + a) * (d + 1) + b] = rank(vertices[a], vertices[b]);
   }
   self_rank_.resize(n);
   for (VertexId v = 0; v < n; ++v) self_rank_[v] = rank(v, v);
@@ -149,9 +142,9 @@ void AssembledTangent::assemble(const Model& model, Vec u) {
     PetscScalar* values = nullptr;
     SNEDE_PETSC(MatSeqAIJGetArray(A_, &values));
     std::fill(values, values + row_start_.back(), 0.0);
-    for_each_projected_element_matrix(model, x.span(), [&](std::size_t k, std::span<const VertexId> vertices,
+    for_each_projected_element_matrix(model, x.span(), [&](ElementId e, std::span<const VertexId> vertices,
                                                            std::span<const double> K) {
-      const std::int32_t* ranks = block_rank_.data() + k * (d + 1) * (d + 1);
+      const std::int32_t* ranks = block_rank_.data() + static_cast<std::size_t>(e) * (d + 1) * (d + 1);
       for (int a = 0; a <= d; ++a)
         for (int i = 0; i < d; ++i) {
           PetscScalar* row = values + row_start_[static_cast<std::size_t>(vertices[a]) * d + i];
@@ -169,7 +162,7 @@ void AssembledTangent::assemble(const Model& model, Vec u) {
   } else {
     SNEDE_PETSC(MatZeroEntries(A_));
     std::vector<PetscInt> block_rows;
-    for_each_projected_element_matrix(model, x.span(), [&](std::size_t, std::span<const VertexId> vertices,
+    for_each_projected_element_matrix(model, x.span(), [&](ElementId, std::span<const VertexId> vertices,
                                                            std::span<const double> K) {
       block_rows.assign(vertices.begin(), vertices.end());
       const auto count = static_cast<PetscInt>(block_rows.size());
@@ -201,7 +194,7 @@ void tangent_diagonal(const Model& model, Vec u, Vec diagonal) {
   std::vector<double> values(model.body().n_dofs(), 0.0);
   {
     ReadView x(u);
-    for_each_projected_element_matrix(model, x.span(), [&](std::size_t, std::span<const VertexId> vertices,
+    for_each_projected_element_matrix(model, x.span(), [&](ElementId, std::span<const VertexId> vertices,
                                                            std::span<const double> K) {
       for (int row = 0; row < n; ++row)
         values[static_cast<std::size_t>(vertices[row / d]) * d + row % d] += K[static_cast<std::size_t>(row) * n + row];

@@ -34,8 +34,8 @@ class AssembledTangent {
   std::uint64_t revision_;
   MatHandle A_;
   std::vector<PetscInt> row_start_;       // AIJ: offset of each scalar row's first value
-  std::vector<std::int32_t> block_rank_;  // per element (in cell_ids order) and block (a, b):
-                                          // b's place among a's sorted neighbours
+  std::vector<std::int32_t> block_rank_;  // per element id and block (a, b): b's place among
+                                          // a's sorted neighbours
   std::vector<std::int32_t> self_rank_;   // per vertex: its own place among its neighbours
 };
 
