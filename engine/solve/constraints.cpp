@@ -104,6 +104,22 @@ void Constraints::projection_block(VertexId v, std::span<double> block) const {
     }
 }
 
+void Constraints::add_complement(std::span<const double> v, std::span<double> out) const {
+  for (std::size_t i = 0; i < vertices_.size(); ++i) {
+    const VertexConstraint& c = vertices_[i];
+    if (c.kind == ConstraintKind::free) continue;
+    const double* x = v.data() + i * dim_;
+    double* y = out.data() + i * dim_;
+    if (c.kind == ConstraintKind::slide) {
+      double along = 0;
+      for (int k = 0; k < dim_; ++k) along += x[k] * c.direction[k];
+      for (int k = 0; k < dim_; ++k) y[k] += x[k] - along * c.direction[k];
+    } else {
+      for (int k = 0; k < dim_; ++k) y[k] += x[k];
+    }
+  }
+}
+
 void Constraints::project_complement(std::span<double> v) const {
   for (std::size_t i = 0; i < vertices_.size(); ++i) {
     const VertexConstraint& c = vertices_[i];

@@ -221,15 +221,13 @@ void Model::tangent_mult(Vec d, Vec out) {
   ReadView x(u_linearization_);
   ReadView direction(d);
   WriteView result(out);
-  std::vector<double> projected(direction.span().begin(), direction.span().end());
-  constraints_.project(projected);
+  // P d in a buffer kept between products (a new one per product cost page faults).
+  projected_direction_.assign(direction.span().begin(), direction.span().end());
+  constraints_.project(projected_direction_);
   EvaluationReport report;
-  body_.tangent_apply(x.span(), projected, result.span(), report);
+  body_.tangent_apply(x.span(), projected_direction_, result.span(), report);
   constraints_.project(result.span());
-  // + (I − P) d
-  std::vector<double> complement(direction.span().begin(), direction.span().end());
-  constraints_.project_complement(complement);
-  for (std::size_t i = 0; i < complement.size(); ++i) result.span()[i] += complement[i];
+  constraints_.add_complement(direction.span(), result.span());  // + (I − P) d
   if (operator_scale_ != 1)
     for (double& x : result.span()) x *= operator_scale_;
   throw_if_domain_error(report);

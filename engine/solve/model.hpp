@@ -116,6 +116,7 @@ class Model : public ConnectivityWatcher {
   std::vector<double> gravity_;        // dim components, or empty
   std::map<std::string, std::vector<double>> channels_;  // name → n_dofs nodal forces
   std::vector<Vec*> carried_fields_;
+  std::vector<double> projected_direction_;  // tangent_mult's P d
   std::vector<double> external_;       // cached f_ext
   bool external_valid_ = false;
   VertexId n_points_ = 0;
