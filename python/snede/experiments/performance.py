@@ -27,7 +27,9 @@ CG_RTOL = 1e-3  # §3.3: ‖r‖ < 1e-3‖f_ext‖
 THESIS_ITERATIONS_PER_SECOND = 55  # §3.3, Pentium III 1 GHz
 THESIS_ITERATIONS = (100, 300)
 STIFFNESS_SAMPLE = 200  # element_stiffness calls timed per size (the public call is O(n_cells), see below)
-REFERENCE_BYTES_PER_TET = 80  # per-element reference data of the kernels: Z⁻¹ (9 doubles) and |τ|
+# Per-element data the kernels stream (engine/fem/element_stream): Z⁻¹ (9 doubles), |τ| and the
+# four vertex ids (int32)
+REFERENCE_BYTES_PER_TET = 96
 
 
 def lame(young: float, poisson: float) -> tuple[float, float]:
@@ -394,7 +396,7 @@ def describe(products, assemblies, cube, quick: bool, divisions) -> str:
         "Matrix bytes are values plus column indices plus row pointers, computed from `MatGetInfo`'s nonzeros "
         "(its 'memory' field is 0 for these formats in PETSc 3.18). The shell's own data is the kernels' "
         f"reference data, {REFERENCE_BYTES_PER_TET} "
-        "bytes per tetrahedron (Z⁻¹ and |τ|); the mesh (connectivity and coordinates, `Mesh.memory_bytes`) is "
+        "bytes per tetrahedron (Z⁻¹, |τ| and the vertex ids, streamed in blocks of four elements); the mesh (connectivity and coordinates, `Mesh.memory_bytes`) is "
         "needed by both approaches and shown separately.", "",
         "## Time per product and memory", "", markdown_table(products, PRODUCT_COLUMNS),
         "![time per product and memory](performance.png)", "",
