@@ -353,11 +353,16 @@ def animate(frames, path, draw, fps: int = 10, projection: str | None = None) ->
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     writer = PillowWriter(fps=fps)
-    with writer.saving(fig, str(path), dpi=72):
+    # Not writer.saving(): on an exception (Ctrl-C while drawing) it would still call finish(),
+    # which fails on a GIF without frames and hides the exception; nothing is written instead.
+    writer.setup(fig, str(path), dpi=72)
+    try:
         for frame in frames:
             for artist in [*ax.collections, *ax.lines, *ax.texts]:
                 artist.remove()
             draw(ax, frame)
             writer.grab_frame()
-    plt.close(fig)
+        writer.finish()
+    finally:
+        plt.close(fig)
     return path

@@ -9,6 +9,8 @@ import sys
 import textwrap
 import time
 
+import pytest
+
 from snede.output import read_series
 
 LONG_SOLVE = textwrap.dedent("""
@@ -17,7 +19,8 @@ LONG_SOLVE = textwrap.dedent("""
     body = snede.Body(mesh, snede.LinearElastic(1e5, 0.3), density=1000.0)
     body.fix(np.isclose(mesh.points[:, 0], 0.0))
     body.add_gravity((0, 0, -9.81))
-    solver = snede.StaticSolver(body, "cg", rtol=1e-13)  # about 1500 iterations, 15 s
+    # Below round-off: CG runs to its iteration limit (about 30 s), far longer than the delay.
+    solver = snede.StaticSolver(body, "cg", rtol=1e-17, max_iterations=30000)
     print("solving", flush=True)
     try:
         print("finished:", solver.solve(), flush=True)
@@ -79,3 +82,16 @@ def test_the_command_line_stops_with_one_line_and_the_series_so_far_reads_back(t
     for step in steps:
         step.mesh.validate()
         assert step.displacement.shape == (step.mesh.n_points, 2)
+
+
+def test_ctrl_c_while_a_gif_is_drawn_stays_a_keyboard_interrupt(tmp_path):
+    # matplotlib's writer.saving() called finish() on the way out, which raised IndexError on a
+    # GIF without frames and hid the KeyboardInterrupt (the command line then exited 1).
+    from snede.plotting import animate
+
+    def draw(ax, frame):
+        raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        animate([0, 1], tmp_path / "cut.gif", draw)
+    assert not (tmp_path / "cut.gif").exists() or (tmp_path / "cut.gif").stat().st_size == 0
