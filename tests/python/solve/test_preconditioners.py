@@ -198,3 +198,19 @@ def test_the_stopping_test_sees_the_true_residual_not_the_preconditioned_one(pre
     # large corrections); the preconditioned norms it reported before were 0.46× and 2.2× the
     # true residual for two of the three on this sheet.
     assert result.residual_history[-1] == pytest.approx(result.residual_norm, rel=0.25)
+
+
+@pytest.mark.parametrize("options", [{}, {"snes_lag_preconditioner": 2}], ids=["refilled", "lagged"])
+def test_newton_with_gamg_converges_before_and_after_a_refinement(options):
+    body = cantilever(2, snede.NeoHookean(1e5, 0.3))
+    solver = snede.StaticSolver(body, "newton", rtol=1e-8, preconditioner="gamg", petsc_options=options)
+    first = solver.solve()
+    assert first.converged, first
+    body.refine_around((0.5, 0.1, 0.1), 0.05)
+    after = solver.solve()
+    assert after.converged, after
+    carried = body.displacement.copy()
+    body.displacement = np.zeros_like(carried)
+    plain = snede.StaticSolver(body, "newton", rtol=1e-8, options_prefix="plain_newton_").solve()
+    assert plain.converged, plain
+    np.testing.assert_allclose(carried, body.displacement, atol=1e-6 * np.abs(carried).max())
