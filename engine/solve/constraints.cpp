@@ -1,6 +1,7 @@
 #include "solve/constraints.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <stdexcept>
 #include <unordered_map>
@@ -92,46 +93,46 @@ void Constraints::project(std::span<double> v) const {
   }
 }
 
+namespace {
+
+// (I − P) x for one vertex's dim numbers, into out (which may be x).
+void complement_of(const VertexConstraint& c, int dim, const double* x, double* out) {
+  if (c.kind == ConstraintKind::free) {
+    std::fill_n(out, dim, 0.0);
+  } else if (c.kind == ConstraintKind::slide) {
+    double along = 0;
+    for (int k = 0; k < dim; ++k) along += x[k] * c.direction[k];
+    for (int k = 0; k < dim; ++k) out[k] = x[k] - along * c.direction[k];
+  } else {  // fixed or absent: P = 0
+    std::copy_n(x, dim, out);
+  }
+}
+
+}  // namespace
+
 void Constraints::projection_block(VertexId v, std::span<double> block) const {
   check_vertex(v);
-  const VertexConstraint& c = vertices_[v];
-  for (int i = 0; i < dim_; ++i)
-    for (int j = 0; j < dim_; ++j) {
-      double& p = block[static_cast<std::size_t>(i * dim_ + j)];
-      if (c.kind == ConstraintKind::free) p = i == j ? 1.0 : 0.0;
-      else if (c.kind == ConstraintKind::slide) p = c.direction[i] * c.direction[j];
-      else p = 0.0;  // fixed or absent
-    }
+  // Column j of P is e_j − (I − P) e_j.
+  std::array<double, 3> unit{}, complement{};
+  for (int j = 0; j < dim_; ++j) {
+    unit.fill(0.0);
+    unit[j] = 1.0;
+    complement_of(vertices_[v], dim_, unit.data(), complement.data());
+    for (int i = 0; i < dim_; ++i) block[static_cast<std::size_t>(i * dim_ + j)] = unit[i] - complement[i];
+  }
 }
 
 void Constraints::add_complement(std::span<const double> v, std::span<double> out) const {
+  std::array<double, 3> complement{};
   for (std::size_t i = 0; i < vertices_.size(); ++i) {
-    const VertexConstraint& c = vertices_[i];
-    if (c.kind == ConstraintKind::free) continue;
-    const double* x = v.data() + i * dim_;
-    double* y = out.data() + i * dim_;
-    if (c.kind == ConstraintKind::slide) {
-      double along = 0;
-      for (int k = 0; k < dim_; ++k) along += x[k] * c.direction[k];
-      for (int k = 0; k < dim_; ++k) y[k] += x[k] - along * c.direction[k];
-    } else {
-      for (int k = 0; k < dim_; ++k) y[k] += x[k];
-    }
+    if (vertices_[i].kind == ConstraintKind::free) continue;
+    complement_of(vertices_[i], dim_, v.data() + i * dim_, complement.data());
+    for (int k = 0; k < dim_; ++k) out[i * dim_ + k] += complement[k];
   }
 }
 
 void Constraints::project_complement(std::span<double> v) const {
-  for (std::size_t i = 0; i < vertices_.size(); ++i) {
-    const VertexConstraint& c = vertices_[i];
-    double* x = v.data() + i * dim_;
-    if (c.kind == ConstraintKind::free) {
-      for (int k = 0; k < dim_; ++k) x[k] = 0;
-    } else if (c.kind == ConstraintKind::slide) {
-      double along = 0;
-      for (int k = 0; k < dim_; ++k) along += x[k] * c.direction[k];
-      for (int k = 0; k < dim_; ++k) x[k] -= along * c.direction[k];
-    }
-  }
+  for (std::size_t i = 0; i < vertices_.size(); ++i) complement_of(vertices_[i], dim_, v.data() + i * dim_, v.data() + i * dim_);
 }
 
 void Constraints::enforce(std::span<double> u) const {

@@ -20,13 +20,13 @@ std::vector<double> projection_blocks(const Model& model) {
 }
 
 // Calls visit(e, vertices, K_e) for every element with its stiffness at u projected on both
-// sides, P_a K_ab P_b, rows and columns ordered by the element's oriented vertices, then by
+// sides, P_a K_ab P_b (P from projection_blocks), rows and columns ordered by the element's oriented vertices, then by
 // component (ElasticBody::element_stiffness's order). Inverted elements of a material that
 // forbids inversion are left out, as the shell leaves them out.
 template <class Visit>
-void for_each_projected_element_matrix(const Model& model, std::span<const double> u, Visit&& visit) {
+void for_each_projected_element_matrix(const Model& model, std::span<const double> u, const std::vector<double>& P,
+                                       Visit&& visit) {
   const int d = model.dim(), n = (d + 1) * d;
-  const std::vector<double> P = projection_blocks(model);
   std::vector<bool> free(model.body().mesh().n_points());
   for (VertexId v = 0; v < static_cast<VertexId>(free.size()); ++v)
     free[v] = model.constraints()[v].kind == ConstraintKind::free;
@@ -58,11 +58,10 @@ void for_each_projected_element_matrix(const Model& model, std::span<const doubl
   });
 }
 
-// The (I − P) block of every vertex, one after another (dim × dim, row-major).
-std::vector<double> complement_blocks(const Model& model) {
-  const int d = model.dim();
-  std::vector<double> blocks = projection_blocks(model);
-  for (std::size_t i = 0; i < blocks.size(); ++i) blocks[i] = ((i % (d * d)) % (d + 1) == 0 ? 1.0 : 0.0) - blocks[i];
+// The (I − P) blocks from the P blocks of projection_blocks.
+std::vector<double> complement_blocks(const std::vector<double>& P, int d) {
+  std::vector<double> blocks(P.size());
+  for (std::size_t i = 0; i < blocks.size(); ++i) blocks[i] = ((i % (d * d)) % (d + 1) == 0 ? 1.0 : 0.0) - P[i];
   return blocks;
 }
 
@@ -136,14 +135,15 @@ void AssembledTangent::assemble(const Model& model, Vec u) {
   if (!matches(model))
     throw std::logic_error("the assembled tangent was made for another mesh: the mesh changed since");
   const int d = model.dim(), n = (d + 1) * d;
-  const std::vector<double> complement = complement_blocks(model);
+  const std::vector<double> P = projection_blocks(model);
+  const std::vector<double> complement = complement_blocks(P, d);
   ReadView x(u);
   if (format_ == MatrixFormat::aij) {
     PetscScalar* values = nullptr;
     SNEDE_PETSC(MatSeqAIJGetArray(A_, &values));
     std::fill(values, values + row_start_.back(), 0.0);
-    for_each_projected_element_matrix(model, x.span(), [&](ElementId e, std::span<const VertexId> vertices,
-                                                           std::span<const double> K) {
+    for_each_projected_element_matrix(model, x.span(), P, [&](ElementId e, std::span<const VertexId> vertices,
+                                                              std::span<const double> K) {
       const std::int32_t* ranks = block_rank_.data() + static_cast<std::size_t>(e) * (d + 1) * (d + 1);
       for (int a = 0; a <= d; ++a)
         for (int i = 0; i < d; ++i) {
@@ -162,8 +162,8 @@ void AssembledTangent::assemble(const Model& model, Vec u) {
   } else {
     SNEDE_PETSC(MatZeroEntries(A_));
     std::vector<PetscInt> block_rows;
-    for_each_projected_element_matrix(model, x.span(), [&](ElementId, std::span<const VertexId> vertices,
-                                                           std::span<const double> K) {
+    for_each_projected_element_matrix(model, x.span(), P, [&](ElementId, std::span<const VertexId> vertices,
+                                                              std::span<const double> K) {
       block_rows.assign(vertices.begin(), vertices.end());
       const auto count = static_cast<PetscInt>(block_rows.size());
       SNEDE_PETSC(MatSetValuesBlocked(A_, count, block_rows.data(), count, block_rows.data(), K.data(), ADD_VALUES));
@@ -191,16 +191,17 @@ void set_rigid_body_near_null_space(const Model& model, Mat A) {
 
 void tangent_diagonal(const Model& model, Vec u, Vec diagonal) {
   const int d = model.dim(), n = (d + 1) * d;
+  const std::vector<double> P = projection_blocks(model);
   std::vector<double> values(model.body().n_dofs(), 0.0);
   {
     ReadView x(u);
-    for_each_projected_element_matrix(model, x.span(), [&](ElementId, std::span<const VertexId> vertices,
-                                                           std::span<const double> K) {
+    for_each_projected_element_matrix(model, x.span(), P, [&](ElementId, std::span<const VertexId> vertices,
+                                                              std::span<const double> K) {
       for (int row = 0; row < n; ++row)
         values[static_cast<std::size_t>(vertices[row / d]) * d + row % d] += K[static_cast<std::size_t>(row) * n + row];
     });
   }
-  const std::vector<double> complement = complement_blocks(model);
+  const std::vector<double> complement = complement_blocks(P, d);
   for (std::size_t dof = 0; dof < values.size(); ++dof) {
     const std::size_t v = dof / d, k = dof % d;
     values[dof] = model.operator_scale() * (values[dof] + complement[(v * d + k) * d + k]);
