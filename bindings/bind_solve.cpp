@@ -17,12 +17,10 @@ py::array_t<double> vec_to_array(Vec v, int dim) { return to_array(vec_values(v)
 void array_to_vec(const DoubleArray& a, Vec v) { set_vec_values(v, view(a)); }
 
 py::array_t<double> reactions_of(Model& model) {
-  Vec R = nullptr;
-  SNEDE_PETSC(VecDuplicate(model.displacement(), &R));
+  VecHandle R;
+  SNEDE_PETSC(VecDuplicate(model.displacement(), R.out()));
   model.reaction_forces(model.displacement(), R);
-  py::array_t<double> out = vec_to_array(R, model.dim());
-  SNEDE_PETSC(VecDestroy(&R));
-  return out;
+  return vec_to_array(R, model.dim());
 }
 
 std::unique_ptr<StaticSolver> make_static_solver(Model& model, const std::string& method, double rtol,
