@@ -6,6 +6,7 @@
 #include "solve/solve_result.hpp"
 #include "solve/static_solver.hpp"
 #include "solve/tangent_assembly.hpp"
+#include "topology/bisection.hpp"
 
 #include <pybind11/stl.h>
 
@@ -26,10 +27,11 @@ py::array_t<double> reactions_of(Model& model) {
 std::unique_ptr<StaticSolver> make_static_solver(Model& model, const std::string& method, double rtol,
                                                  const std::string& criterion, double round_tolerance,
                                                  int max_iterations, const std::string& prefix,
-                                                 const OptionList& petsc_options, const std::string& preconditioner) {
+                                                 const OptionList& petsc_options, const std::string& preconditioner,
+                                                 const Bisection* bisection) {
   StaticOptions options = static_options(method, rtol, criterion, round_tolerance, max_iterations, prefix, petsc_options);
   options.preconditioner = preconditioner;
-  return std::make_unique<StaticSolver>(model, std::move(options));
+  return std::make_unique<StaticSolver>(model, std::move(options), bisection ? &bisection->hierarchy() : nullptr);
 }
 
 // The shell at u: a petsc4py Mat sharing the model's (it applies J at the last point set).
@@ -116,8 +118,9 @@ void bind_solve(py::module_& m) {
   py::class_<StaticSolver>(m, "StaticSolver")
       .def(py::init(&make_static_solver), py::arg("model"), py::arg("method"), py::arg("rtol"), py::arg("criterion"),
            py::arg("round_tolerance"), py::arg("max_iterations"), py::arg("options_prefix"), py::arg("petsc_options"),
-           py::arg("preconditioner"), py::keep_alive<1, 2>())
+           py::arg("preconditioner"), py::arg("bisection"), py::keep_alive<1, 2>(), py::keep_alive<1, 11>())
       .def_property_readonly("preconditioner", &StaticSolver::preconditioner)
+      .def_property_readonly("multigrid_levels", &StaticSolver::multigrid_levels)
       .def("solve", &StaticSolver::solve)
       .def_property_readonly("ksp", [](const StaticSolver& s) { return to_petsc4py(s.ksp()); })
       .def_property_readonly("snes", [](const StaticSolver& s) {

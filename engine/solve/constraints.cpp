@@ -59,6 +59,11 @@ void Constraints::slide(std::span<const VertexId> vertices, std::span<const doub
   }
 }
 
+void Constraints::assign(VertexId v, const VertexConstraint& c) {
+  check_vertex(v);
+  vertices_[v] = c;
+}
+
 void Constraints::release(std::span<const VertexId> vertices) {
   for (VertexId v : vertices) {
     check_vertex(v);

@@ -35,6 +35,8 @@ class Constraints {
   // Slide along `direction` (dim numbers, normalised here) through the current displacement.
   void slide(std::span<const VertexId> vertices, std::span<const double> direction, std::span<const double> u);
   void release(std::span<const VertexId> vertices);
+  // Gives v the constraint `c` as it is (a copy of another mesh's vertex: a multigrid level).
+  void assign(VertexId v, const VertexConstraint& c);
   std::size_t n_constrained() const;
   // Number of independent constrained displacement components.
   std::size_t n_constrained_components() const;

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 
 #include "core/error.hpp"
 #include "core/interrupt.hpp"
@@ -38,10 +39,11 @@ constexpr double newton_stall = 1e-6;
 
 }  // namespace
 
-StaticSolver::StaticSolver(Model& model, StaticOptions options)
+StaticSolver::StaticSolver(Model& model, StaticOptions options, const RefinementHierarchy* hierarchy)
     : model_(model),
       options_(std::move(options)),
-      option_database_(options_.options_prefix, options_.petsc_options) {
+      option_database_(options_.options_prefix, options_.petsc_options),
+      hierarchy_(hierarchy) {
   if (options_.stopping.rtol <= 0 || !std::isfinite(options_.stopping.rtol))
     throw std::invalid_argument("rtol must be positive, got " + std::to_string(options_.stopping.rtol));
   if (!(options_.stopping.round_tolerance >= 0) || !std::isfinite(options_.stopping.round_tolerance))
@@ -59,8 +61,12 @@ StaticSolver::StaticSolver(Model& model, StaticOptions options)
   if (options_.method == StaticMethod::nonlinear_cg && pc_type_ != PCNONE)
     throw std::invalid_argument("a preconditioner ('" + pc_type_ + "') applies to the CG of methods 'cg' and 'newton'; "
                                 "nonlinear CG ('ncg') takes none");
-  // Jacobi reads the shell's diagonal (MatGetDiagonal); every other PC needs entries.
-  needs_matrix_ = pc_type_ != PCNONE && pc_type_ != PCJACOBI;
+  if (pc_type_ == PCMG && !hierarchy_)
+    throw std::invalid_argument("preconditioner 'mg' coarsens along the mesh's bisection hierarchy: refine the mesh "
+                                "by bisection (mesh.refine_uniform or refine_around) before making the solver");
+  // Jacobi reads the shell's diagonal (MatGetDiagonal), mg builds its own levels; every other
+  // PC needs entries.
+  needs_matrix_ = pc_type_ != PCNONE && pc_type_ != PCJACOBI && pc_type_ != PCMG;
   register_line_searches();
   create_objects();  // on a bad option the handles release what was made
 }
@@ -101,6 +107,7 @@ void StaticSolver::create_objects() {
     option_database_.use_for(pc);
     SNEDE_PETSC(PCSetType(pc, pc_type_.c_str()));
     SNEDE_PETSC(PCSetUseAmat(pc, PETSC_FALSE));  // see the Newton branch
+    set_up_multigrid(pc);
     SNEDE_PETSC(KSPSetOperators(ksp_, model_.tangent(), preconditioning_matrix()));
     SNEDE_PETSC(KSPSetTolerances(ksp_, 0.0, 0.0, PETSC_DEFAULT, options_.max_iterations));
     SNEDE_PETSC(KSPSetConvergenceTest(ksp_, ksp_converged_callback, this, nullptr));
@@ -142,13 +149,14 @@ void StaticSolver::create_objects() {
     // A multigrid PC smooths its finest level with the assembled matrix, not the shell (each
     // shell product costs several assembled ones); -<prefix>pc_use_amat turns it back.
     SNEDE_PETSC(PCSetUseAmat(pc, PETSC_FALSE));
+    set_up_multigrid(pc);
     // Truncated Newton (§2.4.3): the inner CG stops early, tightening as the outer converges,
     // and where the tangent is indefinite (far from the solution of a soft body) CG stops at
     // the negative curvature and its iterate so far is used as the search direction.
     // With a PC that is set up anew at every Newton iteration (GAMG on an assembled tangent),
     // a few accurate Newton steps cost less than many truncated ones: at 98 304 neo-Hookean
     // tetrahedra 9 iterations (inner rtol 1e-3) against 37–44 with Eisenstat-Walker.
-    if (needs_matrix_) {
+    if (needs_matrix_ || multigrid_) {
       SNEDE_PETSC(KSPSetTolerances(inner, 1e-3, PETSC_DEFAULT, PETSC_DEFAULT, PETSC_DEFAULT));
     } else {
       SNEDE_PETSC(SNESKSPSetUseEW(snes_, PETSC_TRUE));
@@ -167,10 +175,12 @@ void StaticSolver::create_objects() {
 void StaticSolver::follow_mesh_changes() {
   const bool resized = generation_ != model_.generation();
   const bool stale_matrix = needs_matrix_ && (!assembled_ || !assembled_->matches(model_));
-  if (!resized && !stale_matrix) return;
+  const bool stale_multigrid = multigrid_ && !multigrid_->matches(model_);
+  if (!resized && !stale_matrix && !stale_multigrid) return;
   generation_ = model_.generation();
   if (resized) SNEDE_PETSC(VecDuplicate(model_.displacement(), residual_.out()));
   assembled_.reset();  // its sparsity was the old mesh's (a flip or a cut changes it)
+  multigrid_.reset();
   if (ksp_) {
     SNEDE_PETSC(KSPReset(ksp_));
     SNEDE_PETSC(KSPSetOperators(ksp_, model_.tangent(), preconditioning_matrix()));
@@ -187,13 +197,14 @@ void StaticSolver::follow_mesh_changes() {
     if (options_.method == StaticMethod::newton)
       SNEDE_PETSC(SNESSetJacobian(snes_, model_.tangent(), preconditioning_matrix(), jacobian_callback, this));
   }
-  if (needs_matrix_) {
+  if (needs_matrix_ || pc_type_ == PCMG) {
     // A reset PCGAMG keeps its levels' sizes ("Cannot change local size of Amat after use"):
     // a fresh implementation of the same type, configured from the options again.
     PC pc = nullptr;
     SNEDE_PETSC(KSPGetPC(ksp(), &pc));
     SNEDE_PETSC(PCSetType(pc, PCNONE));
     SNEDE_PETSC(PCSetType(pc, pc_type_.c_str()));
+    set_up_multigrid(pc);
     SNEDE_PETSC(PCSetFromOptions(pc));
   }
 }
@@ -208,6 +219,30 @@ Mat StaticSolver::preconditioning_matrix() {
   return assembled_->mat();
 }
 
+void StaticSolver::set_up_multigrid(PC pc) {
+  if (pc_type_ != PCMG) return;
+  const std::optional<std::string> galerkin = option_database_.string_option(options_.options_prefix + "pc_mg_galerkin");
+  if (galerkin && *galerkin != "none" && *galerkin != "false" && *galerkin != "0")
+    throw std::invalid_argument("-" + options_.options_prefix + "pc_mg_galerkin: 'mg' gives every level its own "
+                                "matrix-free operator from the element kernels; Galerkin products need assembled "
+                                "matrices (use 'gamg')");
+  // PCMG's own -pc_mg_levels would replace the levels configured here: it limits them instead.
+  const std::optional<std::string> levels = option_database_.string_option(options_.options_prefix + "pc_mg_levels");
+  int max_levels = 0;
+  if (levels) {
+    try {
+      std::size_t used = 0;
+      max_levels = std::stoi(*levels, &used);
+      if (used != levels->size()) throw std::invalid_argument(*levels);
+    } catch (const std::exception&) {
+      throw std::invalid_argument("-" + options_.options_prefix + "pc_mg_levels must be an integer, got '" + *levels + "'");
+    }
+  }
+  multigrid_ = std::make_unique<BisectionMultigrid>(model_, *hierarchy_, max_levels);
+  multigrid_->configure(pc, option_database_);
+  preconditioner_filled_ = false;
+}
+
 void StaticSolver::refill_preconditioner(SNES snes, Vec x) {
   PetscInt lag = 1, iteration = 0;
   SNEDE_PETSC(SNESGetLagPreconditioner(snes, &lag));
@@ -215,7 +250,8 @@ void StaticSolver::refill_preconditioner(SNES snes, Vec x) {
   // As SNES decides whether to rebuild the PC: -1 never again, k > 1 every k-th iteration.
   const bool lagged = (lag == -1 || (lag > 1 && iteration % lag != 0)) && preconditioner_filled_;
   if (lagged) return;
-  assembled_->assemble(model_, x);
+  if (assembled_) assembled_->assemble(model_, x);
+  if (multigrid_) multigrid_->update(x);
   preconditioner_filled_ = true;
 }
 
@@ -269,6 +305,7 @@ SolveResult StaticSolver::solve_linear() {
   SNEDE_PETSC(VecSet(step, 0.0));
   const ScaledOperator scaled(model_, system_scale_);
   if (needs_matrix_) assembled_->assemble(model_, u);
+  if (multigrid_) multigrid_->update(u);
   SNEDE_PETSC(KSPSolve(ksp_, rhs, step));
   SNEDE_PETSC(VecAXPY(u, 1.0, step));
   KSPConvergedReason reason;
@@ -404,7 +441,7 @@ PetscErrorCode StaticSolver::jacobian_callback(SNES snes, Vec x, Mat J, Mat P, v
     self.model_.set_linearization_point(x);
     SNEDE_PETSC(MatAssemblyBegin(J, MAT_FINAL_ASSEMBLY));
     SNEDE_PETSC(MatAssemblyEnd(J, MAT_FINAL_ASSEMBLY));
-    if (P != J) self.refill_preconditioner(snes, x);
+    if (P != J || self.multigrid_) self.refill_preconditioner(snes, x);
   });
 }
 

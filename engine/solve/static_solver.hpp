@@ -16,6 +16,7 @@
 #include "core/solver_options.hpp"
 #include <memory>
 
+#include "solve/bisection_multigrid.hpp"
 #include "solve/model.hpp"
 #include "solve/tangent_assembly.hpp"
 #include "solve/solve_result.hpp"
@@ -32,7 +33,8 @@ struct StaticOptions {
   std::string options_prefix = "static_";
   // The PETSc PC type of the CG (linear, or Newton's inner one): "none", "jacobi" (from the
   // shell's diagonal, no matrix), "gamg" (on an assembled tangent with the rigid-body near null
-  // space) or any PETSc PC that works on an assembled matrix ("ilu", "icc", "sor", ...).
+  // space), "mg" (geometric multigrid on the bisection hierarchy, matrix-free on every level;
+  // needs the hierarchy) or any PETSc PC that works on an assembled matrix ("ilu", "icc", ...).
   // Empty: -<prefix>pc_type if given, else "none". -<prefix>pc_type on the command line wins.
   std::string preconditioner;
   OptionList petsc_options;  // this solver's PETSc options, without the prefix
@@ -40,7 +42,9 @@ struct StaticOptions {
 
 class StaticSolver {
  public:
-  StaticSolver(Model& model, StaticOptions options);
+  // hierarchy: the mesh's bisection hierarchy, for the "mg" preconditioner (may be null
+  // otherwise); it must outlive the solver.
+  StaticSolver(Model& model, StaticOptions options, const RefinementHierarchy* hierarchy = nullptr);
   ~StaticSolver();
   StaticSolver(const StaticSolver&) = delete;
   StaticSolver& operator=(const StaticSolver&) = delete;
@@ -53,6 +57,11 @@ class StaticSolver {
   // The PC type in use, and the assembled matrix it is built from (null without one).
   const std::string& preconditioner() const { return pc_type_; }
   Mat preconditioner_matrix() const { return assembled_ ? assembled_->mat() : nullptr; }
+  // Elements per multigrid level, coarsest first (empty unless the PC is "mg" and a solve or
+  // the construction has built the levels).
+  std::vector<std::size_t> multigrid_levels() const {
+    return multigrid_ ? multigrid_->level_cells() : std::vector<std::size_t>{};
+  }
   Model& model() { return model_; }
 
  private:
@@ -62,8 +71,10 @@ class StaticSolver {
   void follow_mesh_changes();
   // The matrix the PC is built from: the shell, or an assembled tangent for the current mesh.
   Mat preconditioning_matrix();
-  // Newton's Jacobian callback: the assembled tangent is refilled unless the SNES lags the
-  // preconditioner at this iteration (-<prefix>snes_lag_preconditioner).
+  // The multigrid levels for the current mesh, configured on `pc` (PC "mg").
+  void set_up_multigrid(PC pc);
+  // Newton's Jacobian callback: the assembled tangent (or the multigrid levels) are refilled
+  // unless the SNES lags the preconditioner at this iteration (-<prefix>snes_lag_preconditioner).
   void refill_preconditioner(SNES snes, Vec x);
   double current_tolerance() const;
   SolveResult solve_linear();
@@ -87,6 +98,8 @@ class StaticSolver {
   std::string pc_type_;
   bool needs_matrix_ = false;          // the PC needs entries: an assembled tangent
   std::unique_ptr<AssembledTangent> assembled_;  // that tangent, for the current mesh
+  const RefinementHierarchy* hierarchy_ = nullptr;
+  std::unique_ptr<BisectionMultigrid> multigrid_;  // PC "mg": the levels for the current mesh
   bool preconditioner_filled_ = false;  // filled since it was made (for lagging)
   std::uint64_t generation_ = 0;
   StoppingRule rule_;  // the stopping rule of the current solve, scaled to the model

@@ -253,6 +253,10 @@ class Mesh(MeshEdits):
             bisection = self.__dict__["_bisection_impl"] = _snede.Bisection(self._impl)
         return bisection
 
+    def _bisection_if_any(self):
+        """The engine's bisection state if the mesh was ever refined by bisection, else None."""
+        return self.__dict__.get("_bisection_impl")
+
     def refine_uniform(self, levels: int = 1) -> int:
         """Bisect every cell ``levels`` times by conforming bisection (§6.5: newest-vertex in
         2D, Maubach's in 3D). On ``meshing.rectangle`` and ``meshing.box`` each level doubles

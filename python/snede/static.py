@@ -37,7 +37,13 @@ class StaticSolver:
       (algebraic multigrid on a tangent assembled from the same element kernels, with the
       rigid-body modes as near null space; refilled at every Newton iteration unless
       ``-static_snes_lag_preconditioner k`` lags it, rebuilt after a cut or refinement); or any
-      PETSc PC that works on an assembled matrix (``"ilu"``, ``"icc"``, ``"sor"``, ``"lu"``).
+      PETSc PC that works on an assembled matrix (``"ilu"``, ``"icc"``, ``"sor"``, ``"lu"``);
+      or ``"mg"``: geometric multigrid on the mesh's bisection hierarchy (§6.5), for a mesh
+      refined with ``mesh.refine_uniform`` or ``refine_around``. Its coarse levels are cuts
+      through the refinement tree, each with its own matrix-free tangent shell over the same
+      element kernels (linearised at the injected state), Chebyshev/Jacobi smoothing and LU on
+      the coarsest level; ``multigrid_levels`` lists their sizes. ``-static_mg_levels_ksp_type``
+      and the other ``-static_mg_*`` options of PETSc's PCMG tune it.
       None (default): ``-static_pc_type`` if given, else ``"none"``. ``-static_pc_type`` on the
       command line wins over the argument. The shell stays the operator in every case.
 
@@ -73,7 +79,8 @@ class StaticSolver:
         self.body = body
         self.method = method
         self._impl = _snede.StaticSolver(body._model, method, float(rtol), criterion, float(round_tolerance),
-                                         max_iterations, options_prefix, option_list(options), preconditioner or "")
+                                         max_iterations, options_prefix, option_list(options), preconditioner or "",
+                                         body.mesh._bisection_if_any())
 
     def solve(self) -> SolveResult:
         return SolveResult._from_engine(self._impl.solve())
@@ -82,6 +89,12 @@ class StaticSolver:
     def preconditioner(self) -> str:
         """The PETSc PC type the CG uses ("none" for ncg)."""
         return self._impl.preconditioner
+
+    @property
+    def multigrid_levels(self) -> list[int]:
+        """Elements per level of the ``"mg"`` preconditioner, coarsest first, the body's mesh
+        last (empty for other preconditioners); rebuilt at the first solve after a mesh change."""
+        return list(self._impl.multigrid_levels)
 
     @property
     def ksp(self):
