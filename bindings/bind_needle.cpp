@@ -6,25 +6,34 @@
 namespace snede::bindings {
 namespace {
 
-Point2 point2(const DoubleArray& a, const char* name) {
-  if (a.size() != 2) throw std::invalid_argument(std::string(name) + " must have 2 components, got " + std::to_string(a.size()));
-  return {a.data()[0], a.data()[1]};
+Point point_of(const DoubleArray& a, int dim, const char* name) {
+  if (a.size() != dim)
+    throw std::invalid_argument(std::string(name) + " must have " + std::to_string(dim) + " components for this " +
+                                std::to_string(dim) + "-D body, got " + std::to_string(a.size()));
+  Point x{0, 0, 0};
+  std::copy_n(a.data(), dim, x.begin());
+  return x;
 }
+
+std::vector<double> point_vector(const Point& x, int dim) { return {x.begin(), x.begin() + dim}; }
 
 std::unique_ptr<NeedleInsertion> make_needle(Model& model, Bisection* bisection, const DoubleArray& entry,
                                              const DoubleArray& direction, const FrictionProfile& friction,
-                                             double static_factor, std::optional<double> h_ref, int max_rearrangements, int solves_per_update, bool extrapolate,
+                                             double static_factor, std::optional<double> h_ref, double radius,
+                                             int max_rearrangements, int solves_per_update, bool extrapolate,
                                              const std::string& method, double rtol, const std::string& criterion,
                                              double round_tolerance, int max_iterations, const std::string& prefix,
                                              const OptionList& petsc_options) {
   NeedleOptions options;
   options.static_factor = static_factor;
   options.h_ref = h_ref;
+  options.radius = radius;
   options.max_rearrangements = max_rearrangements;
   options.solves_per_update = solves_per_update;
   options.extrapolate = extrapolate;
   return std::make_unique<NeedleInsertion>(
-      model, bisection, point2(entry, "entry"), point2(direction, "direction"), friction, options,
+      model, bisection, point_of(entry, model.dim(), "entry"), point_of(direction, model.dim(), "direction"), friction,
+      options,
       static_options(method, rtol, criterion, round_tolerance, max_iterations, prefix, petsc_options));
 }
 
@@ -61,16 +70,16 @@ void bind_needle(py::module_& m) {
 
   py::class_<NeedleInsertion>(m, "NeedleInsertion")
       .def(py::init(&make_needle), py::arg("model"), py::arg("bisection"), py::arg("entry"), py::arg("direction"),
-           py::arg("friction"), py::arg("static_factor"), py::arg("h_ref"), py::arg("max_rearrangements"), py::arg("solves_per_update"), py::arg("extrapolate"),
+           py::arg("friction"), py::arg("static_factor"), py::arg("h_ref"), py::arg("radius"), py::arg("max_rearrangements"), py::arg("solves_per_update"), py::arg("extrapolate"),
            py::arg("method"), py::arg("rtol"), py::arg("criterion"), py::arg("round_tolerance"),
            py::arg("max_iterations"), py::arg("options_prefix"), py::arg("petsc_options"), py::keep_alive<1, 2>(),
            py::keep_alive<1, 3>())
       .def("advance", &NeedleInsertion::advance, py::arg("distance"))
       .def("settle", &NeedleInsertion::settle)
       .def_property_readonly("depth", &NeedleInsertion::depth)
-      .def_property_readonly("tip", &NeedleInsertion::tip)
-      .def_property_readonly("entry", &NeedleInsertion::entry)
-      .def_property_readonly("direction", &NeedleInsertion::direction)
+      .def_property_readonly("tip", [](const NeedleInsertion& n) { return point_vector(n.tip(), n.dim()); })
+      .def_property_readonly("entry", [](const NeedleInsertion& n) { return point_vector(n.entry(), n.dim()); })
+      .def_property_readonly("direction", [](const NeedleInsertion& n) { return point_vector(n.direction(), n.dim()); })
       .def_property_readonly("needle_nodes", [](const NeedleInsertion& n) {
         std::vector<VertexId> ids;
         for (const NeedleNode& node : n.needle_nodes()) ids.push_back(node.vertex);
@@ -88,7 +97,7 @@ void bind_needle(py::module_& m) {
       .def_property_readonly("static_thresholds",
                              [](const NeedleInsertion& n) { return node_field(n, &NeedleNode::static_threshold); })
       .def_property_readonly("friction", [](const NeedleInsertion& n) { return node_field(n, &NeedleNode::friction); })
-      .def("needle_forces", [](NeedleInsertion& n) { return to_array(n.needle_forces(), 2); });
+      .def("needle_forces", [](NeedleInsertion& n) { return to_array(n.needle_forces(), n.dim()); });
 }
 
 }  // namespace snede::bindings

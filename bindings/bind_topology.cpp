@@ -3,6 +3,7 @@
 #include "topology/bisection.hpp"
 #include "topology/dissect.hpp"
 #include "topology/refine_around.hpp"
+#include "topology/refine_near_segment.hpp"
 
 #include <pybind11/stl.h>
 
@@ -27,6 +28,11 @@ void bind_topology(py::module_& m) {
   py::class_<Bisection>(m, "Bisection")
       .def(py::init<Mesh&>(), py::arg("mesh"), py::keep_alive<1, 2>())
       .def("refine_uniform", &Bisection::refine_uniform, py::arg("levels"))
+      .def("refine_near_segment",
+           [](Bisection& b, const DoubleArray& a, const DoubleArray& c, double h, double radius) {
+             return refine_near_segment(b, view(a), view(c), h, radius);
+           },
+           py::arg("a"), py::arg("b"), py::arg("h"), py::arg("radius"))
       .def("refine_around",
            [](Bisection& b, const DoubleArray& x, double h) { return refine_around(b, view(x), h); },
            py::arg("point"), py::arg("h"))

@@ -115,7 +115,9 @@ DelaunayCutter::Point DelaunayCutter::reference(VertexId v) const {
 }
 
 DelaunayCutter::Point DelaunayCutter::deformed(VertexId v, std::span<const double> u) const {
-  return u.empty() ? reference(v) : deformed_point(mesh_, u, v);
+  if (u.empty()) return reference(v);
+  const snede::Point x = deformed_point(mesh_, u, v);
+  return {x[0], x[1]};
 }
 
 ElementId DelaunayCutter::locate(const Point& x, std::span<const double> u, VertexId from) const {

@@ -6,67 +6,147 @@
 namespace snede {
 namespace {
 
-double cross(const Point2& a, const Point2& b) { return a[0] * b[1] - a[1] * b[0]; }
-Point2 minus(const Point2& a, const Point2& b) { return {a[0] - b[0], a[1] - b[1]}; }
+Point minus(const Point& a, const Point& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
+double dot(const Point& a, const Point& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+Point cross(const Point& a, const Point& b) {
+  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
+}
+// The z component of a × b: the signed area in the plane.
+double cross2(const Point& a, const Point& b) { return a[0] * b[1] - a[1] * b[0]; }
+double triple(const Point& a, const Point& b, const Point& c) { return dot(a, cross(b, c)); }
+
+// Distance from x to the line through a with unit direction t.
+double line_distance(const Point& x, const Point& a, const Point& t) {
+  const Point r = minus(x, a);
+  const double along = dot(r, t);
+  return std::sqrt(std::max(0.0, dot(r, r) - along * along));
+}
+
+bool boxes_miss(const std::vector<Point>& corners, const Point& lo, const Point& hi, int d) {
+  for (int k = 0; k < d; ++k) {
+    double mn = corners[0][k], mx = corners[0][k];
+    for (const Point& p : corners) {
+      mn = std::min(mn, p[k]);
+      mx = std::max(mx, p[k]);
+    }
+    if (mx < lo[k] || mn > hi[k]) return true;
+  }
+  return false;
+}
+
+// Edge p–q against segment a–b in the plane: the parameter along a→b, or none.
+std::optional<double> crossing_2d(const Point& a, const Point& b, const Point& p, const Point& q) {
+  const Point ab = minus(b, a);
+  const double dp = cross2(ab, minus(p, a)), dq = cross2(ab, minus(q, a));
+  if ((dp > 0 && dq > 0) || (dp < 0 && dq < 0) || (dp == 0 && dq == 0)) return std::nullopt;
+  const Point pq = minus(q, p);
+  const double da = cross2(pq, minus(a, p)), db = cross2(pq, minus(b, p));
+  if ((da > 0 && db > 0) || (da < 0 && db < 0)) return std::nullopt;
+  return da / (da - db);  // da ≠ db: the edge is not parallel to the segment
+}
+
+// Triangle p, q, r against segment a–b in space (signed volumes): the parameter, or none. A
+// segment in the triangle's plane does not cross it.
+std::optional<double> crossing_3d(const Point& a, const Point& b, const Point& p, const Point& q, const Point& r) {
+  const double va = triple(minus(q, p), minus(r, p), minus(a, p)), vb = triple(minus(q, p), minus(r, p), minus(b, p));
+  if ((va > 0 && vb > 0) || (va < 0 && vb < 0) || va == vb) return std::nullopt;
+  const Point ab = minus(b, a);
+  const double s0 = triple(ab, minus(p, a), minus(q, a)), s1 = triple(ab, minus(q, a), minus(r, a)),
+               s2 = triple(ab, minus(r, a), minus(p, a));
+  if ((s0 < 0 || s1 < 0 || s2 < 0) && (s0 > 0 || s1 > 0 || s2 > 0)) return std::nullopt;  // passes beside it
+  return va / (va - vb);
+}
 
 }  // namespace
 
-Point2 deformed_point(const Mesh& mesh, std::span<const double> u, VertexId v) {
+Point deformed_point(const Mesh& mesh, std::span<const double> u, VertexId v) {
   const auto X = mesh.point(v);
-  const std::size_t i = static_cast<std::size_t>(v) * 2;
-  return {X[0] + u[i], X[1] + u[i + 1]};
+  const int d = mesh.dim();
+  const std::size_t i = static_cast<std::size_t>(v) * d;
+  Point x{0, 0, 0};
+  for (int k = 0; k < d; ++k) x[k] = X[k] + u[i + k];
+  return x;
 }
 
-std::optional<Point2> reference_position(const Mesh& mesh, std::span<const double> u, const Point2& x) {
+std::optional<Point> reference_position(const Mesh& mesh, std::span<const double> u, const Point& x) {
   const Connectivity& c = mesh.connectivity();
-  double best = -1e-12;  // the most interior containing triangle wins (x on an edge: either)
-  std::optional<Point2> found;
+  const int d = mesh.dim();
+  double best = -1e-12;  // the most interior containing element wins (x on a face: either)
+  std::optional<Point> found;
+  std::array<double, 4> lambda{};
   for (ElementId e = 0; e < c.element_capacity(); ++e) {
     if (!c.is_element(e)) continue;
     const Simplex& t = c.element(e).simplex;
-    const Point2 p0 = deformed_point(mesh, u, t.vertex(0)), p1 = deformed_point(mesh, u, t.vertex(1)),
-                 p2 = deformed_point(mesh, u, t.vertex(2));
-    const double area = cross(minus(p1, p0), minus(p2, p0));
-    if (area == 0) continue;
-    const double l1 = cross(minus(x, p0), minus(p2, p0)) / area;
-    const double l2 = cross(minus(p1, p0), minus(x, p0)) / area;
-    const double l0 = 1 - l1 - l2;
-    const double smallest = std::min({l0, l1, l2});
+    const Point p0 = deformed_point(mesh, u, t.vertex(0)), p1 = deformed_point(mesh, u, t.vertex(1)),
+                p2 = deformed_point(mesh, u, t.vertex(2));
+    if (d == 2) {
+      const double area = cross2(minus(p1, p0), minus(p2, p0));
+      if (area == 0) continue;
+      lambda[1] = cross2(minus(x, p0), minus(p2, p0)) / area;
+      lambda[2] = cross2(minus(p1, p0), minus(x, p0)) / area;
+      lambda[0] = 1 - lambda[1] - lambda[2];
+    } else {
+      const Point p3 = deformed_point(mesh, u, t.vertex(3));
+      const Point e1 = minus(p1, p0), e2 = minus(p2, p0), e3 = minus(p3, p0), r = minus(x, p0);
+      const double volume = triple(e1, e2, e3);
+      if (volume == 0) continue;
+      lambda[1] = triple(r, e2, e3) / volume;
+      lambda[2] = triple(e1, r, e3) / volume;
+      lambda[3] = triple(e1, e2, r) / volume;
+      lambda[0] = 1 - lambda[1] - lambda[2] - lambda[3];
+    }
+    const double smallest = *std::min_element(lambda.begin(), lambda.begin() + d + 1);
     if (smallest < best) continue;
     best = smallest;
-    const auto X0 = mesh.point(t.vertex(0)), X1 = mesh.point(t.vertex(1)), X2 = mesh.point(t.vertex(2));
-    found = Point2{l0 * X0[0] + l1 * X1[0] + l2 * X2[0], l0 * X0[1] + l1 * X1[1] + l2 * X2[1]};
+    Point X{0, 0, 0};
+    for (int i = 0; i <= d; ++i)
+      for (int k = 0; k < d; ++k) X[k] += lambda[i] * mesh.point(t.vertex(i))[k];
+    found = X;
   }
   return found;
 }
 
-std::vector<ShaftCrossing> shaft_crossings(const Mesh& mesh, std::span<const double> u, const Point2& a,
-                                           const Point2& b) {
+std::vector<ShaftCrossing> shaft_crossings(const Mesh& mesh, std::span<const double> u, const Point& a,
+                                           const Point& b) {
   std::vector<ShaftCrossing> crossings;
-  const Point2 ab = minus(b, a);
-  const double length = std::hypot(ab[0], ab[1]);
+  const int d = mesh.dim();
+  const Point ab = minus(b, a);
+  const double length = std::sqrt(dot(ab, ab));
   if (length == 0) return crossings;
-  const Point2 lo{std::min(a[0], b[0]), std::min(a[1], b[1])}, hi{std::max(a[0], b[0]), std::max(a[1], b[1])};
+  const Point axis{ab[0] / length, ab[1] / length, ab[2] / length};
+  Point lo{}, hi{};
+  for (int k = 0; k < 3; ++k) {
+    lo[k] = std::min(a[k], b[k]);
+    hi[k] = std::max(a[k], b[k]);
+  }
   const Connectivity& c = mesh.connectivity();
+  std::vector<Point> corners(d);
+  std::vector<VertexId> ids(d);
   for (ElementId e = 0; e < c.element_capacity(); ++e) {
     if (!c.is_element(e)) continue;
-    for (int j = 0; j < 3; ++j) {
+    for (int j = 0; j <= d; ++j) {
       const FaceId f = c.element(e).faces[j];
       const Face& face = c.face(f);
-      if (face.mate != no_id && face.mate < f) continue;  // each interior edge once
-      const VertexId vp = face.simplex.vertex(0), vq = face.simplex.vertex(1);
-      const Point2 p = deformed_point(mesh, u, vp), q = deformed_point(mesh, u, vq);
-      if (std::max(p[0], q[0]) < lo[0] || std::min(p[0], q[0]) > hi[0] || std::max(p[1], q[1]) < lo[1] ||
-          std::min(p[1], q[1]) > hi[1])
-        continue;
-      const double dp = cross(ab, minus(p, a)), dq = cross(ab, minus(q, a));
-      if ((dp > 0 && dq > 0) || (dp < 0 && dq < 0) || (dp == 0 && dq == 0)) continue;
-      const Point2 pq = minus(q, p);
-      const double da = cross(pq, minus(a, p)), db = cross(pq, minus(b, p));
-      if ((da > 0 && db > 0) || (da < 0 && db < 0)) continue;
-      const double t = da / (da - db);  // da ≠ db: the edge is not parallel to the segment
-      const bool p_nearer = std::abs(dp) < std::abs(dq) || (std::abs(dp) == std::abs(dq) && vp < vq);
-      crossings.push_back({p_nearer ? vp : vq, p_nearer ? vq : vp, t * length, face.mate == no_id});
+      if (face.mate != no_id && face.mate < f) continue;  // each interior face once
+      for (int i = 0; i < d; ++i) {
+        ids[i] = face.simplex.vertex(i);
+        corners[i] = deformed_point(mesh, u, ids[i]);
+      }
+      if (boxes_miss(corners, lo, hi, d)) continue;
+      const std::optional<double> t = d == 2 ? crossing_2d(a, b, corners[0], corners[1])
+                                             : crossing_3d(a, b, corners[0], corners[1], corners[2]);
+      if (!t) continue;
+      // The corner nearest the shaft's line (ties: the lower id, for determinism).
+      int nearest = 0;
+      double nearest_distance = line_distance(corners[0], a, axis);
+      for (int i = 1; i < d; ++i) {
+        const double distance = line_distance(corners[i], a, axis);
+        if (distance < nearest_distance || (distance == nearest_distance && ids[i] < ids[nearest])) {
+          nearest = i;
+          nearest_distance = distance;
+        }
+      }
+      crossings.push_back({ids[nearest], *t * length, face.mate == no_id});
     }
   }
   return crossings;

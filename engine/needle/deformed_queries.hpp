@@ -1,7 +1,7 @@
-// Queries on a deformed 2D triangle mesh (points X + u) for the needle (§6.4): where a point
-// of space lies in the reference configuration, and which mesh edges the shaft crosses.
-// They scan the elements (O(n) per call); the needle's meshes are small and the scan is a few
-// microseconds per thousand triangles.
+// Queries on a deformed triangle (2D) or tetrahedral (3D) mesh, points X + u, for the needle
+// (§6.4, §6.9): where a point of space lies in the reference configuration, and which mesh
+// edges (2D) or faces (3D) the shaft crosses. They scan the elements (O(n) per call): a few
+// microseconds per thousand elements.
 #pragma once
 
 #include <array>
@@ -13,25 +13,26 @@
 
 namespace snede {
 
-using Point2 = std::array<double, 2>;
+// A point of the needle's space; in 2D the third coordinate is 0.
+using Point = std::array<double, 3>;
 
-// Where vertex v is in the deformed mesh: X_v + u_v. u: (n_points, 2).
-Point2 deformed_point(const Mesh& mesh, std::span<const double> u, VertexId v);
+// Where vertex v is in the deformed mesh: X_v + u_v. u: (n_points, dim).
+Point deformed_point(const Mesh& mesh, std::span<const double> u, VertexId v);
 
 // The reference position of the material point that sits at x in the deformed mesh (the
-// barycentric coordinates of x in the deformed triangle containing it, applied to the
-// reference corners), or nothing if x is outside the deformed body. u: (n_points, 2).
-std::optional<Point2> reference_position(const Mesh& mesh, std::span<const double> u, const Point2& x);
+// barycentric coordinates of x in the deformed element containing it, applied to the
+// reference corners), or nothing if x is outside the deformed body. u: (n_points, dim).
+std::optional<Point> reference_position(const Mesh& mesh, std::span<const double> u, const Point& x);
 
 struct ShaftCrossing {
-  VertexId near, far;  // the edge's end closest to the shaft's line, and the other end
-  double s = 0;        // where the edge crosses the segment, as a distance from its start
+  VertexId near;  // the crossed edge's (face's) vertex closest to the shaft's line
+  double s = 0;   // where the segment crosses it, as a distance from the segment's start
   bool on_boundary = false;
 };
 
-// Every mesh edge whose deformed image crosses the segment a→b (touching counts, an edge
-// lying along it does not), each once. u: (n_points, 2).
-std::vector<ShaftCrossing> shaft_crossings(const Mesh& mesh, std::span<const double> u, const Point2& a,
-                                           const Point2& b);
+// Every mesh edge (2D) or face (3D) whose deformed image the segment a→b crosses (touching
+// counts, an edge lying along it does not), each once. u: (n_points, dim).
+std::vector<ShaftCrossing> shaft_crossings(const Mesh& mesh, std::span<const double> u, const Point& a,
+                                           const Point& b);
 
 }  // namespace snede

@@ -2,37 +2,55 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <numeric>
 #include <sstream>
 #include <stdexcept>
 
 #include "core/petsc_util.hpp"
 #include "topology/refine_around.hpp"
+#include "topology/refine_near_segment.hpp"
 
 namespace snede {
 namespace {
 
-std::string point_text(const Point2& x) {
+std::string point_text(const Point& x, int dim) {
   std::ostringstream text;
-  text << "(" << x[0] << ", " << x[1] << ")";
+  text << "(";
+  for (int k = 0; k < dim; ++k) text << (k ? ", " : "") << x[k];
+  text << ")";
   return text.str();
+}
+
+double distance(const Point& a, const Point& b) {
+  return std::sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2]));
 }
 
 }  // namespace
 
-NeedleInsertion::NeedleInsertion(Model& model, Bisection* bisection, const Point2& entry, const Point2& direction,
+NeedleInsertion::NeedleInsertion(Model& model, Bisection* bisection, const Point& entry, const Point& direction,
                                  FrictionProfile friction, NeedleOptions options, StaticOptions solver_options)
-    : model_(model), bisection_(bisection), entry_(entry), friction_(std::move(friction)), options_(std::move(options)) {
-  if (model_.dim() != 2 || model_.body().mesh().is_surface())
-    throw std::invalid_argument("needle insertion is implemented for 2D plane-stress bodies; this body is " +
-                                std::to_string(model_.dim()) + "-D");
-  if (!std::isfinite(entry[0]) || !std::isfinite(entry[1]))
-    throw std::invalid_argument("needle entry must be finite, got " + point_text(entry));
-  const double norm = std::hypot(direction[0], direction[1]);
+    : model_(model), bisection_(bisection), dim_(model.dim()), friction_(std::move(friction)), options_(std::move(options)) {
+  if (model_.body().mesh().is_surface())
+    throw std::invalid_argument("needle insertion needs a 2D plane-stress or a 3D tetrahedral body, not a surface");
+  entry_ = {0, 0, 0};
+  Point axis{0, 0, 0};
+  for (int k = 0; k < dim_; ++k) {
+    entry_[k] = entry[k];
+    axis[k] = direction[k];
+  }
+  if (!std::all_of(entry_.begin(), entry_.end(), [](double x) { return std::isfinite(x); }))
+    throw std::invalid_argument("needle entry must be finite, got " + point_text(entry_, dim_));
+  const double norm = distance(axis, Point{0, 0, 0});
   if (!(norm > 0) || !std::isfinite(norm))
-    throw std::invalid_argument("needle direction must be non-zero and finite, got " + point_text(direction));
-  direction_ = {direction[0] / norm, direction[1] / norm};
-  normal_ = {-direction_[1], direction_[0]};
+    throw std::invalid_argument("needle direction must be non-zero and finite, got " + point_text(axis, dim_));
+  for (int k = 0; k < 3; ++k) direction_[k] = axis[k] / norm;
+  normal_ = {-direction_[1], direction_[0], 0};
+  if (dim_ == 3 && !(options_.radius > 0 && std::isfinite(options_.radius)))
+    throw std::invalid_argument("a 3D needle needs a positive, finite radius, got " + std::to_string(options_.radius));
+  if (dim_ == 2 && options_.radius != 0)
+    throw std::invalid_argument("a radius is for 3D needles; in 2D the needle is a line (radius 0), got " +
+                                std::to_string(options_.radius));
   if (!(options_.static_factor >= 1.0) || !std::isfinite(options_.static_factor))
     throw std::invalid_argument("static_factor must be at least 1 (static friction ≥ dynamic), got " +
                                 std::to_string(options_.static_factor));
@@ -51,15 +69,11 @@ NeedleInsertion::NeedleInsertion(Model& model, Bisection* bisection, const Point
   const Mesh& mesh = model_.body().mesh();
   const std::vector<double> u = vec_values(model_.displacement());
   double reach = 0;
-  for (VertexId v = 0; v < mesh.n_points(); ++v) {
-    if (!mesh.is_vertex(v)) continue;
-    const Point2 x = deformed_point(mesh, u, v);
-    reach = std::max(reach, std::hypot(x[0] - entry_[0], x[1] - entry_[1]));
-  }
-  const Point2 far{entry_[0] + 2 * reach * direction_[0], entry_[1] + 2 * reach * direction_[1]};
-  if (shaft_crossings(mesh, u, entry_, far).empty() && !reference_position(mesh, u, entry_))
-    throw std::invalid_argument("the needle from entry " + point_text(entry_) + " along " + point_text(direction_) +
-                                " never meets the body");
+  for (VertexId v = 0; v < mesh.n_points(); ++v)
+    if (mesh.is_vertex(v)) reach = std::max(reach, distance(deformed_point(mesh, u, v), entry_));
+  if (shaft_crossings(mesh, u, entry_, point_at(2 * reach)).empty() && !reference_position(mesh, u, entry_))
+    throw std::invalid_argument("the needle from entry " + point_text(entry_, dim_) + " along " +
+                                point_text(direction_, dim_) + " never meets the body");
   solver_ = std::make_unique<StaticSolver>(model_, std::move(solver_options));
   node_of_vertex_.assign(mesh.n_points(), -1);
   create_predictor_vectors();
@@ -96,12 +110,21 @@ void NeedleInsertion::record_rate(double distance) {
   have_rate_ = true;
 }
 
-double NeedleInsertion::along(const Point2& x) const {
-  return (x[0] - entry_[0]) * direction_[0] + (x[1] - entry_[1]) * direction_[1];
+Point NeedleInsertion::point_at(double s) const {
+  return {entry_[0] + s * direction_[0], entry_[1] + s * direction_[1], entry_[2] + s * direction_[2]};
 }
 
-double NeedleInsertion::across(const Point2& x) const {
-  return (x[0] - entry_[0]) * normal_[0] + (x[1] - entry_[1]) * normal_[1];
+double NeedleInsertion::along(const Point& x) const {
+  return (x[0] - entry_[0]) * direction_[0] + (x[1] - entry_[1]) * direction_[1] + (x[2] - entry_[2]) * direction_[2];
+}
+
+double NeedleInsertion::across(const Point& x) const {
+  if (dim_ == 2) return (x[0] - entry_[0]) * normal_[0] + (x[1] - entry_[1]) * normal_[1];
+  return distance(x, point_at(along(x)));
+}
+
+void NeedleInsertion::fix_where_it_is(VertexId v, std::span<const double> u) {
+  model_.fix(std::span<const VertexId>(&v, 1), u.subspan(at(v), static_cast<std::size_t>(dim_)));
 }
 
 NeedleStepReport NeedleInsertion::advance(double distance) {
@@ -123,8 +146,7 @@ void NeedleInsertion::move_needle(double distance) {
     if (!node.sticking) continue;
     const VertexConstraint& c = model_.constraints()[node.vertex];
     moved.push_back(node.vertex);
-    anchors.push_back(c.anchor[0] + distance * direction_[0]);
-    anchors.push_back(c.anchor[1] + distance * direction_[1]);
+    for (int k = 0; k < dim_; ++k) anchors.push_back(c.anchor[k] + distance * direction_[k]);
   }
   if (!moved.empty()) model_.fix(moved, anchors);
 }
@@ -176,11 +198,18 @@ NeedleStepReport NeedleInsertion::settle() {
 void NeedleInsertion::refine_at_tip() {
   if (!options_.h_ref || depth_ <= 0) return;
   const std::vector<double> u = vec_values(model_.displacement());
-  // refine_around works in the reference configuration: refine around the material point
-  // under the deformed tip.
-  const std::optional<Point2> X = reference_position(model_.body().mesh(), u, tip());
+  // Refinement works in the reference configuration: around the material point under the
+  // deformed tip, and in 3D along the shaft's image since the last update, within r of it.
+  const std::optional<Point> X = reference_position(model_.body().mesh(), u, tip());
   if (!X) return;  // the tip is outside the body
-  refine_around(*bisection_, std::span<const double>(X->data(), 2), *options_.h_ref);
+  const std::span<const double> x(X->data(), static_cast<std::size_t>(dim_));
+  if (dim_ == 2) {
+    refine_around(*bisection_, x, *options_.h_ref);
+    return;
+  }
+  const Point from = refined_from_.value_or(*X);
+  refine_near_segment(*bisection_, std::span<const double>(from.data(), 3), x, *options_.h_ref, options_.radius);
+  refined_from_ = X;
 }
 
 void NeedleInsertion::add_node(NeedleNode node) {
@@ -204,36 +233,44 @@ int NeedleInsertion::intercept_nodes() {
   int added = 0;
   for (const ShaftCrossing& c : crossings) {
     const VertexId v = c.near;
-    if (static_cast<std::size_t>(v) < node_of_vertex_.size() && node_of_vertex_[v] >= 0) continue;
-    if (model_.constraints()[v].kind != ConstraintKind::free) continue;  // held by the user
-    const Point2 x = deformed_point(model_.body().mesh(), u, v);
-    const double s = along(x);
-    if (s < 0 || s > depth_) continue;  // caught once the tip has passed it
-    NeedleNode node;
-    node.vertex = v;
-    node.d_perp = across(x);
-    node.d_needle = s;
-    add_node(node);
-    const double anchor[2] = {u[2 * static_cast<std::size_t>(v)], u[2 * static_cast<std::size_t>(v) + 1]};
-    model_.fix(std::span<const VertexId>(&v, 1), anchor);  // sticks where it is
-    ++added;
+    added += catch_node(v, u);
+  }
+  // 3D: the mesh's image of the cylinder's surface, every vertex the tip has passed within r
+  // of the axis (Figure 6.14).
+  if (dim_ == 3) {
+    const Mesh& mesh = model_.body().mesh();
+    for (VertexId v = 0; v < mesh.n_points(); ++v)
+      if (mesh.is_vertex(v) && across(deformed_point(mesh, u, v)) <= options_.radius) added += catch_node(v, u);
   }
   return added;
+}
+
+int NeedleInsertion::catch_node(VertexId v, std::span<const double> u) {
+  if (static_cast<std::size_t>(v) < node_of_vertex_.size() && node_of_vertex_[v] >= 0) return 0;
+  if (model_.constraints()[v].kind != ConstraintKind::free) return 0;  // held by the user
+  const Point x = deformed_point(model_.body().mesh(), u, v);
+  const double s = along(x);
+  if (s < 0 || s > depth_) return 0;  // caught once the tip has passed it
+  NeedleNode node;
+  node.vertex = v;
+  node.d_perp = across(x);
+  node.d_needle = s;
+  add_node(node);
+  fix_where_it_is(v, u);  // sticks where it is
+  return 1;
 }
 
 void NeedleInsertion::stick(NeedleNode& node, std::span<const double> u) {
   node.sticking = true;
   node.slip_sign = 0;
   node.friction = 0;
-  const std::size_t i = 2 * static_cast<std::size_t>(node.vertex);
-  const double anchor[2] = {u[i], u[i + 1]};
-  model_.fix(std::span<const VertexId>(&node.vertex, 1), anchor);
+  fix_where_it_is(node.vertex, u);
 }
 
 void NeedleInsertion::slip(NeedleNode& node, double sign) {
   node.sticking = false;
   node.slip_sign = sign >= 0 ? 1 : -1;
-  model_.slide(std::span<const VertexId>(&node.vertex, 1), direction_);
+  model_.slide(std::span<const VertexId>(&node.vertex, 1), std::span<const double>(direction_.data(), dim_));
 }
 
 void NeedleInsertion::release(std::size_t index) {
@@ -272,6 +309,10 @@ int NeedleInsertion::update_thresholds() {
     return nodes_[a].d_needle < nodes_[b].d_needle;
   });
   const double lo = std::min(body_entry_, depth_);
+  if (dim_ == 3) {
+    share_surface(lo);
+    return released;
+  }
   for (std::size_t k = 0; k < order.size(); ++k) {
     NeedleNode& node = nodes_[order[k]];
     const double begin = k == 0 ? lo : 0.5 * (nodes_[order[k - 1]].d_needle + node.d_needle);
@@ -285,6 +326,67 @@ int NeedleInsertion::update_thresholds() {
   return released;
 }
 
+void NeedleInsertion::share_surface(double lo) {
+  // The cylinder's surface inside the body, cut into patches (rings of surface_rings_per_h
+  // per min(r, h_ref) along the shaft, surface_sectors around it); each patch belongs to the
+  // needle node nearest to its centre, and adds the profile integrated over its length times
+  // its arc to that node's threshold. The thresholds sum to 2πr ∫ profile exactly.
+  const std::vector<double> u = vec_values(model_.displacement());
+  const Mesh& mesh = model_.body().mesh();
+  for (NeedleNode& node : nodes_) {
+    node.dynamic_threshold = 0;
+    node.share_begin = depth_;
+    node.share_end = lo;
+  }
+  const double length = depth_ - lo;
+  if (nodes_.empty() || !(length > 0)) {
+    for (NeedleNode& node : nodes_) node.static_threshold = 0;
+    return;
+  }
+  const double r = options_.radius;
+  const double ring = std::min(r, options_.h_ref.value_or(r)) / surface_rings_per_h;
+  const int n_rings = static_cast<int>(std::clamp(std::ceil(length / ring), 1.0, static_cast<double>(max_surface_rings)));
+  // Two unit vectors across the shaft.
+  const Point helper = std::abs(direction_[0]) < 0.9 ? Point{1, 0, 0} : Point{0, 1, 0};
+  Point e1{direction_[1] * helper[2] - direction_[2] * helper[1], direction_[2] * helper[0] - direction_[0] * helper[2],
+           direction_[0] * helper[1] - direction_[1] * helper[0]};
+  const double n1 = distance(e1, Point{0, 0, 0});
+  for (double& x : e1) x /= n1;
+  const Point e2{direction_[1] * e1[2] - direction_[2] * e1[1], direction_[2] * e1[0] - direction_[0] * e1[2],
+                 direction_[0] * e1[1] - direction_[1] * e1[0]};
+  std::vector<Point> positions;
+  positions.reserve(nodes_.size());
+  for (const NeedleNode& node : nodes_) positions.push_back(deformed_point(mesh, u, node.vertex));
+  const double arc = 2 * std::numbers::pi * r / surface_sectors;
+  for (int i = 0; i < n_rings; ++i) {
+    const double begin = lo + length * i / n_rings, end = lo + length * (i + 1) / n_rings;
+    const double force_per_arc = friction_.integral(depth_ - end, depth_ - begin);
+    const Point centre = point_at(0.5 * (begin + end));
+    for (int j = 0; j < surface_sectors; ++j) {
+      const double angle = 2 * std::numbers::pi * (j + 0.5) / surface_sectors;
+      Point x = centre;
+      for (int k = 0; k < 3; ++k) x[k] += r * (std::cos(angle) * e1[k] + std::sin(angle) * e2[k]);
+      std::size_t nearest = 0;
+      double best = distance(x, positions[0]);
+      for (std::size_t n = 1; n < positions.size(); ++n) {
+        const double d = distance(x, positions[n]);
+        if (d < best) {
+          best = d;
+          nearest = n;
+        }
+      }
+      NeedleNode& node = nodes_[nearest];
+      node.dynamic_threshold += force_per_arc * arc;
+      node.share_begin = std::min(node.share_begin, begin);
+      node.share_end = std::max(node.share_end, end);
+    }
+  }
+  for (NeedleNode& node : nodes_) {
+    if (node.share_end < node.share_begin) node.share_begin = node.share_end = node.d_needle;  // no patch
+    node.static_threshold = options_.static_factor * node.dynamic_threshold;
+  }
+}
+
 void NeedleInsertion::apply_friction() {
   std::vector<VertexId> slipping;
   std::vector<double> forces;
@@ -292,8 +394,7 @@ void NeedleInsertion::apply_friction() {
     if (node.sticking) continue;
     node.friction = node.slip_sign * node.dynamic_threshold;
     slipping.push_back(node.vertex);
-    forces.push_back(node.friction * direction_[0]);
-    forces.push_back(node.friction * direction_[1]);
+    for (int k = 0; k < dim_; ++k) forces.push_back(node.friction * direction_[k]);
   }
   if (slipping.empty()) model_.clear_channel(options_.friction_channel);
   else model_.set_nodal_forces(options_.friction_channel, slipping, forces);
@@ -306,8 +407,8 @@ int NeedleInsertion::rearrange(NeedleStepReport& report) {
   const std::vector<double> g = model_.potential_gradient(model_.displacement());
   int changes = released;
   for (NeedleNode& node : nodes_) {
-    const std::size_t i = 2 * static_cast<std::size_t>(node.vertex);
-    const double g_along = g[i] * direction_[0] + g[i + 1] * direction_[1];
+    double g_along = 0;
+    for (int k = 0; k < dim_; ++k) g_along += g[at(node.vertex, k)] * direction_[k];
     if (node.sticking) {
       // g is the force the needle exerts to hold the node; along the shaft it is friction.
       if (std::abs(g_along) > node.static_threshold) {
@@ -364,16 +465,16 @@ NeedleStepReport NeedleInsertion::solve_and_rearrange(NeedleStepReport report) {
 std::vector<double> NeedleInsertion::needle_forces() {
   const std::vector<double> g = model_.potential_gradient(model_.displacement());
   std::vector<double> forces;
-  forces.reserve(2 * nodes_.size());
+  forces.reserve(static_cast<std::size_t>(dim_) * nodes_.size());
   for (const NeedleNode& node : nodes_) {
-    const std::size_t i = 2 * static_cast<std::size_t>(node.vertex);
-    double f[2] = {g[i], g[i + 1]};
-    if (!node.sticking) {  // the support holds it across the shaft; friction pulls along it
-      const double g_along = f[0] * direction_[0] + f[1] * direction_[1];
-      for (int k = 0; k < 2; ++k) f[k] += (node.friction - g_along) * direction_[k];
+    double f[3] = {0, 0, 0}, g_along = 0;
+    for (int k = 0; k < dim_; ++k) {
+      f[k] = g[at(node.vertex, k)];
+      g_along += f[k] * direction_[k];
     }
-    forces.push_back(f[0]);
-    forces.push_back(f[1]);
+    if (!node.sticking)  // the support holds it across the shaft; friction pulls along it
+      for (int k = 0; k < dim_; ++k) f[k] += (node.friction - g_along) * direction_[k];
+    forces.insert(forces.end(), f, f + dim_);
   }
   return forces;
 }

@@ -1,18 +1,26 @@
-// Needle insertion into a plane-stress sheet with stick-slip friction (§6.3–§6.7).
+// Needle insertion with stick-slip friction (§6.3–§6.7): into a plane-stress sheet (2D), or
+// into a solid as a rigid cylinder of radius r (3D, §6.9 and Figure 6.14).
 //
-// The needle is a rigid straight line in space: it enters at `entry` along `direction`, and
-// its tip is at entry + depth·direction. When the tip enters an element through an edge, the
-// edge's end closest to the shaft becomes a *needle node* (§6.4); the node keeps its offset
-// d_perp from the shaft and has a position d_needle along it. A needle node either sticks
+// The needle's axis is a straight line in space: it enters at `entry` along `direction`, and
+// its tip is at entry + depth·direction. When the tip enters an element through an edge (2D)
+// or a face (3D), that edge's or face's vertex closest to the axis becomes a *needle node*
+// (§6.4). In 3D every vertex the tip has passed that lies within r of the axis joins the
+// needle too: the needle nodes are the mesh's jagged image of the cylinder's surface. A node
+// keeps its offset d_perp from the axis (signed in 2D, a distance in 3D) and has a position
+// d_needle along it. A needle node either sticks
 // (its displacement is prescribed: it moves with the needle) or slips (it slides along a line
 // parallel to the shaft, loaded by the dynamic friction force in the model's "friction"
 // channel). Friction thresholds come from the friction profile, integrated over the node's
 // share of the shaft (half-way to its neighbours along the shaft, clipped to the part inside
-// the body); the static threshold is static_factor times the dynamic one.
+// the body). In 3D the profile is a force per unit of shaft surface, and a node's share is
+// the part of the cylinder's surface (inside the body) nearer to it than to any other needle
+// node; a node inside the needle that no part of the surface is nearest to has no friction.
+// The static threshold is static_factor times the dynamic one.
 //
 // One update (advance) is the interaction loop of §6.7: move the needle (in halves where the
 // move would invert elements of a material that forbids it), refine to h_ref
-// around the tip (§6.5, one batched change), add intercepted nodes, then solve and rearrange
+// around the tip (§6.5; in 3D along the shaft within r of the axis; one batched change), add
+// intercepted nodes, then solve and rearrange
 // (§6.3.2) until no node changes state: a sticking node whose reaction along the shaft
 // exceeds its static threshold slips; a slipping node whose elastic force along the shaft
 // has fallen below its dynamic threshold (by more than the solver's tolerance) sticks where
@@ -39,7 +47,7 @@ namespace snede {
 struct NeedleNode {
   VertexId vertex = no_id;
   bool sticking = true;
-  double d_perp = 0;           // signed offset from the shaft (along the shaft's normal), held
+  double d_perp = 0;           // offset from the shaft: signed along its normal (2D), distance (3D)
   double d_needle = 0;         // position along the shaft from the entry point (deformed)
   double share_begin = 0, share_end = 0;  // the node's share of the shaft, along it
   double dynamic_threshold = 0;
@@ -50,7 +58,8 @@ struct NeedleNode {
 
 struct NeedleOptions {
   double static_factor = 2.0;
-  std::optional<double> h_ref;  // refine around the tip down to this edge length
+  std::optional<double> h_ref;  // refine around the tip (3D: and along the shaft) to this edge length
+  double radius = 0;            // 3D: the needle's radius (> 0); 2D: 0 (the needle is a line)
   int max_rearrangements = 200; // per update; exceeding it is reported, not hidden
   // The thesis's haptic loop (§6.7): at most this many solves per update (0: until settled);
   // rearrangements still pending are carried into the next update, which is not a failure.
@@ -75,10 +84,12 @@ struct NeedleStepReport {
 
 class NeedleInsertion : public ConnectivityWatcher {
  public:
-  // The model must be a 2D (plane-stress) model. bisection: the mesh's bisection (needed
+  // The model is a 2D (plane-stress) or 3D (tetrahedral) one; entry and direction have its
+  // dimension (the third component is ignored in 2D). bisection: the mesh's bisection (needed
   // when h_ref is set; may be null otherwise). Throws std::invalid_argument for a zero
-  // direction, a needle whose line from entry misses the body, a 3D model, or bad options.
-  NeedleInsertion(Model& model, Bisection* bisection, const Point2& entry, const Point2& direction,
+  // direction, a needle whose line from entry misses the body, a surface mesh, a radius that is
+  // not positive in 3D or not 0 in 2D, or bad options.
+  NeedleInsertion(Model& model, Bisection* bisection, const Point& entry, const Point& direction,
                   FrictionProfile friction, NeedleOptions options, StaticOptions solver_options);
   ~NeedleInsertion() override;
   NeedleInsertion(const NeedleInsertion&) = delete;
@@ -90,12 +101,13 @@ class NeedleInsertion : public ConnectivityWatcher {
   NeedleStepReport settle();
 
   const std::vector<NeedleNode>& needle_nodes() const { return nodes_; }
-  Point2 entry() const { return entry_; }
-  Point2 direction() const { return direction_; }
+  int dim() const { return dim_; }
+  Point entry() const { return entry_; }
+  Point direction() const { return direction_; }
   double depth() const { return depth_; }
-  Point2 tip() const { return {entry_[0] + depth_ * direction_[0], entry_[1] + depth_ * direction_[1]}; }
+  Point tip() const { return point_at(depth_); }
   // Force the needle exerts on the body at each needle node: support reaction plus friction,
-  // (n_needle_nodes, 2), in the order of needle_nodes().
+  // (n_needle_nodes, dim), in the order of needle_nodes().
   std::vector<double> needle_forces();
   const FrictionProfile& friction_profile() const { return friction_; }
   const NeedleOptions& options() const { return options_; }
@@ -105,16 +117,29 @@ class NeedleInsertion : public ConnectivityWatcher {
   void on_change(const Connectivity& connectivity, const ConnectivityChange& change) override;
 
  private:
-  double along(const Point2& x) const;   // position along the shaft from the entry point
-  double across(const Point2& x) const;  // signed offset from the shaft
+  Point point_at(double s) const;       // the point s along the axis from the entry point
+  double along(const Point& x) const;   // position along the shaft from the entry point
+  double across(const Point& x) const;  // offset from the shaft (signed in 2D)
+  // Component i of vertex v's entry in a nodal array (n_points, dim).
+  std::size_t at(VertexId v, int i = 0) const { return static_cast<std::size_t>(v) * dim_ + i; }
+  // Fixes v at its current displacement (u: the state).
+  void fix_where_it_is(VertexId v, std::span<const double> u);
   void refine_at_tip();
   int intercept_nodes();
+  // Makes v a sticking needle node if it is free, not one already and the tip has passed it.
+  int catch_node(VertexId v, std::span<const double> u);
   void stick(NeedleNode& node, std::span<const double> u);
   // Slides along the shaft from where it is; friction pulls it in direction sign (±1).
   void slip(NeedleNode& node, double sign);
   // Positions along the shaft, shares, thresholds; releases nodes off the needle. Returns the
   // number released.
   int update_thresholds();
+  // 3D: each node's share of the shaft's surface inside the body (from lo to the tip), and
+  // its thresholds from it.
+  void share_surface(double lo);
+  static constexpr int surface_sectors = 16;
+  static constexpr int surface_rings_per_h = 2;
+  static constexpr int max_surface_rings = 4096;
   void apply_friction();
   // One rearrangement pass after a solve: the number of nodes whose state changed.
   int rearrange(NeedleStepReport& report);
@@ -134,9 +159,11 @@ class NeedleInsertion : public ConnectivityWatcher {
   Model& model_;
   Bisection* bisection_;
   std::vector<std::int32_t> node_of_vertex_;  // index into nodes_, or -1
-  Point2 entry_, direction_, normal_;
+  int dim_;
+  Point entry_, direction_, normal_;  // normal_: 2D only
   double depth_ = 0;
   double body_entry_ = 0;  // where the shaft enters the body, along it
+  std::optional<Point> refined_from_;  // 3D: where the shaft's refinement continues (reference)
   FrictionProfile friction_;
   NeedleOptions options_;
   std::unique_ptr<StaticSolver> solver_;

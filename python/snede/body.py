@@ -207,6 +207,11 @@ class Body:
     def displacement(self, u) -> None:
         self._model.displacement = self._field("displacement", u)
 
+    def refine_near_segment(self, a, b, h: float, radius: float = 0.0) -> int:
+        """Refine the mesh along a segment (see ``Mesh.refine_near_segment``); the state is
+        interpolated to the new vertices, and solver vectors are reissued once."""
+        return self.mesh.refine_near_segment(a, b, h, radius)
+
     def refine_around(self, point, h: float) -> int:
         """Refine the mesh around ``point`` to edge length ``h`` (see ``Mesh.refine_around``)
         in the middle of a simulation: new midpoints get the mean of their edge ends'

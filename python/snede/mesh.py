@@ -283,6 +283,26 @@ class Mesh(MeshEdits):
             raise ValueError(f"h must be positive and finite, got {h}")
         return self._bisection().refine_around(np.ascontiguousarray(point), h)
 
+    def refine_near_segment(self, a, b, h: float, radius: float = 0.0) -> int:
+        """Bisect until every cell that comes within ``radius`` of the segment ``a``–``b``
+        (shape (dim,) each; a needle's shaft) has edges no longer than ``h``, as one mesh
+        change. Nearness is decided on each cell's bounding ball, so cells up to one cell size
+        beyond ``radius`` may be refined too. Returns how many cells were split."""
+        ends = []
+        for name, point in (("a", a), ("b", b)):
+            point = np.asarray(point, dtype=np.float64)
+            if point.shape != (self.dim,):
+                raise ValueError(f"{name} must have shape ({self.dim},) for this {self.dim}-D mesh, got {point.shape}")
+            if not np.all(np.isfinite(point)):
+                raise ValueError(f"{name} must be finite, got {point}")
+            ends.append(np.ascontiguousarray(point))
+        h, radius = float(h), float(radius)
+        if not (np.isfinite(h) and h > 0):
+            raise ValueError(f"h must be positive and finite, got {h}")
+        if not (np.isfinite(radius) and radius >= 0):
+            raise ValueError(f"radius must be non-negative and finite, got {radius}")
+        return self._bisection().refine_near_segment(ends[0], ends[1], h, radius)
+
     # -- files -------------------------------------------------------------------------
     @classmethod
     def read(cls, path) -> "Mesh":

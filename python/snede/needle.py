@@ -117,15 +117,22 @@ class InsertionReport:
 
 class NeedleInsertion:
     """``NeedleInsertion(body, entry, direction, friction, *, static_factor=2.0, h_ref=None,
-    method="cg", rtol=1e-3)`` on a 2D (plane-stress) ``snede.Body`` of any material.
+    radius=None, method="cg", rtol=1e-3)`` on a 2D (plane-stress) or 3D (tetrahedral)
+    ``snede.Body`` of any material.
 
-    * ``entry``, ``direction``: the needle's line (2 components each, metres); the tip starts
+    * ``entry``, ``direction``: the needle's axis (dim components each, metres); the tip starts
       at ``entry`` (depth 0) and moves along ``direction`` (normalised). The line must meet the
       body. Points are in deformed coordinates: the needle is an object in space.
     * ``friction``: a :class:`FrictionProfile`; the dynamic threshold of a node is the profile
       integrated over its share of the shaft (half-way to its neighbours along the shaft,
-      within the body); the static threshold is ``static_factor`` times it.
-    * ``h_ref``: refine by bisection (§6.5) around the tip to this edge length after every move.
+      within the body); the static threshold is ``static_factor`` times it. In 3D the profile
+      is a force per unit of shaft *surface* (N/m²): the integral is multiplied by 2πr.
+    * ``radius`` (3D only; default 1 mm there): the needle is a rigid cylinder. Its needle
+      nodes are the mesh's jagged image of its surface (Figure 6.14): the vertex nearest the
+      axis of every face the axis crosses, and every vertex the tip has passed within
+      ``radius`` of the axis (deformed coordinates). Giving a radius for a 2D body is an error.
+    * ``h_ref``: refine by bisection (§6.5) around the tip to this edge length after every move;
+      in 3D also along the shaft, every element within ``radius`` of the axis.
     * ``method``, ``rtol``, ``criterion``, ``petsc_options``, ``options_prefix`` (default
       ``needle_``): the static solver (see :class:`snede.StaticSolver`); stopping (6.9).
     * ``max_rearrangements``: per update; reaching it is reported, not hidden.
@@ -144,11 +151,20 @@ class NeedleInsertion:
     """
 
     def __init__(self, body, entry, direction, friction: FrictionProfile, *, static_factor: float = 2.0,
-                 h_ref: float | None = None, method: str = "cg", rtol: float = 1e-3, criterion: str = "6.9",
+                 h_ref: float | None = None, radius: float | None = None, method: str = "cg", rtol: float = 1e-3, criterion: str = "6.9",
                  round_tolerance: float = 1e-8, max_iterations: int = 10000, max_rearrangements: int = 200,
                  solves_per_update: int | None = None, extrapolate: bool = False, options_prefix: str = "needle_", petsc_options: dict | None = None):
-        if body.mesh.dim != 2 or body.mesh.is_surface:
-            raise ValueError(f"needle insertion needs a 2D plane-stress body; this body's mesh is {body.mesh.dim}-D")
+        if body.mesh.is_surface:
+            raise ValueError("needle insertion needs a 2D plane-stress or a 3D tetrahedral body, not a surface mesh")
+        dim = body.mesh.dim
+        if dim == 2 and radius is not None:
+            raise ValueError(f"radius is for 3D needles; in 2D the needle is a line, got radius={radius}")
+        radius = 0.0 if dim == 2 else (1e-3 if radius is None else radius)
+        if dim == 3 and not (np.isfinite(radius) and radius > 0):
+            raise ValueError(f"radius must be positive and finite, got {radius}")
+        for name, value in (("entry", entry), ("direction", direction)):
+            if np.shape(value) != (dim,):
+                raise ValueError(f"{name} must have {dim} components for this {dim}-D body, got shape {np.shape(value)}")
         if not isinstance(friction, FrictionProfile):
             raise TypeError(f"friction must be a snede.FrictionProfile, got {type(friction).__name__}")
         if not (rtol > 0):
@@ -162,7 +178,8 @@ class NeedleInsertion:
         bisection = body.mesh._bisection() if h_ref is not None else None
         self._impl = _snede.NeedleInsertion(
             body._model, bisection, np.asarray(entry, dtype=np.float64), np.asarray(direction, dtype=np.float64),
-            friction._impl, float(static_factor), None if h_ref is None else float(h_ref), max_rearrangements,
+            friction._impl, float(static_factor), None if h_ref is None else float(h_ref), float(radius),
+            max_rearrangements,
             solves_per_update, bool(extrapolate), method, float(rtol), criterion, float(round_tolerance), max_iterations, options_prefix,
             option_list(petsc_options))
 
@@ -247,7 +264,7 @@ class NeedleInsertion:
 
     def needle_forces(self) -> np.ndarray:
         """Forces the needle exerts on the body at its needle nodes (support plus friction),
-        (n_needle_nodes, 2)."""
+        (n_needle_nodes, dim)."""
         return self._impl.needle_forces()
 
     def node_state(self) -> np.ndarray:

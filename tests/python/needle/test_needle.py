@@ -150,7 +150,7 @@ def test_bad_input_names_the_value():
         needle.insert(0.01, -0.001)
     box = snede.meshing.box((1, 1, 1), (2, 2, 2))
     body3 = snede.Body(box, snede.LinearElastic(1e3, 0.3))
-    with pytest.raises(ValueError, match="2D"):
+    with pytest.raises(ValueError, match="3 components for this 3-D body"):  # 3D needles: test_needle3d.py
         snede.NeedleInsertion(body3, (0.0, 0.5), (1.0, 0.0), profile)
 
 

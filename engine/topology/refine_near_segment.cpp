@@ -1,0 +1,120 @@
+#include "topology/refine_near_segment.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+#include <vector>
+
+#include "mesh/element_quality.hpp"
+
+namespace snede {
+namespace {
+
+struct Segment {
+  std::array<double, 3> a{}, b{};
+  int dim = 3;
+  double distance_to(const std::array<double, 3>& x) const {
+    double ab2 = 0, t = 0;
+    for (int k = 0; k < dim; ++k) {
+      ab2 += (b[k] - a[k]) * (b[k] - a[k]);
+      t += (x[k] - a[k]) * (b[k] - a[k]);
+    }
+    t = ab2 > 0 ? std::clamp(t / ab2, 0.0, 1.0) : 0.0;
+    double d2 = 0;
+    for (int k = 0; k < dim; ++k) {
+      const double c = a[k] + t * (b[k] - a[k]) - x[k];
+      d2 += c * c;
+    }
+    return std::sqrt(d2);
+  }
+};
+
+// Whether the simplex with these reference corners may come within radius of the segment:
+// its bounding ball (centroid, farthest corner) does.
+bool may_be_near(const Mesh& mesh, std::span<const VertexId> corners, const Segment& segment, double radius) {
+  const int d = mesh.dim();
+  std::array<double, 3> centre{};
+  for (VertexId v : corners)
+    for (int k = 0; k < d; ++k) centre[k] += mesh.point(v)[k] / static_cast<double>(corners.size());
+  double reach = 0;
+  for (VertexId v : corners) {
+    double d2 = 0;
+    for (int k = 0; k < d; ++k) d2 += (mesh.point(v)[k] - centre[k]) * (mesh.point(v)[k] - centre[k]);
+    reach = std::max(reach, std::sqrt(d2));
+  }
+  return segment.distance_to(centre) <= radius + reach;
+}
+
+void check_point(std::span<const double> x, int dim, const char* name) {
+  if (x.size() != static_cast<std::size_t>(dim))
+    throw std::invalid_argument(std::string("refine_near_segment: ") + name + " has " + std::to_string(x.size()) +
+                                " coordinates, the mesh is " + std::to_string(dim) + "-D");
+  for (double c : x)
+    if (!std::isfinite(c)) throw std::invalid_argument(std::string("refine_near_segment: ") + name + " is not finite");
+}
+
+}  // namespace
+
+std::size_t refine_near_segment(Bisection& bisection, std::span<const double> a, std::span<const double> b, double h,
+                                double radius) {
+  const Mesh& mesh = bisection.mesh();
+  const int d = mesh.dim();
+  if (!(std::isfinite(h) && h > 0))
+    throw std::invalid_argument("refine_near_segment: h must be positive and finite, got " + std::to_string(h));
+  if (!(std::isfinite(radius) && radius >= 0))
+    throw std::invalid_argument("refine_near_segment: radius must be non-negative and finite, got " +
+                                std::to_string(radius));
+  check_point(a, d, "a");
+  check_point(b, d, "b");
+  Segment segment;
+  segment.dim = d;
+  std::copy(a.begin(), a.end(), segment.a.begin());
+  std::copy(b.begin(), b.end(), segment.b.begin());
+  const RefinementHierarchy& tree = bisection.hierarchy();
+  ChangeBatch batch(bisection.mesh().connectivity());  // one change for the watchers (§7.4)
+  std::size_t n_split = 0;
+  bool any_near = false;
+  std::vector<NodeId> stack;
+  for (;;) {
+    // The live elements near the segment with an edge longer than h, found by descending the
+    // tree into the halves whose bounding balls come near it.
+    std::vector<ElementId> too_long;
+    stack.assign(tree.roots().begin(), tree.roots().end());
+    while (!stack.empty()) {
+      const RefinementNode& node = tree.node(stack.back());
+      stack.pop_back();
+      const std::span<const VertexId> corners(node.label.vertex.data(), static_cast<std::size_t>(d) + 1);
+      if (!node.is_leaf()) {
+        if (may_be_near(mesh, corners, segment, radius)) stack.insert(stack.end(), node.children.begin(), node.children.end());
+        continue;
+      }
+      if (node.element == no_id || !may_be_near(mesh, corners, segment, radius)) continue;
+      any_near = true;
+      const double longest = longest_edge(d, mesh.corners(node.element));
+      if (h < 1e-12 * longest) {
+        std::ostringstream message;
+        message << "refine_near_segment: h = " << h << " is below round-off for edges of " << longest;
+        throw std::invalid_argument(message.str());
+      }
+      if (longest > h) too_long.push_back(node.element);
+    }
+    if (!any_near)
+      throw std::invalid_argument("refine_near_segment: the segment does not come within radius " +
+                                  std::to_string(radius) + " of the mesh");
+    if (too_long.empty()) return n_split;
+    // A split spreads to neighbours for conformity: an element listed here may be gone (its id
+    // possibly reused by a new element elsewhere) by the time its turn comes; check it again.
+    for (ElementId e : too_long) {
+      if (!mesh.connectivity().is_element(e)) continue;
+      const Simplex& simplex = mesh.connectivity().element(e).simplex;
+      std::vector<VertexId> corners(static_cast<std::size_t>(d) + 1);
+      for (int i = 0; i <= d; ++i) corners[i] = simplex.vertex(i);
+      if (longest_edge(d, mesh.corners(e)) > h && may_be_near(mesh, corners, segment, radius))
+        n_split += bisection.bisect(e);
+    }
+  }
+}
+
+}  // namespace snede
