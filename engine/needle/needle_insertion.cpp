@@ -74,7 +74,9 @@ NeedleInsertion::NeedleInsertion(Model& model, Bisection* bisection, const Point
   if (shaft_crossings(mesh, u, entry_, point_at(2 * reach)).empty() && !reference_position(mesh, u, entry_))
     throw std::invalid_argument("the needle from entry " + point_text(entry_, dim_) + " along " +
                                 point_text(direction_, dim_) + " never meets the body");
-  solver_ = std::make_unique<StaticSolver>(model_, std::move(solver_options));
+  // The bisection's hierarchy serves the "mg" preconditioner (-needle_pc_type mg).
+  solver_ = std::make_unique<StaticSolver>(model_, std::move(solver_options),
+                                           bisection_ ? &bisection_->hierarchy() : nullptr);
   node_of_vertex_.assign(mesh.n_points(), -1);
   create_predictor_vectors();
   model_.body().mesh().connectivity().add_watcher(this);

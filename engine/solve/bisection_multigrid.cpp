@@ -61,7 +61,10 @@ struct BisectionMultigrid::Level {
 };
 
 BisectionMultigrid::BisectionMultigrid(Model& fine, const RefinementHierarchy& hierarchy, int max_levels)
-    : fine_(fine), hierarchy_(hierarchy), revision_(fine.body().mesh().connectivity().revision()) {
+    : fine_(fine),
+      hierarchy_(hierarchy),
+      revision_(fine.body().mesh().connectivity().revision()),
+      constraints_(fine.constraints().projection_fingerprint()) {
   const Mesh& mesh = fine.body().mesh();
   if (max_levels == 1 || max_levels < 0)
     throw std::invalid_argument("mg needs at least 2 levels (the mesh and a coarser one), got pc_mg_levels " +
@@ -132,8 +135,13 @@ BisectionMultigrid::BisectionMultigrid(Model& fine, const RefinementHierarchy& h
 
 BisectionMultigrid::~BisectionMultigrid() = default;
 
-bool BisectionMultigrid::matches(const Model& fine) const {
+bool BisectionMultigrid::matches_mesh(const Model& fine) const {
   return &fine == &fine_ && fine.body().mesh().connectivity().revision() == revision_;
+}
+
+bool BisectionMultigrid::matches(const Model& fine) const {
+  return &fine == &fine_ && fine.body().mesh().connectivity().revision() == revision_ &&
+         fine.constraints().projection_fingerprint() == constraints_;
 }
 
 std::vector<std::size_t> BisectionMultigrid::level_cells() const {

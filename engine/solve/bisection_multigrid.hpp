@@ -41,8 +41,12 @@ class BisectionMultigrid {
   BisectionMultigrid(const BisectionMultigrid&) = delete;
   BisectionMultigrid& operator=(const BisectionMultigrid&) = delete;
 
-  // Whether the fine mesh is still the one the levels were made for (no edit since).
+  // Whether the fine mesh and its constraints' projections are still those the levels were
+  // made for (no edit, no vertex fixed, released or made to slide since: a needle's stick-slip
+  // changes them between solves, and stale projections make the cycle indefinite).
   bool matches(const Model& fine) const;
+  // Whether only the mesh is still the same (the constraints may have changed).
+  bool matches_mesh(const Model& fine) const;
   // Levels including the finest (the fine model itself).
   int n_levels() const { return static_cast<int>(coarse_.size()) + 1; }
   // Elements per level, coarsest first, the fine mesh last.
@@ -69,6 +73,7 @@ class BisectionMultigrid {
   Model& fine_;
   const RefinementHierarchy& hierarchy_;
   std::uint64_t revision_;
+  std::uint64_t constraints_;  // the fine constraints' projection fingerprint
   std::vector<std::pair<VertexId, VertexId>> midpoint_of_;  // per fine vertex: its bisected edge
   std::vector<std::unique_ptr<Level>> coarse_;               // coarsest first
   std::unique_ptr<AssembledTangent> coarsest_matrix_;

@@ -1,5 +1,7 @@
 #include "solve/constraints.hpp"
 
+#include <bit>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -57,6 +59,22 @@ void Constraints::slide(std::span<const VertexId> vertices, std::span<const doub
       c.anchor[k] = u[static_cast<std::size_t>(v) * dim_ + k];
     }
   }
+}
+
+std::uint64_t Constraints::projection_fingerprint() const {
+  std::uint64_t hash = 1469598103934665603ull;  // FNV-1a over kinds and directions
+  auto mix = [&](std::uint64_t x) {
+    for (int byte = 0; byte < 8; ++byte) {
+      hash ^= (x >> (8 * byte)) & 0xffu;
+      hash *= 1099511628211ull;
+    }
+  };
+  for (const VertexConstraint& c : vertices_) {
+    mix(static_cast<std::uint64_t>(c.kind));
+    if (c.kind == ConstraintKind::slide)
+      for (double x : c.direction) mix(std::bit_cast<std::uint64_t>(x));
+  }
+  return hash;
 }
 
 void Constraints::assign(VertexId v, const VertexConstraint& c) {

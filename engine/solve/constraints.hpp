@@ -35,6 +35,9 @@ class Constraints {
   // Slide along `direction` (dim numbers, normalised here) through the current displacement.
   void slide(std::span<const VertexId> vertices, std::span<const double> direction, std::span<const double> u);
   void release(std::span<const VertexId> vertices);
+  // A hash of which vertices are constrained and how (kinds and slide directions, not the
+  // anchors): what a preconditioner built from the projections depends on.
+  std::uint64_t projection_fingerprint() const;
   // Gives v the constraint `c` as it is (a copy of another mesh's vertex: a multigrid level).
   void assign(VertexId v, const VertexConstraint& c);
   std::size_t n_constrained() const;

@@ -177,6 +177,16 @@ void StaticSolver::follow_mesh_changes() {
   const bool stale_matrix = needs_matrix_ && (!assembled_ || !assembled_->matches(model_));
   const bool stale_multigrid = multigrid_ && !multigrid_->matches(model_);
   if (!resized && !stale_matrix && !stale_multigrid) return;
+  if (!resized && !stale_matrix && multigrid_->matches_mesh(model_)) {
+    // Only the constraints changed (a needle's stick-slip): new levels on the same PC, whose
+    // solver objects and operators stay as they are.
+    PC pc = nullptr;
+    SNEDE_PETSC(KSPGetPC(ksp(), &pc));
+    SNEDE_PETSC(PCSetType(pc, PCNONE));
+    set_up_multigrid(pc);
+    SNEDE_PETSC(PCSetFromOptions(pc));
+    return;
+  }
   generation_ = model_.generation();
   if (resized) SNEDE_PETSC(VecDuplicate(model_.displacement(), residual_.out()));
   assembled_.reset();  // its sparsity was the old mesh's (a flip or a cut changes it)
@@ -240,6 +250,9 @@ void StaticSolver::set_up_multigrid(PC pc) {
   }
   multigrid_ = std::make_unique<BisectionMultigrid>(model_, *hierarchy_, max_levels);
   multigrid_->configure(pc, option_database_);
+  // The levels come with their own operators and interpolations: PCMG must not coarsen the
+  // SNES's shell DM (which it would try after a mesh change, when the PC gets that DM).
+  SNEDE_PETSC(PCSetDM(pc, nullptr));
   preconditioner_filled_ = false;
 }
 
