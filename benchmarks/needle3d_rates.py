@@ -1,0 +1,75 @@
+"""3D needle insertion rates (issue 17) beside the thesis's Figure 6.14 (§6.9), in one run.
+
+The thesis's cube: 10 cm, fixed at the bottom, E = 34 kPa, ν = 0.34; a needle of radius 1 mm
+enters from the left at mid-height and goes 70 mm in, with the Figure 6.4 stand-in friction
+profile (per unit of shaft surface, N/m²) and static friction twice the dynamic. The start mesh
+is the 2 × 2 × 2 Kuhn box bisected 3 times (384 tetrahedra, edges 25 mm); the needle refines
+along its shaft (within r of the axis) and around its tip to h_ref. Each update moves the needle
+by h_ref / 2 and relaxes until no needle node changes between stick and slip (rtol 1e-3, (6.9)).
+
+Printed per case: the final element count, updates, solves (rearrangements), the update rate
+(solves per second, as the thesis's Table 6.5 counts them), CG iterations per solve, seconds, and
+the tip-region deflection. The thesis: linear, 2420 elements, 5 s; neo-Hookean, 29 562 elements,
+1364 s (Pentium III, 1 GHz).
+
+    .venv/bin/python benchmarks/needle3d_rates.py            # about 2 minutes
+
+Not a test: times depend on the machine and its load; compare the ratios of one run.
+"""
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+import snede
+
+SIZE, DEPTH, RADIUS = 0.1, 0.07, 1e-3
+ENTRY, DIRECTION = (-0.005, 0.05, 0.05), (1.0, 0.0, 0.0)
+
+
+def cube(material):
+    mesh = snede.meshing.box((SIZE, SIZE, SIZE), (2, 2, 2))
+    mesh.refine_uniform(3)
+    body = snede.Body(mesh, material)
+    body.fix(np.isclose(mesh.points[:, 2], 0.0))
+    return body
+
+
+def insert(material, h_ref: float, preconditioner: str):
+    body = cube(material)
+    method = "cg" if isinstance(material, snede.LinearElastic) else "newton"
+    needle = snede.NeedleInsertion(body, ENTRY, DIRECTION, snede.FrictionProfile.figure_6_4(), radius=RADIUS,
+                                   h_ref=h_ref, method=method, rtol=1e-3,
+                                   petsc_options={"pc_type": preconditioner})
+    start = time.perf_counter()
+    report = needle.insert(DEPTH, 0.5 * h_ref)
+    seconds = time.perf_counter() - start
+    tip = np.linalg.norm(body.mesh.points + body.displacement - needle.tip, axis=1) < 2 * h_ref
+    deflection = float(np.abs(body.displacement[tip, 2]).max()) if tip.any() else float("nan")
+    return body, needle, report, seconds, deflection
+
+
+def main() -> None:
+    print(__doc__.splitlines()[0])
+    print(f"{'material':<12} {'h_ref [mm]':>10} {'pc':<5} {'elements':>9} {'updates':>8} {'solves':>7} "
+          f"{'solves/s':>9} {'CG/solve':>9} {'seconds':>8} {'|u_z| near tip [mm]':>20}  result")
+    deflections = {}
+    for name, material in (("linear", snede.LinearElastic(34e3, 0.34)), ("neo-Hookean", snede.NeoHookean(34e3, 0.34))):
+        for h_ref in (0.005, 0.0035, 0.0025):
+            for pc in ("none", "mg"):
+                body, needle, report, seconds, deflection = insert(material, h_ref, pc)
+                deflections[(name, h_ref, pc)] = deflection
+                print(f"{name:<12} {h_ref * 1e3:>10.2f} {pc:<5} {body.mesh.n_cells:>9} {report.updates:>8} "
+                      f"{report.rearrangements:>7} {report.update_rate:>9.1f} {report.mean_iterations:>9.1f} "
+                      f"{seconds:>8.2f} {deflection * 1e3:>20.4f}  "
+                      f"{'converged' if report.converged else report.reason}", flush=True)
+    for h_ref in (0.005, 0.0035, 0.0025):
+        linear, neo = deflections[("linear", h_ref, "mg")], deflections[("neo-Hookean", h_ref, "mg")]
+        print(f"   h_ref {h_ref * 1e3:.2f} mm: tip-region deflection linear {linear * 1e3:.4f} mm, neo-Hookean "
+              f"{neo * 1e3:.4f} mm (difference {(neo - linear) * 1e3:+.4f} mm)")
+    print("   thesis (P3 1 GHz): linear 2420 elements 5 s; neo-Hookean 29 562 elements 1364 s")
+
+
+if __name__ == "__main__":
+    main()
