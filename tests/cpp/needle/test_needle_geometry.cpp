@@ -48,13 +48,13 @@ TEST(DeformedQueries, ReferencePositionInvertsAnAffineDeformation) {
     u[2 * v] = 0.1 * X[0] + 0.2 * X[1] + 0.02;
     u[2 * v + 1] = -0.05 * X[0] + 0.3 * X[1] - 0.01;
   }
-  const Point2 X{0.37, 0.61};
-  const Point2 x{X[0] + 0.1 * X[0] + 0.2 * X[1] + 0.02, X[1] - 0.05 * X[0] + 0.3 * X[1] - 0.01};
+  const Point X{0.37, 0.61, 0.0};
+  const Point x{X[0] + 0.1 * X[0] + 0.2 * X[1] + 0.02, X[1] - 0.05 * X[0] + 0.3 * X[1] - 0.01, 0.0};
   const auto found = reference_position(mesh, u, x);
   ASSERT_TRUE(found);
   EXPECT_NEAR((*found)[0], X[0], 1e-14);
   EXPECT_NEAR((*found)[1], X[1], 1e-14);
-  EXPECT_FALSE(reference_position(mesh, u, Point2{-1.0, 0.5}));
+  EXPECT_FALSE(reference_position(mesh, u, Point{-1.0, 0.5, 0.0}));
 }
 
 TEST(DeformedQueries, ShaftCrossingsFindEveryEdgeAcrossTheSegmentOnce) {
@@ -62,13 +62,13 @@ TEST(DeformedQueries, ShaftCrossingsFindEveryEdgeAcrossTheSegmentOnce) {
   const std::vector<double> u(2 * mesh.n_points(), 0.0);
   // y = 0.3 from x = −0.1 to 0.6: crosses the boundary edge x = 0, the vertical edges at
   // x = 0.25 and 0.5, and the diagonals of squares 0, 1 and 2 in row 1 (y in [0.25, 0.5]).
-  const auto crossings = shaft_crossings(mesh, u, Point2{-0.1, 0.3}, Point2{0.6, 0.3});
+  const auto crossings = shaft_crossings(mesh, u, Point{-0.1, 0.3, 0.0}, Point{0.6, 0.3, 0.0});
   ASSERT_EQ(crossings.size(), 6u);
   int boundary = 0;
   for (const ShaftCrossing& c : crossings) {
     boundary += c.on_boundary;
-    const double near_y = mesh.point(c.near)[1], far_y = mesh.point(c.far)[1];
-    EXPECT_LE(std::abs(near_y - 0.3), std::abs(far_y - 0.3));  // the closer end is the needle node
+    // Every crossed edge spans y in [0.25, 0.5]: its end closer to y = 0.3 is the needle node.
+    EXPECT_EQ(mesh.point(c.near)[1], 0.25);
     EXPECT_GE(c.s, 0.0);
     EXPECT_LE(c.s, 0.7);
   }
