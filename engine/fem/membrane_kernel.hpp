@@ -21,11 +21,13 @@
 // Inversion: a triangle in 3D has no inside; a mirror image of it is a rotation of it, so
 // "normal flipped relative to the reference" would call a rigid half-turn inverted. The
 // only loss of orientation a membrane element can suffer is collapse, zero area:
-// det C₂ = |F e₁ × F e₂|² ≤ 0 (the det F̂ ≤ 0 of the volume kernels, F̂ᵀF̂ = C₂), where the
+// det C₂ = |F e₁ × F e₂|² = 0 (the det F̂ ≤ 0 of the volume kernels, F̂ᵀF̂ = C₂), where the
 // neo-Hookean and Veronda-Westmann energies go to +∞ as for an inverted volume element.
 #pragma once
 
 #include <Eigen/Geometry>
+#include <algorithm>
+#include <limits>
 
 #include "fem/constitutive.hpp"
 #include "fem/linear_elastic.hpp"
@@ -64,16 +66,18 @@ MembraneColumns<T> membrane_deformation_gradient(const MembraneReference& ref, c
   return ref.frame.template cast<T>() + U * ref.Z_inv.template cast<T>();
 }
 
-// det C₂ = |F₁ × F₂|², the squared area ratio, from the cross product (no cancellation in
-// C₁₁C₂₂ − C₁₂²). Zero: the element has collapsed. (A non-finite state gives NaN, not
-// "collapsed": the loops report its non-finite result as a domain error, as for volumes.)
-template <class T>
-T membrane_area_ratio_squared(const MembraneColumns<T>& F) {
-  return F.col(0).cross(F.col(1)).squaredNorm();
-}
-
+// Collapsed: the deformed area |F₁ × F₂| (per unit reference area; √det C₂) is round-off,
+// at most 64ε·max(1, |F₁||F₂|) — a few ulps of the reference area (F is of size 1 at rest)
+// or of its deformed edges' parallelogram, the scale of Mesh's zero-area test
+// (mesh/element_quality.hpp). Exactly zero is never seen: F = T + U Z⁻¹ rounds. A non-finite
+// state is not "collapsed": the loops report its non-finite result as a domain error, as
+// for volumes.
 inline bool membrane_collapsed(const MembraneReference& ref, const MembraneColumns<double>& U) {
-  return membrane_area_ratio_squared<double>(membrane_deformation_gradient<double>(ref, U)) <= 0;
+  const MembraneColumns<double> F = membrane_deformation_gradient<double>(ref, U);
+  const double area_squared = F.col(0).cross(F.col(1)).squaredNorm();
+  const double scale_squared = std::max(1.0, F.col(0).squaredNorm() * F.col(1).squaredNorm());
+  constexpr double tolerance = 64 * std::numeric_limits<double>::epsilon();
+  return area_squared <= tolerance * tolerance * scale_squared;
 }
 
 // Small-strain gradient in the reference frame, Tᵀ U Z⁻¹ (LinearElastic).

@@ -35,6 +35,12 @@ def body_of(mesh, material, density=1000.0):
     return snede.Body(mesh, material, density=density, thickness=0.01 if mesh.dim == 2 else None)
 
 
+def remainder_slopes(remainder, h0=1e-3, n=4):
+    """log2 of successive remainder ratios when h halves: 2 for a correct derivative."""
+    values = np.array([remainder(h0 / 2**k) for k in range(n)])
+    return np.log2(values[:-1] / values[1:]), values
+
+
 @pytest.fixture(params=["linear", "stvk", "neohookean", "veronda"])
 def material_name(request):
     return request.param

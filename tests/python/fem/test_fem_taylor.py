@@ -2,13 +2,7 @@
 derivative, for all four materials in 3D and plane stress, at random deformations."""
 import numpy as np
 
-from conftest import all_materials, body_of, small_mesh
-
-
-def remainder_slopes(remainder, h0=1e-3, n=4):
-    """log2 of successive remainder ratios when h halves: 2 for a correct derivative."""
-    values = np.array([remainder(h0 / 2**k) for k in range(n)])
-    return np.log2(values[:-1] / values[1:]), values
+from conftest import all_materials, body_of, remainder_slopes, small_mesh
 
 
 def random_state(body, scale, seed):
