@@ -324,3 +324,44 @@ def test_overflow_is_a_domain_error():
     body = membrane(curved_patch(), snede.VerondaWestmann(3e3, 0.3, 50.0))
     with pytest.raises(snede.DomainError):
         body.internal_forces(30.0 * body.mesh.points)
+
+
+def test_newton_solves_a_pretensioned_membrane_under_a_transverse_load():
+    """A flat neo-Hookean square, its rim pulled out by 10 %: Newton finds the homogeneous
+    stretch (exact on any mesh), then under a small load across its plane the deflection w
+    of the membrane equation t·s·Δw = −p (s the pre-stress S₁₁; P1 Laplacian on the reference
+    triangles, assembled here independently)."""
+    sheet = snede.meshing.rectangle((1.0, 1.0), (8, 8))
+    mesh = lifted(sheet, lambda x, y: 0 * x)
+    thickness, load = 0.001, 1e-3
+    body = snede.Body(mesh, snede.NeoHookean(1e5, 0.3), thickness=thickness)
+    X = mesh.points
+    rim = np.unique(mesh.boundary_faces())
+    inside = np.setdiff1d(np.arange(mesh.n_points), rim)
+    stretch = 0.1 * (X - [0.5, 0.5, 0.0])
+    stretch[:, 2] = 0
+    body.fix(rim, stretch[rim])
+    solver = snede.StaticSolver(body, "newton", rtol=1e-10)
+    assert solver.solve().converged
+    assert np.abs(body.displacement - stretch).max() <= 1e-10
+
+    body.add_nodal_force(inside, (0.0, 0.0, -load))
+    assert solver.solve().converged
+    pre_stress = body.element_stress(stretch)[:, 0, 0]
+    assert np.ptp(pre_stress) <= 1e-10 * pre_stress[0]
+    laplacian = np.zeros((mesh.n_points, mesh.n_points))
+    for cell in mesh.cells:
+        corners = np.c_[np.ones(3), X[cell][:, :2]]
+        gradients = np.linalg.inv(corners)[1:]
+        laplacian[np.ix_(cell, cell)] += 0.5 * abs(np.linalg.det(corners)) * gradients.T @ gradients
+    stiffness = thickness * pre_stress[0] * laplacian[np.ix_(inside, inside)]
+    expected = np.linalg.solve(stiffness, np.full(len(inside), -load))
+    deflection = body.displacement[inside, 2]
+    # the load stretches the membrane further by (∇w)²/2 ~ 1e-6, against a pre-strain of 0.1
+    assert np.abs(deflection - expected).max() <= 1e-4 * np.abs(expected).max()
+
+
+def test_assembled_tangent_is_refused_on_membranes():
+    body = membrane(curved_patch(), all_materials()["stvk"])
+    with pytest.raises(ValueError, match="membranes"):
+        body.assemble_tangent(np.zeros((body.mesh.n_points, 3)))
