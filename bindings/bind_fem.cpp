@@ -39,14 +39,15 @@ py::array_t<double> tangent_of(const ElasticBody& body, const DoubleArray& u, co
 
 py::array_t<double> stress_of(const ElasticBody& body, const DoubleArray& u) {
   const std::vector<double> s = body.element_stress(view(u));
-  py::array_t<double> out({static_cast<py::ssize_t>(s.size() / (body.dim() * body.dim())),
-                           static_cast<py::ssize_t>(body.dim()), static_cast<py::ssize_t>(body.dim())});
+  const int stress_dim = body.mesh().cell_dim();  // a membrane's stress is in-plane, 2 × 2
+  py::array_t<double> out({static_cast<py::ssize_t>(s.size() / (stress_dim * stress_dim)),
+                           static_cast<py::ssize_t>(stress_dim), static_cast<py::ssize_t>(stress_dim)});
   std::copy(s.begin(), s.end(), out.mutable_data());
   return out;
 }
 
 py::array_t<double> stiffness_of(const ElasticBody& body, ElementId e, const DoubleArray& u) {
-  return to_array(body.element_stiffness(e, view(u)), (body.dim() + 1) * body.dim());
+  return to_array(body.element_stiffness(e, view(u)), (body.mesh().cell_dim() + 1) * body.dim());
 }
 
 // std::variant's caster needs default-constructible alternatives; materials have none.

@@ -8,6 +8,10 @@
 // ∂W/∂c = S₃₃/2 = 0 there, W₂(C₂) = W(C) has S₂ = the in-plane block of S. Its
 // derivative needs dc: differentiating S₃₃ = 0 gives
 // dc = −(∂S/∂C : diag(H₂, 0))₃₃ / (∂S/∂C : e₃⊗e₃)₃₃.
+//
+// F may have more rows than columns (Gradient<T, R, D>): the 3 × 2 F of a membrane
+// (fem/membrane_kernel.hpp) enters only through C₂ = FᵀF, P = F S and
+// dP = dF S + F dS, the same formulas. LinearElastic is written in a square F only.
 #pragma once
 
 #include <concepts>
@@ -33,8 +37,8 @@ T plane_stress_c33(const M& m, const Tensor<T, 2>& C2) {
     return m.plane_stress_c33(C2);
 }
 
-template <class T, int D, class M>
-Tensor<T, 3> right_cauchy_green_3d(const M& m, const Tensor<T, D>& F) {
+template <class T, int D, class M, int R>
+Tensor<T, 3> right_cauchy_green_3d(const M& m, const Gradient<T, R, D>& F) {
   if constexpr (D == 3) {
     return F.transpose() * F;
   } else {
@@ -46,32 +50,32 @@ Tensor<T, 3> right_cauchy_green_3d(const M& m, const Tensor<T, D>& F) {
   }
 }
 
-template <class T, int D, class M>
-T energy_density(const M& m, const Tensor<T, D>& F) {
+template <class T, int D, class M, int R>
+T energy_density(const M& m, const Gradient<T, R, D>& F) {
   if constexpr (WrittenInC<M>)
     return m.energy(right_cauchy_green_3d<T, D>(m, F));
   else
     return m.template energy<T, D>(F);
 }
 
-template <class T, int D, class M>
-Tensor<T, D> second_piola(const M& m, const Tensor<T, D>& F) {
+template <class T, int D, class M, int R>
+Tensor<T, D> second_piola(const M& m, const Gradient<T, R, D>& F) {
   if constexpr (WrittenInC<M>)
     return m.stress(right_cauchy_green_3d<T, D>(m, F)).template topLeftCorner<D, D>();
   else
     return m.template second_piola<T, D>(F);
 }
 
-template <class T, int D, class M>
-Tensor<T, D> first_piola(const M& m, const Tensor<T, D>& F) {
+template <class T, int D, class M, int R>
+Gradient<T, R, D> first_piola(const M& m, const Gradient<T, R, D>& F) {
   if constexpr (WrittenInC<M>)
     return F * second_piola<T, D>(m, F);
   else
     return m.template first_piola<T, D>(F);
 }
 
-template <class T, int D, class M>
-Tensor<T, D> first_piola_derivative(const M& m, const Tensor<T, D>& F, const Tensor<T, D>& dF) {
+template <class T, int D, class M, int R>
+Gradient<T, R, D> first_piola_derivative(const M& m, const Gradient<T, R, D>& F, const Gradient<T, R, D>& dF) {
   if constexpr (WrittenInC<M>) {
     const Tensor<T, 3> C = right_cauchy_green_3d<T, D>(m, F);
     Tensor<T, 3> H = Tensor<T, 3>::Zero();

@@ -11,18 +11,17 @@
 #include "core/error.hpp"
 #include "core/log_event.hpp"
 #include "fem/linear_elastic_kernel.hpp"
+#include "fem/local_dofs.hpp"
+#include "fem/membrane_loops.hpp"
 
 namespace snede {
 namespace {
-
-template <class M>
-constexpr bool is_linear = std::is_same_v<M, LinearElastic>;
 
 // The kernels the loops run, on double, Counted or Batch: §3.1's for LinearElastic (no F, a
 // tangent independent of the state), the general F/P/dP ones (§2.3, §4.3) otherwise.
 template <class T, int D, class M, class S>
 T energy_kernel(const M& m, const ElementReference<D, S>& ref, const Tensor<T, D>& U) {
-  if constexpr (is_linear<M>)
+  if constexpr (is_linear_elastic<M>)
     return linear_energy<T, D>(m, ref, U);
   else
     return element_energy<T, D>(m, ref, U);
@@ -30,7 +29,7 @@ T energy_kernel(const M& m, const ElementReference<D, S>& ref, const Tensor<T, D
 
 template <class T, int D, class M, class S>
 Tensor<T, D> force_kernel(const M& m, const ElementReference<D, S>& ref, const Tensor<T, D>& U) {
-  if constexpr (is_linear<M>)
+  if constexpr (is_linear_elastic<M>)
     return -linear_stiffness_columns<T, D>(m, ref, U);
   else
     return element_force_columns<T, D>(m, ref, U);
@@ -38,7 +37,7 @@ Tensor<T, D> force_kernel(const M& m, const ElementReference<D, S>& ref, const T
 
 template <class T, int D, class M, class S>
 Tensor<T, D> tangent_kernel(const M& m, const ElementReference<D, S>& ref, const Tensor<T, D>& U, const Tensor<T, D>& dU) {
-  if constexpr (is_linear<M>)
+  if constexpr (is_linear_elastic<M>)
     return linear_stiffness_columns<T, D>(m, ref, dU);
   else
     return element_tangent_columns<T, D>(m, ref, U, dU);
@@ -52,15 +51,6 @@ decltype(auto) with_material_and_dimension(const Material& material, int dim, Fu
         return dim == 2 ? function(m, std::integral_constant<int, 2>{}) : function(m, std::integral_constant<int, 3>{});
       },
       material);
-}
-
-template <int D>
-Tensor<double, D> gather_differences(std::span<const double> u, const typename ElementStream<D>::Vertices& v) {
-  Tensor<double, D> U;
-  for (int j = 1; j <= D; ++j)
-    for (int k = 0; k < D; ++k)
-      U(k, j - 1) = u[static_cast<std::size_t>(v[j]) * D + k] - u[static_cast<std::size_t>(v[0]) * D + k];
-  return U;
 }
 
 // Calls visit(e, vertices, reference) for every live element, one at a time (the loops that
@@ -205,41 +195,14 @@ KernelFlops count_flops(const M& m) {
   ElementReference<D> ref;
   ref.Z_inv = Tensor<double, D>::Identity();
   ref.measure = 1;
-  Tensor<Counted, D> U, dU;
-  for (int i = 0; i < D; ++i)
-    for (int j = 0; j < D; ++j) {
-      U(i, j) = Counted(0.01 * (i + 2 * j + 1));
-      dU(i, j) = Counted(0.1 * (2 * i + j + 1));
-    }
-  KernelFlops flops;
-  auto run = [](auto&& kernel) {
-    flop_tally() = {};
-    kernel();
-    return flop_tally();
-  };
-  flops.energy = run([&] { energy_kernel<Counted, D>(m, ref, U); }).arithmetic;
-  const FlopTally force = run([&] { force_kernel<Counted, D>(m, ref, U); });
-  flops.force = force.arithmetic;
-  flops.functions = force.functions;
-  flops.tangent = run([&] { tangent_kernel<Counted, D>(m, ref, U, dU); }).arithmetic;
-  return flops;
+  const auto differences = flop_count_differences<D, D>();
+  const auto &U = differences[0], &dU = differences[1];
+  return count_kernel_flops([&] { energy_kernel<Counted, D>(m, ref, U); }, [&] { force_kernel<Counted, D>(m, ref, U); },
+                            [&] { tangent_kernel<Counted, D>(m, ref, U, dU); });
 }
 
 void log_flops(std::int64_t per_element, std::size_t n_elements) {
   SNEDE_PETSC(PetscLogFlops(static_cast<PetscLogDouble>(per_element) * static_cast<PetscLogDouble>(n_elements)));
-}
-
-// The unit direction on local dof `column` (node column / D, component column % D) as the
-// differences dU that the kernels take (node 0 moves every column the other way).
-template <class T, int D>
-Tensor<T, D> unit_differences(int column) {
-  Tensor<T, D> dU = Tensor<T, D>::Zero();
-  const int node = column / D, component = column % D;
-  if (node == 0)
-    dU.row(component).setConstant(T(-1.0));
-  else
-    dU(component, node - 1) = T(1.0);
-  return dU;
 }
 
 }  // namespace
@@ -257,17 +220,18 @@ void throw_if_domain_error(const EvaluationReport& report) {
 ElasticBody::ElasticBody(Mesh& mesh, Material material, double density, double thickness)
     : mesh_(mesh), material_(std::move(material)), density_(density), thickness_(thickness) {
   require_positive("density", density);
-  if (mesh.is_surface())
-    throw std::invalid_argument("an elastic body needs a volume mesh (triangles in 2D or tetrahedra); membranes on "
-                                "surface meshes are not implemented");
-  if (mesh.dim() == 2) {
-    require_positive("thickness (required for a 2D, plane-stress body)", thickness);
-  } else if (thickness != 0) {
-    throw std::invalid_argument("thickness is only for 2D (plane-stress) bodies; this mesh is 3D");
+  if (is_membrane()) {
+    require_positive("thickness (required for a membrane on a surface mesh)", thickness);
+    flops_ = membrane_kernel_flops(material_);
+  } else {
+    if (mesh.dim() == 2)
+      require_positive("thickness (required for a 2D, plane-stress body)", thickness);
+    else if (thickness != 0)
+      throw std::invalid_argument("thickness is only for 2D (plane-stress) bodies and membranes; this mesh is 3D");
+    flops_ = with_material_and_dimension(material_, mesh.dim(), [](const auto& m, auto dimension) {
+      return count_flops<decltype(dimension)::value>(m);
+    });
   }
-  flops_ = with_material_and_dimension(material_, mesh.dim(), [](const auto& m, auto dimension) {
-    return count_flops<decltype(dimension)::value>(m);
-  });
   mesh_.connectivity().add_watcher(this);
 }
 
@@ -283,13 +247,27 @@ const ElementStream<3>& ElasticBody::stream<3>() const {
 }
 
 void ElasticBody::reserve_ids(ElementId capacity) {
-  dim() == 2 ? stream_2d_.reserve_ids(capacity) : stream_3d_.reserve_ids(capacity);
+  if (is_membrane())
+    membranes_.reserve_ids(capacity);
+  else
+    dim() == 2 ? stream_2d_.reserve_ids(capacity) : stream_3d_.reserve_ids(capacity);
 }
 
-void ElasticBody::release(ElementId e) { dim() == 2 ? stream_2d_.release(e) : stream_3d_.release(e); }
+void ElasticBody::release(ElementId e) {
+  if (is_membrane())
+    membranes_.release(e);
+  else
+    dim() == 2 ? stream_2d_.release(e) : stream_3d_.release(e);
+}
 
 void ElasticBody::compute_reference(const Connectivity& connectivity, ElementId e) {
   const auto oriented = connectivity.element(e).simplex.oriented_vertices();
+  if (is_membrane()) {
+    const MembraneElements::Vertices v{oriented[0], oriented[1], oriented[2]};
+    auto corner = [&](int j) { return Eigen::Vector3d(mesh_.point(v[j]).data()); };
+    membranes_.store(e, v, membrane_reference(corner(0), corner(1), corner(2), thickness_));
+    return;
+  }
   auto fill = [&](auto& stream, auto dimension) {
     constexpr int D = decltype(dimension)::value;
     typename ElementStream<D>::Vertices v;
@@ -309,6 +287,7 @@ void ElasticBody::compute_reference(const Connectivity& connectivity, ElementId 
 void ElasticBody::init(const Connectivity& connectivity) {
   stream_2d_ = {};
   stream_3d_ = {};
+  membranes_ = {};
   reserve_ids(connectivity.element_capacity());
   for (ElementId e : connectivity.element_ids()) compute_reference(connectivity, e);
 }
@@ -334,6 +313,12 @@ double ElasticBody::energy(std::span<const double> u, EvaluationReport& report) 
   static const PetscLogEvent event = log_event("SnedeEnergy");
   ScopedEvent logged(event);
   check_size("displacement", u);
+  if (is_membrane()) {
+    std::size_t n_evaluated = 0;
+    const double total = membrane_energy(membranes_, material_, u, report, n_evaluated);
+    log_flops(flops_.energy, n_evaluated);
+    return total;
+  }
   return with_material_and_dimension(material_, dim(), [&](const auto& m, auto dimension) {
     constexpr int D = decltype(dimension)::value;
     std::size_t n_evaluated = 0;
@@ -348,6 +333,10 @@ void ElasticBody::internal_forces(std::span<const double> u, std::span<double> f
   ScopedEvent logged(event);
   check_size("displacement", u);
   check_size("force", f);
+  if (is_membrane()) {
+    log_flops(flops_.force, membrane_internal_forces(membranes_, material_, u, f, report));
+    return;
+  }
   with_material_and_dimension(material_, dim(), [&](const auto& m, auto dimension) {
     constexpr int D = decltype(dimension)::value;
     const std::size_t n = accumulate<true, D>(stream<D>(), forbids_inversion(material_), u, f, report, [m](const ElementBlock<D>& block, const Tensor<Batch, D>& U) {
@@ -364,9 +353,13 @@ void ElasticBody::tangent_apply(std::span<const double> u, std::span<const doubl
   check_size("displacement", u);
   check_size("direction", d);
   check_size("result", out);
+  if (is_membrane()) {
+    log_flops(flops_.tangent, membrane_tangent_apply(membranes_, material_, u, d, out, report));
+    return;
+  }
   with_material_and_dimension(material_, dim(), [&](const auto& m, auto dimension) {
     constexpr int D = decltype(dimension)::value;
-    constexpr bool reads_state = !is_linear<std::decay_t<decltype(m)>>;
+    constexpr bool reads_state = !is_linear_elastic<std::decay_t<decltype(m)>>;
     const std::size_t n = accumulate<reads_state, D>(stream<D>(), forbids_inversion(material_), u, out, report, [m, d](const ElementBlock<D>& block, const Tensor<Batch, D>& U) {
       return tangent_kernel<Batch, D>(m, block.reference, U, gather_differences<D>(d, block));
     });
@@ -376,11 +369,13 @@ void ElasticBody::tangent_apply(std::span<const double> u, std::span<const doubl
 
 std::vector<ElementId> ElasticBody::inverted_elements(std::span<const double> u) const {
   check_size("displacement", u);
+  if (is_membrane()) return membrane_collapsed_elements(membranes_, u);
   return dim() == 2 ? find_inverted<2>(stream<2>(), u) : find_inverted<3>(stream<3>(), u);
 }
 
 std::vector<double> ElasticBody::element_stress(std::span<const double> u) const {
   check_size("displacement", u);
+  if (is_membrane()) return membrane_element_stress(membranes_, material_, u);
   std::vector<double> stress;
   with_material_and_dimension(material_, dim(), [&](const auto& m, auto dimension) {
     constexpr int D = decltype(dimension)::value;
@@ -396,26 +391,22 @@ std::vector<double> ElasticBody::element_stress(std::span<const double> u) const
 std::vector<double> ElasticBody::element_stiffness(ElementId e, std::span<const double> u) const {
   check_size("displacement", u);
   if (!mesh_.connectivity().is_element(e)) throw std::invalid_argument("element " + std::to_string(e) + " does not exist");
+  if (is_membrane()) return membrane_element_stiffness(membranes_, material_, e, u);
   const int n = (dim() + 1) * dim();
   std::vector<double> K(static_cast<std::size_t>(n) * n);
   with_material_and_dimension(material_, dim(), [&](const auto& m, auto dimension) {
     constexpr int D = decltype(dimension)::value;
     const ElementReference<D> ref = stream<D>().reference(e);
     const Tensor<double, D> U = gather_differences<D>(u, stream<D>().vertices(e));
-    for (int column = 0; column < n; ++column) {
-      const Tensor<double, D> G = element_tangent_columns<double, D>(m, ref, U, unit_differences<double, D>(column));
-      for (int j = 1; j <= D; ++j)
-        for (int k = 0; k < D; ++k) {
-          K[static_cast<std::size_t>(j * D + k) * n + column] = G(k, j - 1);
-          K[static_cast<std::size_t>(k) * n + column] -= G(k, j - 1);
-        }
-    }
+    for (int column = 0; column < n; ++column)
+      store_stiffness_column(element_tangent_columns<double, D>(m, ref, U, unit_differences<double, D, D>(column)), column, K);
   });
   return K;
 }
 
 void ElasticBody::for_each_element_stiffness(std::span<const double> u, const StiffnessVisitor& visit) const {
   check_size("displacement", u);
+  if (is_membrane()) return membrane_for_each_element_stiffness(membranes_, material_, u, visit);
   with_material_and_dimension(material_, dim(), [&](const auto& m, auto dimension) {
     constexpr int D = decltype(dimension)::value, n = (D + 1) * D;
     using Material = std::decay_t<decltype(m)>;
@@ -428,7 +419,7 @@ void ElasticBody::for_each_element_stiffness(std::span<const double> u, const St
       if (Material::forbids_inversion) lanes &= ~inverted_lanes<D>(block, U);
       if (!lanes) continue;
       for (int column = 0; column < n; ++column) {
-        const Tensor<Batch, D> G = tangent_kernel<Batch, D>(m, block.reference, U, unit_differences<Batch, D>(column));
+        const Tensor<Batch, D> G = tangent_kernel<Batch, D>(m, block.reference, U, unit_differences<Batch, D, D>(column));
         for (int lane = 0; lane < batch_width; ++lane)
           for (int k = 0; k < D; ++k) {
             double node_0 = 0;
@@ -451,6 +442,12 @@ void ElasticBody::for_each_element_stiffness(std::span<const double> u, const St
 
 std::vector<double> ElasticBody::lumped_mass() const {
   std::vector<double> mass(mesh_.n_points(), 0.0);
+  if (is_membrane()) {
+    membranes_.for_each_live([&](ElementId, const MembraneElements::Vertices& v, const MembraneReference& ref) {
+      for (VertexId vertex : v) mass[vertex] += density_ * ref.measure / 3;
+    });
+    return mass;
+  }
   auto loop = [&](auto dimension) {
     constexpr int D = decltype(dimension)::value;
     for_each_live_element<D>(stream<D>(), [&](ElementId, const auto& v, const ElementReference<D>& ref) {

@@ -3,6 +3,10 @@
 // per-element reference data (Z⁻¹, |τ|) is recomputed only for elements a change reports,
 // in an ElementStream the loops read batch_width elements at a time (fem/element_stream.hpp).
 //
+// On a surface mesh in 3D the body is a membrane (fem/membrane_kernel.hpp): triangles under
+// plane stress on a 3 × 2 F, kept one element at a time (fem/membrane_loops.hpp) rather than
+// in the streams; "inverted" then means collapsed to zero area.
+//
 // Conventions: displacement and force arrays are (n_points, dim) row-major; internal forces
 // are −∂Π_int/∂u; the tangent action is ∂²Π_int/∂u² · d.
 #pragma once
@@ -14,33 +18,17 @@
 #include <vector>
 
 #include "fem/element_stream.hpp"
+#include "fem/evaluation.hpp"
 #include "fem/material.hpp"
+#include "fem/membrane_elements.hpp"
 #include "mesh/mesh.hpp"
 
 namespace snede {
 
-// Which elements could not be evaluated honestly in the last call.
-struct EvaluationReport {
-  std::vector<ElementId> inverted;       // det F ≤ 0
-  std::vector<ElementId> domain_errors;  // non-finite result (exponential overflow)
-};
-
-// An evaluation overflowed (Veronda-Westmann's exponential); the message lists elements.
-class DomainError : public std::domain_error {
-  using std::domain_error::domain_error;
-};
-// Throws DomainError naming the elements if report.domain_errors is not empty.
-void throw_if_domain_error(const EvaluationReport& report);
-
-// Flops per element per kernel, counted by running the kernels on Counted scalars.
-struct KernelFlops {
-  std::int64_t energy = 0, force = 0, tangent = 0;
-  std::int64_t functions = 0;  // sqrt/exp/log calls in the force kernel (not in the counts)
-};
-
 class ElasticBody : public ConnectivityWatcher {
  public:
-  // thickness: required (> 0) for 2D meshes (plane stress), must be 0 for 3D.
+  // thickness: required (> 0) for 2D meshes (plane stress) and surface meshes (membranes),
+  // must be 0 for tetrahedra.
   ElasticBody(Mesh& mesh, Material material, double density, double thickness);
   ~ElasticBody() override;
   ElasticBody(const ElasticBody&) = delete;
@@ -52,6 +40,7 @@ class ElasticBody : public ConnectivityWatcher {
   double density() const { return density_; }
   double thickness() const { return thickness_; }
   int dim() const { return mesh_.dim(); }
+  bool is_membrane() const { return mesh_.is_surface(); }
   std::size_t n_dofs() const { return static_cast<std::size_t>(mesh_.n_points()) * dim(); }
 
   // Π_int(u). +∞ if an element is inverted under a material that forbids inversion.
@@ -65,9 +54,11 @@ class ElasticBody : public ConnectivityWatcher {
                      EvaluationReport& report) const;
   // Ids of the elements with det F ≤ 0 at u.
   std::vector<ElementId> inverted_elements(std::span<const double> u) const;
-  // Second Piola-Kirchhoff stress per live element (σ for LinearElastic): (n_cells, dim, dim).
+  // Second Piola-Kirchhoff stress per live element (σ for LinearElastic): (n_cells, dim, dim);
+  // for a membrane the in-plane (n_cells, 2, 2), in each element's reference tangent frame
+  // (t₁ along its first oriented edge, t₂ = n × t₁).
   std::vector<double> element_stress(std::span<const double> u) const;
-  // Stiffness matrix of element e at u: ((dim+1)·dim)², rows and columns ordered by the
+  // Stiffness matrix of element e at u: ((corners)·dim)², rows and columns ordered by the
   // element's oriented vertices, then by component. For comparison and preconditioning only.
   std::vector<double> element_stiffness(ElementId e, std::span<const double> u) const;
   // Calls visit(e, vertices, K) for every live element with its stiffness at u, as
@@ -76,9 +67,9 @@ class ElasticBody : public ConnectivityWatcher {
   // are left out, as the tangent action leaves them out.
   using StiffnessVisitor = std::function<void(ElementId, std::span<const VertexId>, std::span<const double>)>;
   void for_each_element_stiffness(std::span<const double> u, const StiffnessVisitor& visit) const;
-  // Lumped mass per vertex: a share 1/(dim+1) of each incident element's mass (§2.5).
+  // Lumped mass per vertex: an equal share of each incident element's mass (§2.5).
   std::vector<double> lumped_mass() const;
-  // Consistent gravity load for linear elements: ρ|τ|g/(dim+1) per vertex and element.
+  // Consistent gravity load for linear elements: ρ|τ|g/(corners) per vertex and element.
   std::vector<double> gravity_forces(std::span<const double> g) const;
   KernelFlops flops_per_element() const { return flops_; }
 
@@ -99,6 +90,7 @@ class ElasticBody : public ConnectivityWatcher {
   double thickness_;
   ElementStream<2> stream_2d_;
   ElementStream<3> stream_3d_;
+  MembraneElements membranes_;
   KernelFlops flops_;
 };
 

@@ -4,6 +4,8 @@
 // the same formulas in 2D with λ replaced by λ* = 2λμ/(λ + 2μ) (closed form).
 #pragma once
 
+#include <type_traits>
+
 #include "fem/lame.hpp"
 #include "fem/tensor.hpp"
 
@@ -75,5 +77,9 @@ struct LinearElastic {
     return T(2 * lame.mu) * eps + T(effective_lambda<D>()) * eps.trace() * identity<T, D>();
   }
 };
+
+// The kernels take LinearElastic's own path (no F, a tangent independent of the state).
+template <class M>
+constexpr bool is_linear_elastic = std::is_same_v<M, LinearElastic>;
 
 }  // namespace snede

@@ -9,6 +9,11 @@ namespace snede {
 template <class T, int D>
 using Tensor = Eigen::Matrix<T, D, D>;
 
+// A deformation gradient of a D-dimensional element whose points have R ≥ D coordinates:
+// square (R = D) for volume elements, 3 × 2 for a triangle in 3D (a membrane).
+template <class T, int R, int D>
+using Gradient = Eigen::Matrix<T, R, D>;
+
 template <class T, int D>
 T double_dot(const Tensor<T, D>& a, const Tensor<T, D>& b) {
   return (a.array() * b.array()).sum();

@@ -26,7 +26,14 @@ class Body:
 
     ``material`` is one of ``snede.LinearElastic(E, nu)``, ``snede.StVenantKirchhoff(E, nu)``,
     ``snede.NeoHookean(E, nu)``, ``snede.VerondaWestmann(E, nu, gamma)``. A 2D mesh is a
-    plane-stress sheet and needs ``thickness`` (metres); a 3D mesh must not have one.
+    plane-stress sheet and needs ``thickness`` (metres); a tetrahedral mesh must not have one.
+
+    A surface mesh (triangles in 3D, ``mesh.is_surface``) is an elastic membrane: plane stress
+    in each triangle's plane, displacements (n_points, 3); it needs ``thickness`` too. Its
+    hyperelastic energy depends only on the in-plane stretch FᵀF, so it carries loads across
+    its plane once stretched; the linear material's membrane has no stiffness out of its
+    plane at all (support every vertex out of plane, or use a hyperelastic material). For a
+    membrane "inverted" means collapsed to zero area (a triangle in 3D has no inside).
 
     Inverted elements (det F ≤ 0): neo-Hookean and Veronda-Westmann give energy +inf and
     leave those elements out of forces and tangent actions; St. Venant-Kirchhoff and linear
@@ -37,14 +44,17 @@ class Body:
     def __init__(self, mesh: Mesh, material, density: float = 1000.0, thickness: float | None = None):
         if not isinstance(mesh, Mesh):
             raise TypeError(f"mesh must be a snede.Mesh, got {type(mesh).__name__}")
+        if mesh.is_surface and thickness is None:
+            raise ValueError("a surface mesh is an elastic membrane: give its thickness (e.g. thickness=0.001)")
         if mesh.dim == 2 and thickness is None:
             raise ValueError("a 2D mesh is a plane-stress sheet: give its thickness (e.g. thickness=0.01)")
-        if mesh.dim == 3 and thickness is not None:
-            raise ValueError(f"thickness is only for 2D (plane-stress) meshes; this mesh is 3D (got thickness={thickness})")
+        if mesh.cell_dim == 3 and thickness is not None:
+            raise ValueError(f"thickness is only for 2D (plane-stress) meshes and membranes; this mesh is tetrahedral "
+                             f"(got thickness={thickness})")
         lam, mu = material.lame
         poisson = lam / (2 * (lam + mu))
         if poisson >= LOCKING_POISSON_RATIO:
-            warnings.warn(f"Poisson's ratio {poisson:.4g} is close to 1/2: linear {'tetrahedra' if mesh.dim == 3 else 'triangles'} "
+            warnings.warn(f"Poisson's ratio {poisson:.4g} is close to 1/2: linear {'tetrahedra' if mesh.cell_dim == 3 else 'triangles'} "
                           "lock (volumetric locking) and the body will deform too little; see docs/results/extremes.md",
                           LockingWarning, stacklevel=2)
         self.mesh = mesh
@@ -62,7 +72,7 @@ class Body:
 
     @property
     def thickness(self) -> float | None:
-        return self._impl.thickness if self.dim == 2 else None
+        return self._impl.thickness if self.mesh.cell_dim == 2 else None
 
     def _field(self, name: str, value) -> np.ndarray:
         array = np.asarray(value, dtype=np.float64)
@@ -85,16 +95,20 @@ class Body:
         return self._impl.tangent_apply(self._field("u", u), self._field("d", d))
 
     def inverted_elements(self, u) -> np.ndarray:
-        """Row indices (into ``mesh.cells``) of the cells with det F ≤ 0 at u."""
+        """Row indices (into ``mesh.cells``) of the cells with det F ≤ 0 at u (on a membrane:
+        the cells collapsed to zero area)."""
         ids = np.asarray(self._impl.inverted_elements(self._field("u", u)), dtype=np.int64)
         return np.searchsorted(self.mesh.cell_ids, ids)
 
     def element_stress(self, u) -> np.ndarray:
-        """Second Piola-Kirchhoff stress per cell (σ for LinearElastic): (n_cells, dim, dim)."""
+        """Second Piola-Kirchhoff stress per cell (σ for LinearElastic): (n_cells, dim, dim).
+        On a membrane the in-plane stress, (n_cells, 2, 2), in each cell's reference tangent
+        frame: t₁ along its first edge (``mesh.cells[row][1] − mesh.cells[row][0]``), t₂ = n × t₁
+        with n its normal (the right-hand rule over the cell's vertex order)."""
         return self._impl.element_stress(self._field("u", u))
 
     def element_stiffness(self, row: int, u) -> np.ndarray:
-        """Stiffness matrix of cell ``row`` at u: ((dim+1)·dim)², ordered by the cell's
+        """Stiffness matrix of cell ``row`` at u: (corners·dim)², ordered by the cell's
         vertices (``mesh.cells[row]``) then components. For checks and preconditioners."""
         row = _checks.index(row, "row", self.mesh.n_cells, "rows of mesh.cells")
         return self._impl.element_stiffness(int(self.mesh.cell_ids[row]), self._field("u", u))
@@ -111,15 +125,19 @@ class Body:
     def assemble_tangent(self, u=None, format: str = "baij"):
         """J at ``u`` (default the current displacement) assembled from the same element kernels
         into a new petsc4py ``Mat``: ``format`` "baij" (blocks of dim × dim) or "aij". For
-        preconditioners and comparison; it does not follow later mesh changes."""
+        preconditioners and comparison; it does not follow later mesh changes. Not for
+        membranes yet: the assembly takes every cell to have dim + 1 corners."""
+        if self.mesh.is_surface:
+            raise ValueError("assemble_tangent is not available for membranes (surface meshes) yet: the assembly "
+                             "expects dim + 1 corners per cell; use the matrix-free tangent_operator")
         return self._model.assemble_tangent(self._field("u", self.displacement if u is None else u), str(format))
 
     def lumped_mass(self) -> np.ndarray:
-        """Mass per vertex (kg): 1/(dim+1) of each incident cell's mass (§2.5); (n_points,)."""
+        """Mass per vertex (kg): 1/(cell_dim+1) of each incident cell's mass (§2.5); (n_points,)."""
         return np.asarray(self._impl.lumped_mass())
 
     def gravity_forces(self, g=(0.0, 0.0, -9.81)) -> np.ndarray:
-        """Nodal gravity load ρ|τ|g/(dim+1) per cell and vertex; (n_points, dim)."""
+        """Nodal gravity load ρ|τ|g/(cell_dim+1) per cell and vertex; (n_points, dim)."""
         g = np.asarray(g, dtype=np.float64)
         if g.shape != (self.dim,):
             raise ValueError(f"g must have {self.dim} components, got shape {g.shape}")

@@ -109,6 +109,9 @@ def test_a_surface_can_be_dissected_along_interior_edges():
     mesh.validate()
 
 
-def test_a_body_needs_a_volume_mesh():
-    with pytest.raises(ValueError, match="volume mesh"):
-        snede.Body(snede.Mesh(OCTAHEDRON_POINTS, OCTAHEDRON_CELLS), snede.LinearElastic(E=1e3, nu=0.3))
+def test_a_body_on_a_surface_is_a_membrane_with_a_thickness():
+    surface = snede.Mesh(OCTAHEDRON_POINTS, OCTAHEDRON_CELLS)
+    with pytest.raises(ValueError, match="surface mesh is an elastic membrane: give its thickness"):
+        snede.Body(surface, snede.LinearElastic(E=1e3, nu=0.3))
+    body = snede.Body(surface, snede.LinearElastic(E=1e3, nu=0.3), thickness=0.001)
+    assert body.energy(np.zeros((surface.n_points, 3))) == 0.0
