@@ -55,6 +55,9 @@ DynamicRelaxation::DynamicRelaxation(Model& model, double damping_eta, double dt
                                      const OptionList& petsc_options)
     : model_(model), option_database_(options_prefix, petsc_options) {
   require_valid_damping(damping_eta);
+  if (model.body().mesh().is_surface())
+    throw std::invalid_argument("dynamic relaxation of membranes (surface meshes) is not implemented yet: its CFL "
+                                "time step assumes volume elements; use StaticSolver with method 'newton'");
   require(dt == 0 || positive_finite(dt), "dt", "positive and finite (or 0 for the CFL estimate)", dt);
   register_ts_ss22();
   try {

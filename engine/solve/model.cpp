@@ -197,7 +197,8 @@ double Model::force_scale() const {
   for (int k = 0; k < dim(); ++k) diameter += (hi[k] - lo[k]) * (hi[k] - lo[k]);
   diameter = std::sqrt(diameter);
   const double E = young_modulus(body_.material());
-  return dim() == 3 ? E * diameter * diameter : E * body_.thickness() * diameter;
+  // A membrane (triangles in 3D) carries force through its thickness like a plane-stress sheet.
+  return body_.mesh().cell_dim() == 3 ? E * diameter * diameter : E * body_.thickness() * diameter;
 }
 
 bool Model::admissible(Vec u, std::string* why) const {

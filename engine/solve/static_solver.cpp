@@ -61,6 +61,9 @@ StaticSolver::StaticSolver(Model& model, StaticOptions options, const Refinement
   if (options_.method == StaticMethod::nonlinear_cg && pc_type_ != PCNONE)
     throw std::invalid_argument("a preconditioner ('" + pc_type_ + "') applies to the CG of methods 'cg' and 'newton'; "
                                 "nonlinear CG ('ncg') takes none");
+  if (model.body().mesh().is_surface() && pc_type_ != PCNONE)
+    throw std::invalid_argument("preconditioner '" + pc_type_ + "' is not implemented for membranes (surface meshes): "
+                                "the tangent's diagonal and assembly assume volume elements; use 'none'");
   if (pc_type_ == PCMG && !hierarchy_)
     throw std::invalid_argument("preconditioner 'mg' coarsens along the mesh's bisection hierarchy: refine the mesh "
                                 "by bisection (mesh.refine_uniform or refine_around) before making the solver");

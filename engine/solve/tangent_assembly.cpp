@@ -1,6 +1,7 @@
 #include "solve/tangent_assembly.hpp"
 
 #include <algorithm>
+#include <string>
 #include <vector>
 
 #include "core/error.hpp"
@@ -8,6 +9,12 @@
 
 namespace snede {
 namespace {
+
+// The element-matrix loops below take dim + 1 corners per element: volume meshes only.
+void require_volume_mesh(const Model& model, const char* what) {
+  if (model.body().mesh().is_surface())
+    throw std::invalid_argument(std::string(what) + " is not implemented for membranes (surface meshes) yet");
+}
 
 // Every vertex's block of P (dim × dim, row-major), one after another.
 std::vector<double> projection_blocks(const Model& model) {
@@ -69,6 +76,7 @@ std::vector<double> complement_blocks(const std::vector<double>& P, int d) {
 
 AssembledTangent::AssembledTangent(const Model& model, MatrixFormat format)
     : format_(format), revision_(model.body().mesh().connectivity().revision()) {
+  require_volume_mesh(model, "the assembled tangent");
   const Mesh& mesh = model.body().mesh();
   const Connectivity& c = mesh.connectivity();
   const int d = model.dim();
@@ -190,6 +198,7 @@ void set_rigid_body_near_null_space(const Model& model, Mat A) {
 }
 
 void tangent_diagonal(const Model& model, Vec u, Vec diagonal) {
+  require_volume_mesh(model, "the tangent's diagonal");
   const int d = model.dim(), n = (d + 1) * d;
   const std::vector<double> P = projection_blocks(model);
   std::vector<double> values(model.body().n_dofs(), 0.0);

@@ -344,3 +344,17 @@ def test_assembled_tangent_is_refused_on_membranes():
     body = membrane(curved_patch(), all_materials()["stvk"])
     with pytest.raises(ValueError, match="membranes"):
         body.assemble_tangent(np.zeros((body.mesh.n_points, 3)))
+
+
+def test_what_is_not_implemented_for_membranes_says_so():
+    # The assembled tangent, its diagonal and the CFL step take volume elements: refused on a
+    # membrane rather than computed from the wrong corners.
+    surface, _ = snede.meshing.boundary_surface(snede.meshing.box((1.0, 1.0, 1.0), (2, 2, 2)))
+    body = snede.Body(surface, snede.NeoHookean(1e4, 0.3), thickness=0.01)
+    for preconditioner in ("jacobi", "gamg"):
+        with pytest.raises(ValueError, match="membranes"):
+            snede.StaticSolver(body, "newton", preconditioner=preconditioner)
+    with pytest.raises(ValueError, match="membranes"):
+        snede.DynamicRelaxation(body, damping=20.0)
+    with pytest.raises(Exception, match="error code"):
+        body.tangent_operator(np.zeros((surface.n_points, 3))).getDiagonal()
