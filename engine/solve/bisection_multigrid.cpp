@@ -195,11 +195,25 @@ std::unique_ptr<BisectionMultigrid::Level> BisectionMultigrid::make_level(int k,
   const ElasticBody& body = fine_.body();
   level->body = std::make_unique<ElasticBody>(*level->mesh, body.material(), body.density(), body.thickness());
   level->model = std::make_unique<Model>(*level->body);
-  for (std::size_t i = 0; i < level->vertex.size(); ++i)
-    level->model->constraints().assign(static_cast<VertexId>(i), fine_.constraints()[level->vertex[i]]);
-  if (level->model->constraints().n_constrained_components() < rigid_modes(d)) return nullptr;
+  if (!copy_constraints(*level)) return nullptr;
   SNEDE_PETSC(VecDuplicate(level->model->displacement(), level->state.out()));
   return level;
+}
+
+bool BisectionMultigrid::copy_constraints(Level& level) const {
+  Constraints& constraints = level.model->constraints();
+  for (std::size_t i = 0; i < level.vertex.size(); ++i)
+    constraints.assign(static_cast<VertexId>(i), fine_.constraints()[level.vertex[i]]);
+  return constraints.n_constrained_components() >= rigid_modes(fine_.dim());
+}
+
+bool BisectionMultigrid::follow_constraints() {
+  for (const auto& level : coarse_)
+    if (!copy_constraints(*level)) return false;
+  for (std::size_t i = 0; i < coarse_.size(); ++i)
+    make_interpolation(*coarse_[i], i + 1 < coarse_.size() ? coarse_[i + 1]->vertex : std::vector<VertexId>{});
+  constraints_ = fine_.constraints().projection_fingerprint();
+  return true;
 }
 
 void BisectionMultigrid::make_interpolation(Level& coarse, const std::vector<VertexId>& fine_vertices) const {

@@ -52,6 +52,11 @@ class BisectionMultigrid {
   // Elements per level, coarsest first, the fine mesh last.
   std::vector<std::size_t> level_cells() const;
 
+  // After the fine constraints changed (not the mesh): the coarse levels take them over and the
+  // interpolations are rebuilt, without rebuilding the levels' meshes. False if a level is no
+  // longer held by its constraints (then the levels must be made anew).
+  bool follow_constraints();
+
   // Makes `pc` a PCMG over these levels: interpolations, coarse operators, Chebyshev/Jacobi
   // smoothers, LU on the coarsest. Call before PCSetFromOptions, which may override them
   // (-<prefix>mg_levels_ksp_type, -<prefix>mg_coarse_pc_type, ...).
@@ -66,6 +71,8 @@ class BisectionMultigrid {
   // The coarse level that is a cut of the tree at depth `depth`; null if that cut is not a
   // conforming mesh of the same body.
   std::unique_ptr<Level> make_level(int depth, const std::vector<int>& node_depth) const;
+  // The fine constraints of the level's vertices; whether they hold the level's body.
+  bool copy_constraints(Level& level) const;
   // Interpolation from `coarse` to the level with vertex list `fine_vertices` (fine-mesh ids;
   // empty: the fine mesh itself, every vertex id).
   void make_interpolation(Level& coarse, const std::vector<VertexId>& fine_vertices) const;

@@ -181,12 +181,16 @@ void StaticSolver::follow_mesh_changes() {
   const bool stale_multigrid = multigrid_ && !multigrid_->matches(model_);
   if (!resized && !stale_matrix && !stale_multigrid) return;
   if (!resized && !stale_matrix && multigrid_->matches_mesh(model_)) {
-    // Only the constraints changed (a needle's stick-slip): new levels on the same PC, whose
-    // solver objects and operators stay as they are.
+    // Only the constraints changed (a needle's stick-slip): the same levels take them over (new
+    // levels if one is no longer held), on a fresh PC; the solver objects stay as they are.
     PC pc = nullptr;
     SNEDE_PETSC(KSPGetPC(ksp(), &pc));
     SNEDE_PETSC(PCSetType(pc, PCNONE));
-    set_up_multigrid(pc);
+    if (multigrid_->follow_constraints()) {
+      configure_multigrid(pc);
+    } else {
+      set_up_multigrid(pc);
+    }
     SNEDE_PETSC(PCSetFromOptions(pc));
     return;
   }
@@ -252,6 +256,10 @@ void StaticSolver::set_up_multigrid(PC pc) {
     }
   }
   multigrid_ = std::make_unique<BisectionMultigrid>(model_, *hierarchy_, max_levels);
+  configure_multigrid(pc);
+}
+
+void StaticSolver::configure_multigrid(PC pc) {
   multigrid_->configure(pc, option_database_);
   // The levels come with their own operators and interpolations: PCMG must not coarsen the
   // SNES's shell DM (which it would try after a mesh change, when the PC gets that DM).

@@ -73,6 +73,8 @@ class StaticSolver {
   Mat preconditioning_matrix();
   // The multigrid levels for the current mesh, configured on `pc` (PC "mg").
   void set_up_multigrid(PC pc);
+  // Configures `pc` as a PCMG over the current levels.
+  void configure_multigrid(PC pc);
   // Newton's Jacobian callback: the assembled tangent (or the multigrid levels) are refilled
   // unless the SNES lags the preconditioner at this iteration (-<prefix>snes_lag_preconditioner).
   void refill_preconditioner(SNES snes, Vec x);

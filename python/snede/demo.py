@@ -1,4 +1,4 @@
-"""`make demo`: the built-in scenes (cantilever, cylinder, slab, needle, cut, sheet-cut) with their table, files
+"""`make demo`: the built-in scenes (cantilever, cylinder, slab, needle, needle3d, cut, sheet-cut) with their table, files
 and pictures, then a box cut in two through the §7 connectivity layer."""
 from __future__ import annotations
 
