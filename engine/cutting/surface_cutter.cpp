@@ -35,6 +35,11 @@ double angle_at(const Point3& w, const Point3& a, const Point3& b) {
   return std::atan2(std::sqrt(dot(n, n)), dot(u, v));
 }
 
+Point3 doubled_normal(const Point3& a, const Point3& b, const Point3& c) {
+  const Point3 u = minus(b, a), v = minus(c, a);
+  return {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
+}
+
 // A new node this close (in barycentric weight) to a side goes on that side.
 constexpr double on_side = 1e-6;
 
@@ -104,6 +109,18 @@ std::vector<SurfaceCutter::Wedge> SurfaceCutter::wedges(VertexId b) const {
 bool SurfaceCutter::is_boundary_edge(ElementId triangle, VertexId opposite) const {
   const Connectivity& c = mesh_.connectivity();
   return c.face(c.opposite_face(triangle, opposite)).mate == no_id;
+}
+
+bool SurfaceCutter::keeps_facing(VertexId v, const Point3& x, VertexId merging_into) const {
+  // The edits' own checks refuse only normals turned by 90° or more; on a curved surface
+  // repeated turns short of that can fold it, so the cutter asks for less than 60°.
+  for (const Wedge& w : wedges(v)) {
+    if (w.y == merging_into || w.z == merging_into) continue;  // collapsed away
+    const Point3 y = reference(w.y), z = reference(w.z);
+    const Point3 before = doubled_normal(reference(v), y, z), after = doubled_normal(x, y, z);
+    if (!(dot(before, after) > 0.5 * std::sqrt(dot(before, before) * dot(after, after)))) return false;
+  }
+  return true;
 }
 
 bool SurfaceCutter::on_boundary(VertexId v) const {
@@ -245,13 +262,19 @@ void SurfaceCutter::look_for_entry(const Segment& from, const Segment& to, Plana
   }
   // Figure 5.12a: the swept scalpel crossing a boundary edge.
   std::optional<std::pair<LinkCrossing, VertexId>> first;
+  double first_along = 0;
   for (ElementId e : near) {
     const Simplex& t = c.element(e).simplex;
     for (int k = 0; k < 3; ++k) {
       const VertexId opposite = t.vertex(k), y = t.vertex((k + 1) % 3), z = t.vertex((k + 2) % 3);
       if (!is_boundary_edge(e, opposite)) continue;
       const auto hit = swept_segment_meets_edge(from.head, from.tail, to.head, to.tail, deformed(y), deformed(z));
-      if (hit && (!first || hit->time < first->first.time)) first = std::pair{LinkCrossing{{e, y, z}, hit->time, hit->on_edge}, opposite};
+      // Simultaneous crossings (a fold's layers): the one nearest the scalpel's first end.
+      if (hit && (!first || hit->time < first->first.time ||
+                  (hit->time == first->first.time && hit->along < first_along))) {
+        first = std::pair{LinkCrossing{{e, y, z}, hit->time, hit->on_edge}, opposite};
+        first_along = hit->along;
+      }
     }
   }
   VertexId entry = -1;
@@ -398,7 +421,7 @@ bool SurfaceCutter::move_active_to(const Wedge& w, std::array<double, 3> weights
     for (double& x : part) x /= sum;
     const VertexParents target = VertexParents::barycentric(parents, part);
     const Point3 before = deformed(active_);
-    if (snap_vertex(mesh_, active_, target).done) {
+    if (keeps_facing(active_, reference_at(w, active_, part)) && snap_vertex(mesh_, active_, target).done) {
       moved_[active_] = before;  // follow() reads the active node's old position as a parent
       follow(active_, target);
       return fraction == 1.0;
@@ -408,9 +431,25 @@ bool SurfaceCutter::move_active_to(const Wedge& w, std::array<double, 3> weights
 }
 
 bool SurfaceCutter::flip(VertexId p, VertexId q, PlanarCutReport& report) {
+  const Connectivity& c = mesh_.connectivity();
+  const std::vector<ElementId> wings = elements_with_edge(c, p, q);
+  if (wings.size() != 2) return false;
   std::vector<VertexId> quad{p, q};
-  for (ElementId e : elements_with_edge(mesh_.connectivity(), p, q))
-    for (VertexId v : mesh_.connectivity().element(e).simplex.vertices()) quad.push_back(v);
+  std::vector<Point3> old_normals;
+  for (ElementId e : wings) {
+    const auto t = c.element(e).simplex.oriented_vertices();
+    old_normals.push_back(doubled_normal(reference(t[0]), reference(t[1]), reference(t[2])));
+    quad.push_back(third_vertex(c.element(e).simplex, p, q));
+  }
+  // The new triangles (p, d, c) and (q, c, d), (p, q, c) being the old left one, must turn
+  // by less than 60° from both old ones (as keeps_facing asks of moves).
+  VertexId left = quad[2], right = quad[3];
+  if (c.element(wings[0]).simplex != Simplex(1, {p, q, left})) std::swap(left, right);
+  for (const auto& [x, y, z] : {std::array<VertexId, 3>{p, right, left}, std::array<VertexId, 3>{q, left, right}}) {
+    const Point3 n = doubled_normal(reference(x), reference(y), reference(z));
+    for (const Point3& old : old_normals)
+      if (!(dot(n, old) > 0.5 * std::sqrt(dot(n, n) * dot(old, old)))) return false;
+  }
   if (!flip_edge(mesh_, p, q).done) return false;
   ++report.flips;
   grid_stale_ = true;
@@ -553,7 +592,7 @@ void SurfaceCutter::exit_through(VertexId y, VertexId z, double mu, PlanarCutRep
   for (VertexId tip : tips)
     for (VertexId end : ends)
       if (has_edge(mesh_.connectivity(), tip, end) && distance(reference(tip), reference(end)) < options_.eps_edge &&
-          collapse_edge(mesh_, end, tip, 0).done) {
+          keeps_facing(tip, reference(end), end) && collapse_edge(mesh_, end, tip, 0).done) {
         ++report.edges_contracted;
         incision_vertices_.erase(tip);
         moved_.erase(tip);
@@ -574,11 +613,13 @@ void SurfaceCutter::legalize(PlanarCutReport& report) {
     const std::vector<VertexId> around = touched_;
     for (VertexId v : around) {
       if (!mesh_.is_vertex(v) || c.n_vertex_uses(v) == 0) continue;
-      for (const Wedge& w : wedges(v)) {
-        if (!c.is_element(w.element)) break;
-        for (const auto& [p, q] : {std::pair{v, w.y}, std::pair{w.y, w.z}})
-          if (c.is_element(w.element) && !is_locally_delaunay(mesh_, w.element, p, q) && flip(p, q, report)) flipped = true;
-      }
+      for (const Wedge& w : wedges(v))
+        for (const auto& [p, q] : {std::pair{v, w.y}, std::pair{w.y, w.z}}) {
+          // An earlier flip may have replaced the triangle (and its id been reused).
+          const bool still = c.is_element(w.element) && c.element(w.element).simplex.contains(p) &&
+                             c.element(w.element).simplex.contains(q);
+          if (still && !is_locally_delaunay(mesh_, w.element, p, q) && flip(p, q, report)) flipped = true;
+        }
     }
     if (!flipped) break;
   }

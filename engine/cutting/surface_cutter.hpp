@@ -91,6 +91,9 @@ class SurfaceCutter {
   void follow(VertexId v, const VertexParents& parents);
   std::vector<Wedge> wedges(VertexId b) const;
   bool on_boundary(VertexId v) const;
+  // Whether every triangle of v's star, with v moved to x, turns its normal by less than 60°
+  // (those with vertex merging_into, which a collapse into it removes, aside).
+  bool keeps_facing(VertexId v, const Point3& x, VertexId merging_into = -1) const;
   bool is_boundary_edge(ElementId triangle, VertexId opposite) const;
   Point3 reference_at(const Wedge& w, VertexId b, const std::array<double, 3>& weights) const;
 
