@@ -17,4 +17,5 @@ PYBIND11_MODULE(_snede, m) {
   snede::bindings::bind_needle(m);
   snede::bindings::bind_cutting(m);
   snede::bindings::bind_planar_cutting(m);
+  snede::bindings::bind_surface_cutting(m);
 }

@@ -1,7 +1,10 @@
 #include "topology/flip_edge.hpp"
 
 #include <algorithm>
+#include <array>
+#include <cmath>
 #include <optional>
+#include <span>
 #include <stdexcept>
 
 #include "core/predicates.hpp"
@@ -86,15 +89,41 @@ EditResult flip_edge(Mesh& mesh, VertexId a, VertexId b) {
 
 namespace {
 
-void require_planar_triangles(const Mesh& mesh) {
-  if (mesh.cell_dim() != 2 || mesh.is_surface())
-    throw std::invalid_argument("is_locally_delaunay: needs a 2D triangle mesh");
+void require_triangles(const Mesh& mesh) {
+  if (mesh.cell_dim() != 2) throw std::invalid_argument("is_locally_delaunay: needs a triangle mesh (2D or surface)");
+}
+
+// Interior angle at w of triangle (w, a, b) in 3D.
+double angle_at(std::span<const double> w, std::span<const double> a, std::span<const double> b) {
+  const std::array<double, 3> u{a[0] - w[0], a[1] - w[1], a[2] - w[2]}, v{b[0] - w[0], b[1] - w[1], b[2] - w[2]};
+  const std::array<double, 3> n{u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
+  return std::atan2(std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]), u[0] * v[0] + u[1] * v[1] + u[2] * v[2]);
+}
+
+// §5.3.1: the 2D criterion on a surface, the triangles (p, q, r) and (q, p, s) unfolded.
+bool is_locally_delaunay_unfolded(const Mesh& mesh, VertexId p, VertexId q, VertexId r, VertexId s) {
+  const auto P = mesh.point(p), Q = mesh.point(q), R = mesh.point(r), S = mesh.point(s);
+  if (orientation_3d(P.data(), Q.data(), R.data(), S.data()) == 0) {
+    // Coplanar: drop the coordinate along which the normal of (p, q, r) is largest; the
+    // projection keeps (p, q, r) counter-clockwise when that normal component is positive.
+    const auto n = doubled_vector_area(mesh, p, q, r);
+    int axis = 0;
+    for (int k = 1; k < 3; ++k)
+      if (std::abs(n[k]) > std::abs(n[axis])) axis = k;
+    const auto project = [&](std::span<const double> x) {
+      return std::array<double, 2>{x[(axis + 1) % 3], x[(axis + 2) % 3]};
+    };
+    const auto p2 = project(P), q2 = project(Q), r2 = project(R), s2 = project(S);
+    const int inside = in_circle(p2.data(), q2.data(), r2.data(), s2.data());
+    return (n[axis] > 0 ? inside : -inside) <= 0;
+  }
+  return angle_at(R, P, Q) + angle_at(S, P, Q) <= std::acos(-1.0) * (1 + 1e-12);
 }
 
 }  // namespace
 
 bool is_locally_delaunay(const Mesh& mesh, VertexId a, VertexId b) {
-  require_planar_triangles(mesh);
+  require_triangles(mesh);
   const bool ends_are_vertices = a != b && mesh.is_vertex(a) && mesh.is_vertex(b);
   const std::vector<ElementId> sharing = ends_are_vertices ? elements_with_edge(mesh.connectivity(), a, b) : std::vector<ElementId>{};
   if (sharing.empty()) throw std::invalid_argument("is_locally_delaunay: edge " + vertex_list({a, b}) + " does not exist");
@@ -102,7 +131,7 @@ bool is_locally_delaunay(const Mesh& mesh, VertexId a, VertexId b) {
 }
 
 bool is_locally_delaunay(const Mesh& mesh, ElementId triangle, VertexId a, VertexId b) {
-  require_planar_triangles(mesh);
+  require_triangles(mesh);
   const Connectivity& c = mesh.connectivity();
   if (!c.is_element(triangle) || !c.element(triangle).simplex.contains(a) || !c.element(triangle).simplex.contains(b))
     throw std::invalid_argument("is_locally_delaunay: element " + std::to_string(triangle) + " is not a triangle with edge " +
@@ -116,6 +145,7 @@ bool is_locally_delaunay(const Mesh& mesh, ElementId triangle, VertexId a, Verte
   const auto t = near.oriented_vertices();
   const int k = static_cast<int>(std::find(t.begin(), t.begin() + 3, r) - t.begin());
   const VertexId p = t[(k + 1) % 3], q = t[(k + 2) % 3];
+  if (mesh.is_surface()) return is_locally_delaunay_unfolded(mesh, p, q, r, s);
   return in_circle(mesh.point(p).data(), mesh.point(q).data(), mesh.point(r).data(), mesh.point(s).data()) <= 0;
 }
 

@@ -19,10 +19,15 @@ namespace snede {
 // Throws std::invalid_argument for a tetrahedral mesh.
 EditResult flip_edge(Mesh& mesh, VertexId a, VertexId b);
 
-// §5.2.1: whether interior edge (a, b) of a 2D mesh is legal: the vertex opposite it in one
-// triangle is not strictly inside the other's circumcircle (exact in_circle; cocircular is
-// legal). Boundary edges are Delaunay. Throws std::invalid_argument if (a, b) is not an edge
-// or the mesh is not a 2D triangle mesh.
+// §5.2.1: whether interior edge (a, b) of a triangle mesh is legal: the vertex opposite it in
+// one triangle is not strictly inside the other's circumcircle (exact in_circle; cocircular is
+// legal). Boundary edges are Delaunay. On a surface (§5.3.1) the two triangles are unfolded
+// into one plane: when their four corners are exactly coplanar (orientation_3d) the exact
+// in_circle of their projection onto the coordinate plane facing their normal decides, as in
+// 2D; otherwise the edge is illegal when the two angles facing it add up to more than
+// π (1 + 1e-12) — the unfolded criterion, a floating-point one, with a margin so that nearly
+// cocircular corners are never flipped back and forth. Throws std::invalid_argument if (a, b)
+// is not an edge or the mesh is tetrahedral.
 bool is_locally_delaunay(const Mesh& mesh, VertexId a, VertexId b);
 // The same for edge (a, b) of a known live triangle, in O(1) (a neighbour look-up, no star).
 bool is_locally_delaunay(const Mesh& mesh, ElementId triangle, VertexId a, VertexId b);

@@ -1,0 +1,637 @@
+#include "cutting/surface_cutter.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+#include "core/error.hpp"
+#include "core/petsc_util.hpp"
+#include "cutting/swept_intersections.hpp"
+#include "topology/collapse_edge.hpp"
+#include "topology/dissect.hpp"
+#include "topology/flip_edge.hpp"
+#include "topology/insert_vertex.hpp"
+#include "topology/local_star.hpp"
+#include "topology/remove_vertex.hpp"
+#include "topology/snap_vertex.hpp"
+#include "topology/split_edge.hpp"
+
+namespace snede {
+namespace {
+
+Point3 minus(const Point3& a, const Point3& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
+Point3 lerp(const Point3& a, const Point3& b, double t) {
+  return {a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1]), a[2] + t * (b[2] - a[2])};
+}
+double dot(const Point3& a, const Point3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+double distance(const Point3& a, const Point3& b) { return std::sqrt(dot(minus(a, b), minus(a, b))); }
+
+// Interior angle at w of triangle (w, a, b).
+double angle_at(const Point3& w, const Point3& a, const Point3& b) {
+  const Point3 u = minus(a, w), v = minus(b, w);
+  const Point3 n{u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
+  return std::atan2(std::sqrt(dot(n, n)), dot(u, v));
+}
+
+Point3 doubled_normal(const Point3& a, const Point3& b, const Point3& c) {
+  const Point3 u = minus(b, a), v = minus(c, a);
+  return {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
+}
+
+// A new node this close (in barycentric weight) to a side goes on that side.
+constexpr double on_side = 1e-6;
+
+}  // namespace
+
+SurfaceCutter::SurfaceCutter(Mesh& mesh, Model* model, SurfaceCutterOptions options)
+    : mesh_(mesh), model_(model), options_(options) {
+  if (mesh.cell_dim() != 2 || mesh.space_dim() != 3)
+    throw std::invalid_argument("SurfaceCutter: the mesh must be a surface (triangles in 3D), got cell_dim " +
+                                std::to_string(mesh.cell_dim()) + " in " + std::to_string(mesh.space_dim()) + "D");
+  if (model && &model->body().mesh() != &mesh) throw std::invalid_argument("SurfaceCutter: the model's body is on another mesh");
+  for (const auto& [name, value] : {std::pair{"eps_edge", options.eps_edge}, std::pair{"eps_entry", options.eps_entry},
+                                    std::pair{"eps_exit", options.eps_exit}})
+    require(value >= 0 && std::isfinite(value), std::string("SurfaceCutter: ") + name, "finite and positive (0: the default)", value);
+  // §5.4: thresholds as fractions of the mean edge length.
+  double total = 0;
+  std::size_t edges = 0;
+  const Connectivity& c = mesh.connectivity();
+  for (FaceId f = 0; f < c.face_capacity(); ++f) {
+    if (!c.is_face(f) || (c.face(f).mate != no_id && c.face(f).mate < f)) continue;
+    total += distance(reference(c.face(f).simplex.vertex(0)), reference(c.face(f).simplex.vertex(1)));
+    ++edges;
+  }
+  if (edges == 0) throw std::invalid_argument("SurfaceCutter: the mesh has no edges");
+  const double mean = total / static_cast<double>(edges);
+  if (options_.eps_edge == 0) options_.eps_edge = mean / 3;
+  if (options_.eps_entry == 0) options_.eps_entry = mean / 6;
+  if (options_.eps_exit == 0) options_.eps_exit = mean / 6;
+}
+
+Point3 SurfaceCutter::reference(VertexId v) const {
+  const auto x = mesh_.point(v);
+  return {x[0], x[1], x[2]};
+}
+
+Point3 SurfaceCutter::deformed(VertexId v) const {
+  if (const auto found = moved_.find(v); found != moved_.end()) return found->second;
+  Point3 x = reference(v);
+  const std::size_t at = 3 * static_cast<std::size_t>(v);
+  if (at + 2 < displacement_.size())
+    for (int d = 0; d < 3; ++d) x[d] += displacement_[at + d];
+  return x;
+}
+
+void SurfaceCutter::follow(VertexId v, const VertexParents& parents) {
+  // Watchers interpolate u with the parents' weights, as the reference point is: x follows.
+  Point3 x{0, 0, 0};
+  for (std::size_t k = 0; k < parents.count(); ++k) {
+    const Point3 p = deformed(parents.vertex[k]);
+    for (int d = 0; d < 3; ++d) x[d] += parents.weight[k] * p[d];
+  }
+  moved_[v] = x;
+  grid_stale_ = true;
+}
+
+std::vector<SurfaceCutter::Wedge> SurfaceCutter::wedges(VertexId b) const {
+  const Connectivity& c = mesh_.connectivity();
+  std::vector<Wedge> result;
+  for (ElementId e : local_star(c, b).elements) {
+    const auto t = c.element(e).simplex.oriented_vertices();
+    const int i = static_cast<int>(std::find(t.begin(), t.begin() + 3, b) - t.begin());
+    result.push_back({e, t[(i + 1) % 3], t[(i + 2) % 3]});
+  }
+  return result;
+}
+
+bool SurfaceCutter::is_boundary_edge(ElementId triangle, VertexId opposite) const {
+  const Connectivity& c = mesh_.connectivity();
+  return c.face(c.opposite_face(triangle, opposite)).mate == no_id;
+}
+
+bool SurfaceCutter::keeps_facing(VertexId v, const Point3& x, VertexId merging_into) const {
+  // The edits' own checks refuse only normals turned by 90° or more; on a curved surface
+  // repeated turns short of that can fold it, so the cutter asks for less than 60°.
+  for (const Wedge& w : wedges(v)) {
+    if (w.y == merging_into || w.z == merging_into) continue;  // collapsed away
+    const Point3 y = reference(w.y), z = reference(w.z);
+    const Point3 before = doubled_normal(reference(v), y, z), after = doubled_normal(x, y, z);
+    if (!(dot(before, after) > 0.5 * std::sqrt(dot(before, before) * dot(after, after)))) return false;
+  }
+  return true;
+}
+
+bool SurfaceCutter::on_boundary(VertexId v) const {
+  const Connectivity& c = mesh_.connectivity();
+  for (ElementId e : local_star(c, v).elements)
+    for (VertexId w : c.element(e).simplex.vertices())
+      if (w != v && is_boundary_edge(e, w)) return true;
+  return false;
+}
+
+Point3 SurfaceCutter::reference_at(const Wedge& w, VertexId b, const std::array<double, 3>& weights) const {
+  const Point3 B = reference(b), Y = reference(w.y), Z = reference(w.z);
+  Point3 x{};
+  for (int d = 0; d < 3; ++d) x[d] = weights[0] * B[d] + weights[1] * Y[d] + weights[2] * Z[d];
+  return x;
+}
+
+std::optional<SurfaceCutter::StarHit> SurfaceCutter::hit_in_star(VertexId b, const Segment& scalpel) const {
+  std::optional<StarHit> best;
+  double nearest = std::numeric_limits<double>::infinity();
+  const Point3 xb = deformed(b);
+  for (const Wedge& w : wedges(b)) {
+    const Point3 xy = deformed(w.y), xz = deformed(w.z);
+    const auto hit = segment_meets_triangle(scalpel.head, scalpel.tail, xb, xy, xz, xb);
+    if (!hit) continue;
+    Point3 x{};
+    for (int d = 0; d < 3; ++d) x[d] = hit->weights[0] * xb[d] + hit->weights[1] * xy[d] + hit->weights[2] * xz[d];
+    if (const double r = distance(x, xb); r < nearest) nearest = r, best = StarHit{w, hit->weights};
+  }
+  return best;
+}
+
+std::optional<SurfaceCutter::LinkCrossing> SurfaceCutter::first_link_crossing(VertexId b, const Segment& from,
+                                                                             const Segment& to) const {
+  std::optional<LinkCrossing> first;
+  for (const Wedge& w : wedges(b)) {
+    const auto crossing = swept_segment_meets_edge(from.head, from.tail, to.head, to.tail, deformed(w.y), deformed(w.z));
+    if (crossing && (!first || crossing->time < first->time)) first = LinkCrossing{w, crossing->time, crossing->on_edge};
+  }
+  return first;
+}
+
+double SurfaceCutter::step_limit(VertexId b, const Segment& scalpel) const {
+  double limit = std::numeric_limits<double>::infinity();
+  for (const Wedge& w : wedges(b)) limit = std::min(limit, line_distance(scalpel.head, scalpel.tail, deformed(w.y), deformed(w.z)));
+  return std::max(limit, options_.eps_edge / 4);
+}
+
+std::vector<ElementId> SurfaceCutter::triangles_near(const Segment& from, const Segment& to) {
+  if (grid_stale_ || model_ || grid_revision_ != mesh_.connectivity().revision()) {
+    grid_.build(mesh_, [this](VertexId v) { return deformed(v); });
+    grid_revision_ = mesh_.connectivity().revision();
+    grid_stale_ = false;
+  }
+  Point3 lo = from.head, hi = from.head;
+  for (const Point3& x : {from.tail, to.head, to.tail})
+    for (int d = 0; d < 3; ++d) lo[d] = std::min(lo[d], x[d]), hi[d] = std::max(hi[d], x[d]);
+  return grid_.near(lo, hi);
+}
+
+bool SurfaceCutter::touches_surface(const Segment& scalpel) {
+  const Connectivity& c = mesh_.connectivity();
+  for (ElementId e : triangles_near(scalpel, scalpel)) {
+    const Simplex& t = c.element(e).simplex;
+    const Point3 a = deformed(t.vertex(0));
+    if (segment_meets_triangle(scalpel.head, scalpel.tail, a, deformed(t.vertex(1)), deformed(t.vertex(2)), a)) return true;
+  }
+  return false;
+}
+
+PlanarCutReport SurfaceCutter::move(std::span<const double> segment) {
+  if (segment.size() != 6)
+    throw std::invalid_argument("SurfaceCutter.move: the scalpel is a segment, 2 ends of 3 coordinates; got " +
+                                std::to_string(segment.size()) + " numbers");
+  require_finite_points(segment.data(), segment.size(), 3, "SurfaceCutter.move", "segment");
+  const Segment now{{segment[0], segment[1], segment[2]}, {segment[3], segment[4], segment[5]}};
+  if (now.head == now.tail) throw std::invalid_argument("SurfaceCutter.move: the scalpel's two ends coincide (segment)");
+  const double start = wall_seconds();
+  PlanarCutReport report;
+  report.moves = 1;
+  report.triangles_before = mesh_.n_cells();
+  if (phase_ != Phase::outside && !(mesh_.is_vertex(active_) && mesh_.connectivity().n_vertex_uses(active_) > 0))
+    phase_ = Phase::outside;  // the active node was removed by another edit
+  displacement_.clear();
+  moved_.clear();
+  if (model_) {
+    ReadView view(model_->displacement());
+    displacement_.assign(view.span().begin(), view.span().end());
+    grid_stale_ = true;
+  }
+  touched_.clear();
+  {
+    // A body hears of the move's edits at once, when it is over.
+    ChangeBatch batch(mesh_.connectivity());
+    if (scalpel_) sweep(*scalpel_, now, report);
+    scalpel_ = now;
+    if (phase_ == Phase::cutting) touched_.push_back(active_);
+    legalize(report);
+  }
+  report.triangles_after = mesh_.n_cells();
+  report.seconds = wall_seconds() - start;
+  return report;
+}
+
+void SurfaceCutter::lift() {
+  phase_ = Phase::outside;
+  active_ = -1;
+  scalpel_.reset();
+}
+
+void SurfaceCutter::sweep(const Segment& from, const Segment& to, PlanarCutReport& report) {
+  const double movement = std::max(distance(from.head, to.head), distance(from.tail, to.tail));
+  Segment current = from;
+  double done = 0;
+  // Figure 5.11: steps no longer than d_max near the active node; at most 256 of them.
+  for (int step = 0; step < 256 && done < 1; ++step) {
+    double next = 1;
+    if (phase_ != Phase::outside && movement > 0 && step < 255)
+      next = std::min(1.0, done + step_limit(active_, current) / movement);
+    const Segment target{lerp(from.head, to.head, next), lerp(from.tail, to.tail, next)};
+    if (phase_ == Phase::outside)
+      look_for_entry(current, target, report);
+    else if (phase_ == Phase::entering)
+      begin_incision(target, report);
+    else
+      advance(current, target, report);
+    current = target;
+    done = next;
+  }
+}
+
+void SurfaceCutter::look_for_entry(const Segment& from, const Segment& to, PlanarCutReport& report) {
+  const Connectivity& c = mesh_.connectivity();
+  const std::vector<ElementId> near = triangles_near(from, to);
+  if (!left_surface_) {
+    // After an exit the scalpel must leave the surface before it enters again.
+    left_surface_ = !touches_surface(to);
+    return;
+  }
+  // Figure 5.12a: the swept scalpel crossing a boundary edge.
+  std::optional<std::pair<LinkCrossing, VertexId>> first;
+  double first_along = 0;
+  for (ElementId e : near) {
+    const Simplex& t = c.element(e).simplex;
+    for (int k = 0; k < 3; ++k) {
+      const VertexId opposite = t.vertex(k), y = t.vertex((k + 1) % 3), z = t.vertex((k + 2) % 3);
+      if (!is_boundary_edge(e, opposite)) continue;
+      const auto hit = swept_segment_meets_edge(from.head, from.tail, to.head, to.tail, deformed(y), deformed(z));
+      // Simultaneous crossings (a fold's layers): the one nearest the scalpel's first end.
+      if (hit && (!first || hit->time < first->first.time ||
+                  (hit->time == first->first.time && hit->along < first_along))) {
+        first = std::pair{LinkCrossing{{e, y, z}, hit->time, hit->on_edge}, opposite};
+        first_along = hit->along;
+      }
+    }
+  }
+  VertexId entry = -1;
+  if (first) {
+    const auto& [crossing, opposite] = *first;
+    const VertexId y = crossing.wedge.y, z = crossing.wedge.z;
+    const Point3 at = lerp(reference(y), reference(z), crossing.mu);
+    if (distance(at, reference(y)) <= options_.eps_entry)
+      entry = y;
+    else if (distance(at, reference(z)) <= options_.eps_entry)
+      entry = z;
+    else if ((entry = split(y, z, crossing.mu)) >= 0)
+      ++report.nodes_inserted;
+    else
+      entry = distance(at, reference(y)) < distance(at, reference(z)) ? y : z;
+    tip_entry_ = false;
+  } else {
+    // Figure 5.12b: the scalpel piercing a triangle, the hit nearest its first end.
+    std::optional<std::pair<ElementId, TriangleHit>> pierced;
+    for (ElementId e : near) {
+      const Simplex& t = c.element(e).simplex;
+      const Point3 a = deformed(t.vertex(0));
+      const auto hit = segment_meets_triangle(to.head, to.tail, a, deformed(t.vertex(1)), deformed(t.vertex(2)), to.head);
+      if (hit && (!pierced || hit->along < pierced->second.along)) pierced = std::pair{e, *hit};
+    }
+    if (!pierced) return;
+    const Simplex& t = c.element(pierced->first).simplex;
+    const Wedge w{pierced->first, t.vertex(1), t.vertex(2)};
+    const auto& weights = pierced->second.weights;
+    const Point3 at = reference_at(w, t.vertex(0), weights);
+    for (int k = 0; k < 3 && entry < 0; ++k)
+      if (distance(at, reference(t.vertex(k))) <= options_.eps_entry) entry = t.vertex(k);
+    if (entry < 0) entry = insert_at(w, t.vertex(0), weights, report);
+    if (entry < 0) return;
+    tip_entry_ = !on_boundary(entry);
+  }
+  active_ = entry;
+  phase_ = Phase::entering;
+  touched_.push_back(entry);
+  ++report.entries;
+}
+
+void SurfaceCutter::begin_incision(const Segment& scalpel, PlanarCutReport& report) {
+  const VertexId a = active_;
+  const std::optional<StarHit> hit = hit_in_star(a, scalpel);
+  if (!hit) {
+    if (!touches_surface(scalpel)) phase_ = Phase::outside;  // withdrawn: the entry node stays
+    return;
+  }
+  if (distance(reference_at(hit->wedge, a, hit->weights), reference(a)) <= options_.eps_entry) return;
+  const VertexId b = insert_at(hit->wedge, a, hit->weights, report);
+  if (b < 0 || !has_edge(mesh_.connectivity(), a, b)) return;
+  std::vector<std::array<VertexId, 2>> slit{{a, b}};
+  if (tip_entry_) {
+    // An interior edge does not open (both ends' stars stay whole): split it, so that the
+    // slit a–m–b opens at m.
+    const VertexId m = split(a, b, 0.5);
+    if (m < 0) return;
+    ++report.nodes_inserted;
+    slit = {{a, m}, {m, b}};
+    incision_vertices_.insert(m);
+  }
+  for (VertexId v : dissect_edges(slit)) incision_vertices_.insert(v), touched_.push_back(v);
+  incision_vertices_.insert(a);
+  incision_vertices_.insert(b);
+  touched_.insert(touched_.end(), {a, b});
+  active_ = b;
+  phase_ = Phase::cutting;
+  remesh_around(b, report);
+}
+
+VertexId SurfaceCutter::insert_at(const Wedge& w, VertexId b, const std::array<double, 3>& weights,
+                                  PlanarCutReport& report) {
+  const std::array<VertexId, 3> corners{b, w.y, w.z};
+  const int smallest = static_cast<int>(std::min_element(weights.begin(), weights.end()) - weights.begin());
+  VertexId made = -1;
+  if (weights[smallest] > on_side) {
+    const auto oriented = mesh_.connectivity().element(w.element).simplex.oriented_vertices();
+    std::array<double, 3> in_order{};
+    for (int k = 0; k < 3; ++k) in_order[k] = weights[std::find(corners.begin(), corners.end(), oriented[k]) - corners.begin()];
+    if (const EditResult inserted = insert_vertex(mesh_, w.element, in_order); inserted.done) {
+      made = inserted.vertex;
+      follow(made, VertexParents::barycentric(std::span<const VertexId>(oriented.data(), 3), in_order));
+    }
+  }
+  if (made < 0) {  // on or too near a side: split that side
+    const VertexId s = corners[(smallest + 1) % 3], t = corners[(smallest + 2) % 3];
+    const double ws = weights[(smallest + 1) % 3], wt = weights[(smallest + 2) % 3];
+    made = split(s, t, std::clamp(wt / (ws + wt), 0.05, 0.95));
+  }
+  if (made >= 0) ++report.nodes_inserted;
+  return made;
+}
+
+VertexId SurfaceCutter::split(VertexId a, VertexId b, double t) {
+  const EditResult result = split_edge(mesh_, a, b, t);
+  if (!result.done) return -1;
+  follow(result.vertex, VertexParents::on_edge(a, b, t));
+  return result.vertex;
+}
+
+void SurfaceCutter::advance(const Segment& from, const Segment& to, PlanarCutReport& report) {
+  for (int attempt = 0; attempt < 64 && phase_ == Phase::cutting; ++attempt) {
+    const VertexId b = active_;
+    if (const std::optional<StarHit> hit = hit_in_star(b, to)) {
+      if (!move_active_to(hit->wedge, hit->weights)) ++report.stuck;
+      remesh_around(b, report);
+      split_incision(report);
+      return;
+    }
+    // §5.3.1: the scalpel has left the active triangles across the edge it swept first.
+    const std::optional<LinkCrossing> crossing = first_link_crossing(b, from, to);
+    if (!crossing) {
+      if (touches_surface(to)) ++report.stuck;
+      return;
+    }
+    const Wedge& w = crossing->wedge;
+    move_active_to(w, {0.4, 0.6 * (1 - crossing->mu), 0.6 * crossing->mu});
+    if (is_boundary_edge(w.element, b)) {
+      exit_through(w.y, w.z, crossing->mu, report);
+      return;
+    }
+    if (!flip(w.y, w.z, report)) {
+      // A flip refused (Figure 5.9, or a fold): remove the nearer interior end instead.
+      VertexId first = w.y, second = w.z;
+      if (distance(reference(second), reference(b)) < distance(reference(first), reference(b))) std::swap(first, second);
+      bool removed = false;
+      for (VertexId v : {first, second})
+        if (!removed && !incision_vertices_.count(v) && !on_boundary(v)) removed = remove_node(v, report);
+      if (!removed) {
+        ++report.stuck;
+        return;
+      }
+    }
+  }
+}
+
+bool SurfaceCutter::move_active_to(const Wedge& w, std::array<double, 3> weights) {
+  const std::array<VertexId, 3> parents{active_, w.y, w.z};
+  // Part of the way when the whole way would flatten or fold a triangle of the star.
+  for (double fraction : {1.0, 0.75, 0.5, 0.25}) {
+    std::array<double, 3> part{1 - fraction + fraction * weights[0], fraction * weights[1], fraction * weights[2]};
+    const double sum = part[0] + part[1] + part[2];
+    for (double& x : part) x /= sum;
+    const VertexParents target = VertexParents::barycentric(parents, part);
+    const Point3 before = deformed(active_);
+    if (keeps_facing(active_, reference_at(w, active_, part)) && snap_vertex(mesh_, active_, target).done) {
+      moved_[active_] = before;  // follow() reads the active node's old position as a parent
+      follow(active_, target);
+      return fraction == 1.0;
+    }
+  }
+  return false;
+}
+
+bool SurfaceCutter::flip(VertexId p, VertexId q, PlanarCutReport& report) {
+  const Connectivity& c = mesh_.connectivity();
+  const std::vector<ElementId> wings = elements_with_edge(c, p, q);
+  if (wings.size() != 2) return false;
+  std::vector<VertexId> quad{p, q};
+  std::vector<Point3> old_normals;
+  for (ElementId e : wings) {
+    const auto t = c.element(e).simplex.oriented_vertices();
+    old_normals.push_back(doubled_normal(reference(t[0]), reference(t[1]), reference(t[2])));
+    quad.push_back(third_vertex(c.element(e).simplex, p, q));
+  }
+  // The new triangles (p, d, c) and (q, c, d), (p, q, c) being the old left one, must turn
+  // by less than 60° from both old ones (as keeps_facing asks of moves).
+  VertexId left = quad[2], right = quad[3];
+  if (c.element(wings[0]).simplex != Simplex(1, {p, q, left})) std::swap(left, right);
+  for (const auto& [x, y, z] : {std::array<VertexId, 3>{p, right, left}, std::array<VertexId, 3>{q, left, right}}) {
+    const Point3 n = doubled_normal(reference(x), reference(y), reference(z));
+    for (const Point3& old : old_normals)
+      if (!(dot(n, old) > 0.5 * std::sqrt(dot(n, n) * dot(old, old)))) return false;
+  }
+  if (!flip_edge(mesh_, p, q).done) return false;
+  ++report.flips;
+  grid_stale_ = true;
+  touched_.insert(touched_.end(), quad.begin(), quad.end());
+  return true;
+}
+
+bool SurfaceCutter::remove_node(VertexId v, PlanarCutReport& report) {
+  std::vector<VertexId> link;
+  for (const Wedge& w : wedges(v)) link.insert(link.end(), {w.y, w.z});
+  if (!remove_vertex_by_flips(mesh_, v).done) return false;
+  ++report.nodes_removed;
+  moved_.erase(v);
+  grid_stale_ = true;
+  touched_.insert(touched_.end(), link.begin(), link.end());
+  return true;
+}
+
+void SurfaceCutter::remesh_around(VertexId b, PlanarCutReport& report) {
+  if (!mesh_.is_vertex(b)) return;
+  // §5.3.1: the active triangles' edges to the unfolded Delaunay criterion.
+  for (int round = 0; round < 64; ++round) {
+    bool flipped = false;
+    for (const Wedge& w : wedges(b)) {
+      for (const auto& [p, q] : {std::pair{w.y, w.z}, std::pair{b, w.y}})
+        if (!is_locally_delaunay(mesh_, w.element, p, q) && flip(p, q, report)) {
+          flipped = true;
+          break;
+        }
+      if (flipped) break;
+    }
+    if (!flipped) break;
+  }
+  // Interior nodes closer than ε_edge to the active node go (§5.2.2).
+  for (int round = 0; round < 16; ++round) {
+    const Point3 x = reference(b);
+    VertexId closest = -1;
+    double nearest = options_.eps_edge;
+    for (const Wedge& w : wedges(b))
+      for (VertexId v : {w.y, w.z})
+        if (const double r = distance(reference(v), x); r < nearest && !incision_vertices_.count(v) && !on_boundary(v))
+          nearest = r, closest = v;
+    if (closest < 0 || !remove_node(closest, report)) break;
+  }
+}
+
+void SurfaceCutter::split_incision(PlanarCutReport& report) {
+  const VertexId b = active_;
+  if (phase_ != Phase::cutting) return;
+  // The cut edges: boundary edges (b, c1) of wedge (b, c1, o1) and (b, c2) of (b, o2, c2).
+  std::optional<Wedge> out, in;
+  for (const Wedge& w : wedges(b)) {
+    if (is_boundary_edge(w.element, w.z)) out = w;
+    if (is_boundary_edge(w.element, w.y)) in = w;
+  }
+  if (!out || !in || out->element == in->element) return;
+  const VertexId c1 = out->y, o1 = out->z, o2 = in->y, c2 = in->z;
+  if (o1 == o2 || !incision_vertices_.count(c1) || !incision_vertices_.count(c2)) return;
+  const Point3 pb = reference(b), p1 = reference(o1), p2 = reference(o2);
+  const Point3 pc = lerp(reference(c1), reference(c2), 0.5);
+  // Figure 5.5 unfolded: the cut edges seen as one edge b–c fail the empty-circle test when
+  // the angles facing them add up to more than π.
+  if (angle_at(p1, pb, reference(c1)) + angle_at(p2, pb, reference(c2)) <= std::acos(-1.0) * (1 + 1e-12)) return;
+  // Unfold o1 and o2 to either side of b–c: the line between them crosses it at s.
+  const double length = distance(pb, pc);
+  if (length == 0) return;
+  const Point3 along = minus(pc, pb);
+  const auto unfolded = [&](const Point3& o) {
+    const double x = dot(minus(o, pb), along) / length;
+    return std::pair{x, std::sqrt(std::max(dot(minus(o, pb), minus(o, pb)) - x * x, 0.0))};
+  };
+  const auto [x1, h1] = unfolded(p1);
+  const auto [x2, h2] = unfolded(p2);
+  if (h1 + h2 == 0) return;
+  const double s = (x1 + (x2 - x1) * h1 / (h1 + h2)) / length;
+  if (!(s * length > 0.25 * options_.eps_edge && (1 - s) * length > 0.25 * options_.eps_edge)) return;
+  const Point3 at = lerp(pb, pc, s);
+  // A new node within ε_edge/2 of an opposite node would leave a sliver: that node goes if it
+  // is interior, and the next move looks again.
+  const VertexId nearer = distance(at, p1) < distance(at, p2) ? o1 : o2;
+  if (distance(at, reference(nearer)) < 0.5 * options_.eps_edge) {
+    if (!incision_vertices_.count(nearer) && !on_boundary(nearer) && remove_node(nearer, report)) remesh_around(b, report);
+    return;
+  }
+  const VertexId first = split(b, c1, s);
+  if (first < 0) return;
+  const VertexId second = split(b, c2, s);
+  if (second < 0) {  // keep the lips alike: undo the first
+    collapse_edge(mesh_, c1, first, 0);
+    moved_.erase(first);
+    return;
+  }
+  incision_vertices_.insert(first);
+  incision_vertices_.insert(second);
+  touched_.insert(touched_.end(), {first, second});
+  report.nodes_inserted += 2;
+  ++report.incision_splits;
+  remesh_around(b, report);
+}
+
+std::vector<VertexId> SurfaceCutter::dissect_edges(const std::vector<std::array<VertexId, 2>>& edges) {
+  Connectivity& c = mesh_.connectivity();
+  std::vector<FaceId> faces;
+  for (const auto& [a, b] : edges) {
+    const ElementId e = elements_with_edge(c, a, b).front();
+    faces.push_back(c.opposite_face(e, third_vertex(c.element(e).simplex, a, b)));
+  }
+  const std::vector<SplitVertex> split =
+      dissect(c, faces, [this](VertexId v) { return mesh_.add_vertex(VertexParents::copy_of(v)); });
+  std::vector<VertexId> copies;
+  for (const SplitVertex& s : split) {
+    follow(s.copy, VertexParents::copy_of(s.original));
+    copies.push_back(s.copy);
+  }
+  return copies;
+}
+
+void SurfaceCutter::exit_through(VertexId y, VertexId z, double mu, PlanarCutReport& report) {
+  const Point3 py = reference(y), pz = reference(z), at = lerp(py, pz, mu);
+  VertexId w = -1;
+  if (distance(at, py) <= options_.eps_exit)
+    w = y;
+  else if (distance(at, pz) <= options_.eps_exit)
+    w = z;
+  else if ((w = split(y, z, mu)) >= 0)
+    ++report.nodes_inserted;
+  else
+    w = distance(at, py) < distance(at, pz) ? y : z;
+  const VertexId b = active_;
+  phase_ = Phase::outside;
+  active_ = -1;
+  left_surface_ = false;
+  // An edge (b, w) that is missing or already on the boundary has nothing to open.
+  if (elements_with_edge(mesh_.connectivity(), b, w).size() != 2) return;
+  const std::vector<VertexId> copies = dissect_edges({{b, w}});
+  ++report.exits;
+  // Figure 5.7: the short edges the exit leaves are contracted, each copy of b into its w.
+  std::vector<VertexId> tips{b}, ends{w};
+  for (VertexId v : copies) (mesh_.parents(v).vertex.front() == b ? tips : ends).push_back(v);
+  for (VertexId tip : tips)
+    for (VertexId end : ends)
+      if (has_edge(mesh_.connectivity(), tip, end) && distance(reference(tip), reference(end)) < options_.eps_edge &&
+          keeps_facing(tip, reference(end), end) && collapse_edge(mesh_, end, tip, 0).done) {
+        ++report.edges_contracted;
+        incision_vertices_.erase(tip);
+        moved_.erase(tip);
+      }
+  for (VertexId v : ends) incision_vertices_.insert(v), touched_.push_back(v);
+  for (VertexId v : tips)
+    if (mesh_.is_vertex(v)) incision_vertices_.insert(v), touched_.push_back(v);
+}
+
+void SurfaceCutter::legalize(PlanarCutReport& report) {
+  std::sort(touched_.begin(), touched_.end());
+  touched_.erase(std::unique(touched_.begin(), touched_.end()), touched_.end());
+  const Connectivity& c = mesh_.connectivity();
+  // Lawson flips around the vertices this move touched, a bounded number of rounds (on a
+  // curved surface the unfolded criterion is a heuristic, §5.3.1).
+  for (int round = 0; round < 8; ++round) {
+    bool flipped = false;
+    const std::vector<VertexId> around = touched_;
+    for (VertexId v : around) {
+      if (!mesh_.is_vertex(v) || c.n_vertex_uses(v) == 0) continue;
+      for (const Wedge& w : wedges(v))
+        for (const auto& [p, q] : {std::pair{v, w.y}, std::pair{w.y, w.z}}) {
+          // An earlier flip may have replaced the triangle (and its id been reused).
+          const bool still = c.is_element(w.element) && c.element(w.element).simplex.contains(p) &&
+                             c.element(w.element).simplex.contains(q);
+          if (still && !is_locally_delaunay(mesh_, w.element, p, q) && flip(p, q, report)) flipped = true;
+        }
+    }
+    if (!flipped) break;
+  }
+}
+
+std::vector<VertexId> SurfaceCutter::incision_edges() const {
+  std::vector<VertexId> edges;
+  for (const auto& [simplex, f] : mesh_.connectivity().boundary()) {
+    const auto v = simplex.oriented_vertices();
+    if (incision_vertices_.count(v[0]) && incision_vertices_.count(v[1])) edges.insert(edges.end(), {v[0], v[1]});
+  }
+  return edges;
+}
+
+}  // namespace snede

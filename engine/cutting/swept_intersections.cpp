@@ -1,0 +1,178 @@
+#include "cutting/swept_intersections.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/predicates.hpp"
+
+namespace snede {
+namespace {
+
+Point3 minus(const Point3& a, const Point3& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
+Point3 plus_scaled(const Point3& a, double s, const Point3& d) { return {a[0] + s * d[0], a[1] + s * d[1], a[2] + s * d[2]}; }
+Point3 lerp(const Point3& a, const Point3& b, double t) { return plus_scaled(a, t, minus(b, a)); }
+double dot(const Point3& a, const Point3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+Point3 cross(const Point3& a, const Point3& b) {
+  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
+}
+double norm(const Point3& a) { return std::sqrt(dot(a, a)); }
+
+struct ClosestPoints {
+  double s, t, distance;  // p + s (q − p) and a + t (b − a), both clamped to [0, 1]
+};
+
+// The nearest points of segments p→q and a→b.
+ClosestPoints closest_points(const Point3& p, const Point3& q, const Point3& a, const Point3& b) {
+  const Point3 d1 = minus(q, p), d2 = minus(b, a), r = minus(p, a);
+  const double A = dot(d1, d1), E = dot(d2, d2), F = dot(d2, r);
+  double s = 0, t = 0;
+  if (A <= 0 && E <= 0) {
+  } else if (A <= 0) {
+    t = std::clamp(F / E, 0.0, 1.0);
+  } else {
+    const double C = dot(d1, r);
+    if (E <= 0) {
+      s = std::clamp(-C / A, 0.0, 1.0);
+    } else {
+      const double B = dot(d1, d2), denominator = A * E - B * B;
+      s = denominator > 0 ? std::clamp((B * F - C * E) / denominator, 0.0, 1.0) : 0.0;
+      t = (B * s + F) / E;
+      if (t < 0) {
+        t = 0, s = std::clamp(-C / A, 0.0, 1.0);
+      } else if (t > 1) {
+        t = 1, s = std::clamp((B - C) / A, 0.0, 1.0);
+      }
+    }
+  }
+  return {s, t, norm(minus(plus_scaled(p, s, d1), plus_scaled(a, t, d2)))};
+}
+
+}  // namespace
+
+std::optional<TriangleHit> segment_meets_triangle(const Point3& p, const Point3& q, const Point3& a, const Point3& b,
+                                                  const Point3& c, const Point3& near) {
+  if (collinear_3d(a.data(), b.data(), c.data())) return std::nullopt;
+  const int side_p = orientation_3d(a.data(), b.data(), c.data(), p.data());
+  const int side_q = orientation_3d(a.data(), b.data(), c.data(), q.data());
+  const Point3 normal = cross(minus(b, a), minus(c, a));
+  const double doubled_area = dot(normal, normal);
+  const auto weights_of = [&](const Point3& x) {
+    return std::array<double, 3>{dot(cross(minus(b, x), minus(c, x)), normal) / doubled_area,
+                                 dot(cross(minus(c, x), minus(a, x)), normal) / doubled_area,
+                                 dot(cross(minus(a, x), minus(b, x)), normal) / doubled_area};
+  };
+  if (side_p == 0 && side_q == 0) {
+    // Flat on the plane: clip the segment by the three sides (each a linear constraint in the
+    // fraction along it), then take the point of the remaining piece nearest `near`.
+    double low = 0, high = 1;
+    const std::array<Point3, 3> corners{a, b, c};
+    for (int k = 0; k < 3; ++k) {
+      const Point3& from = corners[k];
+      const Point3 side = cross(normal, minus(corners[(k + 1) % 3], from));  // points inwards
+      const double at_p = dot(side, minus(p, from)), rate = dot(side, minus(q, p));
+      if (rate == 0) {
+        if (at_p < 0) return std::nullopt;
+      } else if (rate > 0) {
+        low = std::max(low, -at_p / rate);
+      } else {
+        high = std::min(high, -at_p / rate);
+      }
+    }
+    if (low > high) return std::nullopt;
+    const Point3 d = minus(q, p);
+    const double length2 = dot(d, d);
+    const double along = length2 > 0 ? std::clamp(dot(minus(near, p), d) / length2, low, high) : low;
+    auto weights = weights_of(lerp(p, q, along));
+    for (double& w : weights) w = std::max(w, 0.0);
+    const double sum = weights[0] + weights[1] + weights[2];
+    for (double& w : weights) w /= sum;
+    return TriangleHit{weights, along};
+  }
+  if (side_p * side_q > 0) return std::nullopt;
+  // The line p→q passes through the closed triangle: its sides are all on one side of it.
+  const int ab = orientation_3d(p.data(), q.data(), a.data(), b.data());
+  const int bc = orientation_3d(p.data(), q.data(), b.data(), c.data());
+  const int ca = orientation_3d(p.data(), q.data(), c.data(), a.data());
+  if ((ab < 0 || bc < 0 || ca < 0) && (ab > 0 || bc > 0 || ca > 0)) return std::nullopt;
+  const double height_p = dot(normal, minus(p, a)), height_q = dot(normal, minus(q, a));
+  const double along = height_p == height_q ? 0.0 : std::clamp(height_p / (height_p - height_q), 0.0, 1.0);
+  auto weights = weights_of(lerp(p, q, along));
+  // The exact signs say which sides the hit is on; zero weights where it is on a side.
+  const std::array<int, 3> opposite{bc, ca, ab};
+  for (int k = 0; k < 3; ++k) weights[k] = opposite[k] == 0 ? 0.0 : std::max(weights[k], 0.0);
+  const double sum = weights[0] + weights[1] + weights[2];
+  if (!(sum > 0)) return std::nullopt;
+  for (double& w : weights) w /= sum;
+  return TriangleHit{weights, along};
+}
+
+std::optional<SweptCrossing> swept_segment_meets_edge(const Point3& h0, const Point3& t0, const Point3& h1,
+                                                      const Point3& t1, const Point3& a, const Point3& b) {
+  const auto head = [&](double g) { return lerp(h0, h1, g); };
+  const auto tail = [&](double g) { return lerp(t0, t1, g); };
+  const double scale = std::max({norm(minus(t0, h0)), norm(minus(t1, h1)), norm(minus(b, a)), norm(minus(h1, h0)),
+                                 norm(minus(t1, t0)), norm(minus(a, h0))});
+  const double tolerance = 1e-9 * scale;
+  const auto meeting = [&](double g) -> std::optional<SweptCrossing> {
+    const ClosestPoints closest = closest_points(head(g), tail(g), a, b);
+    if (closest.distance > tolerance) return std::nullopt;
+    return SweptCrossing{g, closest.s, closest.t};
+  };
+  // (5.1): the scalpel's line and the edge's are coplanar where
+  // f(γ) = (t(γ) − h(γ)) · ((a − h(γ)) × (b − a)) vanishes, a quadratic A γ² + B γ + C.
+  const auto f = [&](double g) { return dot(minus(tail(g), head(g)), cross(minus(a, head(g)), minus(b, a))); };
+  const double f0 = f(0), half = f(0.5), f1 = f(1);
+  const double A = 2 * f1 - 4 * half + 2 * f0, B = f1 - f0 - A, C = f0;
+  const double negligible = 1e-12 * scale * scale * scale;
+  const bool coplanar_throughout =
+      orientation_3d(h0.data(), t0.data(), a.data(), b.data()) == 0 &&
+      orientation_3d(h1.data(), t1.data(), a.data(), b.data()) == 0 && std::abs(half) <= negligible;
+  std::optional<SweptCrossing> first;
+  if (coplanar_throughout) {
+    constexpr int samples = 64;
+    double before = 0;
+    for (int k = 0; k <= samples; ++k) {
+      const double g = static_cast<double>(k) / samples;
+      if (!meeting(g)) {
+        before = g;
+        continue;
+      }
+      if (k == 0) return meeting(0);
+      double miss = before, hit = g;
+      for (int bisection = 0; bisection < 40; ++bisection) {
+        const double middle = 0.5 * (miss + hit);
+        (meeting(middle) ? hit : miss) = middle;
+      }
+      return meeting(hit);
+    }
+    return std::nullopt;
+  }
+  std::array<double, 2> roots{-1, -1};
+  if (std::abs(A) <= negligible) {
+    if (B != 0) roots[0] = -C / B;
+  } else {
+    const double discriminant = B * B - 4 * A * C;
+    if (discriminant >= 0) {
+      // The numerically stable pair of roots.
+      const double q = -0.5 * (B + std::copysign(std::sqrt(discriminant), B));
+      roots = {q / A, q != 0 ? C / q : -1};
+    } else if (discriminant > -1e-12 * B * B) {
+      roots[0] = -B / (2 * A);  // a double root lost to rounding: the scalpel grazes the edge
+    }
+  }
+  std::sort(roots.begin(), roots.end());
+  for (double g : roots) {
+    if (g < -1e-12 || g > 1 + 1e-12) continue;
+    if (auto hit = meeting(std::clamp(g, 0.0, 1.0)); hit && (!first || hit->time < first->time)) first = hit;
+  }
+  return first;
+}
+
+double line_distance(const Point3& p, const Point3& q, const Point3& a, const Point3& b) {
+  const Point3 n = cross(minus(q, p), minus(b, a));
+  const double length = norm(n);
+  if (length <= 1e-12 * norm(minus(q, p)) * norm(minus(b, a))) return closest_points(p, q, a, b).distance;
+  return std::abs(dot(minus(a, p), n)) / length;
+}
+
+}  // namespace snede

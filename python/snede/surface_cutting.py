@@ -1,0 +1,87 @@
+"""Cutting triangulated surfaces in 3D with a line-segment scalpel (thesis §5.3.1).
+
+The scalpel is a segment in space whose ends move with constant velocity between samples.
+Where it meets the surface it drags the active node, the tip of the incision; after every
+step the triangles around it are remeshed as in the 2D Delaunay cut (flips by the unfolded
+empty-circle criterion, removal of nodes closer than ``eps_edge``, incision splits), so the
+mesh stays small and well shaped. On a membrane Body the scalpel moves in deformed
+coordinates and the mesh is edited in the reference configuration; the body keeps its
+state, so a pre-tensioned membrane opens as it is cut. One incision at a time.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from snede import _snede
+from snede.cutting import _points, body_and_mesh, move_along
+from snede.planar_cutting import PlanarCutReport, _threshold
+
+
+class SurfaceCutter:
+    """Delaunay cutting of a surface mesh or membrane Body (triangles in 3D) with a segment.
+
+    ``SurfaceCutter(body_or_mesh, *, eps_edge=None, eps_entry=None, eps_exit=None)``:
+    thresholds in the reference configuration, by default h̄/3, h̄/6 and h̄/6 with h̄ the mean
+    edge length (§5.4).
+
+    ``move(segment)`` moves the scalpel to ``segment`` ((2, 3): its two ends, deformed
+    coordinates); the first move only places it. The swept scalpel crossing a boundary edge
+    enters there, or, crossing none, the scalpel piercing a triangle enters with its tip; the
+    incision follows the scalpel and ends where it leaves through the boundary. ``cut(path)``
+    moves through ``path`` ((n, 2, 3) scalpel positions, the first places it). Both return a
+    :class:`snede.PlanarCutReport` (the same fields as the 2D cutter's). Invalid input raises
+    ``ValueError`` before anything changes.
+    """
+
+    def __init__(self, body_or_mesh, *, eps_edge=None, eps_entry=None, eps_exit=None):
+        self.body, self.mesh, model = body_and_mesh(body_or_mesh)
+        if self.mesh.cell_dim != 2 or self.mesh.space_dim != 3:
+            raise ValueError(f"{type(self).__name__} needs a surface mesh (triangles in 3D); this one has "
+                             f"{self.mesh.cell_dim}-D cells in {self.mesh.space_dim}-D")
+        self._impl = _snede.SurfaceCutter(self.mesh._impl, model, _threshold(eps_edge, "eps_edge"),
+                                          _threshold(eps_entry, "eps_entry"), _threshold(eps_exit, "eps_exit"))
+
+    @property
+    def eps_edge(self) -> float:
+        return self._impl.eps_edge
+
+    @property
+    def eps_entry(self) -> float:
+        return self._impl.eps_entry
+
+    @property
+    def eps_exit(self) -> float:
+        return self._impl.eps_exit
+
+    def move(self, segment) -> PlanarCutReport:
+        segment = _points(segment, (2, 3), "segment")
+        if np.array_equal(segment[0], segment[1]):
+            raise ValueError(f"segment: the scalpel's two ends coincide: {segment.tolist()}")
+        return PlanarCutReport._from_engine(self._impl.move(segment))
+
+    def cut(self, segments, progress=None) -> PlanarCutReport:
+        """Move the scalpel through ``segments`` ((n, 2, 3), n >= 2; the first places it);
+        ``progress(done, total, report)`` is called after each move. The whole path is checked
+        before the first move."""
+        segments = np.asarray(segments, dtype=np.float64)
+        if segments.ndim != 3 or segments.shape[1:] != (2, 3) or len(segments) < 2:
+            raise ValueError(f"segments must be (n, 2, 3) scalpel positions with n >= 2, got shape {segments.shape}")
+        if not np.all(np.isfinite(segments)):
+            raise ValueError("segments has non-finite coordinates")
+        if np.any(np.all(segments[:, 0] == segments[:, 1], axis=1)):
+            raise ValueError("segments: a scalpel position has coinciding ends")
+        return move_along(self.move, segments, PlanarCutReport(), progress)
+
+    def lift(self) -> None:
+        """Lift the scalpel: an incision in progress stays as it is; the next move only places it."""
+        self._impl.lift()
+
+    @property
+    def active_node(self) -> int | None:
+        """The vertex at the tip of the incision in progress, or None."""
+        node = self._impl.active_node
+        return None if node < 0 else int(node)
+
+    def incision_edges(self) -> np.ndarray:
+        """The boundary edges the cuts made (both lips), (n, 2) vertex ids."""
+        return self._impl.incision_edges()
