@@ -12,7 +12,8 @@ Printed per case: the final element count, updates, solves (rearrangements), the
 the tip-region deflection. The thesis: linear, 2420 elements, 5 s; neo-Hookean, 29 562 elements,
 1364 s (Pentium III, 1 GHz).
 
-    .venv/bin/python benchmarks/needle3d_rates.py            # about 2 minutes
+    .venv/bin/python benchmarks/needle3d_rates.py                 # about 2 minutes
+    .venv/bin/python benchmarks/needle3d_rates.py --deflection    # linear against neo-Hookean, about 2 minutes
 
 Not a test: times depend on the machine and its load; compare the ratios of one run.
 """
@@ -37,10 +38,11 @@ def cube(material):
     return body
 
 
-def insert(material, h_ref: float, preconditioner: str, solves_per_update: int | None = None, entry=ENTRY):
+def insert(material, h_ref: float, preconditioner: str, solves_per_update: int | None = None, entry=ENTRY,
+           friction_scale: float = 1.0):
     body = cube(material)
     method = "cg" if isinstance(material, snede.LinearElastic) else "newton"
-    needle = snede.NeedleInsertion(body, entry, DIRECTION, snede.FrictionProfile.figure_6_4(), radius=RADIUS,
+    needle = snede.NeedleInsertion(body, entry, DIRECTION, snede.FrictionProfile.figure_6_4(friction_scale), radius=RADIUS,
                                    h_ref=h_ref, method=method, rtol=1e-3, solves_per_update=solves_per_update,
                                    petsc_options={"pc_type": preconditioner})
     start = time.perf_counter()
@@ -51,7 +53,25 @@ def insert(material, h_ref: float, preconditioner: str, solves_per_update: int |
     return body, needle, report, seconds, deflection
 
 
+def deflection_table() -> None:
+    """Linear against neo-Hookean under the profile scaled by 100: the 2D sheet's force per
+    length spread over its 1 cm thickness, a force per area (about 100 s)."""
+    print("\nLinear against neo-Hookean, profile × 100 (N/m²), h_ref 0.1 m/48, the scene's entry:")
+    for name, material in (("linear", snede.LinearElastic(34e3, 0.34)), ("neo-Hookean", snede.NeoHookean(34e3, 0.34))):
+        body, needle, report, seconds, _ = insert(material, SIZE / 48, "mg", entry=needle3d.ENTRY, friction_scale=100.0)
+        x = body.mesh.points + body.displacement
+        tip = np.linalg.norm(x - needle.tip, axis=1) < 0.004
+        print(f"   {name:<12} {body.mesh.n_cells} tetrahedra, {report.rearrangements} solves, {seconds:.1f} s; "
+              f"max |u| {np.abs(body.displacement).max() * 1e3:.4f} mm, mean u_x within 4 mm of the tip "
+              f"{body.displacement[tip, 0].mean() * 1e3:.4f} mm", flush=True)
+
+
 def main() -> None:
+    import sys
+
+    if "--deflection" in sys.argv[1:]:
+        deflection_table()
+        return
     print(__doc__.splitlines()[0])
     print(f"{'material':<12} {'h_ref [mm]':>10} {'pc':<5} {'elements':>9} {'updates':>8} {'solves':>7} "
           f"{'solves/s':>9} {'CG/solve':>9} {'seconds':>8} {'|u_z| near tip [mm]':>20}  result")
