@@ -9,6 +9,7 @@
 #include "core/error.hpp"
 #include "core/petsc_util.hpp"
 #include "core/predicates.hpp"
+#include "cutting/cut_thresholds.hpp"
 #include "needle/deformed_queries.hpp"
 #include "topology/collapse_edge.hpp"
 #include "topology/dissect.hpp"
@@ -88,25 +89,14 @@ DelaunayCutter::DelaunayCutter(Mesh& mesh, Model* model, DelaunayCutterOptions o
     throw std::invalid_argument("DelaunayCutter: the mesh must be a 2D triangle mesh, got cell_dim " +
                                 std::to_string(mesh.cell_dim()) + " in " + std::to_string(mesh.space_dim()) + "D");
   if (model && &model->body().mesh() != &mesh) throw std::invalid_argument("DelaunayCutter: the model's body is on another mesh");
-  for (const auto& [name, value] : {std::pair{"eps_edge", options.eps_edge}, std::pair{"eps_entry", options.eps_entry},
-                                    std::pair{"eps_exit", options.eps_exit}})
-    require(value >= 0 && std::isfinite(value), std::string("DelaunayCutter: ") + name, "finite and positive (0: the default)", value);
   require(options.short_edge_angle >= 0 && options.short_edge_angle < std::acos(-1.0) / 2,
           "DelaunayCutter: short_edge_angle", "in [0, π/2) radians", options.short_edge_angle);
   // §5.4: thresholds as fractions of the mean edge length.
-  double total = 0;
-  std::size_t edges = 0;
-  const Connectivity& c = mesh.connectivity();
-  for (FaceId f = 0; f < c.face_capacity(); ++f) {
-    if (!c.is_face(f) || (c.face(f).mate != no_id && c.face(f).mate < f)) continue;
-    total += distance(reference(c.face(f).simplex.vertex(0)), reference(c.face(f).simplex.vertex(1)));
-    ++edges;
-  }
-  if (edges == 0) throw std::invalid_argument("DelaunayCutter: the mesh has no edges");
-  const double mean = total / static_cast<double>(edges);
-  if (options_.eps_edge == 0) options_.eps_edge = mean / 3;
-  if (options_.eps_entry == 0) options_.eps_entry = mean / 6;
-  if (options_.eps_exit == 0) options_.eps_exit = mean / 6;
+  const CutThresholds thresholds =
+      resolved_thresholds("DelaunayCutter", mesh, {options.eps_edge, options.eps_entry, options.eps_exit});
+  options_.eps_edge = thresholds.eps_edge;
+  options_.eps_entry = thresholds.eps_entry;
+  options_.eps_exit = thresholds.eps_exit;
 }
 
 DelaunayCutter::Point DelaunayCutter::reference(VertexId v) const {

@@ -84,7 +84,38 @@ def sample_path(path, step: float) -> np.ndarray:
     return np.array(points)
 
 
-class DelaunayCutter:
+class IncisionCutter:
+    """What the Delaunay cutters (2D sheets, surfaces in 3D) share: their thresholds, the
+    incision's active node and edges, and lifting the scalpel. ``_impl`` is the engine's cutter."""
+
+    @property
+    def eps_edge(self) -> float:
+        return self._impl.eps_edge
+
+    @property
+    def eps_entry(self) -> float:
+        return self._impl.eps_entry
+
+    @property
+    def eps_exit(self) -> float:
+        return self._impl.eps_exit
+
+    def lift(self) -> None:
+        """Lift the scalpel: an incision in progress stays as it is; the next move only places it."""
+        self._impl.lift()
+
+    @property
+    def active_node(self) -> int | None:
+        """The vertex at the tip of the incision in progress, or None."""
+        node = self._impl.active_node
+        return None if node < 0 else int(node)
+
+    def incision_edges(self) -> np.ndarray:
+        """The boundary edges the cuts made (both lips), (n, 2) vertex ids."""
+        return self._impl.incision_edges()
+
+
+class DelaunayCutter(IncisionCutter):
     """Delaunay cutting of a 2D triangle mesh or plane-stress Body (§5.2.2, §5.4).
 
     ``DelaunayCutter(body_or_mesh, *, eps_edge=None, eps_entry=None, eps_exit=None,
@@ -111,18 +142,6 @@ class DelaunayCutter:
         self._impl = _snede.DelaunayCutter(self.mesh._impl, model, _threshold(eps_edge, "eps_edge"),
                                            _threshold(eps_entry, "eps_entry"), _threshold(eps_exit, "eps_exit"), angle)
 
-    @property
-    def eps_edge(self) -> float:
-        return self._impl.eps_edge
-
-    @property
-    def eps_entry(self) -> float:
-        return self._impl.eps_entry
-
-    @property
-    def eps_exit(self) -> float:
-        return self._impl.eps_exit
-
     def move(self, point) -> PlanarCutReport:
         return PlanarCutReport._from_engine(self._impl.move(_point(point)))
 
@@ -132,16 +151,3 @@ class DelaunayCutter:
         points = sample_path(path, self.eps_edge if step is None else _threshold(step, "step"))
         return move_along(self.move, points, PlanarCutReport(), progress)
 
-    def lift(self) -> None:
-        """Lift the scalpel: an incision in progress stays as it is; the next move only places it."""
-        self._impl.lift()
-
-    @property
-    def active_node(self) -> int | None:
-        """The vertex at the tip of the incision in progress, or None."""
-        node = self._impl.active_node
-        return None if node < 0 else int(node)
-
-    def incision_edges(self) -> np.ndarray:
-        """The boundary edges the cuts made (both lips), (n, 2) vertex ids."""
-        return self._impl.incision_edges()

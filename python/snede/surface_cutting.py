@@ -14,10 +14,10 @@ import numpy as np
 
 from snede import _snede
 from snede.cutting import _points, body_and_mesh, move_along
-from snede.planar_cutting import PlanarCutReport, _threshold
+from snede.planar_cutting import IncisionCutter, PlanarCutReport, _threshold
 
 
-class SurfaceCutter:
+class SurfaceCutter(IncisionCutter):
     """Delaunay cutting of a surface mesh or membrane Body (triangles in 3D) with a segment.
 
     ``SurfaceCutter(body_or_mesh, *, eps_edge=None, eps_entry=None, eps_exit=None)``:
@@ -41,18 +41,6 @@ class SurfaceCutter:
         self._impl = _snede.SurfaceCutter(self.mesh._impl, model, _threshold(eps_edge, "eps_edge"),
                                           _threshold(eps_entry, "eps_entry"), _threshold(eps_exit, "eps_exit"))
 
-    @property
-    def eps_edge(self) -> float:
-        return self._impl.eps_edge
-
-    @property
-    def eps_entry(self) -> float:
-        return self._impl.eps_entry
-
-    @property
-    def eps_exit(self) -> float:
-        return self._impl.eps_exit
-
     def move(self, segment) -> PlanarCutReport:
         segment = _points(segment, (2, 3), "segment")
         if np.array_equal(segment[0], segment[1]):
@@ -72,16 +60,3 @@ class SurfaceCutter:
             raise ValueError("segments: a scalpel position has coinciding ends")
         return move_along(self.move, segments, PlanarCutReport(), progress)
 
-    def lift(self) -> None:
-        """Lift the scalpel: an incision in progress stays as it is; the next move only places it."""
-        self._impl.lift()
-
-    @property
-    def active_node(self) -> int | None:
-        """The vertex at the tip of the incision in progress, or None."""
-        node = self._impl.active_node
-        return None if node < 0 else int(node)
-
-    def incision_edges(self) -> np.ndarray:
-        """The boundary edges the cuts made (both lips), (n, 2) vertex ids."""
-        return self._impl.incision_edges()
