@@ -18,6 +18,10 @@ namespace {
 constexpr double coarsening_slack = 1.5;
 // Relative tolerance of the conformity check (sums of element measures in floating point).
 constexpr double measure_tolerance = 1e-10;
+// Reused Chebyshev bounds: the estimate times this (PETSc's own estimate-based default is
+// 1.1), and the lower end of the smoothed interval as a fraction of the upper (PETSc's 0.1).
+constexpr double reused_bound_safety = 1.2;
+constexpr double chebyshev_lower_fraction = 0.1;
 
 double total_measure(const Mesh& mesh) {
   double sum = 0;
@@ -282,7 +286,7 @@ void BisectionMultigrid::make_interpolation(Level& coarse, const std::vector<Ver
   SNEDE_PETSC(MatAssemblyEnd(coarse.interpolation, MAT_FINAL_ASSEMBLY));
 }
 
-void BisectionMultigrid::configure(PC pc, const SolverOptions& options) {
+void BisectionMultigrid::configure(PC pc, const SolverOptions& options, const std::vector<double>& smoother_bounds) {
   const auto n = static_cast<PetscInt>(n_levels());
   SNEDE_PETSC(PCSetType(pc, PCMG));
   SNEDE_PETSC(PCMGSetLevels(pc, n, nullptr));
@@ -297,7 +301,16 @@ void BisectionMultigrid::configure(PC pc, const SolverOptions& options) {
     if (l < n - 1)
       SNEDE_PETSC(KSPSetOperators(smoother, coarse_[l]->model->tangent(), coarse_[l]->model->tangent()));
     SNEDE_PETSC(KSPSetType(smoother, KSPCHEBYSHEV));
-    SNEDE_PETSC(KSPChebyshevEstEigSet(smoother, PETSC_DECIDE, PETSC_DECIDE, PETSC_DECIDE, PETSC_DECIDE));
+    if (smoother_bounds.size() == static_cast<std::size_t>(n - 1)) {
+      // The spectrum of the Jacobi-scaled operator hardly depends on h, the state or the
+      // constraints: bounds estimated once serve later set-ups (a needle's every update and
+      // stick-slip change), which then skip the estimate's products on every level.
+      const double largest = reused_bound_safety * smoother_bounds[l - 1];
+      SNEDE_PETSC(KSPChebyshevEstEigSet(smoother, 0, 0, 0, 0));
+      SNEDE_PETSC(KSPChebyshevSetEigenvalues(smoother, largest, chebyshev_lower_fraction * largest));
+    } else {
+      SNEDE_PETSC(KSPChebyshevEstEigSet(smoother, PETSC_DECIDE, PETSC_DECIDE, PETSC_DECIDE, PETSC_DECIDE));
+    }
     PC jacobi = nullptr;
     SNEDE_PETSC(KSPGetPC(smoother, &jacobi));
     options.use_for(jacobi);
@@ -313,6 +326,26 @@ void BisectionMultigrid::configure(PC pc, const SolverOptions& options) {
   SNEDE_PETSC(KSPGetPC(coarse, &direct));
   options.use_for(direct);
   SNEDE_PETSC(PCSetType(direct, PCLU));
+}
+
+std::vector<double> BisectionMultigrid::chebyshev_estimates(PC pc) {
+  PetscInt n = 0;
+  SNEDE_PETSC(PCMGGetLevels(pc, &n));
+  std::vector<double> largest;
+  for (PetscInt l = 1; l < n; ++l) {
+    KSP smoother = nullptr, estimator = nullptr;
+    SNEDE_PETSC(PCMGGetSmoother(pc, l, &smoother));
+    PetscBool chebyshev = PETSC_FALSE;
+    SNEDE_PETSC(PetscObjectTypeCompare(reinterpret_cast<PetscObject>(smoother), KSPCHEBYSHEV, &chebyshev));
+    if (!chebyshev) return {};
+    SNEDE_PETSC(KSPChebyshevEstEigGetKSP(smoother, &estimator));
+    if (!estimator) return {};
+    PetscReal emax = 0, emin = 0;
+    SNEDE_PETSC(KSPComputeExtremeSingularValues(estimator, &emax, &emin));
+    if (!(emax > 0) || !std::isfinite(emax)) return {};
+    largest.push_back(emax);
+  }
+  return largest;
 }
 
 void BisectionMultigrid::update(Vec u) {

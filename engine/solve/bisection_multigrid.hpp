@@ -60,8 +60,14 @@ class BisectionMultigrid {
   // Makes `pc` a PCMG over these levels: interpolations, coarse operators, Chebyshev/Jacobi
   // smoothers, LU on the coarsest. Call before PCSetFromOptions, which may override them
   // (-<prefix>mg_levels_ksp_type, -<prefix>mg_coarse_pc_type, ...).
-  // `options` is the solver's database, which every level's KSP and PC read.
-  void configure(PC pc, const SolverOptions& options);
+  // `options` is the solver's database, which every level's KSP and PC read. `smoother_bounds`:
+  // Chebyshev's largest eigenvalue of the Jacobi-scaled operator per smoothed level (finest
+  // last), as chebyshev_estimates gave them on an earlier configuration with as many levels;
+  // they are used (with a safety factor) instead of estimating again. Empty: estimate.
+  void configure(PC pc, const SolverOptions& options, const std::vector<double>& smoother_bounds = {});
+  // The largest eigenvalues Chebyshev estimated on the smoothed levels of a PCMG set up by
+  // configure (finest last); empty if a level did not estimate (fixed bounds, other smoother).
+  static std::vector<double> chebyshev_estimates(PC pc);
   // Linearises every coarse level at u (the fine state, injected) with the fine model's
   // operator scale, and refills the coarsest level's matrix.
   void update(Vec u);

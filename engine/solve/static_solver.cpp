@@ -260,11 +260,22 @@ void StaticSolver::set_up_multigrid(PC pc) {
 }
 
 void StaticSolver::configure_multigrid(PC pc) {
-  multigrid_->configure(pc, option_database_);
+  // Bounds from another number of levels do not apply.
+  if (smoother_bounds_.size() + 1 != static_cast<std::size_t>(multigrid_->n_levels())) smoother_bounds_.clear();
+  multigrid_->configure(pc, option_database_, smoother_bounds_);
   // The levels come with their own operators and interpolations: PCMG must not coarsen the
   // SNES's shell DM (which it would try after a mesh change, when the PC gets that DM).
   SNEDE_PETSC(PCSetDM(pc, nullptr));
   preconditioner_filled_ = false;
+}
+
+void StaticSolver::remember_smoother_bounds() {
+  if (!multigrid_ || !smoother_bounds_.empty()) return;
+  PC pc = nullptr;
+  SNEDE_PETSC(KSPGetPC(ksp(), &pc));
+  PetscBool is_mg = PETSC_FALSE;
+  SNEDE_PETSC(PetscObjectTypeCompare(reinterpret_cast<PetscObject>(pc), PCMG, &is_mg));
+  if (is_mg) smoother_bounds_ = BisectionMultigrid::chebyshev_estimates(pc);  // called after a solve: set up
 }
 
 void StaticSolver::refill_preconditioner(SNES snes, Vec x) {
@@ -305,6 +316,7 @@ SolveResult StaticSolver::solve() {
         " rigid motions (fix some vertices with body.fix); only " +
         std::to_string(model_.constraints().n_constrained_components()) + " displacement components are constrained");
   SolveResult result = ksp_ ? solve_linear() : solve_nonlinear();
+  if (result.converged) remember_smoother_bounds();
   option_database_.mark_read_options_used();  // a solve reads more (-snes_view, -ksp_converged_reason)
   return result;
 }

@@ -102,6 +102,9 @@ class StaticSolver {
   std::unique_ptr<AssembledTangent> assembled_;  // that tangent, for the current mesh
   const RefinementHierarchy* hierarchy_ = nullptr;
   std::unique_ptr<BisectionMultigrid> multigrid_;  // PC "mg": the levels for the current mesh
+  std::vector<double> smoother_bounds_;  // mg: Chebyshev's estimates from an earlier set-up, reused
+  // mg: remembers Chebyshev's estimates once the PC has made them (after a solve).
+  void remember_smoother_bounds();
   bool preconditioner_filled_ = false;  // filled since it was made (for lagging)
   std::uint64_t generation_ = 0;
   StoppingRule rule_;  // the stopping rule of the current solve, scaled to the model

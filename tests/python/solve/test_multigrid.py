@@ -226,3 +226,24 @@ def test_newton_with_mg_continues_after_a_refinement():
     body.displacement = np.zeros_like(body.displacement)
     assert snede.StaticSolver(body, "newton", rtol=1e-8, preconditioner="mg").solve().converged
     assert relative_difference(body.displacement, reference) < 1e-6
+
+
+def test_chebyshev_bounds_from_the_first_solve_serve_later_ones():
+    # Later set-ups reuse the first solve's eigenvalue estimates (no estimate's products):
+    # the answers stay those of an unpreconditioned solve, the iteration counts comparable.
+    body = cantilever(3, 6)
+    solver, first, _ = solve(body, preconditioner="mg")
+    levels = len(solver.multigrid_levels)
+    x = body.mesh.points
+    body.fix(np.isclose(x[:, 0], 0.4))  # new constraints: levels reconfigured with the same count
+    result = solver.solve()
+    assert result.converged, result.reason
+    assert len(solver.multigrid_levels) == levels
+    reused = body.displacement.copy()
+    _, plain, reference = solve(body)
+    assert relative_difference(reused, reference) < 1e-6
+    body.displacement = np.zeros_like(body.displacement)
+    fresh = snede.StaticSolver(body, "cg", rtol=1e-8, preconditioner="mg").solve()
+    assert fresh.converged
+    assert relative_difference(body.displacement, reference) < 1e-6
+    assert result.iterations <= 1.5 * fresh.iterations
