@@ -14,6 +14,7 @@ the tip-region deflection. The thesis: linear, 2420 elements, 5 s; neo-Hookean, 
 
     .venv/bin/python benchmarks/needle3d_rates.py                 # about 2 minutes
     .venv/bin/python benchmarks/needle3d_rates.py --deflection    # linear against neo-Hookean, about 2 minutes
+    .venv/bin/python benchmarks/needle3d_rates.py --thesis-size   # near 29 562 neo-Hookean elements, about 1 minute
 
 Not a test: times depend on the machine and its load; compare the ratios of one run.
 """
@@ -30,17 +31,18 @@ SIZE, DEPTH, RADIUS = 0.1, 0.07, 1e-3
 ENTRY, DIRECTION = (-0.005, 0.05, 0.05), (1.0, 0.0, 0.0)
 
 
-def cube(material):
-    mesh = snede.meshing.box((SIZE, SIZE, SIZE), (2, 2, 2))
-    mesh.refine_uniform(3)
+def cube(material, start: int = 2, levels: int = 3):
+    """The cube: the start × start × start Kuhn box bisected `levels` times, fixed at the bottom."""
+    mesh = snede.meshing.box((SIZE, SIZE, SIZE), (start, start, start))
+    mesh.refine_uniform(levels)
     body = snede.Body(mesh, material)
     body.fix(np.isclose(mesh.points[:, 2], 0.0))
     return body
 
 
 def insert(material, h_ref: float, preconditioner: str, solves_per_update: int | None = None, entry=ENTRY,
-           friction_scale: float = 1.0):
-    body = cube(material)
+           friction_scale: float = 1.0, start: int = 2, levels: int = 3):
+    body = cube(material, start, levels)
     method = "cg" if isinstance(material, snede.LinearElastic) else "newton"
     needle = snede.NeedleInsertion(body, entry, DIRECTION, snede.FrictionProfile.figure_6_4(friction_scale), radius=RADIUS,
                                    h_ref=h_ref, method=method, rtol=1e-3, solves_per_update=solves_per_update,
@@ -66,11 +68,24 @@ def deflection_table() -> None:
               f"{body.displacement[tip, 0].mean() * 1e3:.4f} mm", flush=True)
 
 
+def thesis_size_table() -> None:
+    """Near the thesis's 29 562 neo-Hookean elements: the 3 × 3 × 3 box bisected twice as the
+    start mesh, one solve per update, mg (about 1 minute)."""
+    print("\nNear the thesis's element count: start 3 × 3 × 3 bisected twice, neo-Hookean, one solve per update, mg:")
+    for divisions in (64, 72):
+        body, needle, report, seconds, _ = insert(snede.NeoHookean(34e3, 0.34), SIZE / divisions, "mg", 1,
+                                                  entry=needle3d.ENTRY, start=3, levels=2)
+        print(f"   h_ref 0.1 m/{divisions}: {body.mesh.n_cells} tetrahedra, {report}; {seconds:.2f} s", flush=True)
+
+
 def main() -> None:
     import sys
 
     if "--deflection" in sys.argv[1:]:
         deflection_table()
+        return
+    if "--thesis-size" in sys.argv[1:]:
+        thesis_size_table()
         return
     print(__doc__.splitlines()[0])
     print(f"{'material':<12} {'h_ref [mm]':>10} {'pc':<5} {'elements':>9} {'updates':>8} {'solves':>7} "
