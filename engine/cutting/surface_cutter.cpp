@@ -22,24 +22,13 @@
 namespace snede {
 namespace {
 
-Point3 minus(const Point3& a, const Point3& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
-Point3 lerp(const Point3& a, const Point3& b, double t) {
-  return {a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1]), a[2] + t * (b[2] - a[2])};
-}
-double dot(const Point3& a, const Point3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-double distance(const Point3& a, const Point3& b) { return std::sqrt(dot(minus(a, b), minus(a, b))); }
-
 // Interior angle at w of triangle (w, a, b).
 double angle_at(const Point3& w, const Point3& a, const Point3& b) {
   const Point3 u = minus(a, w), v = minus(b, w);
-  const Point3 n{u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
-  return std::atan2(std::sqrt(dot(n, n)), dot(u, v));
+  return std::atan2(norm(cross(u, v)), dot(u, v));
 }
 
-Point3 doubled_normal(const Point3& a, const Point3& b, const Point3& c) {
-  const Point3 u = minus(b, a), v = minus(c, a);
-  return {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
-}
+Point3 doubled_normal(const Point3& a, const Point3& b, const Point3& c) { return cross(minus(b, a), minus(c, a)); }
 
 // A new node this close (in barycentric weight) to a side goes on that side.
 constexpr double on_side = 1e-6;

@@ -8,9 +8,9 @@
 #include <optional>
 #include <span>
 
-namespace snede {
+#include "core/vec3.hpp"
 
-using Point3 = std::array<double, 3>;
+namespace snede {
 
 class SweepTriangle {
  public:

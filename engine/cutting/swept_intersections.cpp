@@ -8,15 +8,6 @@
 namespace snede {
 namespace {
 
-Point3 minus(const Point3& a, const Point3& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
-Point3 plus_scaled(const Point3& a, double s, const Point3& d) { return {a[0] + s * d[0], a[1] + s * d[1], a[2] + s * d[2]}; }
-Point3 lerp(const Point3& a, const Point3& b, double t) { return plus_scaled(a, t, minus(b, a)); }
-double dot(const Point3& a, const Point3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-Point3 cross(const Point3& a, const Point3& b) {
-  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
-}
-double norm(const Point3& a) { return std::sqrt(dot(a, a)); }
-
 struct ClosestPoints {
   double s, t, distance;  // p + s (q − p) and a + t (b − a), both clamped to [0, 1]
 };

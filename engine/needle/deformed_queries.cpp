@@ -6,11 +6,6 @@
 namespace snede {
 namespace {
 
-Point minus(const Point& a, const Point& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
-double dot(const Point& a, const Point& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-Point cross(const Point& a, const Point& b) {
-  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
-}
 // The z component of a × b: the signed area in the plane.
 double cross2(const Point& a, const Point& b) { return a[0] * b[1] - a[1] * b[0]; }
 double triple(const Point& a, const Point& b, const Point& c) { return dot(a, cross(b, c)); }

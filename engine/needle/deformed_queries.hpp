@@ -9,12 +9,13 @@
 #include <span>
 #include <vector>
 
+#include "core/vec3.hpp"
 #include "mesh/mesh.hpp"
 
 namespace snede {
 
 // A point of the needle's space; in 2D the third coordinate is 0.
-using Point = std::array<double, 3>;
+using Point = Point3;
 
 // Where vertex v is in the deformed mesh: X_v + u_v. u: (n_points, dim).
 Point deformed_point(const Mesh& mesh, std::span<const double> u, VertexId v);

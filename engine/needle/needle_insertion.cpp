@@ -22,10 +22,6 @@ std::string point_text(const Point& x, int dim) {
   return text.str();
 }
 
-double distance(const Point& a, const Point& b) {
-  return std::sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2]));
-}
-
 }  // namespace
 
 NeedleInsertion::NeedleInsertion(Model& model, Bisection* bisection, const Point& entry, const Point& direction,
@@ -41,10 +37,10 @@ NeedleInsertion::NeedleInsertion(Model& model, Bisection* bisection, const Point
   }
   if (!std::all_of(entry_.begin(), entry_.end(), [](double x) { return std::isfinite(x); }))
     throw std::invalid_argument("needle entry must be finite, got " + point_text(entry_, dim_));
-  const double norm = distance(axis, Point{0, 0, 0});
-  if (!(norm > 0) || !std::isfinite(norm))
+  const double length = norm(axis);
+  if (!(length > 0) || !std::isfinite(length))
     throw std::invalid_argument("needle direction must be non-zero and finite, got " + point_text(axis, dim_));
-  for (int k = 0; k < 3; ++k) direction_[k] = axis[k] / norm;
+  for (int k = 0; k < 3; ++k) direction_[k] = axis[k] / length;
   normal_ = {-direction_[1], direction_[0], 0};
   if (dim_ == 3 && !(options_.radius > 0 && std::isfinite(options_.radius)))
     throw std::invalid_argument("a 3D needle needs a positive, finite radius, got " + std::to_string(options_.radius));
@@ -112,13 +108,9 @@ void NeedleInsertion::record_rate(double distance) {
   have_rate_ = true;
 }
 
-Point NeedleInsertion::point_at(double s) const {
-  return {entry_[0] + s * direction_[0], entry_[1] + s * direction_[1], entry_[2] + s * direction_[2]};
-}
+Point NeedleInsertion::point_at(double s) const { return plus_scaled(entry_, s, direction_); }
 
-double NeedleInsertion::along(const Point& x) const {
-  return (x[0] - entry_[0]) * direction_[0] + (x[1] - entry_[1]) * direction_[1] + (x[2] - entry_[2]) * direction_[2];
-}
+double NeedleInsertion::along(const Point& x) const { return dot(minus(x, entry_), direction_); }
 
 double NeedleInsertion::across(const Point& x) const {
   if (dim_ == 2) return (x[0] - entry_[0]) * normal_[0] + (x[1] - entry_[1]) * normal_[1];
@@ -350,12 +342,10 @@ void NeedleInsertion::share_surface(double lo) {
   const int n_rings = static_cast<int>(std::clamp(std::ceil(length / ring), 1.0, static_cast<double>(max_surface_rings)));
   // Two unit vectors across the shaft.
   const Point helper = std::abs(direction_[0]) < 0.9 ? Point{1, 0, 0} : Point{0, 1, 0};
-  Point e1{direction_[1] * helper[2] - direction_[2] * helper[1], direction_[2] * helper[0] - direction_[0] * helper[2],
-           direction_[0] * helper[1] - direction_[1] * helper[0]};
-  const double n1 = distance(e1, Point{0, 0, 0});
+  Point e1 = cross(direction_, helper);
+  const double n1 = norm(e1);
   for (double& x : e1) x /= n1;
-  const Point e2{direction_[1] * e1[2] - direction_[2] * e1[1], direction_[2] * e1[0] - direction_[0] * e1[2],
-                 direction_[0] * e1[1] - direction_[1] * e1[0]};
+  const Point e2 = cross(direction_, e1);
   std::vector<Point> positions;
   positions.reserve(nodes_.size());
   for (const NeedleNode& node : nodes_) positions.push_back(deformed_point(mesh, u, node.vertex));

@@ -50,9 +50,6 @@ bool close(double a, double b) { return std::abs(a - b) <= measure_tolerance * s
 
 std::size_t rigid_modes(int dim) { return dim == 3 ? 6 : 3; }
 
-template <class Levels>
-int n_levels_so_far(const Levels& coarse) { return static_cast<int>(coarse.size()) + 1; }
-
 }  // namespace
 
 struct BisectionMultigrid::Level {
@@ -114,7 +111,8 @@ BisectionMultigrid::BisectionMultigrid(Model& fine, const RefinementHierarchy& h
   const double ratio = coarsening_slack / static_cast<double>(1 << mesh.dim());
   std::size_t current = mesh.n_cells();
   std::vector<std::unique_ptr<Level>> finest_first;
-  for (int k = finest - 1; k >= 0 && (max_levels == 0 || n_levels_so_far(finest_first) < max_levels); --k) {
+  // finest_first.size() + 1 levels so far, the fine one included.
+  for (int k = finest - 1; k >= 0 && (max_levels == 0 || static_cast<int>(finest_first.size()) + 1 < max_levels); --k) {
     const std::size_t size = cut_size(k);
     if (size >= current) break;
     if (k > 0 && static_cast<double>(size) > ratio * static_cast<double>(current)) continue;

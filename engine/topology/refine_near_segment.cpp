@@ -7,27 +7,20 @@
 #include <stdexcept>
 #include <vector>
 
+#include "core/vec3.hpp"
 #include "mesh/element_quality.hpp"
 
 namespace snede {
 namespace {
 
+// A segment in the mesh's space (2D points padded with z = 0).
 struct Segment {
-  std::array<double, 3> a{}, b{};
-  int dim = 3;
-  double distance_to(const std::array<double, 3>& x) const {
-    double ab2 = 0, t = 0;
-    for (int k = 0; k < dim; ++k) {
-      ab2 += (b[k] - a[k]) * (b[k] - a[k]);
-      t += (x[k] - a[k]) * (b[k] - a[k]);
-    }
-    t = ab2 > 0 ? std::clamp(t / ab2, 0.0, 1.0) : 0.0;
-    double d2 = 0;
-    for (int k = 0; k < dim; ++k) {
-      const double c = a[k] + t * (b[k] - a[k]) - x[k];
-      d2 += c * c;
-    }
-    return std::sqrt(d2);
+  Point3 a{}, b{};
+  double distance_to(const Point3& x) const {
+    const Point3 ab = minus(b, a);
+    const double ab2 = dot(ab, ab);
+    const double t = ab2 > 0 ? std::clamp(dot(minus(x, a), ab) / ab2, 0.0, 1.0) : 0.0;
+    return distance(plus_scaled(a, t, ab), x);
   }
 };
 
@@ -35,7 +28,7 @@ struct Segment {
 // its bounding ball (centroid, farthest corner) does.
 bool may_be_near(const Mesh& mesh, std::span<const VertexId> corners, const Segment& segment, double radius) {
   const int d = mesh.dim();
-  std::array<double, 3> centre{};
+  Point3 centre{};
   for (VertexId v : corners)
     for (int k = 0; k < d; ++k) centre[k] += mesh.point(v)[k] / static_cast<double>(corners.size());
   double reach = 0;
@@ -69,7 +62,6 @@ std::size_t refine_near_segment(Bisection& bisection, std::span<const double> a,
   check_point(a, d, "a");
   check_point(b, d, "b");
   Segment segment;
-  segment.dim = d;
   std::copy(a.begin(), a.end(), segment.a.begin());
   std::copy(b.begin(), b.end(), segment.b.begin());
   const RefinementHierarchy& tree = bisection.hierarchy();
