@@ -15,6 +15,8 @@ void bind_planar_cutting(py::module_& m) {
       .def_readwrite("edges_contracted", &PlanarCutReport::edges_contracted)
       .def_readwrite("entries", &PlanarCutReport::entries)
       .def_readwrite("exits", &PlanarCutReport::exits)
+      .def_readwrite("branches", &PlanarCutReport::branches)
+      .def_readwrite("annihilations", &PlanarCutReport::annihilations)
       .def_readwrite("stuck", &PlanarCutReport::stuck)
       .def_readwrite("triangles_before", &PlanarCutReport::triangles_before)
       .def_readwrite("triangles_after", &PlanarCutReport::triangles_after)

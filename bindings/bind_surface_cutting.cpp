@@ -12,7 +12,7 @@ void bind_surface_cutting(py::module_& m) {
            py::keep_alive<1, 2>(), py::keep_alive<1, 3>())
       .def("move", [](SurfaceCutter& c, const DoubleArray& segment) { return c.move(view(segment)); }, py::arg("segment"))
       .def("lift", &SurfaceCutter::lift)
-      .def_property_readonly("active_node", &SurfaceCutter::active_node)
+      .def_property_readonly("active_nodes", [](const SurfaceCutter& c) { return to_array(c.active_nodes(), 1); })
       .def_property_readonly("cutting", &SurfaceCutter::cutting)
       .def_property_readonly("eps_edge", [](const SurfaceCutter& c) { return c.options().eps_edge; })
       .def_property_readonly("eps_entry", [](const SurfaceCutter& c) { return c.options().eps_entry; })

@@ -78,6 +78,8 @@ void PlanarCutReport::add(const PlanarCutReport& later) {
   edges_contracted += later.edges_contracted;
   entries += later.entries;
   exits += later.exits;
+  branches += later.branches;
+  annihilations += later.annihilations;
   stuck += later.stuck;
   triangles_after = later.triangles_after;
   seconds += later.seconds;

@@ -60,6 +60,8 @@ struct PlanarCutReport {
   int edges_contracted = 0;  // short edges left by an exit (Figure 5.7)
   int entries = 0;
   int exits = 0;
+  int branches = 0;          // surfaces: an incision branching at a fold (Figure 5.14)
+  int annihilations = 0;     // surfaces: incisions meeting and ending together (Figure 5.13)
   int stuck = 0;             // moves that left the active node short of the scalpel
   std::size_t triangles_before = 0;
   std::size_t triangles_after = 0;

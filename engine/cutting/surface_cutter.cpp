@@ -110,6 +110,36 @@ bool SurfaceCutter::on_boundary(VertexId v) const {
   return false;
 }
 
+bool SurfaceCutter::is_active(VertexId v) const {
+  return std::any_of(incisions_.begin(), incisions_.end(), [v](const Incision& i) { return i.active == v; });
+}
+
+SurfaceCutter::Incision* SurfaceCutter::incision_at(VertexId active) {
+  for (Incision& i : incisions_)
+    if (i.active == active) return &i;
+  return nullptr;
+}
+
+std::vector<VertexId> SurfaceCutter::active_nodes() const {
+  std::vector<VertexId> nodes;
+  for (const Incision& i : incisions_) nodes.push_back(i.active);
+  return nodes;
+}
+
+std::vector<VertexId> SurfaceCutter::active_neighbours(VertexId v, VertexId except) const {
+  std::vector<VertexId> found;
+  for (const Wedge& w : wedges(v))
+    for (VertexId u : {w.y, w.z})
+      if (u != except && is_active(u) && std::find(found.begin(), found.end(), u) == found.end()) found.push_back(u);
+  return found;
+}
+
+bool SurfaceCutter::touches_active(ElementId triangle, VertexId except) const {
+  for (VertexId v : mesh_.connectivity().element(triangle).simplex.vertices())
+    if (v != except && is_active(v)) return true;
+  return false;
+}
+
 Point3 SurfaceCutter::reference_at(const Wedge& w, VertexId b, const std::array<double, 3>& weights) const {
   const Point3 B = reference(b), Y = reference(w.y), Z = reference(w.z);
   Point3 x{};
@@ -117,19 +147,24 @@ Point3 SurfaceCutter::reference_at(const Wedge& w, VertexId b, const std::array<
   return x;
 }
 
-std::optional<SurfaceCutter::StarHit> SurfaceCutter::hit_in_star(VertexId b, const Segment& scalpel) const {
-  std::optional<StarHit> best;
-  double nearest = std::numeric_limits<double>::infinity();
+Point3 SurfaceCutter::deformed_at(const Wedge& w, VertexId b, const std::array<double, 3>& weights) const {
+  const Point3 B = deformed(b), Y = deformed(w.y), Z = deformed(w.z);
+  Point3 x{};
+  for (int d = 0; d < 3; ++d) x[d] = weights[0] * B[d] + weights[1] * Y[d] + weights[2] * Z[d];
+  return x;
+}
+
+std::vector<SurfaceCutter::StarHit> SurfaceCutter::hits_in_star(VertexId b, const Segment& scalpel) const {
+  std::vector<std::pair<double, StarHit>> found;
   const Point3 xb = deformed(b);
   for (const Wedge& w : wedges(b)) {
-    const Point3 xy = deformed(w.y), xz = deformed(w.z);
-    const auto hit = segment_meets_triangle(scalpel.head, scalpel.tail, xb, xy, xz, xb);
-    if (!hit) continue;
-    Point3 x{};
-    for (int d = 0; d < 3; ++d) x[d] = hit->weights[0] * xb[d] + hit->weights[1] * xy[d] + hit->weights[2] * xz[d];
-    if (const double r = distance(x, xb); r < nearest) nearest = r, best = StarHit{w, hit->weights};
+    const auto hit = segment_meets_triangle(scalpel.head, scalpel.tail, xb, deformed(w.y), deformed(w.z), xb);
+    if (hit) found.push_back({distance(deformed_at(w, b, hit->weights), xb), StarHit{w, hit->weights}});
   }
-  return best;
+  std::stable_sort(found.begin(), found.end(), [](const auto& p, const auto& q) { return p.first < q.first; });
+  std::vector<StarHit> hits;
+  for (const auto& [r, hit] : found) hits.push_back(hit);
+  return hits;
 }
 
 std::optional<SurfaceCutter::LinkCrossing> SurfaceCutter::first_link_crossing(VertexId b, const Segment& from,
@@ -149,7 +184,7 @@ double SurfaceCutter::step_limit(VertexId b, const Segment& scalpel) const {
 }
 
 std::vector<ElementId> SurfaceCutter::triangles_near(const Segment& from, const Segment& to) {
-  if (grid_stale_ || model_ || grid_revision_ != mesh_.connectivity().revision()) {
+  if (grid_stale_ || grid_revision_ != mesh_.connectivity().revision()) {
     grid_.build(mesh_, [this](VertexId v) { return deformed(v); });
     grid_revision_ = mesh_.connectivity().revision();
     grid_stale_ = false;
@@ -160,13 +195,15 @@ std::vector<ElementId> SurfaceCutter::triangles_near(const Segment& from, const 
   return grid_.near(lo, hi);
 }
 
-bool SurfaceCutter::touches_surface(const Segment& scalpel) {
+bool SurfaceCutter::meets_ring(VertexId a, const Segment& scalpel) const {
   const Connectivity& c = mesh_.connectivity();
-  for (ElementId e : triangles_near(scalpel, scalpel)) {
-    const Simplex& t = c.element(e).simplex;
-    const Point3 a = deformed(t.vertex(0));
-    if (segment_meets_triangle(scalpel.head, scalpel.tail, a, deformed(t.vertex(1)), deformed(t.vertex(2)), a)) return true;
-  }
+  for (const Wedge& w : wedges(a))
+    for (VertexId v : {a, w.y, w.z})
+      for (ElementId e : local_star(c, v).elements) {
+        const Simplex& t = c.element(e).simplex;
+        const Point3 p = deformed(t.vertex(0));
+        if (segment_meets_triangle(scalpel.head, scalpel.tail, p, deformed(t.vertex(1)), deformed(t.vertex(2)), p)) return true;
+      }
   return false;
 }
 
@@ -181,8 +218,10 @@ PlanarCutReport SurfaceCutter::move(std::span<const double> segment) {
   PlanarCutReport report;
   report.moves = 1;
   report.triangles_before = mesh_.n_cells();
-  if (phase_ != Phase::outside && !(mesh_.is_vertex(active_) && mesh_.connectivity().n_vertex_uses(active_) > 0))
-    phase_ = Phase::outside;  // the active node was removed by another edit
+  // An active node removed by another edit ends its incision.
+  std::erase_if(incisions_, [this](const Incision& i) {
+    return !(mesh_.is_vertex(i.active) && mesh_.connectivity().n_vertex_uses(i.active) > 0);
+  });
   displacement_.clear();
   moved_.clear();
   if (model_) {
@@ -191,12 +230,18 @@ PlanarCutReport SurfaceCutter::move(std::span<const double> segment) {
     grid_stale_ = true;
   }
   touched_.clear();
+  refused_.clear();
   {
     // A body hears of the move's edits at once, when it is over.
     ChangeBatch batch(mesh_.connectivity());
-    if (scalpel_) sweep(*scalpel_, now, report);
+    if (scalpel_) {
+      sweep(*scalpel_, now, report);
+    } else {
+      // Placed through the surface: it enters where it pierces it.
+      for (const Contact& contact : piercings(now)) enter(contact, report);
+    }
     scalpel_ = now;
-    if (phase_ == Phase::cutting) touched_.push_back(active_);
+    for (const Incision& i : incisions_) touched_.push_back(i.active);
     legalize(report);
   }
   report.triangles_after = mesh_.n_cells();
@@ -205,124 +250,194 @@ PlanarCutReport SurfaceCutter::move(std::span<const double> segment) {
 }
 
 void SurfaceCutter::lift() {
-  phase_ = Phase::outside;
-  active_ = -1;
+  incisions_.clear();
   scalpel_.reset();
 }
 
 void SurfaceCutter::sweep(const Segment& from, const Segment& to, PlanarCutReport& report) {
   const double movement = std::max(distance(from.head, to.head), distance(from.tail, to.tail));
+  const auto at = [&](double s) { return Segment{lerp(from.head, to.head, s), lerp(from.tail, to.tail, s)}; };
   Segment current = from;
   double done = 0;
-  // Figure 5.11: steps no longer than d_max near the active node; at most 256 of them.
+  // Figure 5.11: steps no longer than d_max near every active node; at most 256 of them.
   for (int step = 0; step < 256 && done < 1; ++step) {
     double next = 1;
-    if (phase_ != Phase::outside && movement > 0 && step < 255)
-      next = std::min(1.0, done + step_limit(active_, current) / movement);
-    const Segment target{lerp(from.head, to.head, next), lerp(from.tail, to.tail, next)};
-    if (phase_ == Phase::outside)
-      look_for_entry(current, target, report);
-    else if (phase_ == Phase::entering)
-      begin_incision(target, report);
-    else
-      advance(current, target, report);
+    if (movement > 0 && step < 255)
+      for (const Incision& i : incisions_) next = std::min(next, done + step_limit(i.active, current) / movement);
+    Segment target = at(next);
+    // An entry node waits for the scalpel to move away from it; halving the step keeps the
+    // places where it meets the node's triangles in them, so that none is lost on the way
+    // (at a crest they move far faster than the scalpel).
+    for (int halving = 0; halving < 40 && loses_place(current, target); ++halving) target = at(next = (done + next) / 2);
+    // The step ends where the scalpel first touches the surface somewhere new (Figure 5.12).
+    const std::vector<Contact> contacts = first_contacts(current, target);
+    if (!contacts.empty()) {
+      next = done + (next - done) * contacts.front().time;
+      target = at(next);
+    }
+    follow_scalpel(current, target, report);
+    for (const Contact& contact : contacts)
+      if (!enter(contact, report)) refused_.insert(contact.element);
     current = target;
     done = next;
   }
 }
 
-void SurfaceCutter::look_for_entry(const Segment& from, const Segment& to, PlanarCutReport& report) {
-  const Connectivity& c = mesh_.connectivity();
-  const std::vector<ElementId> near = triangles_near(from, to);
-  if (!left_surface_) {
-    // After an exit the scalpel must leave the surface before it enters again.
-    left_surface_ = !touches_surface(to);
-    return;
+std::size_t SurfaceCutter::places_in_star(VertexId a, const Segment& scalpel) const {
+  std::vector<Point3> places;
+  for (const StarHit& hit : hits_in_star(a, scalpel)) {
+    const Point3 x = reference_at(hit.wedge, a, hit.weights);
+    if (std::none_of(places.begin(), places.end(), [&](const Point3& p) { return distance(p, x) <= 1e-9 * options_.eps_edge; }))
+      places.push_back(x);
   }
-  // Figure 5.12a: the swept scalpel crossing a boundary edge.
-  std::optional<std::pair<LinkCrossing, VertexId>> first;
-  double first_along = 0;
-  for (ElementId e : near) {
-    const Simplex& t = c.element(e).simplex;
-    for (int k = 0; k < 3; ++k) {
-      const VertexId opposite = t.vertex(k), y = t.vertex((k + 1) % 3), z = t.vertex((k + 2) % 3);
-      if (!is_boundary_edge(e, opposite)) continue;
-      const auto hit = swept_segment_meets_edge(from.head, from.tail, to.head, to.tail, deformed(y), deformed(z));
-      // Simultaneous crossings (a fold's layers): the one nearest the scalpel's first end.
-      if (hit && (!first || hit->time < first->first.time ||
-                  (hit->time == first->first.time && hit->along < first_along))) {
-        first = std::pair{LinkCrossing{{e, y, z}, hit->time, hit->on_edge}, opposite};
-        first_along = hit->along;
-      }
-    }
-  }
-  VertexId entry = -1;
-  if (first) {
-    const auto& [crossing, opposite] = *first;
-    const VertexId y = crossing.wedge.y, z = crossing.wedge.z;
-    const Point3 at = lerp(reference(y), reference(z), crossing.mu);
-    if (distance(at, reference(y)) <= options_.eps_entry)
-      entry = y;
-    else if (distance(at, reference(z)) <= options_.eps_entry)
-      entry = z;
-    else if ((entry = split(y, z, crossing.mu)) >= 0)
-      ++report.nodes_inserted;
-    else
-      entry = distance(at, reference(y)) < distance(at, reference(z)) ? y : z;
-    tip_entry_ = false;
-  } else {
-    // Figure 5.12b: the scalpel piercing a triangle, the hit nearest its first end.
-    std::optional<std::pair<ElementId, TriangleHit>> pierced;
-    for (ElementId e : near) {
-      const Simplex& t = c.element(e).simplex;
-      const Point3 a = deformed(t.vertex(0));
-      const auto hit = segment_meets_triangle(to.head, to.tail, a, deformed(t.vertex(1)), deformed(t.vertex(2)), to.head);
-      if (hit && (!pierced || hit->along < pierced->second.along)) pierced = std::pair{e, *hit};
-    }
-    if (!pierced) return;
-    const Simplex& t = c.element(pierced->first).simplex;
-    const Wedge w{pierced->first, t.vertex(1), t.vertex(2)};
-    const auto& weights = pierced->second.weights;
-    const Point3 at = reference_at(w, t.vertex(0), weights);
-    for (int k = 0; k < 3 && entry < 0; ++k)
-      if (distance(at, reference(t.vertex(k))) <= options_.eps_entry) entry = t.vertex(k);
-    if (entry < 0) entry = insert_at(w, t.vertex(0), weights, report);
-    if (entry < 0) return;
-    tip_entry_ = !on_boundary(entry);
-  }
-  active_ = entry;
-  phase_ = Phase::entering;
-  touched_.push_back(entry);
-  ++report.entries;
+  return places.size();
 }
 
-void SurfaceCutter::begin_incision(const Segment& scalpel, PlanarCutReport& report) {
-  const VertexId a = active_;
-  const std::optional<StarHit> hit = hit_in_star(a, scalpel);
-  if (!hit) {
-    if (!touches_surface(scalpel)) phase_ = Phase::outside;  // withdrawn: the entry node stays
+bool SurfaceCutter::loses_place(const Segment& from, const Segment& to) const {
+  return std::any_of(incisions_.begin(), incisions_.end(), [&](const Incision& i) {
+    if (!i.entering) return false;
+    // A crest is met on both sides at once: two places from the start.
+    const std::size_t before = std::max<std::size_t>(places_in_star(i.active, from), i.branching ? 2 : 0);
+    return places_in_star(i.active, to) < before;
+  });
+}
+
+void SurfaceCutter::follow_scalpel(const Segment& from, const Segment& to, PlanarCutReport& report) {
+  for (VertexId a : active_nodes()) {
+    const Incision* incision = incision_at(a);  // another incision may have ended this one
+    if (!incision) continue;
+    if (incision->entering)
+      begin_incision(a, to, report);
+    else
+      advance(a, from, to, report);
+  }
+}
+
+VertexId SurfaceCutter::free_vertex_near(const Point3& at, std::span<const VertexId> candidates, double radius) const {
+  VertexId best = -1;
+  double nearest = radius;
+  for (VertexId v : candidates)
+    if (const double r = distance(at, reference(v)); r <= nearest && !is_active(v) && active_neighbours(v, -1).empty())
+      nearest = r, best = v;
+  return best;
+}
+
+bool SurfaceCutter::enter(const Contact& contact, PlanarCutReport& report) {
+  const Connectivity& c = mesh_.connectivity();
+  // Earlier edits of this step may have replaced the triangle (and its id been reused).
+  if (!c.is_element(contact.element) || c.element(contact.element).simplex != contact.triangle) return false;
+  if (touches_active(contact.element)) return false;
+  const auto corners = contact.triangle.oriented_vertices();
+  const Wedge w{contact.element, corners[1], corners[2]};
+  const Point3 at = reference_at(w, corners[0], contact.weights);
+  VertexId entry = -1;
+  if (contact.way == Contact::Way::tip) {
+    entry = free_vertex_near(at, std::span<const VertexId>(corners.data(), 3), options_.eps_entry);
+    if (entry < 0) entry = insert_at(w, corners[0], contact.weights, report);
+  } else {
+    // On the edge whose opposite corner has weight 0.
+    const int opposite = static_cast<int>(std::min_element(contact.weights.begin(), contact.weights.end()) -
+                                          contact.weights.begin());
+    const VertexId y = corners[(opposite + 1) % 3], z = corners[(opposite + 2) % 3];
+    if (contact.way == Contact::Way::crest) {
+      for (ElementId e : elements_with_edge(c, y, z))
+        if (touches_active(e)) return false;
+    }
+    const std::array<VertexId, 2> ends{y, z};
+    entry = free_vertex_near(at, ends, options_.eps_entry);
+    const double mu = contact.weights[(opposite + 2) % 3];
+    if (entry < 0 && (entry = split(y, z, mu)) >= 0) ++report.nodes_inserted;
+  }
+  if (entry < 0) return false;
+  incisions_.push_back({entry, true, !on_boundary(entry), contact.way == Contact::Way::crest});
+  touched_.push_back(entry);
+  ++report.entries;
+  return true;
+}
+
+void SurfaceCutter::begin_incision(VertexId a, const Segment& scalpel, PlanarCutReport& report) {
+  const std::vector<StarHit> hits = hits_in_star(a, scalpel);
+  if (hits.empty()) {
+    if (!meets_ring(a, scalpel)) std::erase_if(incisions_, [a](const Incision& i) { return i.active == a; });  // withdrawn
     return;
   }
-  if (distance(reference_at(hit->wedge, a, hit->weights), reference(a)) <= options_.eps_entry) return;
-  const VertexId b = insert_at(hit->wedge, a, hit->weights, report);
+  if (branches(a, scalpel).size() >= 2) {
+    branch(a, scalpel, report);
+    return;
+  }
+  const StarHit& hit = hits.front();
+  if (distance(reference_at(hit.wedge, a, hit.weights), reference(a)) <= options_.eps_entry) return;
+  const VertexId b = insert_at(hit.wedge, a, hit.weights, report);
   if (b < 0 || !has_edge(mesh_.connectivity(), a, b)) return;
-  std::vector<std::array<VertexId, 2>> slit{{a, b}};
-  if (tip_entry_) {
+  open_from(a, {b}, report);
+}
+
+void SurfaceCutter::open_from(VertexId a, const std::vector<VertexId>& ends, PlanarCutReport& report) {
+  std::vector<std::array<VertexId, 2>> slit;
+  if (ends.size() == 1 && !on_boundary(a)) {
     // An interior edge does not open (both ends' stars stay whole): split it, so that the
     // slit a–m–b opens at m.
-    const VertexId m = split(a, b, 0.5);
+    const VertexId m = split(a, ends.front(), 0.5);
     if (m < 0) return;
     ++report.nodes_inserted;
-    slit = {{a, m}, {m, b}};
+    slit = {{a, m}, {m, ends.front()}};
     incision_vertices_.insert(m);
+  } else {
+    for (VertexId b : ends) slit.push_back({a, b});
   }
   for (VertexId v : dissect_edges(slit)) incision_vertices_.insert(v), touched_.push_back(v);
   incision_vertices_.insert(a);
-  incision_vertices_.insert(b);
-  touched_.insert(touched_.end(), {a, b});
-  active_ = b;
-  phase_ = Phase::cutting;
-  remesh_around(b, report);
+  touched_.push_back(a);
+  std::erase_if(incisions_, [a](const Incision& i) { return i.active == a; });
+  for (VertexId b : ends) {
+    incision_vertices_.insert(b);
+    touched_.push_back(b);
+    incisions_.push_back({b, false, false});
+  }
+  for (VertexId b : ends) remesh_around(b, report);
+}
+
+std::vector<SurfaceCutter::StarHit> SurfaceCutter::branches(VertexId a, const Segment& scalpel) const {
+  std::vector<StarHit> far;
+  std::vector<Point3> places;
+  for (const StarHit& hit : hits_in_star(a, scalpel)) {
+    const Point3 x = reference_at(hit.wedge, a, hit.weights);
+    if (distance(x, reference(a)) <= options_.eps_entry) return {};  // the scalpel is still at a
+    if (std::all_of(places.begin(), places.end(), [&](const Point3& p) { return distance(p, x) > options_.eps_entry; }))
+      far.push_back(hit), places.push_back(x);
+  }
+  return far.size() >= 2 ? far : std::vector<StarHit>{};
+}
+
+void SurfaceCutter::branch(VertexId a, const Segment& scalpel, PlanarCutReport& report) {
+  // Figure 5.14: a node at each place, inserted in turn (each into triangles the earlier
+  // ones left alone), then the edges from a to them dissected.
+  const Connectivity& c = mesh_.connectivity();
+  std::vector<Point3> places;
+  for (const StarHit& hit : branches(a, scalpel)) places.push_back(reference_at(hit.wedge, a, hit.weights));
+  std::vector<VertexId> made;
+  const auto apart = [&](const StarHit& hit) {
+    // The triangles the new node will be in: the hit's, and across the side it is on.
+    std::vector<ElementId> hosts{hit.wedge.element};
+    const std::array<VertexId, 3> corners{a, hit.wedge.y, hit.wedge.z};
+    const int smallest = static_cast<int>(std::min_element(hit.weights.begin(), hit.weights.end()) - hit.weights.begin());
+    if (hit.weights[smallest] <= on_side)
+      hosts = elements_with_edge(c, corners[(smallest + 1) % 3], corners[(smallest + 2) % 3]);
+    return std::none_of(hosts.begin(), hosts.end(), [&](ElementId e) {
+      const Simplex& t = c.element(e).simplex;
+      return std::any_of(made.begin(), made.end(), [&](VertexId m) { return t.contains(m); });
+    });
+  };
+  for (const Point3& place : places) {
+    for (const StarHit& hit : hits_in_star(a, scalpel)) {
+      if (!apart(hit) || distance(reference_at(hit.wedge, a, hit.weights), place) > options_.eps_entry) continue;
+      if (const VertexId m = insert_at(hit.wedge, a, hit.weights, report); m >= 0) made.push_back(m);
+      break;
+    }
+  }
+  if (made.empty()) return;
+  if (made.size() >= 2) ++report.branches;
+  open_from(a, made, report);
 }
 
 VertexId SurfaceCutter::insert_at(const Wedge& w, VertexId b, const std::array<double, 3>& weights,
@@ -339,8 +454,10 @@ VertexId SurfaceCutter::insert_at(const Wedge& w, VertexId b, const std::array<d
       follow(made, VertexParents::barycentric(std::span<const VertexId>(oriented.data(), 3), in_order));
     }
   }
-  if (made < 0) {  // on or too near a side: split that side
+  if (made < 0) {  // on or too near a side: split that side, unless its other triangle has another active node
     const VertexId s = corners[(smallest + 1) % 3], t = corners[(smallest + 2) % 3];
+    for (ElementId e : elements_with_edge(mesh_.connectivity(), s, t))
+      if (touches_active(e, b)) return -1;
     const double ws = weights[(smallest + 1) % 3], wt = weights[(smallest + 2) % 3];
     made = split(s, t, std::clamp(wt / (ws + wt), 0.05, 0.95));
   }
@@ -355,25 +472,35 @@ VertexId SurfaceCutter::split(VertexId a, VertexId b, double t) {
   return result.vertex;
 }
 
-void SurfaceCutter::advance(const Segment& from, const Segment& to, PlanarCutReport& report) {
-  for (int attempt = 0; attempt < 64 && phase_ == Phase::cutting; ++attempt) {
-    const VertexId b = active_;
-    if (const std::optional<StarHit> hit = hit_in_star(b, to)) {
-      if (!move_active_to(hit->wedge, hit->weights)) ++report.stuck;
+void SurfaceCutter::advance(VertexId b, const Segment& from, const Segment& to, PlanarCutReport& report) {
+  for (int attempt = 0; attempt < 64 && incision_at(b); ++attempt) {
+    const std::vector<StarHit> hits = hits_in_star(b, to);
+    if (!hits.empty()) {
+      if (branches(b, to).size() >= 2) {
+        branch(b, to, report);
+        return;
+      }
+      if (!move_active_to(b, hits.front().wedge, hits.front().weights)) ++report.stuck;
       remesh_around(b, report);
-      split_incision(report);
+      split_incision(b, report);
       return;
     }
     // §5.3.1: the scalpel has left the active triangles across the edge it swept first.
     const std::optional<LinkCrossing> crossing = first_link_crossing(b, from, to);
     if (!crossing) {
-      if (touches_surface(to)) ++report.stuck;
+      if (meets_ring(b, to)) ++report.stuck;
       return;
     }
     const Wedge& w = crossing->wedge;
-    move_active_to(w, {0.4, 0.6 * (1 - crossing->mu), 0.6 * crossing->mu});
-    if (is_boundary_edge(w.element, b)) {
-      exit_through(w.y, w.z, crossing->mu, report);
+    move_active_to(b, w, {0.4, 0.6 * (1 - crossing->mu), 0.6 * crossing->mu});
+    // An edge not to be flipped ends the incision there (Figure 5.13): a boundary edge (the
+    // exit), or one with another active node across it.
+    const std::vector<ElementId> wings = elements_with_edge(mesh_.connectivity(), w.y, w.z);
+    const bool across_active = std::any_of(wings.begin(), wings.end(), [&](ElementId e) {
+      return e != w.element && touches_active(e);
+    });
+    if (is_boundary_edge(w.element, b) || across_active) {
+      end_at_edge(b, w.y, w.z, crossing->mu, report);
       return;
     }
     if (!flip(w.y, w.z, report)) {
@@ -391,18 +518,18 @@ void SurfaceCutter::advance(const Segment& from, const Segment& to, PlanarCutRep
   }
 }
 
-bool SurfaceCutter::move_active_to(const Wedge& w, std::array<double, 3> weights) {
-  const std::array<VertexId, 3> parents{active_, w.y, w.z};
+bool SurfaceCutter::move_active_to(VertexId b, const Wedge& w, std::array<double, 3> weights) {
+  const std::array<VertexId, 3> parents{b, w.y, w.z};
   // Part of the way when the whole way would flatten or fold a triangle of the star.
   for (double fraction : {1.0, 0.75, 0.5, 0.25}) {
     std::array<double, 3> part{1 - fraction + fraction * weights[0], fraction * weights[1], fraction * weights[2]};
     const double sum = part[0] + part[1] + part[2];
     for (double& x : part) x /= sum;
     const VertexParents target = VertexParents::barycentric(parents, part);
-    const Point3 before = deformed(active_);
-    if (keeps_facing(active_, reference_at(w, active_, part)) && snap_vertex(mesh_, active_, target).done) {
-      moved_[active_] = before;  // follow() reads the active node's old position as a parent
-      follow(active_, target);
+    const Point3 before = deformed(b);
+    if (keeps_facing(b, reference_at(w, b, part)) && snap_vertex(mesh_, b, target).done) {
+      moved_[b] = before;  // follow() reads the active node's old position as a parent
+      follow(b, target);
       return fraction == 1.0;
     }
   }
@@ -420,9 +547,12 @@ bool SurfaceCutter::flip(VertexId p, VertexId q, PlanarCutReport& report) {
     old_normals.push_back(doubled_normal(reference(t[0]), reference(t[1]), reference(t[2])));
     quad.push_back(third_vertex(c.element(e).simplex, p, q));
   }
+  // §5.3.2: no triangle may touch two active nodes.
+  const auto actives = [this](std::initializer_list<VertexId> t) { return std::count_if(t.begin(), t.end(), [this](VertexId v) { return is_active(v); }); };
+  VertexId left = quad[2], right = quad[3];
+  if (actives({p, left, right}) > 1 || actives({q, left, right}) > 1) return false;
   // The new triangles (p, d, c) and (q, c, d), (p, q, c) being the old left one, must turn
   // by less than 60° from both old ones (as keeps_facing asks of moves).
-  VertexId left = quad[2], right = quad[3];
   if (c.element(wings[0]).simplex != Simplex(1, {p, q, left})) std::swap(left, right);
   for (const auto& [x, y, z] : {std::array<VertexId, 3>{p, right, left}, std::array<VertexId, 3>{q, left, right}}) {
     const Point3 n = doubled_normal(reference(x), reference(y), reference(z));
@@ -437,6 +567,8 @@ bool SurfaceCutter::flip(VertexId p, VertexId q, PlanarCutReport& report) {
 }
 
 bool SurfaceCutter::remove_node(VertexId v, PlanarCutReport& report) {
+  // §5.3.2: active nodes stay, and so do the nodes that separate two of them.
+  if (is_active(v) || active_neighbours(v, -1).size() > 1) return false;
   std::vector<VertexId> link;
   for (const Wedge& w : wedges(v)) link.insert(link.end(), {w.y, w.z});
   if (!remove_vertex_by_flips(mesh_, v).done) return false;
@@ -448,7 +580,7 @@ bool SurfaceCutter::remove_node(VertexId v, PlanarCutReport& report) {
 }
 
 void SurfaceCutter::remesh_around(VertexId b, PlanarCutReport& report) {
-  if (!mesh_.is_vertex(b)) return;
+  if (!mesh_.is_vertex(b) || !incision_at(b)) return;
   // §5.3.1: the active triangles' edges to the unfolded Delaunay criterion.
   for (int round = 0; round < 64; ++round) {
     bool flipped = false;
@@ -462,7 +594,8 @@ void SurfaceCutter::remesh_around(VertexId b, PlanarCutReport& report) {
     }
     if (!flipped) break;
   }
-  // Interior nodes closer than ε_edge to the active node go (§5.2.2).
+  // Interior nodes closer than ε_edge to the active node go (§5.2.2); one that separates b
+  // from another active node is where both incisions end (Figure 5.13).
   for (int round = 0; round < 16; ++round) {
     const Point3 x = reference(b);
     VertexId closest = -1;
@@ -471,13 +604,17 @@ void SurfaceCutter::remesh_around(VertexId b, PlanarCutReport& report) {
       for (VertexId v : {w.y, w.z})
         if (const double r = distance(reference(v), x); r < nearest && !incision_vertices_.count(v) && !on_boundary(v))
           nearest = r, closest = v;
-    if (closest < 0 || !remove_node(closest, report)) break;
+    if (closest < 0) break;
+    if (!active_neighbours(closest, b).empty()) {
+      end_at_node(b, closest, report);
+      return;
+    }
+    if (!remove_node(closest, report)) break;
   }
 }
 
-void SurfaceCutter::split_incision(PlanarCutReport& report) {
-  const VertexId b = active_;
-  if (phase_ != Phase::cutting) return;
+void SurfaceCutter::split_incision(VertexId b, PlanarCutReport& report) {
+  if (!incision_at(b)) return;
   // The cut edges: boundary edges (b, c1) of wedge (b, c1, o1) and (b, c2) of (b, o2, c2).
   std::optional<Wedge> out, in;
   for (const Wedge& w : wedges(b)) {
@@ -546,7 +683,8 @@ std::vector<VertexId> SurfaceCutter::dissect_edges(const std::vector<std::array<
   return copies;
 }
 
-void SurfaceCutter::exit_through(VertexId y, VertexId z, double mu, PlanarCutReport& report) {
+void SurfaceCutter::end_at_edge(VertexId b, VertexId y, VertexId z, double mu, PlanarCutReport& report) {
+  const bool exit = elements_with_edge(mesh_.connectivity(), y, z).size() == 1;
   const Point3 py = reference(y), pz = reference(z), at = lerp(py, pz, mu);
   VertexId w = -1;
   if (distance(at, py) <= options_.eps_exit)
@@ -557,28 +695,46 @@ void SurfaceCutter::exit_through(VertexId y, VertexId z, double mu, PlanarCutRep
     ++report.nodes_inserted;
   else
     w = distance(at, py) < distance(at, pz) ? y : z;
-  const VertexId b = active_;
-  phase_ = Phase::outside;
-  active_ = -1;
-  left_surface_ = false;
-  // An edge (b, w) that is missing or already on the boundary has nothing to open.
-  if (elements_with_edge(mesh_.connectivity(), b, w).size() != 2) return;
-  const std::vector<VertexId> copies = dissect_edges({{b, w}});
+  if (!exit) {
+    end_at_node(b, w, report);
+    return;
+  }
+  const std::vector<VertexId> copies = join_at(w, {b});
+  if (copies.empty()) return;
   ++report.exits;
   // Figure 5.7: the short edges the exit leaves are contracted, each copy of b into its w.
-  std::vector<VertexId> tips{b}, ends{w};
-  for (VertexId v : copies) (mesh_.parents(v).vertex.front() == b ? tips : ends).push_back(v);
+  std::vector<VertexId> tips{b}, exit_ends{w};
+  for (VertexId v : copies) (mesh_.parents(v).vertex.front() == b ? tips : exit_ends).push_back(v);
   for (VertexId tip : tips)
-    for (VertexId end : ends)
+    for (VertexId end : exit_ends)
       if (has_edge(mesh_.connectivity(), tip, end) && distance(reference(tip), reference(end)) < options_.eps_edge &&
           keeps_facing(tip, reference(end), end) && collapse_edge(mesh_, end, tip, 0).done) {
         ++report.edges_contracted;
         incision_vertices_.erase(tip);
         moved_.erase(tip);
       }
-  for (VertexId v : ends) incision_vertices_.insert(v), touched_.push_back(v);
-  for (VertexId v : tips)
-    if (mesh_.is_vertex(v)) incision_vertices_.insert(v), touched_.push_back(v);
+}
+
+void SurfaceCutter::end_at_node(VertexId b, VertexId w, PlanarCutReport& report) {
+  std::vector<VertexId> met{b};
+  for (VertexId a : active_neighbours(w, b)) met.push_back(a);
+  if (!join_at(w, met).empty() && met.size() > 1) ++report.annihilations;
+}
+
+std::vector<VertexId> SurfaceCutter::join_at(VertexId w, const std::vector<VertexId>& actives) {
+  std::vector<std::array<VertexId, 2>> edges;
+  for (VertexId a : actives) {
+    std::erase_if(incisions_, [a](const Incision& i) { return i.active == a; });
+    // An edge that is missing or already on the boundary has nothing to open.
+    if (elements_with_edge(mesh_.connectivity(), a, w).size() == 2) edges.push_back({a, w});
+  }
+  if (edges.empty()) return {};
+  std::vector<VertexId> copies = dissect_edges(edges);
+  for (VertexId v : copies) incision_vertices_.insert(v), touched_.push_back(v);
+  for (VertexId v : actives) incision_vertices_.insert(v), touched_.push_back(v);
+  incision_vertices_.insert(w);
+  touched_.push_back(w);
+  return copies;
 }
 
 void SurfaceCutter::legalize(PlanarCutReport& report) {

@@ -1,30 +1,39 @@
-// Cutting a triangulated surface in 3D with a line-segment scalpel (§5.3.1, single incision),
-// on a bare surface mesh or a membrane body that may be deformed: the scalpel moves in
-// deformed coordinates x = X + u and the mesh is edited in the reference configuration.
+// Cutting a triangulated surface in 3D with a line-segment scalpel (§5.3), on a bare surface
+// mesh or a membrane body that may be deformed: the scalpel moves in deformed coordinates
+// x = X + u and the mesh is edited in the reference configuration.
 //
-// The scalpel is a segment whose ends move with constant velocity between samples. Each move
-// is taken in steps no longer than d_max (Figure 5.11: the distance between the scalpel's line
-// and the lines of the edges opposite the active node, at least ε_edge/4). In each step:
-//  * outside, the swept scalpel (equation (5.1)) crossing a boundary edge enters there
-//    (Figure 5.12a); otherwise the scalpel piercing a triangle enters with its tip there
-//    (Figure 5.12b). The candidate triangles come from a uniform grid (TriangleGrid). The
-//    incision begins when the scalpel meets the entry node's star more than ε_entry away: a node
-//    is inserted there and the edge to it dissected — for a tip entry the edge is first split,
-//    so that the slit has an interior node and opens;
-//  * cutting, the scalpel is intersected with the active triangles and the active node moved
-//    to the intersection. When it misses them, the edge opposite the active node that the
-//    swept scalpel crosses first is flipped away (refused flips, Figure 5.9, remove its nearer
-//    interior end instead, Figure 5.10) after the node has moved 0.6 of the way towards it;
-//    a boundary edge there is the exit (Figure 5.7);
-//  * the active triangles are flipped to the unfolded Delaunay criterion (is_locally_delaunay
-//    on a surface), interior nodes within ε_edge of the active node removed, and the incision
-//    split (Figure 5.5) where its cut edges, unfolded about the active node, fail the
-//    empty-circle test: new nodes on both lips where the unfolded line through the opposite
-//    nodes crosses them.
+// The scalpel is a segment whose ends move with constant velocity between samples. A move is
+// taken in steps no longer than d_max of every active node (Figure 5.11: the distance between
+// the scalpel's line and the lines of the edges opposite the active node, at least ε_edge/4),
+// and cut short where the scalpel first touches the surface somewhere new. Each step:
+//  * every incision follows the scalpel (§5.3.1). An entry node waits until the scalpel has
+//    moved ε_entry from it, then the edge to a new active node is dissected (for an entry
+//    inside the surface the edge is first split, so that the slit has an interior node and
+//    opens). A cutting incision's active node moves to where the scalpel meets its triangles;
+//    when the scalpel misses them, the edge opposite the active node that the swept scalpel
+//    crosses first is flipped away (refused flips, Figure 5.9, remove its nearer interior end
+//    instead, Figure 5.10) after the node has moved 0.6 of the way towards it. Then the active
+//    triangles are flipped to the unfolded Delaunay criterion, interior nodes within ε_edge of
+//    the active node removed, and the incision split (Figure 5.5) where its cut edges, unfolded
+//    about the active node, fail the empty-circle test;
+//  * the scalpel meeting an active node's triangles in several places far apart branches the
+//    incision (Figure 5.14): a new active node at each place, the edges to them dissected;
+//  * an incision ends where its active node reaches an edge it may not flip (Figure 5.13,
+//    annihilation): a boundary edge (the exit, Figure 5.7) or an edge whose other triangle has
+//    another active node, whose incision then ends there too. A node that separates two active
+//    nodes and is closer than ε_edge to one of them is where both end;
+//  * new incisions begin in one of the three ways of Figure 5.12, on triangles that touch no
+//    active node: the swept scalpel crossing a boundary edge into its triangle, an end of the
+//    scalpel passing through a triangle, or the swept scalpel meeting an interior edge from
+//    outside both its triangles (a fold's crest), which branches at the next step. The
+//    candidates come from a uniform grid (TriangleGrid). A scalpel placed through the surface
+//    (the first move after construction or lift()) enters where it pierces it.
+// Every triangle touches at most one active node (§5.3.2): flips that would join two, removals
+// of nodes between two, and entries into triangles of an active node are refused.
 // Departures from the thesis: the new incision nodes go on the cut edges (a chord of the
-// path), not onto the path itself; one incision at a time (§5.3.2's multiple and branching
-// incisions are not handled: the scalpel drives one active node, and a second piercing of the
-// surface is ignored while it cuts).
+// path), not onto the path itself; a node separating two incisions annihilates them only when
+// it is within ε_edge, and the edge case inserts the node where the scalpel crosses the edge
+// rather than on the extrapolated path.
 #pragma once
 
 #include <optional>
@@ -56,21 +65,28 @@ class SurfaceCutter {
   SurfaceCutter(Mesh& mesh, Model* model, SurfaceCutterOptions options);
 
   // Moves the scalpel to `segment` (6 numbers: its two ends, deformed coordinates); the first
-  // move after construction or lift() only places it. Throws std::invalid_argument, before
-  // changing anything, for non-finite coordinates or coinciding ends. The report's fields
-  // mean what they mean for the 2D cutter.
+  // move after construction or lift() places it, entering where it pierces the surface.
+  // Throws std::invalid_argument, before changing anything, for non-finite coordinates or
+  // coinciding ends. The report's fields mean what they mean for the 2D cutter.
   PlanarCutReport move(std::span<const double> segment);
+  // Lifts the scalpel: the incisions in progress stay as they are and stop being active.
   void lift();
 
-  VertexId active_node() const { return phase_ == Phase::cutting ? active_ : -1; }
-  bool cutting() const { return phase_ == Phase::cutting; }
+  // The active nodes of the incisions in progress (entry nodes included), oldest first.
+  std::vector<VertexId> active_nodes() const;
+  bool cutting() const { return !incisions_.empty(); }
   std::vector<VertexId> incision_edges() const;
   const SurfaceCutterOptions& options() const { return options_; }
 
  private:
-  enum class Phase { outside, entering, cutting };
   struct Segment {
     Point3 head, tail;
+  };
+  struct Incision {
+    VertexId active;
+    bool entering;   // the entry node: nothing cut yet
+    bool inside;     // entered inside the surface (its first edge is split so that it opens)
+    bool branching;  // entered at a fold's crest: expected to branch
   };
   struct Wedge {  // triangle (b, y, z) of b's star, in its orientation
     ElementId element;
@@ -84,6 +100,13 @@ class SurfaceCutter {
     Wedge wedge;
     double time, mu;
   };
+  struct Contact {  // where the scalpel first touches the surface away from every incision
+    enum class Way { boundary_edge, tip, crest } way;
+    double time;                    // fraction of the step
+    ElementId element;
+    Simplex triangle;               // the element's simplex when the contact was found
+    std::array<double, 3> weights;  // in its oriented vertex order; 0 opposite the edge for edge ways
+  };
 
   Point3 reference(VertexId v) const;
   Point3 deformed(VertexId v) const;
@@ -91,42 +114,76 @@ class SurfaceCutter {
   void follow(VertexId v, const VertexParents& parents);
   std::vector<Wedge> wedges(VertexId b) const;
   bool on_boundary(VertexId v) const;
+  bool is_active(VertexId v) const;
+  Incision* incision_at(VertexId active);
+  // The active nodes adjacent to v other than `except`.
+  std::vector<VertexId> active_neighbours(VertexId v, VertexId except) const;
+  bool touches_active(ElementId triangle, VertexId except = -1) const;
   // Whether every triangle of v's star, with v moved to x, turns its normal by less than 60°
   // (those with vertex merging_into, which a collapse into it removes, aside).
   bool keeps_facing(VertexId v, const Point3& x, VertexId merging_into = -1) const;
   bool is_boundary_edge(ElementId triangle, VertexId opposite) const;
   Point3 reference_at(const Wedge& w, VertexId b, const std::array<double, 3>& weights) const;
+  Point3 deformed_at(const Wedge& w, VertexId b, const std::array<double, 3>& weights) const;
 
-  std::optional<StarHit> hit_in_star(VertexId b, const Segment& scalpel) const;
+  std::vector<StarHit> hits_in_star(VertexId b, const Segment& scalpel) const;  // nearest b first
   std::optional<LinkCrossing> first_link_crossing(VertexId b, const Segment& from, const Segment& to) const;
   double step_limit(VertexId b, const Segment& scalpel) const;  // d_max, Figure 5.11
   std::vector<ElementId> triangles_near(const Segment& from, const Segment& to);
-  bool touches_surface(const Segment& scalpel);
+  // Whether the scalpel meets a triangle with a vertex in a's star.
+  bool meets_ring(VertexId a, const Segment& scalpel) const;
+  // The candidate within `radius` of `at` nearest it that is neither active nor next to an
+  // active node, or -1.
+  VertexId free_vertex_near(const Point3& at, std::span<const VertexId> candidates, double radius) const;
 
   void sweep(const Segment& from, const Segment& to, PlanarCutReport& report);
-  void look_for_entry(const Segment& from, const Segment& to, PlanarCutReport& report);
-  void begin_incision(const Segment& scalpel, PlanarCutReport& report);
-  void advance(const Segment& from, const Segment& to, PlanarCutReport& report);
-  // Moves the active node to the point with `weights` in its star triangle, or part of the way.
-  bool move_active_to(const Wedge& w, std::array<double, 3> weights);
+  // How many distinct places the scalpel meets a's star at.
+  std::size_t places_in_star(VertexId a, const Segment& scalpel) const;
+  // Whether an entry node's star meets the scalpel in fewer places at `to` than at `from`
+  // (than two for a crest).
+  bool loses_place(const Segment& from, const Segment& to) const;
+  void follow_scalpel(const Segment& from, const Segment& to, PlanarCutReport& report);
+  // The earliest new contacts (simultaneous ones together) as the scalpel moves from `from`
+  // to `to`, on triangles that touch no active node (surface_contacts.cpp).
+  std::vector<Contact> first_contacts(const Segment& from, const Segment& to);
+  // Where the scalpel pierces triangles that touch no active node, nearest its first end first.
+  std::vector<Contact> piercings(const Segment& scalpel);
+  // Whether the scalpel meets the triangle with a weight above a tolerance at `corner` (each
+  // corner when corner is -1): not just on the opposite side.
+  bool meets_inside(const Segment& scalpel, ElementId triangle, int corner) const;
+  bool enter(const Contact& contact, PlanarCutReport& report);
+  void begin_incision(VertexId a, const Segment& scalpel, PlanarCutReport& report);
+  // Dissects the edges from a to `ends` (after splitting a lone interior one, so that it
+  // opens); `ends` become the active nodes in place of a.
+  void open_from(VertexId a, const std::vector<VertexId>& ends, PlanarCutReport& report);
+  void advance(VertexId b, const Segment& from, const Segment& to, PlanarCutReport& report);
+  // Hits of `scalpel` in a's star farther than ε_entry from a and from each other, or nothing
+  // when fewer than two (Figure 5.14).
+  std::vector<StarHit> branches(VertexId a, const Segment& scalpel) const;
+  void branch(VertexId a, const Segment& scalpel, PlanarCutReport& report);
+  // Moves the active node b to the point with `weights` in its star triangle, or part of the way.
+  bool move_active_to(VertexId b, const Wedge& w, std::array<double, 3> weights);
   // A new vertex at `weights` in triangle (b, y, z), on a side when a weight is (nearly) 0.
   VertexId insert_at(const Wedge& w, VertexId b, const std::array<double, 3>& weights, PlanarCutReport& report);
   VertexId split(VertexId a, VertexId b, double t);
   bool flip(VertexId p, VertexId q, PlanarCutReport& report);
   bool remove_node(VertexId v, PlanarCutReport& report);
   void remesh_around(VertexId b, PlanarCutReport& report);
-  void split_incision(PlanarCutReport& report);
-  void exit_through(VertexId y, VertexId z, double mu, PlanarCutReport& report);
+  void split_incision(VertexId b, PlanarCutReport& report);
+  // Ends b's incision at edge (y, z) of its star (Figure 5.7, 5.13), with every incision
+  // whose active node is across it.
+  void end_at_edge(VertexId b, VertexId y, VertexId z, double mu, PlanarCutReport& report);
+  // Ends b's incision at its neighbour w, with those of w's other active neighbours.
+  void end_at_node(VertexId b, VertexId w, PlanarCutReport& report);
+  // Ends the incisions of `actives` by dissecting their edges to w; returns the copies made.
+  std::vector<VertexId> join_at(VertexId w, const std::vector<VertexId>& actives);
   std::vector<VertexId> dissect_edges(const std::vector<std::array<VertexId, 2>>& edges);
   void legalize(PlanarCutReport& report);
 
   Mesh& mesh_;
   Model* model_;
   SurfaceCutterOptions options_;
-  Phase phase_ = Phase::outside;
-  VertexId active_ = -1;
-  bool tip_entry_ = false;
-  bool left_surface_ = true;  // after an exit, no entry until the scalpel has left the surface
+  std::vector<Incision> incisions_;
   std::optional<Segment> scalpel_;
   std::vector<double> displacement_;                // u at the start of the move (3 per point)
   std::unordered_map<VertexId, Point3> moved_;      // deformed positions of vertices edited since
@@ -135,6 +192,7 @@ class SurfaceCutter {
   bool grid_stale_ = true;
   std::unordered_set<VertexId> incision_vertices_;
   std::vector<VertexId> touched_;
+  std::unordered_set<ElementId> refused_;  // contacts this move could not enter
 };
 
 }  // namespace snede

@@ -1,4 +1,5 @@
-"""Mesh generators: structured boxes and rectangles, unstructured cylinders (gmsh)."""
+"""Mesh generators: structured boxes and rectangles, unstructured cylinders (gmsh), and
+surfaces in 3D for cutting (height fields, the Gaussian bell of Figure 5.19, a folded sheet)."""
 from __future__ import annotations
 
 import itertools
@@ -114,6 +115,48 @@ def cylinder(length=0.1, radius=0.03, h=0.01, seed: int | None = None) -> Mesh:
     # gmsh lists nodes that are not in any tetrahedron (geometry points); keep only used ones.
     used, cells = np.unique(cells, return_inverse=True)
     return Mesh(points[used], cells.reshape(-1, 4))
+
+
+def lifted(sheet: Mesh, to_space) -> Mesh:
+    """The triangles of a 2D mesh mapped into 3D by ``to_space(x, y) -> (n, 3)`` points."""
+    if sheet.cell_dim != 2 or sheet.space_dim != 2:
+        raise ValueError(f"lifted maps a 2D triangle mesh, got {sheet.cell_dim}-D cells in {sheet.space_dim}-D")
+    x, y = sheet.points.T
+    points = np.asarray(to_space(x, y), dtype=np.float64)
+    if points.shape != (len(x), 3) or not np.all(np.isfinite(points)):
+        raise ValueError(f"to_space must give finite ({len(x)}, 3) points, got shape {points.shape}")
+    return Mesh(points, sheet.cells)
+
+
+def height_field(height, size=(1.0, 1.0), divisions=(10, 10)) -> Mesh:
+    """The surface z = height(x, y) over ``rectangle(size, divisions)`` (``height`` takes and
+    returns numpy arrays)."""
+    return lifted(rectangle(size, divisions), lambda x, y: np.c_[x, y, np.broadcast_to(height(x, y), x.shape)])
+
+
+def gaussian_bell(amplitude: float = 0.4, spread: float = 0.08, divisions: int = 14) -> Mesh:
+    """z = amplitude · exp(−((x − ½)² + (y − ½)²) / spread) over the unit square, 2·divisions²
+    triangles: by default the 392-triangle bell of the thesis's Figure 5.19."""
+    return height_field(lambda x, y: amplitude * np.exp(-((x - 0.5) ** 2 + (y - 0.5) ** 2) / spread),
+                        divisions=(divisions, divisions))
+
+
+def folded_sheet(flat: float = 0.4, radius: float = 0.15, divisions=(10, 8)) -> Mesh:
+    """A unit-wide sheet folded over itself along y: a lower layer z = 0 for x in [0, flat], a
+    half-cylinder crease of ``radius``, and an upper layer z = 2·radius running back towards
+    x = 0, as long as the rest of the sheet allows (the sheet's length is 1.4)."""
+    length = 1.4
+
+    def to_space(x, y):
+        s = x * length  # arc length across the sheet
+        angle = np.clip((s - flat) / radius, 0.0, math.pi)
+        crease = (s > flat) & (s < flat + math.pi * radius)
+        upper = s >= flat + math.pi * radius
+        sx = np.where(crease, flat + radius * np.sin(angle), np.where(upper, flat - (s - flat - math.pi * radius), s))
+        sz = np.where(crease, radius - radius * np.cos(angle), np.where(upper, 2 * radius, 0.0))
+        return np.c_[sx, y, sz]
+
+    return lifted(rectangle((1.0, 1.0), divisions), to_space)
 
 
 def boundary_surface(mesh: Mesh) -> tuple[Mesh, np.ndarray]:

@@ -21,9 +21,10 @@ from snede.cutting import body_and_mesh, engine_sum, move_along
 class PlanarCutReport:
     """What one ``move`` (or a whole ``cut``) did: edge ``flips``, ``nodes_removed`` near the
     active node, ``nodes_inserted`` (entry, exit and incision splits), ``incision_splits``
-    (Figure 5.5), ``edges_contracted`` after exits (Figure 5.7), ``entries``, ``exits``, moves
-    that left the active node short of the scalpel (``stuck``), the triangle counts before
-    and after, and the time in ``seconds``."""
+    (Figure 5.5), ``edges_contracted`` after exits (Figure 5.7), ``entries``, ``exits``, on
+    surfaces ``branches`` (Figure 5.14) and ``annihilations`` (incisions meeting, Figure
+    5.13), moves that left the active node short of the scalpel (``stuck``), the triangle
+    counts before and after, and the time in ``seconds``."""
 
     moves: int = 0
     flips: int = 0
@@ -33,6 +34,8 @@ class PlanarCutReport:
     edges_contracted: int = 0
     entries: int = 0
     exits: int = 0
+    branches: int = 0
+    annihilations: int = 0
     stuck: int = 0
     triangles_before: int = 0
     triangles_after: int = 0
@@ -45,9 +48,15 @@ class PlanarCutReport:
     def __add__(self, later: "PlanarCutReport") -> "PlanarCutReport":
         return PlanarCutReport._from_engine(engine_sum(self, later, _snede.PlanarCutReport))
 
+    def _surface_events(self) -> str:
+        if not (self.branches or self.annihilations):
+            return ""
+        return f", {self.branches} branches, {self.annihilations} annihilations"
+
     def __str__(self) -> str:
         return (f"{self.moves} moves: {self.flips} flips, {self.nodes_removed} nodes removed, {self.nodes_inserted} "
-                f"inserted ({self.incision_splits} incision splits), {self.entries} entries, {self.exits} exits; "
+                f"inserted ({self.incision_splits} incision splits), {self.entries} entries, {self.exits} exits"
+                f"{self._surface_events()}; "
                 f"{self.triangles_before} → {self.triangles_after} triangles in {self.seconds * 1e3:.2f} ms")
 
 

@@ -1,12 +1,15 @@
-"""Cutting triangulated surfaces in 3D with a line-segment scalpel (thesis §5.3.1).
+"""Cutting triangulated surfaces in 3D with a line-segment scalpel (thesis §5.3).
 
 The scalpel is a segment in space whose ends move with constant velocity between samples.
-Where it meets the surface it drags the active node, the tip of the incision; after every
+Where it meets the surface it drags an active node, the tip of an incision; after every
 step the triangles around it are remeshed as in the 2D Delaunay cut (flips by the unfolded
 empty-circle criterion, removal of nodes closer than ``eps_edge``, incision splits), so the
-mesh stays small and well shaped. On a membrane Body the scalpel moves in deformed
-coordinates and the mesh is edited in the reference configuration; the body keeps its
-state, so a pre-tensioned membrane opens as it is cut. One incision at a time.
+mesh stays small and well shaped. A segment can cut a curved surface in several places at
+once (§5.3.2): every place it touches anew starts an incision, an incision branches where
+the scalpel meets its triangles in several places (a fold), and incisions that meet end
+together. On a membrane Body the scalpel moves in deformed coordinates and the mesh is
+edited in the reference configuration; the body keeps its state, so a pre-tensioned
+membrane opens as it is cut.
 """
 from __future__ import annotations
 
@@ -25,11 +28,15 @@ class SurfaceCutter(IncisionCutter):
     edge length (§5.4).
 
     ``move(segment)`` moves the scalpel to ``segment`` ((2, 3): its two ends, deformed
-    coordinates); the first move only places it. The swept scalpel crossing a boundary edge
-    enters there, or, crossing none, the scalpel piercing a triangle enters with its tip; the
-    incision follows the scalpel and ends where it leaves through the boundary. ``cut(path)``
-    moves through ``path`` ((n, 2, 3) scalpel positions, the first places it). Both return a
-    :class:`snede.PlanarCutReport` (the same fields as the 2D cutter's). Invalid input raises
+    coordinates); the first move places it, entering where it pierces the surface. Later
+    moves start incisions where the scalpel touches the surface anew (Figure 5.12): the swept
+    scalpel crossing a boundary edge into its triangle, an end of the scalpel passing through
+    a triangle, or the scalpel meeting an interior edge from outside both its triangles (a
+    crest; that incision branches at once). Each incision follows the scalpel, branches where
+    the scalpel meets its triangles in several places, and ends where it leaves through the
+    boundary or meets another incision. ``cut(path)`` moves through ``path`` ((n, 2, 3)
+    scalpel positions, the first places it). Both return a :class:`snede.PlanarCutReport`
+    (the 2D cutter's fields plus ``branches`` and ``annihilations``). Invalid input raises
     ``ValueError`` before anything changes.
     """
 
@@ -40,6 +47,17 @@ class SurfaceCutter(IncisionCutter):
                              f"{self.mesh.cell_dim}-D cells in {self.mesh.space_dim}-D")
         self._impl = _snede.SurfaceCutter(self.mesh._impl, model, _threshold(eps_edge, "eps_edge"),
                                           _threshold(eps_entry, "eps_entry"), _threshold(eps_exit, "eps_exit"))
+
+    @property
+    def active_nodes(self) -> list[int]:
+        """The tips of the incisions in progress (entry nodes included), oldest first."""
+        return [int(v) for v in self._impl.active_nodes.ravel()]
+
+    @property
+    def active_node(self) -> int | None:
+        """The tip of the oldest incision in progress, or None (see ``active_nodes``)."""
+        nodes = self.active_nodes
+        return nodes[0] if nodes else None
 
     def move(self, segment) -> PlanarCutReport:
         segment = _points(segment, (2, 3), "segment")

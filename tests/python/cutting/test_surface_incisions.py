@@ -1,0 +1,112 @@
+"""Multiple incisions on surfaces (§5.3.2): a segment scalpel cutting a curved surface in
+several places. A fold cut once gives two incisions; a crest met from outside branches
+(Figure 5.12c, 5.14); incisions that meet end together (annihilation, Figure 5.13); a path
+crossing its own incision leaves and enters again. The outcome is checked by what the
+surface becomes: which pieces it falls into and on which side of the scalpel's sweep each
+piece lies. Random scalpels over folds keep every triangle touching at most one active node."""
+import numpy as np
+import pytest
+
+import snede
+from surface_checks import along, check_surface, components, folded, mean_edge, normals, up, vertical_scalpels
+
+
+def graph_normal(slope_x):
+    """The upward normal of z = f(x) (slope_x = f')."""
+    return lambda p: np.c_[-slope_x(p[:, 0]), np.zeros(len(p)), np.ones(len(p))]
+
+
+def cut_checked(mesh, scalpels, normal):
+    cutter = snede.SurfaceCutter(mesh)
+    h = mean_edge(mesh)
+    total = snede.PlanarCutReport()
+    for scalpel in scalpels:
+        total = total + cutter.move(scalpel)
+        check_surface(mesh, cutter, normal, h)
+    return cutter, total
+
+
+def split_by_plane_y(mesh, y0):
+    """The surface falls into two pieces, one on each side of the plane y = y0 (its lips on it)."""
+    pieces = components(mesh)
+    assert len(pieces) == 2
+    y = [mesh.points[p, 1] for p in pieces]
+    lower, upper = sorted(y, key=np.mean)
+    assert lower.max() <= y0 + 1e-12 and upper.min() >= y0 - 1e-12
+
+
+def test_folded_sheet_cut_once_gives_two_incisions():
+    """A vertical scalpel crossing the fold pierces both layers: two entries at once, two
+    incisions, two exits; the lower layer, the upper layer's tail and the rest (joined by the
+    crease) come apart."""
+    mesh = folded()
+    start, original = mesh.points.copy(), normals(mesh)
+    centroids = start[mesh.cells].mean(axis=1)
+
+    def original_normal(points):
+        return original[np.argmin(((centroids[None] - points[:, None]) ** 2).sum(-1), axis=1)]
+
+    path = along(np.array([[0.2, -0.2], [0.25, 0.5], [0.2, 1.2]]), snede.SurfaceCutter(folded()).eps_edge)
+    cutter, total = cut_checked(mesh, [[[x, y, 1.0], [x, y, -1.0]] for x, y in path], original_normal)
+    assert (total.entries, total.exits) == (2, 2)
+    heights = np.unique(mesh.points[np.unique(cutter.incision_edges()), 2])
+    np.testing.assert_allclose(heights, [0.0, 0.3], atol=1e-12)
+    assert len(components(mesh)) == 3
+
+
+@pytest.mark.parametrize("y0", [0.47, 0.5], ids=["between-vertices", "through-vertices"])
+def test_crest_met_from_outside_branches(y0):
+    """A horizontal scalpel lowered onto a ridge z = 0.3 − 1.2 (x − ½)² meets its crest from
+    outside (Figure 5.12c): one entry, which branches down both flanks and leaves through
+    both sides; the ridge falls into two pieces either side of the plane y = y0."""
+    mesh = snede.meshing.height_field(lambda x, y: 0.3 - 1.2 * (x - 0.5) ** 2, divisions=(16, 16))
+    scalpels = [[[-0.1, y0, z], [1.1, y0, z]] for z in np.linspace(0.5, -0.1, 80)]
+    cutter, total = cut_checked(mesh, scalpels, graph_normal(lambda x: -2.4 * (x - 0.5)))
+    assert (total.entries, total.branches, total.exits, total.annihilations) == (1, 1, 2, 0)
+    split_by_plane_y(mesh, y0)
+
+
+@pytest.mark.parametrize("y0", [0.47, 0.5], ids=["between-vertices", "through-vertices"])
+def test_incisions_meeting_in_a_valley_annihilate(y0):
+    """The same scalpel lowered into a valley z = 1.2 (x − ½)² enters at both rims; the two
+    incisions meet at the bottom and end there together (Figure 5.13): one boundary across."""
+    mesh = snede.meshing.height_field(lambda x, y: 1.2 * (x - 0.5) ** 2, divisions=(16, 16))
+    scalpels = [[[-0.1, y0, z], [1.1, y0, z]] for z in np.linspace(0.5, -0.1, 80)]
+    cutter, total = cut_checked(mesh, scalpels, graph_normal(lambda x: 2.4 * (x - 0.5)))
+    assert (total.entries, total.branches, total.exits, total.annihilations) == (2, 0, 0, 1)
+    assert cutter.active_nodes == []
+    split_by_plane_y(mesh, y0)
+
+
+def test_horizontal_scalpel_cuts_the_cap_off_the_bell():
+    """A horizontal scalpel at height 0.2 pushed across Figure 5.19's bell meets its front
+    flank from outside, branches around it and the branches meet behind: the cap above the
+    level z = 0.2 comes off, every one of its vertices at or above that level and every other
+    vertex at or below it."""
+    mesh = snede.meshing.gaussian_bell()
+    bell_normal_at = __import__("surface_checks").bell_normal
+    scalpels = [[[-0.1, y, 0.2], [1.1, y, 0.2]] for y in np.linspace(-0.2, 1.2, 120)]
+    cutter, total = cut_checked(mesh, scalpels, bell_normal_at)
+    assert (total.entries, total.branches, total.annihilations) == (1, 1, 1)
+    pieces = sorted(components(mesh), key=len)
+    assert len(pieces) == 2
+    cap, base = (mesh.points[p, 2] for p in pieces)
+    assert cap.min() >= 0.2 - 1e-12 and base.max() <= 0.2 + 1e-12
+
+
+def test_path_crossing_its_own_incision_leaves_and_enters_again():
+    """A vertical scalpel on a flat square: in from the left, up, left and down across its own
+    first leg, out at the bottom. It leaves through the first incision's lip and enters
+    through the other lip, so the loop it closed cuts out the square it enclosed, and the
+    bottom-left corner comes off too: three pieces. Their corners are where the path turns
+    to within its sampling step (an incision turns along a chord)."""
+    mesh = snede.meshing.height_field(lambda x, y: 0 * x, divisions=(12, 12))
+    path = along(np.array([[-0.2, 0.3], [0.7, 0.3], [0.7, 0.7], [0.3, 0.7], [0.3, -0.2]]), 0.02)
+    cutter, total = cut_checked(mesh, vertical_scalpels(path), up)
+    assert total.entries == 2 and total.exits == 2
+    pieces = components(mesh)
+    assert len(pieces) == 3
+    boxes = sorted((np.r_[mesh.points[p, :2].min(0), mesh.points[p, :2].max(0)] for p in pieces), key=np.sum)
+    np.testing.assert_allclose(boxes[0], [0, 0, 0.3, 0.3], atol=0.02)  # the corner
+    np.testing.assert_allclose(boxes[1], [0.3, 0.3, 0.7, 0.7], atol=0.02)  # the enclosed square
+    np.testing.assert_allclose(boxes[2], [0, 0, 1, 1], atol=1e-12)
