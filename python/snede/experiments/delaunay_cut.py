@@ -107,12 +107,15 @@ def mean_edge_length(points, cells) -> float:
 
 
 def triangle_angles(points, cells) -> np.ndarray:
-    """(m, 3) interior angles in degrees, from the coordinates."""
-    x = np.asarray(points)[np.asarray(cells)]
+    """(m, 3) interior angles in degrees, from the coordinates: triangles in the plane or in
+    space (a planar point is taken as z = 0)."""
+    x = np.asarray(points, dtype=float)[np.asarray(cells)]
+    if x.shape[-1] == 2:
+        x = np.concatenate([x, np.zeros(x.shape[:-1] + (1,))], axis=-1)
     angles = []
     for k in range(3):
         u, v = x[:, (k + 1) % 3] - x[:, k], x[:, (k + 2) % 3] - x[:, k]
-        angles.append(np.arctan2(np.abs(u[:, 0] * v[:, 1] - u[:, 1] * v[:, 0]), (u * v).sum(axis=1)))
+        angles.append(np.arctan2(np.linalg.norm(np.cross(u, v), axis=1), (u * v).sum(axis=1)))
     return np.degrees(np.array(angles).T)
 
 
@@ -465,7 +468,7 @@ def draw_mesh(axis, points, cells, path, title: str, incision=None, worst: bool 
     if worst:
         angles = triangle_angles(points, cells).min(axis=1)
         k = int(np.argmin(angles))
-        axis.fill(*points[cells[k]].T, color="tab:orange", alpha=0.8, zorder=3)
+        axis.fill(*points[cells[k], :2].T, color="tab:orange", alpha=0.8, zorder=3)  # a top view in 3D
         title += f"\nsmallest angle {angles[k]:.1f}° (orange)"
     if incision is not None:
         for a, b in incision:
