@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include "core/predicates.hpp"
 
@@ -97,6 +98,30 @@ std::optional<TriangleHit> segment_meets_triangle(const Point3& p, const Point3&
   return TriangleHit{weights, along};
 }
 
+// The roots in [0, 1] (with rounding slack) of the quadratic through (0, f0), (½, half),
+// (1, f1), smallest first; nothing when it vanishes identically (within `negligible`).
+std::vector<double> quadratic_roots(double f0, double half, double f1, double negligible) {
+  const double A = 2 * f1 - 4 * half + 2 * f0, B = f1 - f0 - A, C = f0;
+  std::vector<double> roots;
+  if (std::abs(A) <= negligible) {
+    if (std::abs(B) > negligible) roots.push_back(-C / B);
+  } else {
+    const double discriminant = B * B - 4 * A * C;
+    if (discriminant >= 0) {
+      // The numerically stable pair of roots.
+      const double q = -0.5 * (B + std::copysign(std::sqrt(discriminant), B));
+      roots.push_back(q / A);
+      if (q != 0) roots.push_back(C / q);
+    } else if (discriminant > -1e-12 * B * B) {
+      roots.push_back(-B / (2 * A));  // a double root lost to rounding: a grazing contact
+    }
+  }
+  std::erase_if(roots, [](double g) { return g < -1e-12 || g > 1 + 1e-12; });
+  for (double& g : roots) g = std::clamp(g, 0.0, 1.0);
+  std::sort(roots.begin(), roots.end());
+  return roots;
+}
+
 std::optional<SweptCrossing> swept_segment_meets_edge(const Point3& h0, const Point3& t0, const Point3& h1,
                                                       const Point3& t1, const Point3& a, const Point3& b) {
   const auto head = [&](double g) { return lerp(h0, h1, g); };
@@ -109,54 +134,45 @@ std::optional<SweptCrossing> swept_segment_meets_edge(const Point3& h0, const Po
     if (closest.distance > tolerance) return std::nullopt;
     return SweptCrossing{g, closest.s, closest.t};
   };
+  const auto first_meeting = [&](const std::vector<double>& times) {
+    std::optional<SweptCrossing> first;
+    for (double g : times)
+      if (auto hit = meeting(g); hit && (!first || hit->time < first->time)) first = hit;
+    return first;
+  };
   // (5.1): the scalpel's line and the edge's are coplanar where
-  // f(γ) = (t(γ) − h(γ)) · ((a − h(γ)) × (b − a)) vanishes, a quadratic A γ² + B γ + C.
+  // f(γ) = (t(γ) − h(γ)) · ((a − h(γ)) × (b − a)) vanishes, a quadratic in γ.
   const auto f = [&](double g) { return dot(minus(tail(g), head(g)), cross(minus(a, head(g)), minus(b, a))); };
-  const double f0 = f(0), half = f(0.5), f1 = f(1);
-  const double A = 2 * f1 - 4 * half + 2 * f0, B = f1 - f0 - A, C = f0;
   const double negligible = 1e-12 * scale * scale * scale;
   const bool coplanar_throughout =
       orientation_3d(h0.data(), t0.data(), a.data(), b.data()) == 0 &&
-      orientation_3d(h1.data(), t1.data(), a.data(), b.data()) == 0 && std::abs(half) <= negligible;
-  std::optional<SweptCrossing> first;
-  if (coplanar_throughout) {
-    constexpr int samples = 64;
-    double before = 0;
-    for (int k = 0; k <= samples; ++k) {
-      const double g = static_cast<double>(k) / samples;
-      if (!meeting(g)) {
-        before = g;
-        continue;
-      }
-      if (k == 0) return meeting(0);
-      double miss = before, hit = g;
-      for (int bisection = 0; bisection < 40; ++bisection) {
-        const double middle = 0.5 * (miss + hit);
-        (meeting(middle) ? hit : miss) = middle;
-      }
-      return meeting(hit);
-    }
-    return std::nullopt;
+      orientation_3d(h1.data(), t1.data(), a.data(), b.data()) == 0 && std::abs(f(0.5)) <= negligible;
+  if (!coplanar_throughout) return first_meeting(quadratic_roots(f(0), f(0.5), f(1), negligible));
+  // Flat in one plane throughout (the scalpel moving flat on a flat surface): two segments in
+  // a plane first meet at the start, or when an end of one touches the other: an end of the
+  // scalpel crosses the edge's line (linear in γ), or the scalpel's line sweeps over an end of
+  // the edge (quadratic in γ). Signed areas are measured against the plane's normal.
+  Point3 normal{0, 0, 0};
+  for (const Point3& n : {cross(minus(t0, h0), minus(b, a)), cross(minus(t1, h1), minus(b, a)),
+                          cross(minus(h1, h0), minus(b, a)), cross(minus(t0, h0), minus(h1, h0))})
+    if (dot(n, n) > dot(normal, normal)) normal = n;
+  std::vector<double> times{0.0};
+  if (dot(normal, normal) <= negligible * negligible) {
+    // Everything on one line: contact begins where an end of one segment reaches the other.
+    for (int k = 0; k <= 64; ++k) times.push_back(k / 64.0);
+    return first_meeting(times);
   }
-  std::array<double, 2> roots{-1, -1};
-  if (std::abs(A) <= negligible) {
-    if (B != 0) roots[0] = -C / B;
-  } else {
-    const double discriminant = B * B - 4 * A * C;
-    if (discriminant >= 0) {
-      // The numerically stable pair of roots.
-      const double q = -0.5 * (B + std::copysign(std::sqrt(discriminant), B));
-      roots = {q / A, q != 0 ? C / q : -1};
-    } else if (discriminant > -1e-12 * B * B) {
-      roots[0] = -B / (2 * A);  // a double root lost to rounding: the scalpel grazes the edge
-    }
+  const auto area = [&](const Point3& x, const Point3& y, const Point3& z) { return dot(cross(minus(y, x), minus(z, x)), normal); };
+  for (const auto& [p0, p1] : {std::pair{h0, h1}, std::pair{t0, t1}}) {
+    const double d0 = area(a, b, p0), d1 = area(a, b, p1);
+    if (d0 != d1) times.push_back(d0 / (d0 - d1));
   }
-  std::sort(roots.begin(), roots.end());
-  for (double g : roots) {
-    if (g < -1e-12 || g > 1 + 1e-12) continue;
-    if (auto hit = meeting(std::clamp(g, 0.0, 1.0)); hit && (!first || hit->time < first->time)) first = hit;
+  for (const Point3& end : {a, b}) {
+    const auto g = [&](double s) { return area(head(s), tail(s), end); };
+    for (double root : quadratic_roots(g(0), g(0.5), g(1), negligible)) times.push_back(root);
   }
-  return first;
+  std::erase_if(times, [](double g) { return !(g >= 0 && g <= 1); });
+  return first_meeting(times);
 }
 
 double line_distance(const Point3& p, const Point3& q, const Point3& a, const Point3& b) {

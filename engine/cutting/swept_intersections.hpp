@@ -34,8 +34,9 @@ struct SweptCrossing {
 // (a, b): the scalpel's line and the edge's are coplanar at the roots of a quadratic in γ
 // (the thesis's equation (5.1) solved for α); a root counts when the two segments meet there
 // (within 1e-9 of their lengths). A sweep that stays coplanar with the edge throughout (the
-// scalpel moving flat on a flat surface) has no isolated roots: its first contact is found
-// by sampling γ in 64 steps and bisecting.
+// scalpel moving flat on a flat surface) has no isolated roots: its first contact is at the
+// start or where an end of one segment touches the other (an end of the scalpel crossing the
+// edge's line, or the scalpel's line passing an end of the edge), solved in the plane.
 std::optional<SweptCrossing> swept_segment_meets_edge(const Point3& h0, const Point3& t0, const Point3& h1,
                                                       const Point3& t1, const Point3& a, const Point3& b);
 

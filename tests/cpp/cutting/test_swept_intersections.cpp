@@ -166,18 +166,15 @@ TEST(SweptSegmentMeetsEdge, FlatOnThePlaneOfTheEdgeTheFirstContactIsSampled) {
       swept_segment_meets_edge({-3, 1.5, 0}, {-2, 1.5, 0}, {1, 1.5, 0}, {2, 1.5, 0}, {0, -1, 0}, {0, 1, 0}));
 }
 
-TEST(SweptSegmentMeetsEdge, KnownBugAFlatContactBetweenTwoSamplesIsMissed) {
+TEST(SweptSegmentMeetsEdge, ShortFlatContactIsFound) {
   // Everything in z = 0: the scalpel along y from −1 to 1 at x = 2.1γ − 1, the edge from
   // (0, −0.5, 0) to (0.01, 0.5, 0), nearly parallel to it. The scalpel first touches the edge at
   // its end a when x = 0: γ = 1/2.1 (0.476), a quarter along the scalpel, and leaves it at
-  // x = 0.01, γ = 0.481, between the samples 30/64 and 31/64.
-  // KNOWN BUG (the sampled branch of swept_segment_meets_edge): a contact shorter than 1/64 of
-  // the sweep falls between the samples and is missed: a scalpel lying flat on a flat surface
-  // passes through an edge nearly parallel to it. The right answer is
-  // expect_crossing(crossing, 1 / 2.1, 0.25, 0). This checks the miss so that a fix shows.
+  // x = 0.01, γ = 0.481: a contact shorter than 1/64 of the sweep.
   const auto crossing =
       swept_segment_meets_edge({-1, -1, 0}, {-1, 1, 0}, {1.1, -1, 0}, {1.1, 1, 0}, {0, -0.5, 0}, {0.01, 0.5, 0});
-  EXPECT_FALSE(crossing) << "fixed? then replace this check by the right answer above";
+  ASSERT_TRUE(crossing);
+  expect_crossing(crossing, 1 / 2.1, 0.25, 0);
 }
 
 TEST(LineDistance, SkewIntersectingAndParallelLines) {
