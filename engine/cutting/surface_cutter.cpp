@@ -90,14 +90,29 @@ bool SurfaceCutter::is_boundary_edge(ElementId triangle, VertexId opposite) cons
   return c.face(c.opposite_face(triangle, opposite)).mate == no_id;
 }
 
-bool SurfaceCutter::keeps_facing(VertexId v, const Point3& x, VertexId merging_into) const {
+bool SurfaceCutter::keeps_facing(VertexId v, const Point3& x, VertexId merging_into, Wedge* refused_by) const {
   // The edits' own checks refuse only normals turned by 90° or more; on a curved surface
-  // repeated turns short of that can fold it, so the cutter asks for less than 60°.
-  for (const Wedge& w : wedges(v)) {
+  // repeated turns short of that can fold it, so the cutter asks for less than 60°. That turn
+  // is measured from the triangle as it is before this edit, so successive moves can add up:
+  // a star triangle that v's moves turn into a sliver swings by tens of degrees each time and
+  // folds over in a few moves (the bell's exits). So the new normal must also be within 60° of
+  // the star's vector area, which does not drift (moving v leaves it unchanged when v's link
+  // is closed, or its ends coincide as on the incision's lips), or at least no further from it
+  // than before (a triangle already beyond 60° may move, but not towards folding).
+  const std::vector<Wedge> star = wedges(v);
+  Point3 area{0, 0, 0};
+  for (const Wedge& w : star) area = plus_scaled(area, 1.0, doubled_normal(reference(v), reference(w.y), reference(w.z)));
+  for (const Wedge& w : star) {
     if (w.y == merging_into || w.z == merging_into) continue;  // collapsed away
     const Point3 y = reference(w.y), z = reference(w.z);
     const Point3 before = doubled_normal(reference(v), y, z), after = doubled_normal(x, y, z);
-    if (!(dot(before, after) > 0.5 * std::sqrt(dot(before, before) * dot(after, after)))) return false;
+    // Refused: cos(before, after) ≤ 1/2, or both cos(after, area) ≤ 1/2 and cos(after, area) < cos(before, area).
+    if (!(dot(before, after) > 0.5 * std::sqrt(dot(before, before) * dot(after, after))) ||
+        (!(dot(after, area) > 0.5 * norm(after) * norm(area)) &&
+         !(dot(after, area) * norm(before) >= dot(before, area) * norm(after)))) {
+      if (refused_by) *refused_by = w;
+      return false;
+    }
   }
   return true;
 }
@@ -480,7 +495,13 @@ void SurfaceCutter::advance(VertexId b, const Segment& from, const Segment& to, 
         branch(b, to, report);
         return;
       }
-      if (!move_active_to(b, hits.front().wedge, hits.front().weights)) ++report.stuck;
+      std::optional<Wedge> blocking;
+      if (!move_active_to(b, hits.front().wedge, hits.front().weights, &blocking)) {
+        // A star triangle would fold over on the whole way (the 2D cutter's triangle that
+        // the way inverts): its link edge is cleared away and the hit looked for again.
+        if (blocking && clear_link_edge(b, blocking->y, blocking->z, report)) continue;
+        ++report.stuck;
+      }
       remesh_around(b, report);
       split_incision(b, report);
       return;
@@ -503,22 +524,25 @@ void SurfaceCutter::advance(VertexId b, const Segment& from, const Segment& to, 
       end_at_edge(b, w.y, w.z, crossing->mu, report);
       return;
     }
-    if (!flip(w.y, w.z, report)) {
-      // A flip refused (Figure 5.9, or a fold): remove the nearer interior end instead.
-      VertexId first = w.y, second = w.z;
-      if (distance(reference(second), reference(b)) < distance(reference(first), reference(b))) std::swap(first, second);
-      bool removed = false;
-      for (VertexId v : {first, second})
-        if (!removed && !incision_vertices_.count(v) && !on_boundary(v)) removed = remove_node(v, report);
-      if (!removed) {
-        ++report.stuck;
-        return;
-      }
+    if (!clear_link_edge(b, w.y, w.z, report)) {
+      ++report.stuck;
+      return;
     }
   }
 }
 
-bool SurfaceCutter::move_active_to(VertexId b, const Wedge& w, std::array<double, 3> weights) {
+bool SurfaceCutter::clear_link_edge(VertexId b, VertexId y, VertexId z, PlanarCutReport& report) {
+  if (flip(y, z, report)) return true;
+  // A flip refused (Figure 5.9, or a fold): remove the nearer interior end instead.
+  VertexId first = y, second = z;
+  if (distance(reference(second), reference(b)) < distance(reference(first), reference(b))) std::swap(first, second);
+  for (VertexId v : {first, second})
+    if (!incision_vertices_.count(v) && !on_boundary(v) && remove_node(v, report)) return true;
+  return false;
+}
+
+bool SurfaceCutter::move_active_to(VertexId b, const Wedge& w, std::array<double, 3> weights,
+                                   std::optional<Wedge>* blocking) {
   const std::array<VertexId, 3> parents{b, w.y, w.z};
   // Part of the way when the whole way would flatten or fold a triangle of the star.
   for (double fraction : {1.0, 0.75, 0.5, 0.25}) {
@@ -527,7 +551,12 @@ bool SurfaceCutter::move_active_to(VertexId b, const Wedge& w, std::array<double
     for (double& x : part) x /= sum;
     const VertexParents target = VertexParents::barycentric(parents, part);
     const Point3 before = deformed(b);
-    if (keeps_facing(b, reference_at(w, b, part)) && snap_vertex(mesh_, b, target).done) {
+    Wedge refused_by{};
+    if (!keeps_facing(b, reference_at(w, b, part), -1, &refused_by)) {
+      if (blocking && fraction == 1.0) *blocking = refused_by;
+      continue;
+    }
+    if (snap_vertex(mesh_, b, target).done) {
       moved_[b] = before;  // follow() reads the active node's old position as a parent
       follow(b, target);
       return fraction == 1.0;

@@ -120,8 +120,10 @@ class SurfaceCutter {
   std::vector<VertexId> active_neighbours(VertexId v, VertexId except) const;
   bool touches_active(ElementId triangle, VertexId except = -1) const;
   // Whether every triangle of v's star, with v moved to x, turns its normal by less than 60°
-  // (those with vertex merging_into, which a collapse into it removes, aside).
-  bool keeps_facing(VertexId v, const Point3& x, VertexId merging_into = -1) const;
+  // and ends within 60° of the star's vector area, or no further from it than before (those
+  // with vertex merging_into, which a collapse into it removes, aside). If not, the first
+  // triangle refused goes to *refused_by.
+  bool keeps_facing(VertexId v, const Point3& x, VertexId merging_into = -1, Wedge* refused_by = nullptr) const;
   bool is_boundary_edge(ElementId triangle, VertexId opposite) const;
   Point3 reference_at(const Wedge& w, VertexId b, const std::array<double, 3>& weights) const;
   Point3 deformed_at(const Wedge& w, VertexId b, const std::array<double, 3>& weights) const;
@@ -161,12 +163,17 @@ class SurfaceCutter {
   // when fewer than two (Figure 5.14).
   std::vector<StarHit> branches(VertexId a, const Segment& scalpel) const;
   void branch(VertexId a, const Segment& scalpel, PlanarCutReport& report);
-  // Moves the active node b to the point with `weights` in its star triangle, or part of the way.
-  bool move_active_to(VertexId b, const Wedge& w, std::array<double, 3> weights);
+  // Moves the active node b to the point with `weights` in its star triangle, or part of the way;
+  // true only for the whole way. When keeps_facing refuses the whole way, the star triangle in
+  // the way goes to *blocking.
+  bool move_active_to(VertexId b, const Wedge& w, std::array<double, 3> weights,
+                      std::optional<Wedge>* blocking = nullptr);
   // A new vertex at `weights` in triangle (b, y, z), on a side when a weight is (nearly) 0.
   VertexId insert_at(const Wedge& w, VertexId b, const std::array<double, 3>& weights, PlanarCutReport& report);
   VertexId split(VertexId a, VertexId b, double t);
   bool flip(VertexId p, VertexId q, PlanarCutReport& report);
+  // Link edge (y, z) of b's star out of the way: flipped, or else its nearer interior end removed.
+  bool clear_link_edge(VertexId b, VertexId y, VertexId z, PlanarCutReport& report);
   bool remove_node(VertexId v, PlanarCutReport& report);
   void remesh_around(VertexId b, PlanarCutReport& report);
   void split_incision(VertexId b, PlanarCutReport& report);
