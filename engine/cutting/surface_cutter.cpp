@@ -33,6 +33,9 @@ Point3 doubled_normal(const Point3& a, const Point3& b, const Point3& c) { retur
 // A new node this close (in barycentric weight) to a side goes on that side.
 constexpr double on_side = 1e-6;
 
+// No edit may leave a triangle turned 75° or more from the uncut surface's normal there.
+const double facing_cosine = std::cos(75.0 * std::acos(-1.0) / 180);
+
 }  // namespace
 
 SurfaceCutter::SurfaceCutter(Mesh& mesh, Model* model, SurfaceCutterOptions options)
@@ -47,6 +50,8 @@ SurfaceCutter::SurfaceCutter(Mesh& mesh, Model* model, SurfaceCutterOptions opti
   options_.eps_edge = thresholds.eps_edge;
   options_.eps_entry = thresholds.eps_entry;
   options_.eps_exit = thresholds.eps_exit;
+  for (VertexId v = 0; v < mesh.n_points(); ++v)
+    if (mesh.is_vertex(v) && mesh.connectivity().n_vertex_uses(v) > 0) surface_normals_[v] = star_area(v);
 }
 
 Point3 SurfaceCutter::reference(VertexId v) const {
@@ -71,6 +76,10 @@ void SurfaceCutter::follow(VertexId v, const VertexParents& parents) {
     for (int d = 0; d < 3; ++d) x[d] += parents.weight[k] * p[d];
   }
   moved_[v] = x;
+  // The uncut surface's normal there, interpolated as the point is.
+  Point3 n{0, 0, 0};
+  for (std::size_t k = 0; k < parents.count(); ++k) n = plus_scaled(n, parents.weight[k], surface_normal(parents.vertex[k]));
+  surface_normals_[v] = n;
   grid_stale_ = true;
 }
 
@@ -90,26 +99,34 @@ bool SurfaceCutter::is_boundary_edge(ElementId triangle, VertexId opposite) cons
   return c.face(c.opposite_face(triangle, opposite)).mate == no_id;
 }
 
+Point3 SurfaceCutter::star_area(VertexId v) const {
+  Point3 area{0, 0, 0};
+  for (const Wedge& w : wedges(v)) area = plus_scaled(area, 1.0, doubled_normal(reference(v), reference(w.y), reference(w.z)));
+  return area;
+}
+
+Point3 SurfaceCutter::surface_normal(VertexId v) const {
+  if (const auto found = surface_normals_.find(v); found != surface_normals_.end()) return found->second;
+  return star_area(v);  // a vertex another edit made since: its star's vector area
+}
+
+bool SurfaceCutter::faces_surface(const Point3& normal, VertexId a, VertexId b, VertexId c) const {
+  const Point3 surface = plus_scaled(plus_scaled(surface_normal(a), 1.0, surface_normal(b)), 1.0, surface_normal(c));
+  return dot(normal, surface) > facing_cosine * norm(normal) * norm(surface);
+}
+
 bool SurfaceCutter::keeps_facing(VertexId v, const Point3& x, VertexId merging_into, Wedge* refused_by) const {
   // The edits' own checks refuse only normals turned by 90° or more; on a curved surface
-  // repeated turns short of that can fold it, so the cutter asks for less than 60°. That turn
-  // is measured from the triangle as it is before this edit, so successive moves can add up:
-  // a star triangle that v's moves turn into a sliver swings by tens of degrees each time and
-  // folds over in a few moves (the bell's exits). So the new normal must also be within 60° of
-  // the star's vector area, which does not drift (moving v leaves it unchanged when v's link
-  // is closed, or its ends coincide as on the incision's lips), or at least no further from it
-  // than before (a triangle already beyond 60° may move, but not towards folding).
-  const std::vector<Wedge> star = wedges(v);
-  Point3 area{0, 0, 0};
-  for (const Wedge& w : star) area = plus_scaled(area, 1.0, doubled_normal(reference(v), reference(w.y), reference(w.z)));
-  for (const Wedge& w : star) {
+  // repeated turns short of that can fold it, so the cutter asks each edit for less than 60°,
+  // and every new triangle to face the way the uncut surface does where it is (the turns of
+  // successive edits add up: a star triangle that v's moves squeeze into a sliver swings by
+  // tens of degrees each time).
+  for (const Wedge& w : wedges(v)) {
     if (w.y == merging_into || w.z == merging_into) continue;  // collapsed away
     const Point3 y = reference(w.y), z = reference(w.z);
     const Point3 before = doubled_normal(reference(v), y, z), after = doubled_normal(x, y, z);
-    // Refused: cos(before, after) ≤ 1/2, or both cos(after, area) ≤ 1/2 and cos(after, area) < cos(before, area).
     if (!(dot(before, after) > 0.5 * std::sqrt(dot(before, before) * dot(after, after))) ||
-        (!(dot(after, area) > 0.5 * norm(after) * norm(area)) &&
-         !(dot(after, area) * norm(before) >= dot(before, area) * norm(after)))) {
+        !faces_surface(after, v, w.y, w.z)) {
       if (refused_by) *refused_by = w;
       return false;
     }
@@ -585,6 +602,7 @@ bool SurfaceCutter::flip(VertexId p, VertexId q, PlanarCutReport& report) {
   if (c.element(wings[0]).simplex != Simplex(1, {p, q, left})) std::swap(left, right);
   for (const auto& [x, y, z] : {std::array<VertexId, 3>{p, right, left}, std::array<VertexId, 3>{q, left, right}}) {
     const Point3 n = doubled_normal(reference(x), reference(y), reference(z));
+    if (!faces_surface(n, x, y, z)) return false;
     for (const Point3& old : old_normals)
       if (!(dot(n, old) > 0.5 * std::sqrt(dot(n, n) * dot(old, old)))) return false;
   }
@@ -603,6 +621,7 @@ bool SurfaceCutter::remove_node(VertexId v, PlanarCutReport& report) {
   if (!remove_vertex_by_flips(mesh_, v).done) return false;
   ++report.nodes_removed;
   moved_.erase(v);
+  surface_normals_.erase(v);
   grid_stale_ = true;
   touched_.insert(touched_.end(), link.begin(), link.end());
   return true;
@@ -741,6 +760,7 @@ void SurfaceCutter::end_at_edge(VertexId b, VertexId y, VertexId z, double mu, P
         ++report.edges_contracted;
         incision_vertices_.erase(tip);
         moved_.erase(tip);
+        surface_normals_.erase(tip);
       }
 }
 

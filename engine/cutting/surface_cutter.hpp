@@ -123,6 +123,12 @@ class SurfaceCutter {
   // and ends within 60° of the star's vector area, or no further from it than before (those
   // with vertex merging_into, which a collapse into it removes, aside). If not, the first
   // triangle refused goes to *refused_by.
+  Point3 star_area(VertexId v) const;  // the vector area of v's star (twice)
+  // The uncut surface's normal at v (not normalised): its star's vector area when the cutter
+  // was made, interpolated to the vertices made since as their points are.
+  Point3 surface_normal(VertexId v) const;
+  // Whether a triangle with this normal and corners faces the way the uncut surface does there.
+  bool faces_surface(const Point3& normal, VertexId a, VertexId b, VertexId c) const;
   bool keeps_facing(VertexId v, const Point3& x, VertexId merging_into = -1, Wedge* refused_by = nullptr) const;
   bool is_boundary_edge(ElementId triangle, VertexId opposite) const;
   Point3 reference_at(const Wedge& w, VertexId b, const std::array<double, 3>& weights) const;
@@ -198,6 +204,7 @@ class SurfaceCutter {
   std::optional<std::uint64_t> grid_revision_;
   bool grid_stale_ = true;
   std::unordered_set<VertexId> incision_vertices_;
+  std::unordered_map<VertexId, Point3> surface_normals_;
   std::vector<VertexId> touched_;
   std::unordered_set<ElementId> refused_;  // contacts this move could not enter
 };
