@@ -32,7 +32,8 @@ void bind_edits(py::module_& m) {
         [](Mesh& mesh, ElementId e, const DoubleArray& weights) { return insert_vertex(mesh, e, view(weights)); },
         py::arg("mesh"), py::arg("element"), py::arg("weights"));
   m.def("collapse_edge", &collapse_edge, py::arg("mesh"), py::arg("keep"), py::arg("gone"), py::arg("t"));
-  m.def("remove_vertex_by_flips", &remove_vertex_by_flips, py::arg("mesh"), py::arg("vertex"));
+  m.def("remove_vertex_by_flips", [](Mesh& mesh, VertexId v) { return remove_vertex_by_flips(mesh, v); }, py::arg("mesh"),
+        py::arg("vertex"));
   m.def("snap_vertex",
         [](Mesh& mesh, VertexId v, const IndexArray& parents, const DoubleArray& weights) {
           return snap_vertex(mesh, v, parents_of(parents, weights));

@@ -2,6 +2,7 @@
 // (§5.3.2, Figure 5.12): the three ways in.
 #include <algorithm>
 
+#include "core/predicates.hpp"
 #include "cutting/surface_cutter.hpp"
 #include "cutting/swept_intersections.hpp"
 
@@ -15,6 +16,13 @@ constexpr double inside_weight = 1e-9;
 // Where after a crossing at `time` the scalpel is looked at: just after, halfway, and at the
 // end of the step (a boundary edge counts as entered if the scalpel goes into its triangle).
 constexpr std::array<double, 3> later_fractions{1e-3, 0.25, 1.0};
+
+// Whether segment p→q lies in the plane of triangle x (a scalpel flat on the surface touches it
+// along a piece, not at a point: neither its ends nor its sweep enter anywhere new there).
+bool in_plane(const Point3& p, const Point3& q, const std::array<Point3, 3>& x) {
+  return orientation_3d(x[0].data(), x[1].data(), x[2].data(), p.data()) == 0 &&
+         orientation_3d(x[0].data(), x[1].data(), x[2].data(), q.data()) == 0;
+}
 
 }  // namespace
 
@@ -39,7 +47,7 @@ std::vector<SurfaceCutter::Contact> SurfaceCutter::first_contacts(const Segment&
     const std::array<Point3, 3> x{deformed(o[0]), deformed(o[1]), deformed(o[2])};
     // An end of the scalpel passing through the triangle (Figure 5.12b).
     for (const auto& [p, q] : {std::pair{from.head, to.head}, std::pair{from.tail, to.tail}})
-      if (p != q)
+      if (p != q && !in_plane(p, q, x))
         if (const auto hit = segment_meets_triangle(p, q, x[0], x[1], x[2], p))
           found.push_back({Contact::Way::tip, hit->along, e, triangle, hit->weights});
     for (int k = 0; k < 3; ++k) {
@@ -70,6 +78,9 @@ std::vector<SurfaceCutter::Contact> SurfaceCutter::first_contacts(const Segment&
       const int far_corner = static_cast<int>(std::find_if(p.begin(), p.begin() + 3, [&](VertexId v) {
                                                 return v != o[i] && v != o[j];
                                               }) - p.begin());
+      const Segment at = scalpel_at(time);
+      const std::array<Point3, 3> y{deformed(p[0]), deformed(p[1]), deformed(p[2])};
+      if (in_plane(at.head, at.tail, x) || in_plane(at.head, at.tail, y)) continue;
       const Segment before = scalpel_at(time * (1 - 1e-3));
       if (meets_inside(before, e, k) || meets_inside(before, other, far_corner)) continue;
       if (later(e, k) || later(other, far_corner)) found.push_back({Contact::Way::crest, time, e, triangle, weights});

@@ -33,7 +33,7 @@ Point3 doubled_normal(const Point3& a, const Point3& b, const Point3& c) { retur
 // A new node this close (in barycentric weight) to a side goes on that side.
 constexpr double on_side = 1e-6;
 
-// No edit may leave a triangle turned 75° or more from the uncut surface's normal there.
+// No edit may leave a triangle turned 75° or more from the uncut surface's normal at a corner.
 const double facing_cosine = std::cos(75.0 * std::acos(-1.0) / 180);
 
 }  // namespace
@@ -111,8 +111,11 @@ Point3 SurfaceCutter::surface_normal(VertexId v) const {
 }
 
 bool SurfaceCutter::faces_surface(const Point3& normal, VertexId a, VertexId b, VertexId c) const {
-  const Point3 surface = plus_scaled(plus_scaled(surface_normal(a), 1.0, surface_normal(b)), 1.0, surface_normal(c));
-  return dot(normal, surface) > facing_cosine * norm(normal) * norm(surface);
+  // At every corner: a triangle across a sharp crease must not lean away from either side.
+  for (VertexId v : {a, b, c})
+    if (const Point3 surface = surface_normal(v); !(dot(normal, surface) > facing_cosine * norm(normal) * norm(surface)))
+      return false;
+  return true;
 }
 
 bool SurfaceCutter::keeps_facing(VertexId v, const Point3& x, VertexId merging_into, Wedge* refused_by) const {
@@ -300,7 +303,7 @@ void SurfaceCutter::sweep(const Segment& from, const Segment& to, PlanarCutRepor
     // An entry node waits for the scalpel to move away from it; halving the step keeps the
     // places where it meets the node's triangles in them, so that none is lost on the way
     // (at a crest they move far faster than the scalpel).
-    for (int halving = 0; halving < 40 && loses_place(current, target); ++halving) target = at(next = (done + next) / 2);
+    for (int halving = 0; halving < 20 && loses_place(current, target); ++halving) target = at(next = (done + next) / 2);
     // The step ends where the scalpel first touches the surface somewhere new (Figure 5.12).
     const std::vector<Contact> contacts = first_contacts(current, target);
     if (!contacts.empty()) {
@@ -393,8 +396,8 @@ void SurfaceCutter::begin_incision(VertexId a, const Segment& scalpel, PlanarCut
     if (!meets_ring(a, scalpel)) std::erase_if(incisions_, [a](const Incision& i) { return i.active == a; });  // withdrawn
     return;
   }
-  if (branches(a, scalpel).size() >= 2) {
-    branch(a, scalpel, report);
+  if (const double apart = branch_distance(a); branches(a, scalpel, apart).size() >= 2) {
+    branch(a, scalpel, apart, report);
     return;
   }
   const StarHit& hit = hits.front();
@@ -429,26 +432,34 @@ void SurfaceCutter::open_from(VertexId a, const std::vector<VertexId>& ends, Pla
   for (VertexId b : ends) remesh_around(b, report);
 }
 
-std::vector<SurfaceCutter::StarHit> SurfaceCutter::branches(VertexId a, const Segment& scalpel) const {
+double SurfaceCutter::branch_distance(VertexId a) {
+  // A crest entry branches as soon as the scalpel meets both sides apart from the entry node:
+  // one side may be steep, its hit leaving the star before the other has gone ε_entry. The
+  // short edges this leaves go as the scalpel moves on (§5.3.2).
+  const Incision* incision = incision_at(a);
+  return incision && incision->branching ? 1e-2 * options_.eps_edge : options_.eps_entry;
+}
+
+std::vector<SurfaceCutter::StarHit> SurfaceCutter::branches(VertexId a, const Segment& scalpel, double apart) const {
   std::vector<StarHit> far;
   std::vector<Point3> places;
   for (const StarHit& hit : hits_in_star(a, scalpel)) {
     const Point3 x = reference_at(hit.wedge, a, hit.weights);
-    if (distance(x, reference(a)) <= options_.eps_entry) return {};  // the scalpel is still at a
-    if (std::all_of(places.begin(), places.end(), [&](const Point3& p) { return distance(p, x) > options_.eps_entry; }))
+    if (distance(x, reference(a)) <= apart) return {};  // the scalpel is still at a
+    if (std::all_of(places.begin(), places.end(), [&](const Point3& p) { return distance(p, x) > apart; }))
       far.push_back(hit), places.push_back(x);
   }
   return far.size() >= 2 ? far : std::vector<StarHit>{};
 }
 
-void SurfaceCutter::branch(VertexId a, const Segment& scalpel, PlanarCutReport& report) {
+void SurfaceCutter::branch(VertexId a, const Segment& scalpel, double apart, PlanarCutReport& report) {
   // Figure 5.14: a node at each place, inserted in turn (each into triangles the earlier
   // ones left alone), then the edges from a to them dissected.
   const Connectivity& c = mesh_.connectivity();
   std::vector<Point3> places;
-  for (const StarHit& hit : branches(a, scalpel)) places.push_back(reference_at(hit.wedge, a, hit.weights));
+  for (const StarHit& hit : branches(a, scalpel, apart)) places.push_back(reference_at(hit.wedge, a, hit.weights));
   std::vector<VertexId> made;
-  const auto apart = [&](const StarHit& hit) {
+  const auto keeps_apart = [&](const StarHit& hit) {
     // The triangles the new node will be in: the hit's, and across the side it is on.
     std::vector<ElementId> hosts{hit.wedge.element};
     const std::array<VertexId, 3> corners{a, hit.wedge.y, hit.wedge.z};
@@ -462,7 +473,7 @@ void SurfaceCutter::branch(VertexId a, const Segment& scalpel, PlanarCutReport& 
   };
   for (const Point3& place : places) {
     for (const StarHit& hit : hits_in_star(a, scalpel)) {
-      if (!apart(hit) || distance(reference_at(hit.wedge, a, hit.weights), place) > options_.eps_entry) continue;
+      if (!keeps_apart(hit) || distance(reference_at(hit.wedge, a, hit.weights), place) > apart) continue;
       if (const VertexId m = insert_at(hit.wedge, a, hit.weights, report); m >= 0) made.push_back(m);
       break;
     }
@@ -508,8 +519,8 @@ void SurfaceCutter::advance(VertexId b, const Segment& from, const Segment& to, 
   for (int attempt = 0; attempt < 64 && incision_at(b); ++attempt) {
     const std::vector<StarHit> hits = hits_in_star(b, to);
     if (!hits.empty()) {
-      if (branches(b, to).size() >= 2) {
-        branch(b, to, report);
+      if (branches(b, to, options_.eps_entry).size() >= 2) {
+        branch(b, to, options_.eps_entry, report);
         return;
       }
       std::optional<Wedge> blocking;
@@ -618,7 +629,12 @@ bool SurfaceCutter::remove_node(VertexId v, PlanarCutReport& report) {
   if (is_active(v) || active_neighbours(v, -1).size() > 1) return false;
   std::vector<VertexId> link;
   for (const Wedge& w : wedges(v)) link.insert(link.end(), {w.y, w.z});
-  if (!remove_vertex_by_flips(mesh_, v).done) return false;
+  // The new triangles must face the way the surface does, as those of moves and flips.
+  const auto faces = [this](const Simplex& t) {
+    const auto o = t.oriented_vertices();
+    return faces_surface(doubled_normal(reference(o[0]), reference(o[1]), reference(o[2])), o[0], o[1], o[2]);
+  };
+  if (!remove_vertex_by_flips(mesh_, v, faces).done) return false;
   ++report.nodes_removed;
   moved_.erase(v);
   surface_normals_.erase(v);
@@ -718,9 +734,11 @@ std::vector<VertexId> SurfaceCutter::dissect_edges(const std::vector<std::array<
   Connectivity& c = mesh_.connectivity();
   std::vector<FaceId> faces;
   for (const auto& [a, b] : edges) {
-    const ElementId e = elements_with_edge(c, a, b).front();
-    faces.push_back(c.opposite_face(e, third_vertex(c.element(e).simplex, a, b)));
+    // A missing edge, or one already on the boundary, has nothing to open.
+    const std::vector<ElementId> wings = elements_with_edge(c, a, b);
+    if (wings.size() == 2) faces.push_back(c.opposite_face(wings.front(), third_vertex(c.element(wings.front()).simplex, a, b)));
   }
+  if (faces.empty()) return {};
   const std::vector<SplitVertex> split =
       dissect(c, faces, [this](VertexId v) { return mesh_.add_vertex(VertexParents::copy_of(v)); });
   std::vector<VertexId> copies;
@@ -774,11 +792,10 @@ std::vector<VertexId> SurfaceCutter::join_at(VertexId w, const std::vector<Verte
   std::vector<std::array<VertexId, 2>> edges;
   for (VertexId a : actives) {
     std::erase_if(incisions_, [a](const Incision& i) { return i.active == a; });
-    // An edge that is missing or already on the boundary has nothing to open.
-    if (elements_with_edge(mesh_.connectivity(), a, w).size() == 2) edges.push_back({a, w});
+    edges.push_back({a, w});
   }
-  if (edges.empty()) return {};
   std::vector<VertexId> copies = dissect_edges(edges);
+  if (copies.empty()) return {};
   for (VertexId v : copies) incision_vertices_.insert(v), touched_.push_back(v);
   for (VertexId v : actives) incision_vertices_.insert(v), touched_.push_back(v);
   incision_vertices_.insert(w);

@@ -165,10 +165,11 @@ class SurfaceCutter {
   // opens); `ends` become the active nodes in place of a.
   void open_from(VertexId a, const std::vector<VertexId>& ends, PlanarCutReport& report);
   void advance(VertexId b, const Segment& from, const Segment& to, PlanarCutReport& report);
-  // Hits of `scalpel` in a's star farther than ε_entry from a and from each other, or nothing
+  // Hits of `scalpel` in a's star farther than `apart` from a and from each other, or nothing
   // when fewer than two (Figure 5.14).
-  std::vector<StarHit> branches(VertexId a, const Segment& scalpel) const;
-  void branch(VertexId a, const Segment& scalpel, PlanarCutReport& report);
+  std::vector<StarHit> branches(VertexId a, const Segment& scalpel, double apart) const;
+  double branch_distance(VertexId a);  // `apart` for a's incision
+  void branch(VertexId a, const Segment& scalpel, double apart, PlanarCutReport& report);
   // Moves the active node b to the point with `weights` in its star triangle, or part of the way;
   // true only for the whole way. When keeps_facing refuses the whole way, the star triangle in
   // the way goes to *blocking.

@@ -69,7 +69,8 @@ bool strictly_between(std::span<const double> x, std::span<const double> v, std:
 // Ear clipping of `polygon` (counter-clockwise in `plane`): the triangles, or the reason the
 // greedy choice got stuck.
 std::optional<std::vector<Simplex>> ear_triangulation(const Mesh& mesh, const RetriangulationPlane& plane,
-                                                      std::vector<VertexId> remaining, std::string& why_not) {
+                                                      std::vector<VertexId> remaining, const TriangleCheck& acceptable,
+                                                      std::string& why_not) {
   std::vector<Simplex> triangles;
   while (remaining.size() > 3) {
     const std::size_t n = remaining.size();
@@ -88,6 +89,8 @@ std::optional<std::vector<Simplex>> ear_triangulation(const Mesh& mesh, const Re
       }
       if (problem.empty() && has_edge(mesh.connectivity(), previous, following))
         problem = "edge " + vertex_list({previous, following}) + " already exists";
+      if (problem.empty() && acceptable && !acceptable(Simplex(1, {previous, tip, following})))
+        problem = "the caller refuses triangle " + vertex_list({previous, tip, following});
       if (!problem.empty()) {
         last_problem = problem;
         continue;
@@ -105,7 +108,9 @@ std::optional<std::vector<Simplex>> ear_triangulation(const Mesh& mesh, const Re
     triangles.push_back(Simplex(1, {remaining[(i + n - 1) % n], remaining[i], remaining[(i + 1) % n]}));
     remaining.erase(remaining.begin() + static_cast<std::ptrdiff_t>(i));
   }
-  const std::string problem = plane.triangle_problem(remaining[0], remaining[1], remaining[2]);
+  std::string problem = plane.triangle_problem(remaining[0], remaining[1], remaining[2]);
+  if (problem.empty() && acceptable && !acceptable(Simplex(1, {remaining[0], remaining[1], remaining[2]})))
+    problem = "the caller refuses triangle " + vertex_list({remaining[0], remaining[1], remaining[2]});
   if (!problem.empty()) {
     why_not = problem;
     return std::nullopt;
@@ -116,7 +121,7 @@ std::optional<std::vector<Simplex>> ear_triangulation(const Mesh& mesh, const Re
 
 }  // namespace
 
-EditResult remove_vertex_by_flips(Mesh& mesh, VertexId v) {
+EditResult remove_vertex_by_flips(Mesh& mesh, VertexId v, const TriangleCheck& acceptable) {
   if (mesh.cell_dim() != 2)
     throw std::invalid_argument("remove_vertex_by_flips: needs a triangle mesh (2D or surface), not a tetrahedral mesh");
   if (!mesh.is_vertex(v))
@@ -143,7 +148,7 @@ EditResult remove_vertex_by_flips(Mesh& mesh, VertexId v) {
   }
   const RetriangulationPlane plane(mesh, polygon);
   if (!plane.has_normal()) return EditResult::refused(removing() + "its star has no area");
-  const std::optional<std::vector<Simplex>> triangles = ear_triangulation(mesh, plane, polygon, why_not);
+  const std::optional<std::vector<Simplex>> triangles = ear_triangulation(mesh, plane, polygon, acceptable, why_not);
   if (!triangles) return EditResult::refused(removing() + why_not);
   // A link of three vertices closes into one triangle; on a closed surface it may exist already.
   const Simplex& last_triangle = triangles->back();

@@ -3,6 +3,8 @@
 // Mesh::remove_vertex.
 #pragma once
 
+#include <functional>
+
 #include "mesh/mesh.hpp"
 #include "topology/edit_result.hpp"
 
@@ -20,8 +22,10 @@ namespace snede {
 // retriangulated the same way. The whole retriangulation is planned first: refused, leaving
 // the mesh unchanged, when it cannot be completed (the greedy ear choice may refuse a link
 // with collinear vertices that some other triangulation would handle).
-// Watchers hear one change (a ChangeBatch). Throws std::invalid_argument for a tetrahedral
-// mesh or a v that is not a live vertex.
-EditResult remove_vertex_by_flips(Mesh& mesh, VertexId v);
+// `acceptable`, when given, may refuse ears too (a cutter's own shape checks). Watchers hear
+// one change (a ChangeBatch). Throws std::invalid_argument for a tetrahedral mesh or a v that
+// is not a live vertex.
+using TriangleCheck = std::function<bool(const Simplex&)>;
+EditResult remove_vertex_by_flips(Mesh& mesh, VertexId v, const TriangleCheck& acceptable = {});
 
 }  // namespace snede

@@ -29,17 +29,36 @@ def normals(mesh):
     return np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
 
 
+def largest_turn_between_neighbours(mesh):
+    """The largest angle (degrees) between the normals of two triangles sharing an edge."""
+    n = normals(mesh)
+    n = n / np.linalg.norm(n, axis=1)[:, None]
+    sides = np.sort(np.concatenate([mesh.cells[:, [0, 1]], mesh.cells[:, [1, 2]], mesh.cells[:, [2, 0]]]), axis=1)
+    owner = np.tile(np.arange(mesh.n_cells), 3)
+    order = np.lexsort(sides.T[::-1])
+    sides, owner = sides[order], owner[order]
+    shared = np.all(sides[1:] == sides[:-1], axis=1)
+    cosines = np.einsum("ij,ij->i", n[owner[:-1][shared]], n[owner[1:][shared]])
+    return np.degrees(np.arccos(np.clip(cosines, -1, 1))).max(initial=0.0)
+
+
 def check_surface(mesh, cutter, original_normal, h):
     """Valid, no flat triangle, every normal on its side of the surface, incisions on the
-    boundary, at most one active node per triangle (§5.3.2)."""
+    boundary, at most one active node per triangle (§5.3.2). Where the surface has no normal
+    field to compare with (original_normal None: a fold's crease, as coarse as its curvature),
+    no two neighbouring triangles may turn by 120° or more (the uncut fold's largest turn is
+    53°; a triangle folded over its neighbour turns by nearly 180°)."""
     mesh.validate()
     n = normals(mesh)
     areas = 0.5 * np.linalg.norm(n, axis=1)
     assert areas.min() > 1e-8 * h * h
-    centroids = mesh.points[mesh.cells].mean(axis=1)
-    expected = original_normal(centroids)
-    facing = np.einsum("ij,ij->i", n, expected) / (2 * areas * np.linalg.norm(expected, axis=1))
-    assert facing.min() > 0.05, "a triangle folded over against the surface"
+    if original_normal is None:
+        assert largest_turn_between_neighbours(mesh) < 120, "a triangle folded over its neighbour"
+    else:
+        centroids = mesh.points[mesh.cells].mean(axis=1)
+        expected = original_normal(centroids)
+        facing = np.einsum("ij,ij->i", n, expected) / (2 * areas * np.linalg.norm(expected, axis=1))
+        assert facing.min() > 0.05, "a triangle folded over against the surface"
     edges = cutter.incision_edges()
     if edges.size:
         boundary = {tuple(sorted(f)) for f in mesh.boundary_faces()}

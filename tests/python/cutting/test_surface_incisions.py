@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import snede
-from surface_checks import along, check_surface, components, folded, mean_edge, normals, up, vertical_scalpels
+from surface_checks import along, bell_normal, check_surface, components, folded, mean_edge, up, vertical_scalpels
 
 
 def graph_normal(slope_x):
@@ -26,13 +26,17 @@ def cut_checked(mesh, scalpels, normal):
     return cutter, total
 
 
-def split_by_plane_y(mesh, y0):
-    """The surface falls into two pieces, one on each side of the plane y = y0 (its lips on it)."""
+def split_by_plane_y(mesh, cutter, y0):
+    """The surface falls into two pieces, one on each side of the plane y = y0. The lips are
+    on the plane to within ε_entry: an entry or exit within ε_entry (ε_exit) of a vertex
+    starts or ends there (the thesis's fix-up), and a move cut short leaves the active node
+    behind the scalpel."""
     pieces = components(mesh)
     assert len(pieces) == 2
     y = [mesh.points[p, 1] for p in pieces]
     lower, upper = sorted(y, key=np.mean)
-    assert lower.max() <= y0 + 1e-12 and upper.min() >= y0 - 1e-12
+    slack = max(cutter.eps_entry, cutter.eps_exit)
+    assert lower.max() <= y0 + slack and upper.min() >= y0 - slack
 
 
 def test_folded_sheet_cut_once_gives_two_incisions():
@@ -40,18 +44,27 @@ def test_folded_sheet_cut_once_gives_two_incisions():
     incisions, two exits; the lower layer, the upper layer's tail and the rest (joined by the
     crease) come apart."""
     mesh = folded()
-    start, original = mesh.points.copy(), normals(mesh)
-    centroids = start[mesh.cells].mean(axis=1)
-
-    def original_normal(points):
-        return original[np.argmin(((centroids[None] - points[:, None]) ** 2).sum(-1), axis=1)]
-
     path = along(np.array([[0.2, -0.2], [0.25, 0.5], [0.2, 1.2]]), snede.SurfaceCutter(folded()).eps_edge)
-    cutter, total = cut_checked(mesh, [[[x, y, 1.0], [x, y, -1.0]] for x, y in path], original_normal)
+    cutter, total = cut_checked(mesh, [[[x, y, 1.0], [x, y, -1.0]] for x, y in path], None)
     assert (total.entries, total.exits) == (2, 2)
     heights = np.unique(mesh.points[np.unique(cutter.incision_edges()), 2])
     np.testing.assert_allclose(heights, [0.0, 0.3], atol=1e-12)
     assert len(components(mesh)) == 3
+
+
+@pytest.mark.parametrize("y0", [0.45, 0.5], ids=["between-vertices", "through-vertices"])
+def test_fold_met_at_its_crease_branches_onto_both_layers(y0):
+    """Figure 5.14: a vertical scalpel pushed towards the fold's crease from outside meets it
+    (Figure 5.12c), branches onto the upper and the lower layer, and both branches leave
+    through the free edges: the sheet falls into two pieces either side of the plane y = y0.
+    The sheet is twice as fine as folded()'s: on that one, whose crease is three triangles
+    across, the lower branch at y0 = 0.5 sticks where the crease's long triangles meet the
+    layer (a known limit)."""
+    mesh = snede.meshing.folded_sheet(divisions=(20, 16))
+    scalpels = [[[x, y0, -1.0], [x, y0, 1.0]] for x in np.linspace(0.8, -0.2, 100)]
+    cutter, total = cut_checked(mesh, scalpels, None)
+    assert (total.entries, total.branches, total.exits, total.annihilations) == (1, 1, 2, 0)
+    split_by_plane_y(mesh, cutter, y0)
 
 
 @pytest.mark.parametrize("y0", [0.47, 0.5], ids=["between-vertices", "through-vertices"])
@@ -63,7 +76,7 @@ def test_crest_met_from_outside_branches(y0):
     scalpels = [[[-0.1, y0, z], [1.1, y0, z]] for z in np.linspace(0.5, -0.1, 80)]
     cutter, total = cut_checked(mesh, scalpels, graph_normal(lambda x: -2.4 * (x - 0.5)))
     assert (total.entries, total.branches, total.exits, total.annihilations) == (1, 1, 2, 0)
-    split_by_plane_y(mesh, y0)
+    split_by_plane_y(mesh, cutter, y0)
 
 
 @pytest.mark.parametrize("y0", [0.47, 0.5], ids=["between-vertices", "through-vertices"])
@@ -75,7 +88,7 @@ def test_incisions_meeting_in_a_valley_annihilate(y0):
     cutter, total = cut_checked(mesh, scalpels, graph_normal(lambda x: 2.4 * (x - 0.5)))
     assert (total.entries, total.branches, total.exits, total.annihilations) == (2, 0, 0, 1)
     assert cutter.active_nodes == []
-    split_by_plane_y(mesh, y0)
+    split_by_plane_y(mesh, cutter, y0)
 
 
 def test_horizontal_scalpel_cuts_the_cap_off_the_bell():
@@ -84,9 +97,8 @@ def test_horizontal_scalpel_cuts_the_cap_off_the_bell():
     level z = 0.2 comes off, every one of its vertices at or above that level and every other
     vertex at or below it."""
     mesh = snede.meshing.gaussian_bell()
-    bell_normal_at = __import__("surface_checks").bell_normal
     scalpels = [[[-0.1, y, 0.2], [1.1, y, 0.2]] for y in np.linspace(-0.2, 1.2, 120)]
-    cutter, total = cut_checked(mesh, scalpels, bell_normal_at)
+    cutter, total = cut_checked(mesh, scalpels, bell_normal)
     assert (total.entries, total.branches, total.annihilations) == (1, 1, 1)
     pieces = sorted(components(mesh), key=len)
     assert len(pieces) == 2
@@ -110,3 +122,35 @@ def test_path_crossing_its_own_incision_leaves_and_enters_again():
     np.testing.assert_allclose(boxes[0], [0, 0, 0.3, 0.3], atol=0.02)  # the corner
     np.testing.assert_allclose(boxes[1], [0.3, 0.3, 0.7, 0.7], atol=0.02)  # the enclosed square
     np.testing.assert_allclose(boxes[2], [0, 0, 1, 1], atol=1e-12)
+
+
+def ridge():
+    return snede.meshing.height_field(lambda x, y: 0.3 - 1.2 * (x - 0.5) ** 2, divisions=(16, 16))
+
+
+def random_sweep(rng, step):
+    """Both ends of the scalpel along random polylines through a box around the unit square,
+    at most `step` apart from one position to the next: scalpels at every slant, lying on the
+    surface, crossing folds, crests and earlier incisions."""
+    corners = rng.uniform([-0.3, -0.3, -0.3], [1.3, 1.3, 0.6], (2, 5, 3))
+    ends = [along(c, step) for c in corners]
+    n = min(map(len, ends))
+    return np.stack([ends[0][:n], ends[1][:n]], axis=1)
+
+
+@pytest.mark.parametrize("surface, normal", [(snede.meshing.gaussian_bell, bell_normal),
+                                             (ridge, graph_normal(lambda x: -2.4 * (x - 0.5))), (folded, None)],
+                         ids=["bell", "ridge", "fold"])
+@pytest.mark.parametrize("seed", range(8))
+def test_random_scalpels_keep_the_surface_valid(surface, normal, seed):
+    """Every move of a random scalpel keeps the surface valid, unfolded, with incisions on the
+    boundary and no triangle touching two active nodes; the runs enter, and cut."""
+    mesh = surface()
+    cutter = snede.SurfaceCutter(mesh)
+    scalpels = [s for s in random_sweep(np.random.default_rng(seed), cutter.eps_edge) if not np.allclose(s[0], s[1])]
+    h = mean_edge(mesh)
+    total = snede.PlanarCutReport()
+    for scalpel in scalpels:
+        total = total + cutter.move(scalpel)
+        check_surface(mesh, cutter, normal, h)
+    assert total.moves == len(scalpels) and total.entries >= 1
