@@ -10,6 +10,7 @@
 #include "core/petsc_util.hpp"
 #include "core/predicates.hpp"
 #include "cutting/cut_thresholds.hpp"
+#include "cutting/incision_star.hpp"
 #include "needle/deformed_queries.hpp"
 #include "topology/collapse_edge.hpp"
 #include "topology/dissect.hpp"
@@ -178,24 +179,9 @@ DelaunayCutter::Point DelaunayCutter::target_of(const Point& x, std::span<const 
   return {l[0] * Xb[0] + l[1] * Y[0] + l[2] * Z[0], l[0] * Xb[1] + l[1] * Y[1] + l[2] * Z[1]};
 }
 
-std::vector<DelaunayCutter::Wedge> DelaunayCutter::wedges(VertexId b) const {
-  const Connectivity& c = mesh_.connectivity();
-  std::vector<Wedge> result;
-  for (ElementId e : local_star(c, b).elements) {
-    const auto t = c.element(e).simplex.oriented_vertices();
-    const int i = static_cast<int>(std::find(t.begin(), t.begin() + 3, b) - t.begin());
-    result.push_back({e, t[(i + 1) % 3], t[(i + 2) % 3]});
-  }
-  return result;
-}
+std::vector<Wedge> DelaunayCutter::wedges(VertexId b) const { return star_wedges(mesh_.connectivity(), b); }
 
-bool DelaunayCutter::on_boundary(VertexId v) const {
-  const Connectivity& c = mesh_.connectivity();
-  for (ElementId e : local_star(c, v).elements)
-    for (VertexId w : c.element(e).simplex.vertices())
-      if (w != v && c.face(c.opposite_face(e, w)).mate == no_id) return true;
-  return false;
-}
+bool DelaunayCutter::on_boundary(VertexId v) const { return touches_boundary(mesh_.connectivity(), v); }
 
 std::optional<DelaunayCutter::Crossing> DelaunayCutter::first_boundary_crossing(const Point& from, const Point& to,
                                                                                std::span<const double> u) const {
@@ -357,7 +343,7 @@ bool DelaunayCutter::fix_up_entry(const Point& p, PlanarCutReport& report) {
     const int k = static_cast<int>(std::min_element(weights.begin(), weights.end()) - weights.begin());
     // On a boundary side (an incision's lip, most often) the new incision would run along
     // the boundary: the entry stays postponed until the scalpel is in the material.
-    if (c.face(c.opposite_face(host, corners[k])).mate == no_id) return false;
+    if (is_boundary_edge(c, host, corners[k])) return false;
     const VertexId s = corners[(k + 1) % 3], t = corners[(k + 2) % 3];
     const double along = weights[(k + 2) % 3] / (weights[(k + 1) % 3] + weights[(k + 2) % 3]);
     made = split_edge(mesh_, s, t, std::clamp(along, 0.05, 0.95));
@@ -460,7 +446,7 @@ bool DelaunayCutter::advance(const Point& target, PlanarCutReport& report) {
         VertexId y = blocking->y, z = blocking->z;
         double lambda = line_crossing(x, target, reference(y), reference(z));
         for (const Wedge& w : wedges(active_)) {
-          if (c.face(c.opposite_face(w.element, active_)).mate != no_id) continue;
+          if (!is_boundary_edge(c, w.element, active_)) continue;
           if (const auto hit = segments_cross(x, target, reference(w.y), reference(w.z))) {
             y = w.y, z = w.z, lambda = hit->second;
             break;
@@ -490,19 +476,7 @@ bool DelaunayCutter::advance(const Point& target, PlanarCutReport& report) {
 void DelaunayCutter::remesh_around(VertexId b, PlanarCutReport& report) {
   const Connectivity& c = mesh_.connectivity();
   // Flips towards Delaunay: the edges of the active triangles (spokes and link edges).
-  for (int round = 0; round < 64; ++round) {
-    bool flipped = false;
-    for (const Wedge& w : wedges(b)) {
-      for (const auto& [p, q] : {std::pair{w.y, w.z}, std::pair{b, w.y}}) {
-        if (!is_locally_delaunay(mesh_, w.element, p, q) && flip(p, q, report)) {
-          flipped = true;
-          break;
-        }
-      }
-      if (flipped) break;
-    }
-    if (!flipped) break;
-  }
+  flip_star_towards_delaunay(mesh_, b, [&](VertexId p, VertexId q) { return flip(p, q, report); });
   // Interior nodes too close to the active node (§5.2.2), by distance or by angles (§5.5).
   for (int round = 0; round < 16; ++round) {
     const Point x = reference(b);
@@ -588,8 +562,8 @@ void DelaunayCutter::split_incision(PlanarCutReport& report) {
   // The cut edges: boundary edges b→c1 (in the wedge (b, c1, o1)) and c2→b (in (b, o2, c2)).
   std::optional<Wedge> out, in;
   for (const Wedge& w : wedges(b)) {
-    if (c.face(c.opposite_face(w.element, w.z)).mate == no_id) out = w;
-    if (c.face(c.opposite_face(w.element, w.y)).mate == no_id) in = w;
+    if (is_boundary_edge(c, w.element, w.z)) out = w;
+    if (is_boundary_edge(c, w.element, w.y)) in = w;
   }
   if (!out || !in || out->element == in->element) return;
   const VertexId c1 = out->y, o1 = out->z, o2 = in->y, c2 = in->z;
@@ -651,7 +625,7 @@ void DelaunayCutter::predict_exit(const Point& direction, PlanarCutReport& repor
   const Point ahead{x[0] + options_.eps_exit * direction[0] / length, x[1] + options_.eps_exit * direction[1] / length};
   const Connectivity& c = mesh_.connectivity();
   for (const Wedge& w : wedges(active_)) {
-    if (c.face(c.opposite_face(w.element, active_)).mate != no_id) continue;
+    if (!is_boundary_edge(c, w.element, active_)) continue;
     if (const auto hit = segments_cross(x, ahead, reference(w.y), reference(w.z))) {
       exit_through(w.y, w.z, hit->second, report);
       return;
@@ -699,13 +673,6 @@ void DelaunayCutter::exit_through(VertexId y, VertexId z, double lambda, PlanarC
   exit_point_ = scalpel_;
 }
 
-std::vector<VertexId> DelaunayCutter::incision_edges() const {
-  std::vector<VertexId> edges;
-  for (const auto& [simplex, f] : mesh_.connectivity().boundary()) {
-    const auto v = simplex.oriented_vertices();
-    if (incision_vertices_.count(v[0]) && incision_vertices_.count(v[1])) edges.insert(edges.end(), {v[0], v[1]});
-  }
-  return edges;
-}
+std::vector<VertexId> DelaunayCutter::incision_edges() const { return lip_edges(mesh_.connectivity(), incision_vertices_); }
 
 }  // namespace snede

@@ -35,6 +35,7 @@
 #include <unordered_set>
 #include <vector>
 
+#include "cutting/incision_star.hpp"
 #include "solve/model.hpp"
 
 namespace snede {
@@ -95,10 +96,6 @@ class DelaunayCutter {
  private:
   enum class Phase { outside, entering, cutting };
   using Point = std::array<double, 2>;
-  struct Wedge {  // triangle (b, y, z) of b's star, counter-clockwise
-    ElementId element;
-    VertexId y, z;
-  };
   struct Crossing {  // where a segment meets boundary edge (y, z): y + lambda (z − y)
     VertexId y, z;
     double lambda, s;  // s: fraction along the segment

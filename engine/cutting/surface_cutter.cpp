@@ -9,6 +9,7 @@
 #include "core/error.hpp"
 #include "core/petsc_util.hpp"
 #include "cutting/cut_thresholds.hpp"
+#include "cutting/incision_star.hpp"
 #include "cutting/swept_intersections.hpp"
 #include "topology/collapse_edge.hpp"
 #include "topology/dissect.hpp"
@@ -83,20 +84,10 @@ void SurfaceCutter::follow(VertexId v, const VertexParents& parents) {
   grid_stale_ = true;
 }
 
-std::vector<SurfaceCutter::Wedge> SurfaceCutter::wedges(VertexId b) const {
-  const Connectivity& c = mesh_.connectivity();
-  std::vector<Wedge> result;
-  for (ElementId e : local_star(c, b).elements) {
-    const auto t = c.element(e).simplex.oriented_vertices();
-    const int i = static_cast<int>(std::find(t.begin(), t.begin() + 3, b) - t.begin());
-    result.push_back({e, t[(i + 1) % 3], t[(i + 2) % 3]});
-  }
-  return result;
-}
+std::vector<Wedge> SurfaceCutter::wedges(VertexId b) const { return star_wedges(mesh_.connectivity(), b); }
 
 bool SurfaceCutter::is_boundary_edge(ElementId triangle, VertexId opposite) const {
-  const Connectivity& c = mesh_.connectivity();
-  return c.face(c.opposite_face(triangle, opposite)).mate == no_id;
+  return snede::is_boundary_edge(mesh_.connectivity(), triangle, opposite);
 }
 
 Point3 SurfaceCutter::star_area(VertexId v) const {
@@ -137,13 +128,7 @@ bool SurfaceCutter::keeps_facing(VertexId v, const Point3& x, VertexId merging_i
   return true;
 }
 
-bool SurfaceCutter::on_boundary(VertexId v) const {
-  const Connectivity& c = mesh_.connectivity();
-  for (ElementId e : local_star(c, v).elements)
-    for (VertexId w : c.element(e).simplex.vertices())
-      if (w != v && is_boundary_edge(e, w)) return true;
-  return false;
-}
+bool SurfaceCutter::on_boundary(VertexId v) const { return touches_boundary(mesh_.connectivity(), v); }
 
 bool SurfaceCutter::is_active(VertexId v) const {
   return std::any_of(incisions_.begin(), incisions_.end(), [v](const Incision& i) { return i.active == v; });
@@ -646,18 +631,7 @@ bool SurfaceCutter::remove_node(VertexId v, PlanarCutReport& report) {
 void SurfaceCutter::remesh_around(VertexId b, PlanarCutReport& report) {
   if (!mesh_.is_vertex(b) || !incision_at(b)) return;
   // §5.3.1: the active triangles' edges to the unfolded Delaunay criterion.
-  for (int round = 0; round < 64; ++round) {
-    bool flipped = false;
-    for (const Wedge& w : wedges(b)) {
-      for (const auto& [p, q] : {std::pair{w.y, w.z}, std::pair{b, w.y}})
-        if (!is_locally_delaunay(mesh_, w.element, p, q) && flip(p, q, report)) {
-          flipped = true;
-          break;
-        }
-      if (flipped) break;
-    }
-    if (!flipped) break;
-  }
+  flip_star_towards_delaunay(mesh_, b, [&](VertexId p, VertexId q) { return flip(p, q, report); });
   // Interior nodes closer than ε_edge to the active node go (§5.2.2); one that separates b
   // from another active node is where both incisions end (Figure 5.13).
   for (int round = 0; round < 16; ++round) {
@@ -826,13 +800,6 @@ void SurfaceCutter::legalize(PlanarCutReport& report) {
   }
 }
 
-std::vector<VertexId> SurfaceCutter::incision_edges() const {
-  std::vector<VertexId> edges;
-  for (const auto& [simplex, f] : mesh_.connectivity().boundary()) {
-    const auto v = simplex.oriented_vertices();
-    if (incision_vertices_.count(v[0]) && incision_vertices_.count(v[1])) edges.insert(edges.end(), {v[0], v[1]});
-  }
-  return edges;
-}
+std::vector<VertexId> SurfaceCutter::incision_edges() const { return lip_edges(mesh_.connectivity(), incision_vertices_); }
 
 }  // namespace snede

@@ -43,6 +43,7 @@
 #include <vector>
 
 #include "cutting/delaunay_cutter.hpp"
+#include "cutting/incision_star.hpp"
 #include "cutting/sweep_triangle.hpp"
 #include "cutting/triangle_grid.hpp"
 #include "solve/model.hpp"
@@ -87,10 +88,6 @@ class SurfaceCutter {
     bool entering;   // the entry node: nothing cut yet
     bool inside;     // entered inside the surface (its first edge is split so that it opens)
     bool branching;  // entered at a fold's crest: expected to branch
-  };
-  struct Wedge {  // triangle (b, y, z) of b's star, in its orientation
-    ElementId element;
-    VertexId y, z;
   };
   struct StarHit {  // the scalpel meets triangle (b, y, z) at these barycentric weights
     Wedge wedge;
