@@ -174,12 +174,12 @@ def densify(path, step: float) -> np.ndarray:
 
 
 def resample(path, step: float) -> np.ndarray:
-    """Points equally spaced along the polyline (at most ``step`` apart), so that means over
-    them are means over the path's length."""
+    """Points equally spaced along the polyline (at most ``step`` apart; in the plane or in
+    space), so that means over them are means over the path's length."""
     path = np.asarray(path, dtype=float)
     along = np.r_[0, np.cumsum(np.linalg.norm(np.diff(path, axis=0), axis=1))]
     s = np.linspace(0, along[-1], int(math.ceil(along[-1] / step)) + 1)
-    return np.c_[np.interp(s, along, path[:, 0]), np.interp(s, along, path[:, 1])]
+    return np.stack([np.interp(s, along, path[:, k]) for k in range(path.shape[1])], axis=1)
 
 
 def inside(points) -> np.ndarray:

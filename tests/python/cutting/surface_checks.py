@@ -109,19 +109,6 @@ def random_path(rng, corners=4):
 
 
 def components(mesh):
-    """The vertex sets of the connected pieces of the mesh (through shared vertices)."""
-    parent = np.arange(len(mesh.points))
-
-    def root(v):
-        while parent[v] != v:
-            parent[v] = parent[parent[v]]
-            v = parent[v]
-        return v
-
-    for a, b, c in mesh.cells:
-        parent[root(b)] = root(a)
-        parent[root(c)] = root(a)
-    pieces = {}
-    for v in np.unique(mesh.cells):
-        pieces.setdefault(root(v), []).append(v)
-    return [np.array(p) for p in pieces.values()]
+    """The vertex sets of the pieces the mesh falls into (Mesh.connected_components)."""
+    count, label = mesh.connected_components()
+    return [np.unique(mesh.cells[label == k]) for k in range(count)]
