@@ -81,7 +81,6 @@ void SurfaceCutter::follow(VertexId v, const VertexParents& parents) {
   Point3 n{0, 0, 0};
   for (std::size_t k = 0; k < parents.count(); ++k) n = plus_scaled(n, parents.weight[k], surface_normal(parents.vertex[k]));
   surface_normals_[v] = n;
-  grid_stale_ = true;
 }
 
 std::vector<Wedge> SurfaceCutter::wedges(VertexId b) const { return star_wedges(mesh_.connectivity(), b); }
@@ -204,15 +203,28 @@ double SurfaceCutter::step_limit(VertexId b, const Segment& scalpel) const {
 }
 
 std::vector<ElementId> SurfaceCutter::triangles_near(const Segment& from, const Segment& to) {
-  if (grid_stale_ || grid_revision_ != mesh_.connectivity().revision()) {
+  // The grid is built once per move (or when another edit changed the mesh since); the
+  // triangles this move's edits made are around the vertices it touched or moved, and join
+  // the candidates as they are, so that a step costs no rebuild.
+  const Connectivity& c = mesh_.connectivity();
+  if (rebuild_grid_) {
     grid_.build(mesh_, [this](VertexId v) { return deformed(v); });
-    grid_revision_ = mesh_.connectivity().revision();
-    grid_stale_ = false;
+    grid_revision_ = c.revision();
+    rebuild_grid_ = false;
   }
-  Point3 lo = from.head, hi = from.head;
-  for (const Point3& x : {from.tail, to.head, to.tail})
-    for (int d = 0; d < 3; ++d) lo[d] = std::min(lo[d], x[d]), hi[d] = std::max(hi[d], x[d]);
-  return grid_.near(lo, hi);
+  std::vector<ElementId> found;
+  for (ElementId e : grid_.near_sweep(from.head, from.tail, to.head, to.tail))
+    if (c.is_element(e)) found.push_back(e);
+  if (c.revision() != *grid_revision_) {
+    std::vector<VertexId> edited = touched_;
+    for (const auto& [v, x] : moved_) edited.push_back(v);
+    for (VertexId v : edited)
+      if (mesh_.is_vertex(v))
+        for (ElementId e : local_star(c, v).elements) found.push_back(e);
+    std::sort(found.begin(), found.end());
+    found.erase(std::unique(found.begin(), found.end()), found.end());
+  }
+  return found;
 }
 
 bool SurfaceCutter::meets_ring(VertexId a, const Segment& scalpel) const {
@@ -247,8 +259,9 @@ PlanarCutReport SurfaceCutter::move(std::span<const double> segment) {
   if (model_) {
     ReadView view(model_->displacement());
     displacement_.assign(view.span().begin(), view.span().end());
-    grid_stale_ = true;
   }
+  // Deformed positions or the mesh may have changed since the grid was built.
+  rebuild_grid_ = rebuild_grid_ || model_ || grid_revision_ != mesh_.connectivity().revision();
   touched_.clear();
   refused_.clear();
   {
@@ -604,7 +617,6 @@ bool SurfaceCutter::flip(VertexId p, VertexId q, PlanarCutReport& report) {
   }
   if (!flip_edge(mesh_, p, q).done) return false;
   ++report.flips;
-  grid_stale_ = true;
   touched_.insert(touched_.end(), quad.begin(), quad.end());
   return true;
 }
@@ -623,7 +635,6 @@ bool SurfaceCutter::remove_node(VertexId v, PlanarCutReport& report) {
   ++report.nodes_removed;
   moved_.erase(v);
   surface_normals_.erase(v);
-  grid_stale_ = true;
   touched_.insert(touched_.end(), link.begin(), link.end());
   return true;
 }

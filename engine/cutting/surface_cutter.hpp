@@ -199,8 +199,8 @@ class SurfaceCutter {
   std::vector<double> displacement_;                // u at the start of the move (3 per point)
   std::unordered_map<VertexId, Point3> moved_;      // deformed positions of vertices edited since
   TriangleGrid grid_;
-  std::optional<std::uint64_t> grid_revision_;
-  bool grid_stale_ = true;
+  std::optional<std::uint64_t> grid_revision_;  // the mesh's when the grid was built
+  bool rebuild_grid_ = true;
   std::unordered_set<VertexId> incision_vertices_;
   std::unordered_map<VertexId, Point3> surface_normals_;
   std::vector<VertexId> touched_;

@@ -45,20 +45,46 @@ std::uint64_t TriangleGrid::key(const Cell& cell) {
   return bits(cell[0]) | bits(cell[1]) << 21 | bits(cell[2]) << 42;
 }
 
-std::vector<ElementId> TriangleGrid::near(const Point3& lo, const Point3& hi) const {
+bool TriangleGrid::collect(const Point3& lo, const Point3& hi, std::vector<ElementId>& found) const {
   const Cell from = cell_of(lo), to = cell_of(hi);
   double count = 1;
   for (int d = 0; d < 3; ++d) count *= static_cast<double>(to[d] - from[d] + 1);
-  if (count > static_cast<double>(cells_.size())) return all_;
-  std::vector<ElementId> found;
+  if (count > static_cast<double>(cells_.size())) return false;
   for (std::int64_t i0 = from[0]; i0 <= to[0]; ++i0)
     for (std::int64_t i1 = from[1]; i1 <= to[1]; ++i1)
       for (std::int64_t i2 = from[2]; i2 <= to[2]; ++i2)
         if (const auto cell = cells_.find(key({i0, i1, i2})); cell != cells_.end())
           found.insert(found.end(), cell->second.begin(), cell->second.end());
+  return true;
+}
+
+std::vector<ElementId> TriangleGrid::unique(std::vector<ElementId> found) {
   std::sort(found.begin(), found.end());
   found.erase(std::unique(found.begin(), found.end()), found.end());
   return found;
+}
+
+std::vector<ElementId> TriangleGrid::near(const Point3& lo, const Point3& hi) const {
+  std::vector<ElementId> found;
+  return collect(lo, hi, found) ? unique(std::move(found)) : all_;
+}
+
+std::vector<ElementId> TriangleGrid::near_sweep(const Point3& h0, const Point3& t0, const Point3& h1,
+                                                const Point3& t1) const {
+  // A bilinear patch lies in the hull of its corners: the sweep cut along the segment into
+  // pieces about a cell long, each piece's box.
+  const double length = std::max(distance(h0, t0), distance(h1, t1));
+  const int pieces = static_cast<int>(std::clamp(std::ceil(length / cell_size_), 1.0, 64.0));
+  std::vector<ElementId> found;
+  for (int k = 0; k < pieces; ++k) {
+    const double s0 = static_cast<double>(k) / pieces, s1 = static_cast<double>(k + 1) / pieces;
+    const std::array<Point3, 4> corners{lerp(h0, t0, s0), lerp(h0, t0, s1), lerp(h1, t1, s0), lerp(h1, t1, s1)};
+    Point3 lo = corners[0], hi = corners[0];
+    for (const Point3& x : corners)
+      for (int d = 0; d < 3; ++d) lo[d] = std::min(lo[d], x[d]), hi[d] = std::max(hi[d], x[d]);
+    if (!collect(lo, hi, found)) return all_;
+  }
+  return unique(std::move(found));
 }
 
 }  // namespace snede
