@@ -63,7 +63,8 @@ def _parser() -> argparse.ArgumentParser:
                                           "options as they are set up).")
     # SUPPRESS: `--quiet run ...` is not undone by the subcommand's default
     run.add_argument("--quiet", action="store_true", default=argparse.SUPPRESS, help=quiet)
-    run.add_argument("scene", help="cantilever, cylinder, slab, needle, cut, sheet-cut, or path/to/scene.py")
+    run.add_argument("scene", help="cantilever, cylinder, slab, needle, needle3d, cut, sheet-cut, membrane-cut, "
+                                      "or path/to/scene.py")
     run.add_argument("--material", choices=MATERIAL_NAMES, help="material model (default: the scene's)")
     run.add_argument("--method", choices=METHODS,
                      help="cg: linear CG (linear material); ncg: nonlinear CG; newton: truncated Newton; "
@@ -72,7 +73,7 @@ def _parser() -> argparse.ArgumentParser:
                      help="relaxation tolerance ε of the stopping criterion (6.9) (default 1e-6; needle: 1e-3)")
     run.add_argument("--divisions", type=_positive_int,
                      help="structured mesh resolution (cantilever, cut: n × n/4 × n/4; slab: n × n; "
-                          "needle: n × n, n a power of 2; sheet-cut: n × 3n/5)")
+                          "needle: n × n, n a power of 2; sheet-cut: n × 3n/5; membrane-cut: the bell's n × n)")
     run.add_argument("--speed", type=_positive_float,
                      help="needle: insertion speed, in h_ref per update (default 0.1)")
     run.add_argument("--mesh-size", type=_positive_float, help="target edge length (m) for gmsh meshes (cylinder)")

@@ -93,17 +93,20 @@ def highlighted(faces, highlight) -> np.ndarray:
 def draw_3d(ax, points, faces, u, scale: float = 1.0, norm=None, highlight=None, light=(-0.4, -0.7, 0.6)):
     """The deformed boundary surface (``faces``: (n, 3) vertex ids, outward) coloured by |u|
     (mean over each face's vertices) and shaded by its normal against ``light``, with the faces
-    of ``highlight`` ((m, 3) vertex ids) in red; returns how many were highlighted."""
+    of ``highlight`` ((m, 3) vertex ids) in red, or, for a surface mesh, its edges ((m, 2): the
+    lips of an incision) as red lines; returns how many were highlighted."""
     import matplotlib.cm as cm
     import matplotlib.colors as colors
-    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
+    from mpl_toolkits.mplot3d.art3d import Line3DCollection, Poly3DCollection
+
+    lines = highlight is not None and np.shape(highlight)[-1] == 2
 
     deformed = points + scale * u
     magnitude = np.linalg.norm(u, axis=1)
     if norm is None:
         norm = colors.Normalize(vmin=magnitude.min(), vmax=max(magnitude.max(), 1e-300))
     colour = cm.viridis(norm(magnitude[faces].mean(axis=1)))
-    marked = highlighted(faces, highlight) if highlight is not None else np.zeros(len(faces), dtype=bool)
+    marked = highlighted(faces, highlight) if highlight is not None and not lines else np.zeros(len(faces), dtype=bool)
     colour[marked] = HIGHLIGHT
     triangles = deformed[faces]
     normal = np.cross(triangles[:, 1] - triangles[:, 0], triangles[:, 2] - triangles[:, 0])
@@ -113,6 +116,10 @@ def draw_3d(ax, points, faces, u, scale: float = 1.0, norm=None, highlight=None,
     ax.add_collection3d(Poly3DCollection(triangles, facecolors=colour, edgecolors=(0, 0, 0, 0.35),
                                          linewidths=0.75 * _edge_width(3 * len(faces) // 2), zorder=2,
                                          gid="surface"))
+    if lines and len(highlight):
+        ax.add_collection3d(Line3DCollection(deformed[np.asarray(highlight)], colors=[HIGHLIGHT], linewidths=1.5,
+                                             zorder=3, gid="incision"))
+        return len(highlight)
     return int(marked.sum())
 
 
@@ -268,7 +275,8 @@ def draw_body(body, title: str = "", displacement=None, scale: float = 1.0, deco
         import matplotlib.colors as colors
         from mpl_toolkits.mplot3d.art3d import Line3DCollection
 
-        faces = mesh.boundary_faces()
+        membrane = mesh.cell_dim == 2  # a surface mesh in 3D: its triangles are what is drawn
+        faces = mesh.cells if membrane else mesh.boundary_faces()
         fig = plt.figure(figsize=(7, 5))
         ax = fig.add_subplot(projection="3d")
         ax.computed_zorder = False  # the wireframe behind the surface, markers and arrows on top
@@ -279,7 +287,7 @@ def draw_body(body, title: str = "", displacement=None, scale: float = 1.0, deco
         norm = colors.Normalize(vmin=magnitude.min(), vmax=max(magnitude.max(), 1e-300))
         marked = draw_3d(ax, points, faces, u, scale, norm, highlight)
         if highlight is not None:
-            handles[0].set_label(f"incision ({marked} faces)")
+            handles[0].set_label(f"incision ({marked} {'edges' if membrane else 'faces'})")
         surface = np.unique(faces)
         drawn = [deformed[surface]] + ([points[surface]] if reference else [])
         tails = draw_loads(ax, deformed, forces, length)
@@ -326,7 +334,8 @@ def plot_body(body, path, title: str = "", displacement=None, scale: float = 1.0
     names of the channels to draw, "gravity" among them for gravity), ``fixed`` (vertex ids or
     a boolean mask) as black triangles. ``decorate(ax)`` draws on top of a 2D picture.
     ``highlight``, boundary faces ((m, 3) vertex ids, e.g. ``TetrahedralCutter.incision_faces()``)
-    or in 2D boundary edges ((m, 2), e.g. ``DelaunayCutter.incision_edges()``), is drawn in red;
+    or in 2D and on a membrane (a surface mesh in 3D, whose triangles are drawn) boundary edges
+    ((m, 2), e.g. ``DelaunayCutter.incision_edges()``), is drawn in red;
     ``view`` is the 3D camera: the arguments of ``Axes3D.view_init``, (elevation, azimuth) in
     degrees and optionally the roll and the vertical axis ("z", or "y" for a body loaded along y)."""
     plt = _figure()
@@ -338,6 +347,18 @@ def plot_body(body, path, title: str = "", displacement=None, scale: float = 1.0
     fig.savefig(path, dpi=120, bbox_inches="tight", bbox_extra_artists=fig.get_default_bbox_extra_artists() + labels)
     plt.close(fig)
     return path
+
+
+def save_3d(path, draw, title: str, figsize=(6, 5)) -> Path:
+    """Save a PNG of one 3D picture: ``draw(ax)`` draws it on a 3D axis, titled ``title``."""
+    plt = _figure()
+    fig = plt.figure(figsize=figsize)
+    ax = fig.add_subplot(projection="3d")
+    draw(ax)
+    ax.set_title(title)
+    fig.savefig(path, dpi=120, bbox_inches="tight")
+    plt.close(fig)
+    return Path(path)
 
 
 def animate(frames, path, draw, fps: int = 10, projection: str | None = None) -> Path:

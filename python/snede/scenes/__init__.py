@@ -68,7 +68,7 @@ def solve_entries(results) -> dict:
 
 
 def builders() -> dict:
-    from snede.scenes import cantilever, cut, cylinder, needle, needle3d, sheet_cut, slab
+    from snede.scenes import cantilever, cut, cylinder, membrane_cut, needle, needle3d, sheet_cut, slab
 
     return {"cantilever": cantilever, "cylinder": cylinder, "slab": slab, "needle": needle, "needle3d": needle3d,
-            "cut": cut, "sheet-cut": sheet_cut}
+            "cut": cut, "sheet-cut": sheet_cut, "membrane-cut": membrane_cut}

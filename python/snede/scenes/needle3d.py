@@ -14,11 +14,12 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import partial
 
 import numpy as np
 
 import snede
-from snede.plotting import animate, draw_3d
+from snede.plotting import animate, draw_3d, save_3d
 from snede.scenes import Scene, material
 
 SIZE, DEPTH, RADIUS = 0.1, 0.07, 1e-3
@@ -162,16 +163,9 @@ class Insertion:
 
     def draw_surface(self, path, frame: Frame):
         """A picture of the needle's jagged surface in the mesh, coloured by |u| (Figure 6.14)."""
-        from snede.plotting import _figure
-
-        plt = _figure()
-        fig = plt.figure(figsize=(7, 4))
-        ax = fig.add_subplot(projection="3d")
-        self._draw_frame(ax, frame)
-        ax.set_title(f"needle surface in the mesh: {len(frame.faces)} faces, {self.body.mesh.n_cells} tetrahedra")
-        fig.savefig(path, dpi=120, bbox_inches="tight")
-        plt.close(fig)
-        return path
+        return save_3d(path, partial(self._draw_frame, frame=frame),
+                       f"needle surface in the mesh: {len(frame.faces)} faces, {self.body.mesh.n_cells} tetrahedra",
+                       figsize=(7, 4))
 
     def shaft_force(self) -> float:
         """Total force the needle exerts on the body along its shaft (N)."""
