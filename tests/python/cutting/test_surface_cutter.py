@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 
 import snede
-from surface_checks import along, bell, bell_height, bell_normal, check_surface, flat_square, folded, mean_edge, \
-    normals, random_path, up, vertical_scalpels
+from surface_checks import along, bell, bell_normal, check_surface, flat_square, mean_edge, random_path, up, \
+    vertical_scalpels
 
 
 @pytest.mark.parametrize("surface, normal, seed", [

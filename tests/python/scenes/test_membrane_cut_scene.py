@@ -16,7 +16,7 @@ from snede import run_scene
 from snede.output import read_series
 from snede.scenes import membrane_cut
 
-from test_scenes import not_blank, red_pixels, run_cli
+from test_scenes import assert_gif_shows_the_cut, not_blank, red_pixels, run_cli
 from test_sheet_cut_scene import lip_pairs, widest_gap
 
 DIVISIONS = 10  # 200 triangles: about 3 seconds with the pictures
@@ -94,12 +94,7 @@ def test_files_and_pictures(membrane):
         assert not_blank(png)
         with Image.open(png) as image:
             assert red_pixels(image) > 50  # the lips
-    with Image.open(files["gif"]) as gif:
-        assert gif.n_frames == summary["frames"]
-        gif.seek(0)
-        assert red_pixels(gif) == 0  # stretched, not yet cut
-        gif.seek(gif.n_frames - 1)
-        assert red_pixels(gif) > 10
+    assert_gif_shows_the_cut(files["gif"], summary["frames"], 10)
 
 
 def test_cli_prints_a_line_per_move(tmp_path):

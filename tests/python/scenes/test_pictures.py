@@ -9,7 +9,6 @@ import pytest
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
-from matplotlib.collections import LineCollection  # noqa: E402
 from matplotlib.quiver import Quiver  # noqa: E402
 from mpl_toolkits.mplot3d import proj3d  # noqa: E402
 

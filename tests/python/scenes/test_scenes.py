@@ -13,7 +13,6 @@ import pytest
 
 import snede
 from snede import run_scene
-from snede.__main__ import main
 from snede.output import SeriesWriter
 from snede.scenes import builders
 
@@ -104,6 +103,19 @@ def red_pixels(image) -> int:
     rgb = np.asarray(image.convert("RGB"), dtype=float) / 255
     r, g, b = rgb[..., 0], rgb[..., 1], rgb[..., 2]
     return int(((r > 0.35) & (r > 2.5 * g) & (r > 2.5 * b)).sum())
+
+
+def assert_gif_shows_the_cut(path, frames: int, red_at_end: int) -> None:
+    """The animation has `frames` frames, no incision red in the first and more than
+    `red_at_end` red pixels in the last."""
+    from PIL import Image
+
+    with Image.open(path) as gif:
+        assert gif.n_frames == frames
+        gif.seek(0)
+        assert red_pixels(gif) == 0  # not yet cut
+        gif.seek(gif.n_frames - 1)
+        assert red_pixels(gif) > red_at_end
 
 
 def run_cli(*args, cwd=None):

@@ -20,7 +20,7 @@ from PIL import Image
 from snede import run_scene
 from snede.scenes import sheet_cut
 
-from test_scenes import not_blank, red_pixels, run_cli
+from test_scenes import assert_gif_shows_the_cut, not_blank, red_pixels, run_cli
 
 DIVISIONS = 20  # 20 × 12 squares, 38 moves: about 4 seconds with the animation
 
@@ -159,12 +159,7 @@ def test_picture_and_animation_show_the_incision(sheet):
     assert not_blank(files["png"])
     with Image.open(files["png"]) as png:
         assert red_pixels(png) > 100
-    with Image.open(files["gif"]) as gif:
-        assert gif.n_frames == summary["frames"]
-        gif.seek(0)
-        assert red_pixels(gif) == 0  # stretched, not yet cut
-        gif.seek(gif.n_frames - 1)
-        assert red_pixels(gif) > 20
+    assert_gif_shows_the_cut(files["gif"], summary["frames"], 20)
 
 
 def test_cli_prints_a_line_per_move_with_the_solve_reason(tmp_path):
