@@ -14,7 +14,7 @@ the tip-region deflection. The thesis: linear, 2420 elements, 5 s; neo-Hookean, 
 
     .venv/bin/python benchmarks/needle3d_rates.py                 # about 2 minutes
     .venv/bin/python benchmarks/needle3d_rates.py --deflection    # linear against neo-Hookean, about 2 minutes
-    .venv/bin/python benchmarks/needle3d_rates.py --thesis-size   # near 29 562 neo-Hookean elements, about 1 minute
+    .venv/bin/python benchmarks/needle3d_rates.py --thesis-size   # near 29 562 elements, one solve per update, about 70 s
 
 Not a test: times depend on the machine and its load; compare the ratios of one run.
 """
@@ -41,12 +41,13 @@ def cube(material, start: int = 2, levels: int = 3):
 
 
 def insert(material, h_ref: float, preconditioner: str, solves_per_update: int | None = None, entry=ENTRY,
-           friction_scale: float = 1.0, start: int = 2, levels: int = 3):
+           friction_scale: float = 1.0, start: int = 2, levels: int = 3, inexact: bool = False):
     body = cube(material, start, levels)
     method = "cg" if isinstance(material, snede.LinearElastic) else "newton"
+    options = {"pc_type": preconditioner, **({"snes_ksp_ew": None} if inexact and method == "newton" else {})}
     needle = snede.NeedleInsertion(body, entry, DIRECTION, snede.FrictionProfile.figure_6_4(friction_scale), radius=RADIUS,
                                    h_ref=h_ref, method=method, rtol=1e-3, solves_per_update=solves_per_update,
-                                   petsc_options={"pc_type": preconditioner})
+                                   petsc_options=options)
     start = time.perf_counter()
     report = needle.insert(DEPTH, 0.5 * h_ref)
     seconds = time.perf_counter() - start
@@ -70,12 +71,17 @@ def deflection_table() -> None:
 
 def thesis_size_table() -> None:
     """Near the thesis's 29 562 neo-Hookean elements: the 3 × 3 × 3 box bisected twice as the
-    start mesh, one solve per update, mg (about 1 minute)."""
-    print("\nNear the thesis's element count: start 3 × 3 × 3 bisected twice, neo-Hookean, one solve per update, mg:")
-    for divisions in (64, 72):
-        body, needle, report, seconds, _ = insert(snede.NeoHookean(34e3, 0.34), SIZE / divisions, "mg", 1,
-                                                  entry=needle3d.ENTRY, start=3, levels=2)
-        print(f"   h_ref 0.1 m/{divisions}: {body.mesh.n_cells} tetrahedra, {report}; {seconds:.2f} s", flush=True)
+    start mesh, one solve per update (the haptic loop), mg, Newton exact and inexact
+    (Eisenstat–Walker); the linear material at the larger size for the update rate (about 70 s)."""
+    print("\nNear the thesis's element count: start 3 × 3 × 3 bisected twice, one solve per update, mg:")
+    neo_hookean, linear = snede.NeoHookean(34e3, 0.34), snede.LinearElastic(34e3, 0.34)
+    for material, divisions, inexact in ((neo_hookean, 64, False), (neo_hookean, 64, True), (neo_hookean, 72, False),
+                                         (neo_hookean, 72, True), (linear, 72, False)):
+        body, needle, report, seconds, _ = insert(material, SIZE / divisions, "mg", 1, entry=needle3d.ENTRY, start=3,
+                                                  levels=2, inexact=inexact)
+        newton = {False: ", exact Newton", True: ", inexact Newton (snes_ksp_ew)"}[inexact] if material is neo_hookean else ""
+        print(f"   {type(material).__name__}{newton}, h_ref 0.1 m/{divisions}: {body.mesh.n_cells} tetrahedra, {report}; "
+              f"{seconds:.2f} s, {report.updates / seconds:.1f} updates/s", flush=True)
 
 
 def main() -> None:

@@ -135,10 +135,11 @@ class NeedleInsertion:
       in 3D also along the shaft, every element within ``radius`` of the axis.
     * ``method``, ``rtol``, ``criterion``, ``petsc_options``, ``options_prefix`` (default
       ``needle_``): the static solver (see :class:`snede.StaticSolver`); stopping (6.9).
-      Newton is inexact by default (``snes_ksp_ew``, Eisenstat–Walker: early steps solve
-      their linear systems loosely): 15 % less time on the 22k-tetrahedron neo-Hookean
-      insertion of ``benchmarks/needle3d_rates.py --thesis-size``, the same stopping test.
-      ``petsc_options={"snes_ksp_ew": "false"}`` (or ``-needle_snes_ksp_ew false``) turns it off.
+      Inexact Newton (``petsc_options={"snes_ksp_ew": None}`` or ``-needle_snes_ksp_ew``,
+      Eisenstat–Walker: early steps solve their linear systems loosely) pays in the haptic
+      loop: 12–16 % less time with one solve per update at 22k–34k neo-Hookean tetrahedra
+      (``benchmarks/needle3d_rates.py --thesis-size``), but 8 % more when every update is
+      settled (the ``needle3d`` scene: more Newton steps, each with a new preconditioner).
     * ``max_rearrangements``: per update; reaching it is reported, not hidden.
     * ``solves_per_update``: None (default) relaxes and rearranges until no node changes state
       in every update; an integer k allows at most k solves per update and carries pending
@@ -179,8 +180,6 @@ class NeedleInsertion:
         max_iterations = _checks.count(max_iterations, "max_iterations", 1)
         self.body = body
         self.friction_profile = friction
-        if method == "newton":
-            petsc_options = {"snes_ksp_ew": None, **(petsc_options or {})}
         bisection = body.mesh._bisection() if h_ref is not None else None
         self._impl = _snede.NeedleInsertion(
             body._model, bisection, np.asarray(entry, dtype=np.float64), np.asarray(direction, dtype=np.float64),
