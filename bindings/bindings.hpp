@@ -28,6 +28,7 @@ void bind_needle(py::module_& m);
 void bind_cutting(py::module_& m);
 void bind_planar_cutting(py::module_& m);
 void bind_surface_cutting(py::module_& m);
+void bind_distributed(py::module_& m);
 
 using DoubleArray = py::array_t<double, py::array::c_style | py::array::forcecast>;
 using IndexArray = py::array_t<std::int64_t, py::array::c_style | py::array::forcecast>;

@@ -18,4 +18,5 @@ PYBIND11_MODULE(_snede, m) {
   snede::bindings::bind_cutting(m);
   snede::bindings::bind_planar_cutting(m);
   snede::bindings::bind_surface_cutting(m);
+  snede::bindings::bind_distributed(m);
 }

@@ -6,6 +6,7 @@
 
 #include <petscdm.h>
 #include <petscksp.h>
+#include <petscsf.h>
 #include <petscsnes.h>
 #include <petscts.h>
 
@@ -25,6 +26,7 @@ inline const char* petsc_type_name(SNES*) noexcept { return "SNES"; }
 inline const char* petsc_type_name(TS*) noexcept { return "TS"; }
 inline const char* petsc_type_name(DM*) noexcept { return "DM"; }
 inline const char* petsc_type_name(PetscContainer*) noexcept { return "PetscContainer"; }
+inline const char* petsc_type_name(PetscSF*) noexcept { return "PetscSF"; }
 
 template <class Object, PetscErrorCode (*destroy)(Object*)>
 class PetscHandle {
@@ -75,5 +77,6 @@ using SnesHandle = PetscHandle<SNES, SNESDestroy>;
 using TsHandle = PetscHandle<TS, TSDestroy>;
 using DmHandle = PetscHandle<DM, DMDestroy>;
 using ContainerHandle = PetscHandle<PetscContainer, PetscContainerDestroy>;
+using SfHandle = PetscHandle<PetscSF, PetscSFDestroy>;
 
 }  // namespace snede

@@ -1,0 +1,33 @@
+// A mesh partitioned over the ranks of a communicator by PETSc (issue 18): the serial cells
+// given on rank 0 are handed to DMPlex, distributed with DMPlexDistribute (its partitioner,
+// PTScotch or the default, chosen with -petscpartitioner_type), and each rank's part is held
+// in snede's own connectivity, so the same kernels run on the local cells. Cells are not
+// overlapped: a cell lives on exactly one rank; a vertex on several ranks' cells is owned by
+// one of them (PETSc's point SF decides) and a ghost on the others.
+#pragma once
+
+#include <mpi.h>
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "mesh/mesh.hpp"
+
+namespace snede {
+
+struct DistributedMesh {
+  MPI_Comm comm = MPI_COMM_NULL;
+  std::unique_ptr<Mesh> local;                // this rank's cells, local vertex ids 0..n-1
+  std::vector<std::int64_t> global_vertex;    // the serial mesh's id of each local vertex
+  std::vector<std::uint8_t> owned;            // 1 where this rank owns the local vertex
+  std::int64_t n_global_vertices = 0;
+  std::int64_t n_global_cells = 0;
+};
+
+// Collective on `comm`. Rank 0 passes the serial mesh (every vertex used by a cell); the other
+// ranks pass nullptr. Throws the same std::invalid_argument on every rank when rank 0's mesh is
+// missing or has unused vertices (the decision is broadcast, so no rank waits for another).
+DistributedMesh distribute_mesh(MPI_Comm comm, const Mesh* serial);
+
+}  // namespace snede
