@@ -1,5 +1,8 @@
 #include "bindings.hpp"
 #include "mesh/distributed_mesh.hpp"
+#include "solve/distributed_static.hpp"
+
+#include <pybind11/stl.h>
 
 namespace snede::bindings {
 
@@ -9,6 +12,7 @@ void bind_distributed(py::module_& m) {
           "local", [](DistributedMesh& d) -> Mesh& { return *d.local; }, py::return_value_policy::reference_internal)
       .def_property_readonly("global_vertex", [](const DistributedMesh& d) { return to_array(d.global_vertex, 1); })
       .def_property_readonly("owned", [](const DistributedMesh& d) { return to_array(d.owned, 1); })
+      .def_property_readonly("global_number", [](const DistributedMesh& d) { return to_array(d.global_number, 1); })
       .def_readonly("n_global_vertices", &DistributedMesh::n_global_vertices)
       .def_readonly("n_global_cells", &DistributedMesh::n_global_cells);
   // `comm` is the communicator's Fortran handle (mpi4py's Comm.py2f()).
@@ -18,6 +22,20 @@ void bind_distributed(py::module_& m) {
         return distribute_mesh(MPI_Comm_f2c(static_cast<MPI_Fint>(comm)), serial);
       },
       py::arg("comm"), py::arg("serial").none(true));
+
+  py::class_<DistributedStatic>(m, "DistributedStatic")
+      .def(py::init([](DistributedMesh& part, const py::handle& material, double thickness, std::vector<std::int64_t> fixed,
+                       std::vector<double> fixed_values, std::vector<std::int64_t> loaded, std::vector<double> forces) {
+             return std::make_unique<DistributedStatic>(
+                 part, material_from(material), thickness,
+                 DistributedConditions{std::move(fixed), std::move(fixed_values), std::move(loaded), std::move(forces)});
+           }),
+           py::arg("part"), py::arg("material"), py::arg("thickness"), py::arg("fixed"), py::arg("fixed_values"),
+           py::arg("loaded"), py::arg("forces"), py::keep_alive<1, 2>())
+      .def("solve", &DistributedStatic::solve, py::arg("method"), py::arg("rtol"), py::arg("max_iterations"),
+           py::arg("prefix"))
+      .def("energy", &DistributedStatic::energy)
+      .def("local_displacement", [](DistributedStatic& s) { return to_array(s.local_displacement(), 1); });
 }
 
 }  // namespace snede::bindings

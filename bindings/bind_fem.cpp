@@ -8,6 +8,16 @@
 #include <optional>
 
 namespace snede::bindings {
+
+Material material_from(const py::handle& object) {
+  if (py::isinstance<LinearElastic>(object)) return object.cast<LinearElastic>();
+  if (py::isinstance<StVenantKirchhoff>(object)) return object.cast<StVenantKirchhoff>();
+  if (py::isinstance<NeoHookean>(object)) return object.cast<NeoHookean>();
+  if (py::isinstance<VerondaWestmann>(object)) return object.cast<VerondaWestmann>();
+  throw py::type_error("material must be LinearElastic, StVenantKirchhoff, NeoHookean or VerondaWestmann, got " +
+                       py::str(py::type::of(object)).cast<std::string>());
+}
+
 namespace {
 
 
@@ -51,15 +61,6 @@ py::array_t<double> stiffness_of(const ElasticBody& body, ElementId e, const Dou
 }
 
 // std::variant's caster needs default-constructible alternatives; materials have none.
-Material material_from(const py::handle& object) {
-  if (py::isinstance<LinearElastic>(object)) return object.cast<LinearElastic>();
-  if (py::isinstance<StVenantKirchhoff>(object)) return object.cast<StVenantKirchhoff>();
-  if (py::isinstance<NeoHookean>(object)) return object.cast<NeoHookean>();
-  if (py::isinstance<VerondaWestmann>(object)) return object.cast<VerondaWestmann>();
-  throw py::type_error("material must be LinearElastic, StVenantKirchhoff, NeoHookean or VerondaWestmann, got " +
-                       py::str(py::type::of(object)).cast<std::string>());
-}
-
 std::unique_ptr<ElasticBody> make_body(Mesh& mesh, const py::handle& material, double density, double thickness) {
   return std::make_unique<ElasticBody>(mesh, material_from(material), density, thickness);
 }

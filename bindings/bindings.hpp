@@ -9,12 +9,16 @@
 #include <vector>
 
 #include "core/solver_options.hpp"
+#include "fem/material.hpp"
 #include "mesh/vertex_parents.hpp"
 #include "solve/static_solver.hpp"
 
 namespace snede::bindings {
 
 namespace py = pybind11;
+
+// The engine's Material from a Python material object (TypeError for anything else).
+Material material_from(const py::handle& object);
 
 void bind_core(py::module_& m);
 void bind_mesh(py::module_& m);

@@ -100,18 +100,18 @@ DistributedMesh distribute_mesh(MPI_Comm comm, const Mesh* serial) {
   PetscInt c_start = 0, c_end = 0, v_start = 0, v_end = 0;
   SNEDE_PETSC(DMPlexGetHeightStratum(part, 0, &c_start, &c_end));
   SNEDE_PETSC(DMPlexGetDepthStratum(part, 0, &v_start, &v_end));
-  // Ghost vertices: the leaves of the point SF (owned by another rank).
-  std::vector<std::uint8_t> owned(static_cast<std::size_t>(v_end - v_start), 1);
-  PetscSF point_sf = nullptr;
-  SNEDE_PETSC(DMGetPointSF(part, &point_sf));
-  PetscInt n_roots = 0, n_leaves = 0;
-  const PetscInt* leaves = nullptr;
-  const PetscSFNode* remotes = nullptr;
-  SNEDE_PETSC(PetscSFGetGraph(point_sf, &n_roots, &n_leaves, &leaves, &remotes));
-  for (PetscInt k = 0; k < n_leaves && n_roots >= 0; ++k) {
-    const PetscInt point = leaves ? leaves[k] : k;
-    if (point >= v_start && point < v_end) owned[static_cast<std::size_t>(point - v_start)] = 0;
+  // PETSc's vertex numbering (from the point SF): −(n + 1) marks a ghost whose owner numbers it n.
+  IS numbering = nullptr;
+  SNEDE_PETSC(DMPlexGetVertexNumbering(part, &numbering));
+  const PetscInt* numbers = nullptr;
+  SNEDE_PETSC(ISGetIndices(numbering, &numbers));
+  std::vector<std::uint8_t> owned;
+  std::vector<std::int64_t> global_number;
+  for (PetscInt v = 0; v < v_end - v_start; ++v) {
+    owned.push_back(numbers[v] >= 0);
+    global_number.push_back(numbers[v] >= 0 ? numbers[v] : -(numbers[v] + 1));
   }
+  SNEDE_PETSC(ISRestoreIndices(numbering, &numbers));
 
   Vec local_coordinates = nullptr;
   PetscSection section = nullptr;
@@ -146,6 +146,7 @@ DistributedMesh distribute_mesh(MPI_Comm comm, const Mesh* serial) {
   result.local = std::make_unique<Mesh>(cell_dim, space_dim, std::move(points), local_cells);
   result.global_vertex = std::move(global_vertex);
   result.owned = std::move(owned);
+  result.global_number = std::move(global_number);
   result.n_global_vertices = shape[2];
   result.n_global_cells = shape[3];
   return result;

@@ -21,6 +21,9 @@ struct DistributedMesh {
   std::unique_ptr<Mesh> local;                // this rank's cells, local vertex ids 0..n-1
   std::vector<std::int64_t> global_vertex;    // the serial mesh's id of each local vertex
   std::vector<std::uint8_t> owned;            // 1 where this rank owns the local vertex
+  // PETSc's vertex numbering: each rank's owned vertices are numbered contiguously, in rank
+  // order; a ghost carries its owner's number. A distributed vector's row block of a vertex.
+  std::vector<std::int64_t> global_number;
   std::int64_t n_global_vertices = 0;
   std::int64_t n_global_cells = 0;
 };

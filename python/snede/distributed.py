@@ -7,7 +7,10 @@ each local vertex (``global_vertex``), and which of them the rank owns (``owned`
 several ranks' cells is owned by exactly one). Cells are not overlapped. A problem with rank
 0's input raises the same ``ValueError`` on every rank. Run with ``mpirun -n N``.
 
-Solvers on a distributed mesh are not there yet: this is the partition they will run on.
+:class:`DistributedStatic` solves a static problem on the parts: the same element kernels on
+every rank's cells, PETSc's SNES and KSP on a vector distributed by owned vertices, so the
+same problem gives the same displacement on any number of ranks. It has no preconditioner
+yet, no gravity, and the mesh cannot be edited (cuts, bisection, needles stay serial).
 """
 from __future__ import annotations
 
@@ -17,6 +20,7 @@ import numpy as np
 
 from snede import _snede
 from snede.mesh import Mesh
+from snede.result import SolveResult
 
 
 @dataclass
@@ -27,6 +31,7 @@ class DistributedMesh:
     local: Mesh
     global_vertex: np.ndarray  # (n_local_vertices,) serial vertex id of each local vertex
     owned: np.ndarray  # (n_local_vertices,) bool: this rank owns the vertex
+    global_number: np.ndarray  # (n_local_vertices,) PETSc's numbering: owned rows contiguous per rank
     n_global_vertices: int
     n_global_cells: int
     _impl: object = None  # keeps the engine's part (which holds `local`) alive
@@ -41,5 +46,54 @@ def distribute(mesh: Mesh | None, comm=None) -> DistributedMesh:
     serial = mesh._impl if (comm.rank == 0 and isinstance(mesh, Mesh)) else None
     part = _snede.distribute_mesh(comm.py2f(), serial)
     return DistributedMesh(comm=comm, local=Mesh._wrap(part.local), global_vertex=part.global_vertex.ravel().copy(),
-                           owned=part.owned.ravel().astype(bool), n_global_vertices=int(part.n_global_vertices),
+                           owned=part.owned.ravel().astype(bool), global_number=part.global_number.ravel().copy(),
+                           n_global_vertices=int(part.n_global_vertices),
                            n_global_cells=int(part.n_global_cells), _impl=part)
+
+
+class DistributedStatic:
+    """A static solve on a :class:`DistributedMesh` (collective throughout).
+
+    ``DistributedStatic(part, material, *, thickness=None, fixed=(), fixed_values=None,
+    forces=None)``: ``fixed`` are serial vertex ids held at ``fixed_values`` ((len(fixed), dim),
+    default zero); ``forces`` maps serial vertex ids to nodal force vectors. Every rank passes
+    the same conditions. ``solve(method="cg" | "newton", rtol=1e-8)`` returns a
+    :class:`snede.SolveResult` with PETSc's reason; ``-<prefix>snes_*``/``-<prefix>ksp_*``
+    options apply (prefix ``dstatic_``)."""
+
+    def __init__(self, part: DistributedMesh, material, *, thickness=None, fixed=(), fixed_values=None, forces=None):
+        self.part = part
+        dim = part.local.dim
+        fixed = np.asarray(fixed, dtype=np.int64).ravel()
+        values = np.zeros((len(fixed), dim)) if fixed_values is None else np.asarray(fixed_values, dtype=np.float64)
+        if values.shape != (len(fixed), dim):
+            raise ValueError(f"fixed_values must be ({len(fixed)}, {dim}), got shape {values.shape}")
+        forces = forces or {}
+        loaded = np.array(list(forces), dtype=np.int64)
+        loads = np.array([np.asarray(f, dtype=np.float64) for f in forces.values()]).reshape(len(loaded), -1) \
+            if forces else np.zeros((0, dim))
+        if len(loaded) and loads.shape[1] != dim:
+            raise ValueError(f"forces must be {dim}-vectors, got {loads.shape[1]} components")
+        self._impl = _snede.DistributedStatic(part._impl, material, float(thickness or 0.0), fixed.tolist(),
+                                              values.ravel().tolist(), loaded.tolist(), loads.ravel().tolist())
+
+    def solve(self, method: str = "cg", rtol: float = 1e-8, max_iterations: int = 10000,
+              options_prefix: str = "dstatic_") -> SolveResult:
+        return SolveResult._from_engine(self._impl.solve(method, float(rtol), int(max_iterations), options_prefix))
+
+    def energy(self) -> float:
+        """Π(u) = Π_int(u) − f_extᵀu of the whole body."""
+        return self._impl.energy()
+
+    def local_displacement(self) -> np.ndarray:
+        """(n_local_vertices, dim): this rank's vertices, owned and ghosts."""
+        return self._impl.local_displacement().reshape(-1, self.part.local.dim)
+
+    def gathered_displacement(self) -> np.ndarray:
+        """(n_global_vertices, dim) in the serial mesh's vertex order, on every rank."""
+        u, part = self.local_displacement(), self.part
+        pieces = part.comm.allgather((part.global_vertex[part.owned], u[part.owned]))
+        out = np.zeros((part.n_global_vertices, part.local.dim))
+        for ids, values in pieces:
+            out[ids] = values
+        return out

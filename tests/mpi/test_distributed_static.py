@@ -1,0 +1,103 @@
+"""snede.DistributedStatic on 1, 2 and 3 ranks (see test_distribute.py for how they run): a
+cantilever loaded at its tip, linear (cg, no preconditioner) and neo-Hookean (Newton). Every
+rank count gives the displacement snede's serial StaticSolver gives on the whole mesh (to
+1e-8 relative: both stop at their own rtol 1e-12), the same CG iteration count, and the same
+energy; a bar in 2D (plane stress) too. Collective calls are made on every rank."""
+import numpy as np
+import pytest
+from mpi4py import MPI
+
+import snede
+
+COMM = MPI.COMM_WORLD
+
+
+def cantilever(dim):
+    if dim == 3:
+        return snede.meshing.box((4.0, 1.0, 1.0), (8, 2, 2)), None
+    return snede.meshing.rectangle((4.0, 1.0), (16, 4)), 0.1
+
+
+def conditions(mesh):
+    x = mesh.points
+    fixed = np.flatnonzero(np.isclose(x[:, 0], 0.0))
+    tip = np.flatnonzero(np.isclose(x[:, 0], 4.0))
+    force = np.zeros(mesh.dim)
+    force[-1] = -200.0 / len(tip)
+    return fixed, tip, force
+
+
+def serial_solution(mesh, material, thickness, method):
+    fixed, tip, force = conditions(mesh)
+    body = snede.Body(mesh, material, thickness=thickness)
+    body.fix(fixed)
+    body.add_nodal_force(tip, force)
+    result = snede.StaticSolver(body, method, preconditioner="none", rtol=1e-12).solve()
+    assert result.converged, result
+    return body.displacement
+
+
+@pytest.mark.parametrize("dim", [3, 2])
+@pytest.mark.parametrize("material, method", [(snede.LinearElastic(1e5, 0.3), "cg"),
+                                              (snede.NeoHookean(1e5, 0.3), "newton")], ids=["linear-cg", "neohookean-newton"])
+def test_every_rank_count_gives_the_serial_displacement(dim, material, method):
+    serial, thickness = cantilever(dim)
+    fixed, tip, force = conditions(serial)
+    part = snede.distribute(serial if COMM.rank == 0 else None)
+    problem = snede.DistributedStatic(part, material, thickness=thickness, fixed=fixed,
+                                      forces={int(v): force for v in tip})
+    result = problem.solve(method, rtol=1e-12)
+    assert result.converged, result
+    u = problem.gathered_displacement()
+    expected = serial_solution(snede.meshing.box((4.0, 1.0, 1.0), (8, 2, 2)) if dim == 3 else cantilever(2)[0],
+                               material, thickness, method)
+    assert np.abs(u - expected).max() <= 1e-8 * np.abs(expected).max()
+    # What every rank holds agrees with the gathered field, ghosts included.
+    np.testing.assert_array_equal(problem.local_displacement(), u[part.global_vertex])
+    # The same numbers on every rank count: iterations (CG) and energy.
+    energy = problem.energy()
+    assert len(set(COMM.allgather(round(energy, 9)))) == 1
+    if method == "cg":
+        assert len(set(COMM.allgather(result.iterations))) == 1
+
+
+def test_iteration_count_and_energy_do_not_depend_on_the_rank_count():
+    """The linear cantilever's CG iteration count and energy, solved on this communicator and
+    on every rank alone (COMM_SELF, the whole mesh): equal (energy to 1e-12 relative)."""
+    serial, _ = cantilever(3)
+    fixed, tip, force = conditions(serial)
+    forces = {int(v): force for v in tip}
+    material = snede.LinearElastic(1e5, 0.3)
+    together = snede.DistributedStatic(snede.distribute(serial if COMM.rank == 0 else None), material, fixed=fixed,
+                                       forces=forces)
+    shared = together.solve("cg", rtol=1e-10)
+    alone = snede.DistributedStatic(snede.distribute(serial, MPI.COMM_SELF), material, fixed=fixed, forces=forces)
+    single = alone.solve("cg", rtol=1e-10, options_prefix="alone_")
+    assert shared.iterations == single.iterations
+    assert together.energy() == pytest.approx(alone.energy(), rel=1e-12)
+
+
+def test_an_inverted_element_is_never_converged():
+    """A neo-Hookean bar whose end is held 1.5 lengths back, through the bar: the elements next
+    to it are inverted (on whichever rank holds them), the residual is NaN on every rank, and
+    every rank reports PETSc's DIVERGED_FNORM_NAN."""
+    serial, _ = cantilever(3)
+    x = serial.points
+    fixed = np.flatnonzero(np.isclose(x[:, 0], 0.0) | np.isclose(x[:, 0], 4.0))
+    values = np.zeros((len(fixed), 3))
+    values[np.isclose(x[fixed, 0], 4.0), 0] = -6.0
+    part = snede.distribute(serial if COMM.rank == 0 else None)
+    problem = snede.DistributedStatic(part, snede.NeoHookean(1e5, 0.3), fixed=fixed, fixed_values=values)
+    result = problem.solve("newton", rtol=1e-10, max_iterations=20)
+    assert not result.converged
+    assert set(COMM.allgather(result.reason)) == {"DIVERGED_FNORM_NAN"}
+
+
+def test_bad_conditions_raise_the_same_error_everywhere():
+    serial, _ = cantilever(3)
+    part = snede.distribute(serial if COMM.rank == 0 else None)
+    with pytest.raises(ValueError, match="is not a vertex of the serial mesh"):
+        snede.DistributedStatic(part, snede.LinearElastic(1e5, 0.3), fixed=[len(serial.points)])
+    with pytest.raises(ValueError, match="fixed_values must be"):
+        snede.DistributedStatic(part, snede.LinearElastic(1e5, 0.3), fixed=[0, 1], fixed_values=np.zeros((3, 3)))
+    assert COMM.allreduce(1) == COMM.size
