@@ -226,7 +226,8 @@ SolveResult DistributedStatic::solve(const std::string& method, double rtol, int
     KSPConvergedReason ksp_reason = KSP_CONVERGED_ITERATING;
     SNEDE_PETSC(KSPGetConvergedReason(ksp, &ksp_reason));
     result.converged = ksp_reason > 0 && reason >= 0;
-    result.reason = ksp_reason > 0 || reason >= 0 ? KSPConvergedReasons[ksp_reason] : SNESConvergedReasons[reason];
+    // CG's own reason (DIVERGED_ITS, DIVERGED_INDEFINITE_MAT), unless CG never ran.
+    result.reason = ksp_reason != KSP_CONVERGED_ITERATING ? KSPConvergedReasons[ksp_reason] : SNESConvergedReasons[reason];
     result.iterations = static_cast<int>(linear);
   } else {
     result.converged = reason > 0;
