@@ -32,8 +32,8 @@ void bind_distributed(py::module_& m) {
            }),
            py::arg("part"), py::arg("material"), py::arg("thickness"), py::arg("fixed"), py::arg("fixed_values"),
            py::arg("loaded"), py::arg("forces"), py::keep_alive<1, 2>())
-      .def("solve", &DistributedStatic::solve, py::arg("method"), py::arg("rtol"), py::arg("max_iterations"),
-           py::arg("prefix"))
+      .def("solve", &DistributedStatic::solve, py::arg("method"), py::arg("preconditioner"), py::arg("rtol"),
+           py::arg("max_iterations"), py::arg("prefix"))
       .def("energy", &DistributedStatic::energy)
       .def("local_displacement", [](DistributedStatic& s) { return to_array(s.local_displacement(), 1); });
 }

@@ -37,6 +37,14 @@ PetscErrorCode jacobian_callback(SNES, Vec u, Mat, Mat, void* context) {
   return petsc_callback("snede distributed Jacobian", [&] { static_cast<DistributedStatic*>(context)->linearize_at(u); });
 }
 
+PetscErrorCode diagonal_callback(Mat A, Vec diagonal) {
+  return petsc_callback("snede distributed tangent MatGetDiagonal", [&] {
+    void* context = nullptr;
+    SNEDE_PETSC(MatShellGetContext(A, &context));
+    static_cast<DistributedStatic*>(context)->tangent_diagonal(diagonal);
+  });
+}
+
 PetscErrorCode mult_callback(Mat A, Vec d, Vec out) {
   return petsc_callback("snede distributed tangent MatMult", [&] {
     void* context = nullptr;
@@ -101,6 +109,7 @@ DistributedStatic::DistributedStatic(DistributedMesh& part, Material material, d
 
   SNEDE_PETSC(MatCreateShell(comm, n_owned * dim_, n_owned * dim_, PETSC_DETERMINE, PETSC_DETERMINE, this, tangent_.out()));
   SNEDE_PETSC(MatShellSetOperation(tangent_, MATOP_MULT, reinterpret_cast<void (*)(void)>(mult_callback)));
+  SNEDE_PETSC(MatShellSetOperation(tangent_, MATOP_GET_DIAGONAL, reinterpret_cast<void (*)(void)>(diagonal_callback)));
   SNEDE_PETSC(MatSetOption(tangent_, MAT_SYMMETRIC, PETSC_TRUE));
 
   // The state starts at the prescribed displacements (zero elsewhere).
@@ -190,9 +199,37 @@ void DistributedStatic::tangent_mult(Vec d, Vec out) {
   SNEDE_PETSC(VecRestoreArray(out, &y));
 }
 
-SolveResult DistributedStatic::solve(const std::string& method, double rtol, int max_iterations, const std::string& prefix) {
+void DistributedStatic::tangent_diagonal(Vec diagonal) {
+  // diag(P K P + I − P): the element stiffnesses' diagonals on this rank's cells, the ghosts'
+  // shares added into their owners, 1 on fixed dofs (for PCJACOBI).
+  std::fill(out_local_.begin(), out_local_.end(), 0.0);
+  const auto d = static_cast<std::size_t>(dim_);
+  body_.for_each_element_stiffness(u_linearization_, [&](ElementId, std::span<const VertexId> vertices,
+                                                           std::span<const double> K) {
+    const std::size_t n = vertices.size() * d;
+    for (std::size_t row = 0; row < n; ++row)
+      out_local_[static_cast<std::size_t>(vertices[row / d]) * d + row % d] += K[row * n + row];
+  });
+  for (std::size_t i = 0; i < out_local_.size(); ++i)
+    if (fixed_local_[i]) out_local_[i] = 0.0;
+  SNEDE_PETSC(VecZeroEntries(diagonal));
+  add_to_global(out_local_, diagonal);
+  PetscInt start = 0, end = 0;
+  SNEDE_PETSC(VecGetOwnershipRange(diagonal, &start, &end));
+  PetscScalar* y = nullptr;
+  SNEDE_PETSC(VecGetArray(diagonal, &y));
+  for (std::size_t k = 0; k < owned_rows_.size(); ++k)
+    if (fixed_local_[static_cast<std::size_t>(owned_local_dof_[k])]) y[owned_rows_[k] - start] = 1.0;
+  SNEDE_PETSC(VecRestoreArray(diagonal, &y));
+}
+
+SolveResult DistributedStatic::solve(const std::string& method, const std::string& preconditioner, double rtol,
+                                     int max_iterations, const std::string& prefix) {
   if (method != "cg" && method != "newton")
     throw std::invalid_argument("DistributedStatic.solve: method must be \"cg\" or \"newton\", got \"" + method + "\"");
+  if (preconditioner != "none" && preconditioner != "jacobi")
+    throw std::invalid_argument("DistributedStatic.solve: preconditioner must be \"none\" or \"jacobi\", got \"" +
+                                preconditioner + "\"");
   if (!(rtol > 0)) throw std::invalid_argument("DistributedStatic.solve: rtol must be positive");
   const double start = wall_seconds();
   SnesHandle snes;
@@ -206,7 +243,7 @@ SolveResult DistributedStatic::solve(const std::string& method, double rtol, int
   SNEDE_PETSC(SNESGetKSP(snes, &ksp));
   SNEDE_PETSC(KSPSetType(ksp, KSPCG));
   SNEDE_PETSC(KSPGetPC(ksp, &pc));
-  SNEDE_PETSC(PCSetType(pc, PCNONE));
+  SNEDE_PETSC(PCSetType(pc, preconditioner == "jacobi" ? PCJACOBI : PCNONE));
   if (method == "cg") {
     SNEDE_PETSC(SNESSetType(snes, SNESKSPONLY));
     SNEDE_PETSC(KSPSetTolerances(ksp, rtol, 0.0, PETSC_DEFAULT, max_iterations));

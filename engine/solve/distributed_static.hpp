@@ -41,8 +41,10 @@ class DistributedStatic {
   DistributedStatic& operator=(const DistributedStatic&) = delete;
 
   // Collective. "cg": one Newton step solved by CG (linear problems); "newton": Newton with
-  // CG inside, until ‖F‖ ≤ rtol ‖F(u₀)‖. No preconditioner; options under `prefix`.
-  SolveResult solve(const std::string& method, double rtol, int max_iterations, const std::string& prefix);
+  // CG inside, until ‖F‖ ≤ rtol ‖F(u₀)‖. Preconditioner "none" or "jacobi" (the tangent's
+  // diagonal, assembled across the ranks); options under `prefix`.
+  SolveResult solve(const std::string& method, const std::string& preconditioner, double rtol, int max_iterations,
+                    const std::string& prefix);
   // Π(u) = Π_int(u) − f_extᵀu over the whole body (collective).
   double energy();
   // The displacement of this rank's vertices (owned and ghosts), (n_local_vertices, dim).
@@ -52,6 +54,7 @@ class DistributedStatic {
   void residual(Vec u, Vec F);
   void linearize_at(Vec u);
   void tangent_mult(Vec d, Vec out);
+  void tangent_diagonal(Vec diagonal);
 
  private:
   void to_local(Vec global, std::vector<double>& local);

@@ -9,8 +9,8 @@ several ranks' cells is owned by exactly one). Cells are not overlapped. A probl
 
 :class:`DistributedStatic` solves a static problem on the parts: the same element kernels on
 every rank's cells, PETSc's SNES and KSP on a vector distributed by owned vertices, so the
-same problem gives the same displacement on any number of ranks. It has no preconditioner
-yet, no gravity, and the mesh cannot be edited (cuts, bisection, needles stay serial).
+same problem gives the same displacement on any number of ranks. Its preconditioner is
+Jacobi or none; it has no gravity yet, and the mesh cannot be edited (cuts, bisection, needles stay serial).
 """
 from __future__ import annotations
 
@@ -57,7 +57,8 @@ class DistributedStatic:
     ``DistributedStatic(part, material, *, thickness=None, fixed=(), fixed_values=None,
     forces=None)``: ``fixed`` are serial vertex ids held at ``fixed_values`` ((len(fixed), dim),
     default zero); ``forces`` maps serial vertex ids to nodal force vectors. Every rank passes
-    the same conditions. ``solve(method="cg" | "newton", rtol=1e-8)`` returns a
+    the same conditions. ``solve(method="cg" | "newton", rtol=1e-8, preconditioner="none" |
+    "jacobi")`` returns a
     :class:`snede.SolveResult` with PETSc's reason; ``-<prefix>snes_*``/``-<prefix>ksp_*``
     options apply (prefix ``dstatic_``)."""
 
@@ -77,9 +78,12 @@ class DistributedStatic:
         self._impl = _snede.DistributedStatic(part._impl, material, float(thickness or 0.0), fixed.tolist(),
                                               values.ravel().tolist(), loaded.tolist(), loads.ravel().tolist())
 
-    def solve(self, method: str = "cg", rtol: float = 1e-8, max_iterations: int = 10000,
+    def solve(self, method: str = "cg", rtol: float = 1e-8, max_iterations: int = 10000, preconditioner: str = "none",
               options_prefix: str = "dstatic_") -> SolveResult:
-        return SolveResult._from_engine(self._impl.solve(method, float(rtol), int(max_iterations), options_prefix))
+        """``method`` "cg" (linear) or "newton"; ``preconditioner`` "none" or "jacobi" (the
+        tangent's diagonal, summed across the ranks)."""
+        return SolveResult._from_engine(self._impl.solve(method, preconditioner, float(rtol), int(max_iterations),
+                                                         options_prefix))
 
     def energy(self) -> float:
         """Π(u) = Π_int(u) − f_extᵀu of the whole body."""

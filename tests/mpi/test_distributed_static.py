@@ -101,3 +101,49 @@ def test_bad_conditions_raise_the_same_error_everywhere():
     with pytest.raises(ValueError, match="fixed_values must be"):
         snede.DistributedStatic(part, snede.LinearElastic(1e5, 0.3), fixed=[0, 1], fixed_values=np.zeros((3, 3)))
     assert COMM.allreduce(1) == COMM.size
+
+
+def test_jacobi_is_the_same_on_every_rank_count_and_saves_iterations():
+    """Jacobi on the diagonal summed across the ranks: the serial StaticSolver's displacement,
+    the same CG iteration count on every rank count as on each rank alone, and fewer
+    iterations than without a preconditioner."""
+    serial, _ = cantilever(3)
+    fixed, tip, force = conditions(serial)
+    forces = {int(v): force for v in tip}
+    material = snede.LinearElastic(1e5, 0.3)
+    shared = snede.DistributedStatic(snede.distribute(serial if COMM.rank == 0 else None), material, fixed=fixed,
+                                     forces=forces)
+    jacobi = shared.solve("cg", rtol=1e-10, preconditioner="jacobi")
+    alone = snede.DistributedStatic(snede.distribute(serial, MPI.COMM_SELF), material, fixed=fixed, forces=forces)
+    single = alone.solve("cg", rtol=1e-10, preconditioner="jacobi", options_prefix="alone_")
+    plain = snede.DistributedStatic(snede.distribute(serial, MPI.COMM_SELF), material, fixed=fixed, forces=forces)
+    none = plain.solve("cg", rtol=1e-10, options_prefix="plain_")
+    assert jacobi.converged and jacobi.iterations == single.iterations < none.iterations
+    expected = serial_solution(snede.meshing.box((4.0, 1.0, 1.0), (8, 2, 2)), material, None, "cg")
+    u = shared.gathered_displacement()
+    assert np.abs(u - expected).max() <= 1e-7 * np.abs(expected).max()
+
+
+def test_parts_touching_at_a_single_vertex():
+    """Two tetrahedra sharing only a vertex (one per rank on 2 ranks): the shared vertex is
+    owned once, and a solve with both far faces held and the free corners pulled gives the
+    serial displacement."""
+    points = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1], [-1, 0, 0], [0, -1, 0], [0, 0, -1.0]])
+    serial = snede.Mesh(points, [[0, 1, 2, 3], [0, 4, 6, 5]])
+    part = snede.distribute(serial if COMM.rank == 0 else None)
+    owners = np.concatenate(COMM.allgather(part.global_vertex[part.owned]))
+    np.testing.assert_array_equal(np.sort(owners), np.arange(7))
+    if COMM.size == 2:
+        assert COMM.allgather(part.local.n_cells) == [1, 1]  # PETSc's partitioner splits them
+    material = snede.LinearElastic(1e5, 0.3)
+    fixed, forces = [1, 2, 4, 5], {3: (0.0, 0.0, 10.0), 6: (0.0, 0.0, -10.0), 0: (5.0, 0.0, 0.0)}
+    problem = snede.DistributedStatic(part, material, fixed=fixed, forces=forces)
+    result = problem.solve("cg", rtol=1e-12)
+    assert result.converged, result
+    body = snede.Body(snede.Mesh(points, [[0, 1, 2, 3], [0, 4, 6, 5]]), material)
+    body.fix(fixed)
+    for vertex, force in forces.items():
+        body.add_nodal_force([vertex], force)
+    assert snede.StaticSolver(body, "cg", preconditioner="none", rtol=1e-12).solve().converged
+    np.testing.assert_allclose(problem.gathered_displacement(), body.displacement, rtol=0,
+                               atol=1e-9 * np.abs(body.displacement).max())
