@@ -166,7 +166,8 @@ def _command(parser, args, unknown, petsc) -> int:
     _check_scene_options(parser, args, scenes[args.scene])
     scene = scenes[args.scene].build(args)
     summary = run_scene.run(scene, args.method, args.rtol, args.out, progress=not args.quiet)
-    run_scene.print_table([summary])
+    if summary.get("rank", 0) == 0:  # on several MPI ranks, rank 0 reports
+        run_scene.print_table([summary])
     return 0 if summary["converged"] else 1
 
 

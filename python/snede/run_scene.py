@@ -90,6 +90,13 @@ def picture_arguments(scene, method: str) -> dict:
             "decorate": scene.decorate, "fixed": fixed, **(scene.picture() if scene.picture else {})}
 
 
+def _world():
+    """MPI.COMM_WORLD when the run has several ranks (mpirun -n N), else None."""
+    from mpi4py import MPI
+
+    return MPI.COMM_WORLD if MPI.COMM_WORLD.size > 1 else None
+
+
 def run(scene, method: str | None, rtol: float | None, out: Path, progress: bool = True) -> dict:
     """Solve (or evolve) the scene with ``method`` (None: ``fitting_method(scene)``), write the
     series, the picture and summary.json; the summary."""
@@ -97,9 +104,23 @@ def run(scene, method: str | None, rtol: float | None, out: Path, progress: bool
     rtol = rtol or scene.default_rtol
     body = scene.body
     folder = Path(out) / scene.name
-    folder.mkdir(parents=True, exist_ok=True)
-    writer = SeriesWriter(folder / scene.name)
-    outcome = (scene.evolve or partial(solve_once, scene))(method, rtol, writer, folder, progress)
+    comm = _world()
+    if comm is not None:
+        # Several MPI ranks (issue 18): a static solve over all of them, rank 0 writes.
+        from snede.distributed_scene import solve_distributed, unsupported
+
+        if (why := unsupported(scene, method)) is not None:
+            raise NotImplementedError(f"{scene.name} on {comm.size} MPI ranks: {why}")
+        if comm.rank == 0:
+            folder.mkdir(parents=True, exist_ok=True)
+        writer = SeriesWriter(folder / scene.name) if comm.rank == 0 else None
+        outcome = solve_distributed(scene, method, rtol, writer, comm)
+        if comm.rank != 0:
+            return {"scene": scene.name, "rank": comm.rank, **outcome}
+    else:
+        folder.mkdir(parents=True, exist_ok=True)
+        writer = SeriesWriter(folder / scene.name)
+        outcome = (scene.evolve or partial(solve_once, scene))(method, rtol, writer, folder, progress)
     picture = plot_body(body, folder / f"{scene.name}.png", **picture_arguments(scene, method))
     value = scene.probe(body)
     files = outcome.pop("files", {})

@@ -1,0 +1,46 @@
+"""A static scene on several ranks through the command line's path (run_scene.run, as
+`mpirun -n N python -m snede run cantilever` calls it): the probe and files as the serial run
+gives them; scenes that change their mesh are refused with NotImplementedError on every rank.
+On one rank the serial path runs (the serial tests cover it)."""
+import argparse
+import json
+from pathlib import Path
+
+import pytest
+from mpi4py import MPI
+
+from snede import StaticSolver, run_scene
+from snede.scenes import cantilever, needle
+
+COMM = MPI.COMM_WORLD
+several = pytest.mark.skipif(COMM.size == 1, reason="the distributed path needs several ranks")
+
+
+def options(**given):
+    defaults = {"divisions": None, "material": None, "speed": None, "mesh_size": None}
+    return argparse.Namespace(**{**defaults, **given})
+
+
+@several
+def test_cantilever_on_several_ranks_matches_the_serial_run(tmp_path_factory):
+    folder = Path(COMM.bcast(str(tmp_path_factory.mktemp("mpi")) if COMM.rank == 0 else None))
+    summary = run_scene.run(cantilever.build(options(divisions=8)), None, 1e-10, folder, progress=False)
+    assert summary["converged"] and summary["ranks"] == COMM.size
+    assert sum(summary["cells_per_rank"]) == 8 * 2 * 2 * 6
+    if COMM.rank == 0:
+        # Rank 0 wrote what a serial run writes, and its probe is the serial solve's.
+        written = json.loads((folder / "cantilever" / "summary.json").read_text())
+        assert written["value"] == pytest.approx(summary["value"])
+        assert (folder / "cantilever" / "cantilever.xdmf").exists() and (folder / "cantilever" / "cantilever.png").exists()
+        serial = cantilever.build(options(divisions=8))
+        assert StaticSolver(serial.body, "cg", preconditioner="none", rtol=1e-12).solve().converged
+        assert summary["value"] == pytest.approx(serial.probe(serial.body), rel=1e-8)
+    COMM.Barrier()
+
+
+@several
+def test_a_scene_that_changes_its_mesh_is_refused_on_every_rank(tmp_path_factory):
+    folder = Path(COMM.bcast(str(tmp_path_factory.mktemp("mpi")) if COMM.rank == 0 else None))
+    with pytest.raises(NotImplementedError, match=r"needle on \d MPI ranks: it changes its mesh"):
+        run_scene.run(needle.build(options()), None, None, folder, progress=False)
+    assert COMM.allreduce(1) == COMM.size  # no rank left waiting
