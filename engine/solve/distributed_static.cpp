@@ -187,15 +187,20 @@ void DistributedStatic::tangent_mult(Vec d, Vec out) {
     if (fixed_local_[i]) out_local_[i] = 0.0;
   SNEDE_PETSC(VecZeroEntries(out));
   add_to_global(out_local_, out);
+  set_fixed_rows(out, d, 0.0);
+}
+
+void DistributedStatic::set_fixed_rows(Vec out, Vec source, double value) {
   PetscInt start = 0, end = 0;
   SNEDE_PETSC(VecGetOwnershipRange(out, &start, &end));
   PetscScalar* y = nullptr;
   const PetscScalar* x = nullptr;
   SNEDE_PETSC(VecGetArray(out, &y));
-  SNEDE_PETSC(VecGetArrayRead(d, &x));
+  if (source) SNEDE_PETSC(VecGetArrayRead(source, &x));
   for (std::size_t k = 0; k < owned_rows_.size(); ++k)
-    if (fixed_local_[static_cast<std::size_t>(owned_local_dof_[k])]) y[owned_rows_[k] - start] = x[owned_rows_[k] - start];
-  SNEDE_PETSC(VecRestoreArrayRead(d, &x));
+    if (const PetscInt i = owned_rows_[k] - start; fixed_local_[static_cast<std::size_t>(owned_local_dof_[k])])
+      y[i] = x ? x[i] : value;
+  if (source) SNEDE_PETSC(VecRestoreArrayRead(source, &x));
   SNEDE_PETSC(VecRestoreArray(out, &y));
 }
 
@@ -214,13 +219,7 @@ void DistributedStatic::tangent_diagonal(Vec diagonal) {
     if (fixed_local_[i]) out_local_[i] = 0.0;
   SNEDE_PETSC(VecZeroEntries(diagonal));
   add_to_global(out_local_, diagonal);
-  PetscInt start = 0, end = 0;
-  SNEDE_PETSC(VecGetOwnershipRange(diagonal, &start, &end));
-  PetscScalar* y = nullptr;
-  SNEDE_PETSC(VecGetArray(diagonal, &y));
-  for (std::size_t k = 0; k < owned_rows_.size(); ++k)
-    if (fixed_local_[static_cast<std::size_t>(owned_local_dof_[k])]) y[owned_rows_[k] - start] = 1.0;
-  SNEDE_PETSC(VecRestoreArray(diagonal, &y));
+  set_fixed_rows(diagonal, nullptr, 1.0);
 }
 
 SolveResult DistributedStatic::solve(const std::string& method, const std::string& preconditioner, double rtol,

@@ -59,6 +59,8 @@ class DistributedStatic {
  private:
   void to_local(Vec global, std::vector<double>& local);
   void add_to_global(const std::vector<double>& local, Vec global);
+  // The fixed owned rows of `out` set to `source`'s entries, or to `value` without a source.
+  void set_fixed_rows(Vec out, Vec source, double value);
 
   DistributedMesh& part_;
   ElasticBody body_;
