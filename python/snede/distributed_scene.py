@@ -1,11 +1,12 @@
 """A static scene on several MPI ranks (issue 18): ``mpirun -n 2 python -m snede run
 cantilever``. Rank 0 builds the scene as usual; its mesh is distributed (snede.distribute), the
-held vertices and nodal loads become a snede.DistributedStatic (Jacobi-preconditioned CG or
+held vertices and the external forces (nodal loads and the lumped gravity, the same whatever
+the state) become a snede.DistributedStatic (Jacobi-preconditioned CG or
 Newton), and the solution is gathered back into rank 0's body, which writes the series, the
 picture and the summary as a serial run does (the files are written by rank 0, not
 collectively). What does not run distributed yet is refused on every rank with
 NotImplementedError naming it: scenes that change their mesh or evolve in time (cuts,
-bisection, needles stay serial), gravity, membranes, and methods other than cg and newton.
+bisection, needles stay serial), membranes, and methods other than cg and newton.
 """
 from __future__ import annotations
 
@@ -25,8 +26,6 @@ def unsupported(scene, method: str) -> str | None:
         return f"method {method!r} (distributed solves are cg and newton)"
     if body.mesh.is_surface:
         return "membranes are not distributed yet"
-    if body._model.has_gravity:
-        return "gravity is not distributed yet"
     if scene.fixed is None:
         return "the scene does not say which vertices it holds"
     return None

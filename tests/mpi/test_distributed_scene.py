@@ -10,7 +10,7 @@ import pytest
 from mpi4py import MPI
 
 from snede import StaticSolver, run_scene
-from snede.scenes import cantilever, needle
+from snede.scenes import cantilever, cylinder, needle
 
 COMM = MPI.COMM_WORLD
 several = pytest.mark.skipif(COMM.size == 1, reason="the distributed path needs several ranks")
@@ -35,6 +35,20 @@ def test_cantilever_on_several_ranks_matches_the_serial_run(tmp_path_factory):
         serial = cantilever.build(options(divisions=8))
         assert StaticSolver(serial.body, "cg", preconditioner="none", rtol=1e-12).solve().converged
         assert summary["value"] == pytest.approx(serial.probe(serial.body), rel=1e-8)
+    COMM.Barrier()
+
+
+@several
+def test_a_neo_hookean_cylinder_under_gravity_matches_the_serial_solve(tmp_path_factory):
+    """Gravity reaches the distributed solve as the lumped nodal forces of the serial mesh
+    (they do not depend on the state): Newton on N ranks gives the serial tip sag."""
+    folder = Path(COMM.bcast(str(tmp_path_factory.mktemp("mpi")) if COMM.rank == 0 else None))
+    summary = run_scene.run(cylinder.build(options()), None, 1e-10, folder, progress=False)
+    assert summary["converged"] and summary["ranks"] == COMM.size
+    if COMM.rank == 0:
+        serial = cylinder.build(options())
+        assert StaticSolver(serial.body, "newton", preconditioner="none", rtol=1e-12).solve().converged
+        assert summary["value"] == pytest.approx(serial.probe(serial.body), rel=1e-7)
     COMM.Barrier()
 
 
