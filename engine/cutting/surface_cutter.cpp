@@ -382,7 +382,7 @@ bool SurfaceCutter::enter(const Contact& contact, PlanarCutReport& report) {
     if (entry < 0 && (entry = split(y, z, mu)) >= 0) ++report.nodes_inserted;
   }
   if (entry < 0) return false;
-  incisions_.push_back({entry, true, !on_boundary(entry), contact.way == Contact::Way::crest});
+  incisions_.push_back({entry, true, contact.way == Contact::Way::crest});
   touched_.push_back(entry);
   ++report.entries;
   return true;

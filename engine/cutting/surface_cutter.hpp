@@ -86,7 +86,6 @@ class SurfaceCutter {
   struct Incision {
     VertexId active;
     bool entering;   // the entry node: nothing cut yet
-    bool inside;     // entered inside the surface (its first edge is split so that it opens)
     bool branching;  // entered at a fold's crest: expected to branch
   };
   struct StarHit {  // the scalpel meets triangle (b, y, z) at these barycentric weights
