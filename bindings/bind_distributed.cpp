@@ -1,5 +1,6 @@
 #include "bindings.hpp"
 #include "mesh/distributed_mesh.hpp"
+#include "solve/distributed_relaxation.hpp"
 #include "solve/distributed_static.hpp"
 
 #include <pybind11/stl.h>
@@ -24,18 +25,25 @@ void bind_distributed(py::module_& m) {
       py::arg("comm"), py::arg("serial").none(true));
 
   py::class_<DistributedStatic>(m, "DistributedStatic")
-      .def(py::init([](DistributedMesh& part, const py::handle& material, double thickness, std::vector<std::int64_t> fixed,
-                       std::vector<double> fixed_values, std::vector<std::int64_t> loaded, std::vector<double> forces) {
+      .def(py::init([](DistributedMesh& part, const py::handle& material, double density, double thickness,
+                       std::vector<std::int64_t> fixed, std::vector<double> fixed_values, std::vector<std::int64_t> loaded,
+                       std::vector<double> forces) {
              return std::make_unique<DistributedStatic>(
-                 part, material_from(material), thickness,
+                 part, material_from(material), density, thickness,
                  DistributedConditions{std::move(fixed), std::move(fixed_values), std::move(loaded), std::move(forces)});
            }),
-           py::arg("part"), py::arg("material"), py::arg("thickness"), py::arg("fixed"), py::arg("fixed_values"),
+           py::arg("part"), py::arg("material"), py::arg("density"), py::arg("thickness"), py::arg("fixed"), py::arg("fixed_values"),
            py::arg("loaded"), py::arg("forces"), py::keep_alive<1, 2>())
       .def("solve", &DistributedStatic::solve, py::arg("method"), py::arg("preconditioner"), py::arg("rtol"),
            py::arg("max_iterations"), py::arg("prefix"))
       .def("energy", &DistributedStatic::energy)
       .def("local_displacement", [](DistributedStatic& s) { return to_array(s.local_displacement(), 1); });
+
+  py::class_<DistributedRelaxation>(m, "DistributedRelaxation")
+      .def(py::init<DistributedStatic&, double, double, const std::string&>(), py::arg("problem"), py::arg("damping"),
+           py::arg("dt"), py::arg("prefix"), py::keep_alive<1, 2>())
+      .def("run", &DistributedRelaxation::run, py::arg("rtol"), py::arg("max_steps"))
+      .def_property_readonly("dt", &DistributedRelaxation::time_step);
 }
 
 }  // namespace snede::bindings

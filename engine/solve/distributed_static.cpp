@@ -10,6 +10,10 @@
 
 #include "core/error.hpp"
 #include "core/petsc_util.hpp"
+#include "mesh/element_quality.hpp"
+#include "solve/dynamic_relaxation.hpp"
+#include "solve/static_solver.hpp"
+#include "solve/stopping.hpp"
 
 namespace snede {
 namespace {
@@ -29,12 +33,19 @@ void check_conditions(const DistributedConditions& c, int dim, std::int64_t n_ve
   check(c.loaded, c.forces.size(), "loaded");
 }
 
-PetscErrorCode residual_callback(SNES, Vec u, Vec F, void* context) {
-  return petsc_callback("snede distributed residual", [&] { static_cast<DistributedStatic*>(context)->residual(u, F); });
+PetscErrorCode residual_callback(SNES snes, Vec u, Vec F, void* context) {
+  return petsc_callback("snede distributed residual", [&] {
+    // Every rank agrees on the verdict, so line searches shorten the same step everywhere.
+    if (!static_cast<DistributedStatic*>(context)->residual(u, F)) SNEDE_PETSC(SNESSetFunctionDomainError(snes));
+  });
 }
 
-PetscErrorCode jacobian_callback(SNES, Vec u, Mat, Mat, void* context) {
-  return petsc_callback("snede distributed Jacobian", [&] { static_cast<DistributedStatic*>(context)->linearize_at(u); });
+PetscErrorCode jacobian_callback(SNES, Vec u, Mat J, Mat P, void* context) {
+  return petsc_callback("snede distributed Jacobian", [&] {
+    auto* problem = static_cast<DistributedStatic*>(context);
+    problem->linearize_at(u);
+    if (P != J) problem->assemble_tangent();
+  });
 }
 
 PetscErrorCode diagonal_callback(Mat A, Vec diagonal) {
@@ -55,9 +66,9 @@ PetscErrorCode mult_callback(Mat A, Vec d, Vec out) {
 
 }  // namespace
 
-DistributedStatic::DistributedStatic(DistributedMesh& part, Material material, double thickness,
+DistributedStatic::DistributedStatic(DistributedMesh& part, Material material, double density, double thickness,
                                      const DistributedConditions& conditions)
-    : part_(part), body_(*part.local, material, 1.0 /* density: no inertia or gravity here */, thickness),
+    : part_(part), body_(*part.local, material, density, thickness),
       dim_(part.local->dim()) {
   check_conditions(conditions, dim_, part.n_global_vertices);
   const MPI_Comm comm = part.comm;
@@ -79,7 +90,8 @@ DistributedStatic::DistributedStatic(DistributedMesh& part, Material material, d
     if (const auto found = local_of.find(conditions.loaded[k]); found != local_of.end())
       for (int d = 0; d < dim_; ++d) load_local[found->second * dim_ + d] += conditions.forces[k * dim_ + d];
 
-  std::vector<PetscInt> rows(n_dofs);
+  std::vector<PetscInt>& rows = local_rows_;
+  rows.resize(n_dofs);
   PetscInt n_owned = 0;
   for (std::size_t v = 0; v < n_local; ++v) {
     for (int d = 0; d < dim_; ++d) rows[v * dim_ + d] = static_cast<PetscInt>(part.global_number[v] * dim_ + d);
@@ -147,13 +159,13 @@ void DistributedStatic::add_to_global(const std::vector<double>& local, Vec glob
   SNEDE_PETSC(VecScatterEnd(scatter_, local_vec_, global, ADD_VALUES, SCATTER_REVERSE));
 }
 
-void DistributedStatic::residual(Vec u, Vec F) {
-  // F = P(−f_int(u) − f_ext) + (I − P)(u − ū).
+bool DistributedStatic::residual(Vec u, Vec F) {
+  // F = P(−f_int(u) − f_ext) + (I − P)(u − ū); the fixed rows' −f_int − f_ext are the reactions.
   to_local(u, u_local_);
   EvaluationReport report;
   std::vector<double> f(u_local_.size(), 0.0);
   body_.internal_forces(u_local_, f, report);
-  for (std::size_t i = 0; i < f.size(); ++i) f[i] = fixed_local_[i] ? 0.0 : -f[i];
+  for (double& x : f) x = -x;
   SNEDE_PETSC(VecZeroEntries(F));
   add_to_global(f, F);
   PetscInt start = 0, end = 0;
@@ -162,17 +174,82 @@ void DistributedStatic::residual(Vec u, Vec F) {
   const PetscScalar* x = nullptr;
   SNEDE_PETSC(VecGetArray(F, &r));
   SNEDE_PETSC(VecGetArrayRead(u, &x));
-  // An inverted element (or an overflow) on any rank makes the residual NaN on its owned rows,
-  // so the norm every rank sees is NaN and SNES stops with DIVERGED_FNORM_NAN.
-  const bool failed = !report.inverted.empty() || !report.domain_errors.empty();
+  const bool inverted = !report.inverted.empty() && forbids_inversion(body_.material());
+  // Ranks with an inverted element, ranks with a non-finite one, ‖reactions‖².
+  double sums[3] = {inverted ? 1.0 : 0.0, report.domain_errors.empty() ? 0.0 : 1.0, 0.0};
   for (std::size_t k = 0; k < owned_rows_.size(); ++k) {
     const PetscInt i = owned_rows_[k] - start;
     const auto dof = static_cast<std::size_t>(owned_local_dof_[k]);
-    r[i] = fixed_local_[dof] ? x[i] - fixed_value_local_[dof] : r[i] - load_owned_[k];
-    if (failed) r[i] = std::numeric_limits<double>::quiet_NaN();
+    r[i] -= load_owned_[k];
+    if (fixed_local_[dof]) {
+      sums[2] += r[i] * r[i];
+      r[i] = x[i] - fixed_value_local_[dof];
+    }
   }
+  MPI_Allreduce(MPI_IN_PLACE, sums, 3, MPI_DOUBLE, MPI_SUM, part_.comm);
+  last_reaction_norm_ = std::sqrt(sums[2]);
+  last_failure_ = sums[1] > 0 ? "DIVERGED_NONFINITE_STATE" : sums[0] > 0 ? "DIVERGED_INVERTED_ELEMENTS" : "";
+  // A failure on any rank makes the residual NaN everywhere: no solver can call it converged.
+  const bool admissible = last_failure_.empty();
+  if (!admissible)
+    for (std::size_t k = 0; k < owned_rows_.size(); ++k) r[owned_rows_[k] - start] = std::numeric_limits<double>::quiet_NaN();
   SNEDE_PETSC(VecRestoreArrayRead(u, &x));
   SNEDE_PETSC(VecRestoreArray(F, &r));
+  return admissible;
+}
+
+double DistributedStatic::external_force_norm() {
+  double local = 0;
+  for (double f : load_owned_) local += f * f;
+  double total = 0;
+  MPI_Allreduce(&local, &total, 1, MPI_DOUBLE, MPI_SUM, part_.comm);
+  return std::sqrt(total);
+}
+
+double DistributedStatic::force_scale() {
+  const std::vector<double>& p = part_.local->points();
+  std::vector<double> low(dim_, std::numeric_limits<double>::infinity()), high(dim_, std::numeric_limits<double>::infinity());
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    low[i % dim_] = std::min(low[i % dim_], p[i]);
+    high[i % dim_] = std::min(high[i % dim_], -p[i]);  // −max, so one MIN reduction serves both
+  }
+  MPI_Allreduce(MPI_IN_PLACE, low.data(), dim_, MPI_DOUBLE, MPI_MIN, part_.comm);
+  MPI_Allreduce(MPI_IN_PLACE, high.data(), dim_, MPI_DOUBLE, MPI_MIN, part_.comm);
+  double diameter = 0;
+  for (int k = 0; k < dim_; ++k) diameter += (-high[k] - low[k]) * (-high[k] - low[k]);
+  return snede::force_scale(young_modulus(body_.material()), part_.local->cell_dim(), body_.thickness(),
+                            std::sqrt(diameter));
+}
+
+void DistributedStatic::inverse_lumped_mass(Vec out) {
+  const std::vector<double> mass = body_.lumped_mass();
+  for (std::size_t i = 0; i < out_local_.size(); ++i) out_local_[i] = mass[i / static_cast<std::size_t>(dim_)];
+  SNEDE_PETSC(VecZeroEntries(out));
+  add_to_global(out_local_, out);
+  PetscInt n = 0;
+  PetscScalar* m = nullptr;
+  SNEDE_PETSC(VecGetLocalSize(out, &n));
+  SNEDE_PETSC(VecGetArray(out, &m));
+  for (PetscInt i = 0; i < n; ++i) m[i] = m[i] > 0 ? 1 / m[i] : 0.0;
+  SNEDE_PETSC(VecRestoreArray(out, &m));
+}
+
+double DistributedStatic::cfl_time_step() {
+  double dt = snede::cfl_time_step(*part_.local, body_.material(), body_.density());
+  MPI_Allreduce(MPI_IN_PLACE, &dt, 1, MPI_DOUBLE, MPI_MIN, part_.comm);
+  return dt;
+}
+
+Mat DistributedStatic::assembled_tangent() {
+  if (!assembled_)
+    assembled_ = std::make_unique<DistributedAssembledTangent>(part_, body_, local_rows_, fixed_local_,
+                                                               static_cast<PetscInt>(owned_rows_.size()));
+  return assembled_->mat();
+}
+
+void DistributedStatic::assemble_tangent() {
+  assembled_tangent();
+  assembled_->assemble(u_linearization_);
 }
 
 void DistributedStatic::tangent_mult(Vec d, Vec out) {
@@ -224,10 +301,14 @@ void DistributedStatic::tangent_diagonal(Vec diagonal) {
 
 SolveResult DistributedStatic::solve(const std::string& method, const std::string& preconditioner, double rtol,
                                      int max_iterations, const std::string& prefix) {
-  if (method != "cg" && method != "newton")
-    throw std::invalid_argument("DistributedStatic.solve: method must be \"cg\" or \"newton\", got \"" + method + "\"");
-  if (preconditioner != "none" && preconditioner != "jacobi")
-    throw std::invalid_argument("DistributedStatic.solve: preconditioner must be \"none\" or \"jacobi\", got \"" +
+  if (method != "cg" && method != "newton" && method != "ncg")
+    throw std::invalid_argument("DistributedStatic.solve: method must be \"cg\", \"newton\" or \"ncg\", got \"" +
+                                method + "\"");
+  if (preconditioner != "none" && preconditioner != "jacobi" && preconditioner != "gamg")
+    throw std::invalid_argument("DistributedStatic.solve: preconditioner must be \"none\", \"jacobi\" or \"gamg\", got \"" +
+                                preconditioner + "\"");
+  if (method == "ncg" && preconditioner != "none")
+    throw std::invalid_argument("DistributedStatic.solve: nonlinear CG ('ncg') takes no preconditioner, got \"" +
                                 preconditioner + "\"");
   if (!(rtol > 0)) throw std::invalid_argument("DistributedStatic.solve: rtol must be positive");
   const double start = wall_seconds();
@@ -235,19 +316,29 @@ SolveResult DistributedStatic::solve(const std::string& method, const std::strin
   SNEDE_PETSC(SNESCreate(part_.comm, snes.out()));
   SNEDE_PETSC(SNESSetOptionsPrefix(snes, prefix.c_str()));
   SNEDE_PETSC(SNESSetFunction(snes, work_, residual_callback, this));
-  // The shell needs no assembly: SNES's Jacobian step only sets the linearisation point.
-  SNEDE_PETSC(SNESSetJacobian(snes, tangent_, tangent_, jacobian_callback, this));
+  // The shell needs no assembly: SNES's Jacobian step sets the linearisation point (and fills
+  // GAMG's assembled copy). Nonlinear CG's line search takes K(x)d from it too.
+  const bool assembled = preconditioner == "gamg";
+  SNEDE_PETSC(SNESSetJacobian(snes, tangent_, assembled ? assembled_tangent() : tangent_.get(), jacobian_callback, this));
   KSP ksp = nullptr;
   PC pc = nullptr;
   SNEDE_PETSC(SNESGetKSP(snes, &ksp));
   SNEDE_PETSC(KSPSetType(ksp, KSPCG));
   SNEDE_PETSC(KSPGetPC(ksp, &pc));
-  SNEDE_PETSC(PCSetType(pc, preconditioner == "jacobi" ? PCJACOBI : PCNONE));
+  SNEDE_PETSC(PCSetType(pc, preconditioner == "jacobi" ? PCJACOBI : assembled ? PCGAMG : PCNONE));
   if (method == "cg") {
     SNEDE_PETSC(SNESSetType(snes, SNESKSPONLY));
     SNEDE_PETSC(KSPSetTolerances(ksp, rtol, 0.0, PETSC_DEFAULT, max_iterations));
-  } else {
+  } else if (method == "newton") {
     SNEDE_PETSC(SNESSetType(snes, SNESNEWTONLS));
+    SNEDE_PETSC(SNESSetTolerances(snes, 0.0, rtol, 0.0, max_iterations, PETSC_DEFAULT));
+  } else {
+    register_line_searches();
+    SNEDE_PETSC(SNESSetType(snes, SNESNCG));
+    SNEDE_PETSC(SNESNCGSetType(snes, SNES_NCG_PRP));
+    SNESLineSearch line_search = nullptr;
+    SNEDE_PETSC(SNESGetLineSearch(snes, &line_search));
+    SNEDE_PETSC(SNESLineSearchSetType(line_search, "snede_secant"));
     SNEDE_PETSC(SNESSetTolerances(snes, 0.0, rtol, 0.0, max_iterations, PETSC_DEFAULT));
   }
   SNEDE_PETSC(SNESSetFromOptions(snes));
@@ -271,11 +362,12 @@ SolveResult DistributedStatic::solve(const std::string& method, const std::strin
     result.iterations = static_cast<int>(iterations);
     result.linear_iterations = static_cast<int>(linear);
   }
-  residual(u_, work_);
+  // An inverted element or a non-finite state is never converged.
+  const bool admissible = residual(u_, work_);
   PetscReal norm = 0;
   SNEDE_PETSC(VecNorm(work_, NORM_2, &norm));
   result.residual_norm = norm;
-  if (!std::isfinite(norm)) result.converged = false;  // an inverted element is never converged
+  if (!admissible || !std::isfinite(norm)) result.converged = false;
   result.energy = energy();
   result.seconds = wall_seconds() - start;
   return result;

@@ -4,7 +4,9 @@
 // scatters the state to the rank's vertices (owned and ghosts), evaluates locally, and adds
 // the ghosts' contributions into their owners (a VecScatter, forward then reverse with
 // ADD_VALUES); energies are summed over the ranks. The tangent is a matrix-free MatShell on the
-// communicator, so PETSc's SNES and KSP run unchanged on any number of ranks.
+// communicator, so PETSc's SNES and KSP run unchanged on any number of ranks; GAMG gets an
+// assembled MPIAIJ copy (distributed_assembly.hpp), and dynamic relaxation drives the same
+// residual through a TS (distributed_relaxation.hpp).
 //
 // Constraints and loads are given by the serial mesh's vertex ids, the same on every rank:
 // fixed vertices (all components), their displacements, and nodal forces. A fixed dof's
@@ -20,6 +22,7 @@
 #include "core/petsc_handle.hpp"
 #include "fem/elastic_body.hpp"
 #include "mesh/distributed_mesh.hpp"
+#include "solve/distributed_assembly.hpp"
 #include "solve/solve_result.hpp"
 
 namespace snede {
@@ -34,15 +37,19 @@ struct DistributedConditions {
 class DistributedStatic {
  public:
   // Collective. Throws std::invalid_argument (the same on every rank) for conditions of the
-  // wrong size or ids outside the serial mesh.
-  DistributedStatic(DistributedMesh& part, Material material, double thickness, const DistributedConditions& conditions);
+  // wrong size or ids outside the serial mesh. The density only sets the lumped masses of
+  // dynamic relaxation (no gravity here: give it as nodal forces).
+  DistributedStatic(DistributedMesh& part, Material material, double density, double thickness,
+                    const DistributedConditions& conditions);
   ~DistributedStatic();
   DistributedStatic(const DistributedStatic&) = delete;
   DistributedStatic& operator=(const DistributedStatic&) = delete;
 
   // Collective. "cg": one Newton step solved by CG (linear problems); "newton": Newton with
-  // CG inside, until ‖F‖ ≤ rtol ‖F(u₀)‖. Preconditioner "none" or "jacobi" (the tangent's
-  // diagonal, assembled across the ranks); options under `prefix`.
+  // CG inside; "ncg": nonlinear CG (Polak-Ribière) with the secant line search of §4.4.2. Both
+  // nonlinear methods stop when ‖F‖ ≤ rtol ‖F(u₀)‖. Preconditioner (cg and newton) "none",
+  // "jacobi" (the tangent's diagonal, assembled across the ranks) or "gamg" (on the assembled
+  // tangent); options under `prefix`.
   SolveResult solve(const std::string& method, const std::string& preconditioner, double rtol, int max_iterations,
                     const std::string& prefix);
   // Π(u) = Π_int(u) − f_extᵀu over the whole body (collective).
@@ -50,11 +57,36 @@ class DistributedStatic {
   // The displacement of this rank's vertices (owned and ghosts), (n_local_vertices, dim).
   std::vector<double> local_displacement();
 
-  // The SNES callbacks' work.
-  void residual(Vec u, Vec F);
+  // What the solvers (SNES callbacks, DistributedRelaxation) use. All collective.
+  // F = P(−f_int(u) − f_ext) + (I − P)(u − ū). Returns false when an element on some rank is
+  // inverted (for a material that forbids it) or not finite; F is then NaN on every rank.
+  bool residual(Vec u, Vec F);
+  // ‖reactions‖ (the residual −f_int − f_ext on the fixed dofs) from the latest residual().
+  double last_reaction_norm() const { return last_reaction_norm_; }
+  // Why the latest residual() failed ("DIVERGED_INVERTED_ELEMENTS", "DIVERGED_NONFINITE_STATE"),
+  // or empty.
+  const std::string& last_failure() const { return last_failure_; }
+  double external_force_norm();
+  // (6.9)'s force scale E·H² (E·t·H in 2D), H the whole body's diameter.
+  double force_scale();
+  // 1/m per owned dof from the lumped masses (§2.5) summed over the ranks, 0 without mass.
+  void inverse_lumped_mass(Vec out);
+  // (2.61) on the whole mesh: the smallest over the ranks.
+  double cfl_time_step();
+  // The fixed owned rows of `v` set to zero (a motion the constraints allow).
+  void zero_fixed_rows(Vec v) { set_fixed_rows(v, nullptr, 0.0); }
   void linearize_at(Vec u);
   void tangent_mult(Vec d, Vec out);
   void tangent_diagonal(Vec diagonal);
+  // The assembled tangent (for GAMG), made on first use; assemble_tangent() fills it at the
+  // linearisation point.
+  Mat assembled_tangent();
+  void assemble_tangent();
+
+  Vec state() const { return u_; }
+  MPI_Comm comm() const { return part_.comm; }
+  const Material& material() const { return body_.material(); }
+  std::int64_t n_global_dofs() const { return part_.n_global_vertices * dim_; }
 
  private:
   void to_local(Vec global, std::vector<double>& local);
@@ -68,12 +100,16 @@ class DistributedStatic {
   std::vector<std::uint8_t> fixed_local_;   // per local dof
   std::vector<double> fixed_value_local_;   // per local dof
   std::vector<double> load_owned_;          // per owned dof (forces counted once, at the owner)
+  std::vector<PetscInt> local_rows_;        // global row of each local dof (owned and ghost)
   std::vector<PetscInt> owned_rows_;        // global row of each owned dof, in local order
   std::vector<PetscInt> owned_local_dof_;   // local dof of each owned dof
   VecHandle u_, work_;
   Vec local_vec_ = nullptr;                 // sequential, all local dofs
   VecScatter scatter_ = nullptr;
   MatHandle tangent_;
+  std::unique_ptr<DistributedAssembledTangent> assembled_;
+  double last_reaction_norm_ = 0;
+  std::string last_failure_;
   std::vector<double> u_local_, u_linearization_, d_local_, out_local_;
 };
 

@@ -15,9 +15,6 @@ namespace {
 
 // ---- Helpers of DynamicRelaxation -------------------------------------------------------
 
-// A blown-up state (§4.4.1).
-constexpr double blow_up_norm = 1e15;
-
 void project_onto_allowed_motions(const Model& model, Vec v) {
   PetscScalar* data = nullptr;
   PetscInt n = 0;
@@ -25,15 +22,6 @@ void project_onto_allowed_motions(const Model& model, Vec v) {
   SNEDE_PETSC(VecGetArray(v, &data));
   model.constraints().project({data, static_cast<std::size_t>(n)});
   SNEDE_PETSC(VecRestoreArray(v, &data));
-}
-
-// Modulus of the dilatational wave: λ + 2μ in 3D, E/(1 − ν²) = 4μ(λ+μ)/(λ+2μ) in plane stress.
-// Veronda-Westmann's small-strain stiffness has λ' = λ + 2μ(2γ − 1) (§4.3.4, see
-// veronda_westmann.hpp): with λ alone its default step was up to 3× too large at γ = 50.
-double dilatational_modulus(const Material& material, int dim) {
-  Lame lame = std::visit([](const auto& m) { return m.lame; }, material);
-  if (const auto* vw = std::get_if<VerondaWestmann>(&material)) lame.lambda += 2 * lame.mu * (2 * vw->gamma - 1);
-  return dim == 3 ? lame.lambda + 2 * lame.mu : 4 * lame.mu * (lame.lambda + lame.mu) / (lame.lambda + 2 * lame.mu);
 }
 
 // Restores TS max steps (the user's cap, -<prefix>ts_max_steps) however a solve ends.
@@ -47,7 +35,27 @@ class MaxStepsGuard {
   PetscInt cap_;
 };
 
+// Modulus of the dilatational wave: λ + 2μ in 3D, E/(1 − ν²) = 4μ(λ+μ)/(λ+2μ) in plane stress.
+// Veronda-Westmann's small-strain stiffness has λ' = λ + 2μ(2γ − 1) (§4.3.4, see
+// veronda_westmann.hpp): with λ alone its default step was up to 3× too large at γ = 50.
+double dilatational_modulus(const Material& material, int dim) {
+  Lame lame = std::visit([](const auto& m) { return m.lame; }, material);
+  if (const auto* vw = std::get_if<VerondaWestmann>(&material)) lame.lambda += 2 * lame.mu * (2 * vw->gamma - 1);
+  return dim == 3 ? lame.lambda + 2 * lame.mu : 4 * lame.mu * (lame.lambda + lame.mu) / (lame.lambda + 2 * lame.mu);
+}
+
 }  // namespace
+
+// h: with the shortest edge (the h of the text around (2.61)) the estimate exceeded the
+// stability limit 2/√λ_max(M⁻¹K) by 1.4–1.8× on structured boxes and gmsh cylinders, so the
+// default step would blow up. The inscribed diameter is the element length in 1D and gave
+// 0.3–0.98 of the limit on the same meshes (2D and 3D, ν from 0 to 0.49).
+double cfl_time_step(const Mesh& mesh, const Material& material, double density) {
+  double size = std::numeric_limits<double>::infinity();
+  for (ElementId e : mesh.cell_ids()) size = std::min(size, element_quality(mesh.dim(), mesh.corners(e)).inscribed_diameter);
+  const double wave_speed = std::sqrt(dilatational_modulus(material, mesh.dim()) / density);
+  return 2 / std::sqrt(3.0) * size / wave_speed;  // (2.61)
+}
 
 // ---- DynamicRelaxation --------------------------------------------------------------------
 
@@ -111,17 +119,8 @@ DynamicRelaxation::~DynamicRelaxation() {
                    [](TS, PetscReal, Vec, Vec, void*) { return orphaned_callback_error("DynamicRelaxation"); }, nullptr);
 }
 
-// h: with the shortest edge (the h of the text around (2.61)) the estimate exceeded the
-// stability limit 2/√λ_max(M⁻¹K) by 1.4–1.8× on structured boxes and gmsh cylinders, so the
-// default step would blow up. The inscribed diameter is the element length in 1D and gave
-// 0.3–0.98 of the limit on the same meshes (2D and 3D, ν from 0 to 0.49).
 double DynamicRelaxation::cfl_time_step() const {
-  const Mesh& mesh = model_.body().mesh();
-  double size = std::numeric_limits<double>::infinity();
-  for (ElementId e : mesh.cell_ids()) size = std::min(size, element_quality(mesh.dim(), mesh.corners(e)).inscribed_diameter);
-  const double wave_speed =
-      std::sqrt(dilatational_modulus(model_.body().material(), mesh.dim()) / model_.body().density());
-  return 2 / std::sqrt(3.0) * size / wave_speed;  // (2.61)
+  return snede::cfl_time_step(model_.body().mesh(), model_.body().material(), model_.body().density());
 }
 
 double DynamicRelaxation::time_step() const {

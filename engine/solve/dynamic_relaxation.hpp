@@ -27,6 +27,13 @@
 
 namespace snede {
 
+// A blown-up state (§4.4.1): ‖u‖ beyond this.
+inline constexpr double blow_up_norm = 1e15;
+
+// (2.61): Δt = (2/√3) h/c, c = √((λ+2μ)/ρ) (plane stress: √(E/((1−ν²)ρ))), h the smallest
+// element size, taken as the diameter of the smallest inscribed sphere (circle); ∞ without cells.
+double cfl_time_step(const Mesh& mesh, const Material& material, double density);
+
 class DynamicRelaxation {
  public:
   // damping_eta: η ≥ 0 (1/s). dt: the time step (s), or 0 for the CFL estimate (2.61), which
@@ -44,8 +51,7 @@ class DynamicRelaxation {
   // Steps until ‖F(u)‖ ≤ rtol·√(‖f_ext‖² + ‖f_react‖²) (6.9), or max_steps ("DIVERGED_MAX_IT").
   SolveResult run(double rtol, int max_steps);
 
-  // (2.61): Δt = (2/√3) h/c, c = √((λ+2μ)/ρ) (plane stress: √(E/((1−ν²)ρ))), h the
-  // smallest element size, taken as the diameter of the smallest inscribed sphere (circle).
+  // (2.61) on the model's mesh (the free function cfl_time_step).
   double cfl_time_step() const;
   // §4.4.1: a step is stable if an undamped run from the current state does not blow up
   // within flop_budget flops (force kernel flops × elements per step), and at least

@@ -11,6 +11,7 @@
 #include <petsc/private/linesearchimpl.h>
 
 #include <cmath>
+#include <stdexcept>
 
 #include "core/error.hpp"
 #include "solve/static_solver.hpp"
@@ -26,9 +27,11 @@ constexpr int max_halvings = 30;
 void apply_line_search(SNESLineSearch ls, Slope slope_kind) {
   SNES snes = nullptr;
   SNEDE_PETSC(SNESLineSearchGetSNES(ls, &snes));
-  void* context = nullptr;
-  SNEDE_PETSC(SNESGetApplicationContext(snes, &context));
-  Model& model = callback_owner<StaticSolver>(context, "StaticSolver").model();
+  // K(x)d comes from the SNES's own Jacobian (a shell whose callback sets the linearisation
+  // point), so the search serves any problem that gives one: serial or distributed.
+  Mat J = nullptr, P = nullptr;
+  SNEDE_PETSC(SNESGetJacobian(snes, &J, &P, nullptr, nullptr));
+  if (!J) throw std::logic_error("the snede line searches need the SNES's Jacobian (SNESSetJacobian)");
   Vec X, F, Y, W, G;
   SNEDE_PETSC(SNESLineSearchGetVecs(ls, &X, &F, &Y, &W, &G));
   PetscReal steptol, maxstep, rtol, atol, ltol;
@@ -42,8 +45,8 @@ void apply_line_search(SNESLineSearch ls, Slope slope_kind) {
   SNEDE_PETSC(VecScale(d, -1.0));
 
   auto tangent_slope = [&](Vec at) {
-    model.set_linearization_point(at);
-    SNEDE_PETSC(MatMult(model.tangent(), d, Kd));
+    SNEDE_PETSC(SNESComputeJacobian(snes, at, J, P));
+    SNEDE_PETSC(MatMult(J, d, Kd));
     PetscScalar value = 0;
     SNEDE_PETSC(VecDot(d, Kd, &value));
     return value;

@@ -7,6 +7,7 @@
 #include "core/error.hpp"
 #include "core/norms.hpp"
 #include "core/petsc_util.hpp"
+#include "solve/stopping.hpp"
 #include "solve/tangent_assembly.hpp"
 
 namespace snede {
@@ -196,9 +197,7 @@ double Model::force_scale() const {
   double diameter = 0;
   for (int k = 0; k < dim(); ++k) diameter += (hi[k] - lo[k]) * (hi[k] - lo[k]);
   diameter = std::sqrt(diameter);
-  const double E = young_modulus(body_.material());
-  // A membrane (triangles in 3D) carries force through its thickness like a plane-stress sheet.
-  return body_.mesh().cell_dim() == 3 ? E * diameter * diameter : E * body_.thickness() * diameter;
+  return snede::force_scale(young_modulus(body_.material()), body_.mesh().cell_dim(), body_.thickness(), diameter);
 }
 
 bool Model::admissible(Vec u, std::string* why) const {

@@ -135,6 +135,8 @@ void StaticSolver::create_objects() {
   SNEDE_PETSC(SNESSetObjective(snes_, objective_callback, this));
   SNEDE_PETSC(SNESSetTolerances(snes_, 0.0, 0.0, 0.0, options_.max_iterations, -1));
   SNEDE_PETSC(SNESSetConvergenceTest(snes_, snes_converged_callback, this, nullptr));
+  // Nonlinear CG's line searches take K(x)d from the Jacobian too (line_search.cpp).
+  SNEDE_PETSC(SNESSetJacobian(snes_, model_.tangent(), preconditioning_matrix(), jacobian_callback, this));
   if (options_.method == StaticMethod::nonlinear_cg) {
     SNEDE_PETSC(SNESSetType(snes_, SNESNCG));
     SNEDE_PETSC(SNESNCGSetType(snes_, SNES_NCG_PRP));
@@ -143,7 +145,6 @@ void StaticSolver::create_objects() {
     SNEDE_PETSC(SNESLineSearchSetType(line_search, "snede_secant"));
   } else {
     SNEDE_PETSC(SNESSetType(snes_, SNESNEWTONLS));
-    SNEDE_PETSC(SNESSetJacobian(snes_, model_.tangent(), preconditioning_matrix(), jacobian_callback, this));
     SNEDE_PETSC(KSPSetType(inner, KSPCG));
     PC pc = nullptr;
     SNEDE_PETSC(KSPGetPC(inner, &pc));
@@ -211,8 +212,7 @@ void StaticSolver::follow_mesh_changes() {
     SNEDE_PETSC(SNESSetDM(snes_, dm));  // the SNES holds its own reference
     SNEDE_PETSC(SNESSetObjective(snes_, objective_callback, this));
     SNEDE_PETSC(SNESSetFunction(snes_, residual_, residual_callback, this));
-    if (options_.method == StaticMethod::newton)
-      SNEDE_PETSC(SNESSetJacobian(snes_, model_.tangent(), preconditioning_matrix(), jacobian_callback, this));
+    SNEDE_PETSC(SNESSetJacobian(snes_, model_.tangent(), preconditioning_matrix(), jacobian_callback, this));
   }
   if (needs_matrix_ || pc_type_ == PCMG) {
     // A reset PCGAMG keeps its levels' sizes ("Cannot change local size of Amat after use"):

@@ -8,6 +8,12 @@
 
 namespace snede {
 
+// E·H² (volumes) or E·t·H (sheets and membranes, which carry force through their thickness t):
+// the force that strains a body of diameter H by one, the scale of (6.9)'s round-off floor.
+inline double force_scale(double young_modulus, int cell_dim, double thickness, double diameter) {
+  return cell_dim == 3 ? young_modulus * diameter * diameter : young_modulus * thickness * diameter;
+}
+
 enum class StoppingCriterion { load_relative /* (6.8) */, with_reactions /* (6.9) */ };
 
 struct StoppingRule {

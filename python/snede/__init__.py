@@ -23,14 +23,14 @@ from snede.needle import FrictionProfile, NeedleInsertion  # noqa: F401
 from snede.cutting import TetrahedralCutter, CutReport  # noqa: F401
 from snede.planar_cutting import DelaunayCutter, PlanarCutReport  # noqa: F401
 from snede.surface_cutting import SurfaceCutter  # noqa: F401
-from snede.distributed import DistributedMesh, DistributedStatic, distribute  # noqa: F401
+from snede.distributed import DistributedMesh, DistributedRelaxation, DistributedStatic, distribute  # noqa: F401
 from snede.subdivision_cutting import SubdivisionCutter  # noqa: F401
 from snede import meshing  # noqa: F401
 
 __all__ = [
     "Mesh", "MeshQuality", "Body", "meshing", "StaticSolver", "DynamicRelaxation", "SolveResult",
     "FrictionProfile", "NeedleInsertion", "TetrahedralCutter", "CutReport", "DelaunayCutter", "PlanarCutReport", "SurfaceCutter",
-    "SubdivisionCutter", "DistributedMesh", "DistributedStatic", "distribute",
+    "SubdivisionCutter", "DistributedMesh", "DistributedRelaxation", "DistributedStatic", "distribute",
     "LinearElastic", "StVenantKirchhoff", "NeoHookean", "VerondaWestmann",
     "EditResult", "FileError", "InvalidMesh", "PetscError", "DomainError", "LockingWarning", "PETSc",
 ]

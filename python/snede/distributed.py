@@ -9,8 +9,10 @@ several ranks' cells is owned by exactly one). Cells are not overlapped. A probl
 
 :class:`DistributedStatic` solves a static problem on the parts: the same element kernels on
 every rank's cells, PETSc's SNES and KSP on a vector distributed by owned vertices, so the
-same problem gives the same displacement on any number of ranks. Its preconditioner is
-Jacobi or none; it has no gravity yet, and the mesh cannot be edited (cuts, bisection, needles stay serial).
+same problem gives the same displacement on any number of ranks: linear CG, Newton, nonlinear
+CG, with no preconditioner, Jacobi or GAMG; :class:`DistributedRelaxation` relaxes it in time.
+Gravity is given as nodal forces, and the mesh cannot be edited (cuts, bisection, needles stay
+serial).
 """
 from __future__ import annotations
 
@@ -18,7 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from snede import _snede
+from snede import _checks, _snede
 from snede.mesh import Mesh
 from snede.result import SolveResult
 
@@ -54,34 +56,41 @@ def distribute(mesh: Mesh | None, comm=None) -> DistributedMesh:
 class DistributedStatic:
     """A static solve on a :class:`DistributedMesh` (collective throughout).
 
-    ``DistributedStatic(part, material, *, thickness=None, fixed=(), fixed_values=None,
-    forces=None)``: ``fixed`` are serial vertex ids held at ``fixed_values`` ((len(fixed), dim),
-    default zero); ``forces`` maps serial vertex ids to nodal force vectors. Every rank passes
-    the same conditions. ``solve(method="cg" | "newton", rtol=1e-8, preconditioner="none" |
-    "jacobi")`` returns a
-    :class:`snede.SolveResult` with PETSc's reason; ``-<prefix>snes_*``/``-<prefix>ksp_*``
-    options apply (prefix ``dstatic_``)."""
+    ``DistributedStatic(part, material, *, density=1000.0, thickness=None, fixed=(),
+    fixed_values=None, forces=None)``: ``fixed`` are serial vertex ids held at ``fixed_values``
+    ((len(fixed), dim), default zero); ``forces`` maps serial vertex ids to nodal force vectors
+    (gravity too: there is no body force here). Every rank passes the same conditions. The
+    density only sets the masses of :class:`DistributedRelaxation`.
 
-    def __init__(self, part: DistributedMesh, material, *, thickness=None, fixed=(), fixed_values=None, forces=None):
+    ``solve(method="cg" | "newton" | "ncg", rtol=1e-8, preconditioner="none" | "jacobi" |
+    "gamg")`` returns a :class:`snede.SolveResult` with PETSc's reason; ``-<prefix>snes_*``/
+    ``-<prefix>ksp_*``/``-<prefix>pc_*`` options apply (prefix ``dstatic_``)."""
+
+    def __init__(self, part: DistributedMesh, material, *, density: float = 1000.0, thickness=None, fixed=(),
+                 fixed_values=None, forces=None):
         self.part = part
         dim = part.local.dim
         fixed = np.asarray(fixed, dtype=np.int64).ravel()
         values = np.zeros((len(fixed), dim)) if fixed_values is None else np.asarray(fixed_values, dtype=np.float64)
         if values.shape != (len(fixed), dim):
             raise ValueError(f"fixed_values must be ({len(fixed)}, {dim}), got shape {values.shape}")
+        if not (np.isfinite(density) and density > 0):
+            raise ValueError(f"density must be positive and finite, got {density}")
         forces = forces or {}
         loaded = np.array(list(forces), dtype=np.int64)
         loads = np.array([np.asarray(f, dtype=np.float64) for f in forces.values()]).reshape(len(loaded), -1) \
             if forces else np.zeros((0, dim))
         if len(loaded) and loads.shape[1] != dim:
             raise ValueError(f"forces must be {dim}-vectors, got {loads.shape[1]} components")
-        self._impl = _snede.DistributedStatic(part._impl, material, float(thickness or 0.0), fixed.tolist(),
-                                              values.ravel().tolist(), loaded.tolist(), loads.ravel().tolist())
+        self._impl = _snede.DistributedStatic(part._impl, material, float(density), float(thickness or 0.0),
+                                              fixed.tolist(), values.ravel().tolist(), loaded.tolist(),
+                                              loads.ravel().tolist())
 
     def solve(self, method: str = "cg", rtol: float = 1e-8, max_iterations: int = 10000, preconditioner: str = "none",
               options_prefix: str = "dstatic_") -> SolveResult:
-        """``method`` "cg" (linear) or "newton"; ``preconditioner`` "none" or "jacobi" (the
-        tangent's diagonal, summed across the ranks)."""
+        """``method`` "cg" (linear), "newton" or "ncg" (nonlinear CG, no preconditioner);
+        ``preconditioner`` "none", "jacobi" (the tangent's diagonal, summed across the ranks) or
+        "gamg" (PETSc's algebraic multigrid on the assembled tangent, MPIAIJ)."""
         return SolveResult._from_engine(self._impl.solve(method, preconditioner, float(rtol), int(max_iterations),
                                                          options_prefix))
 
@@ -101,3 +110,28 @@ class DistributedStatic:
         for ids, values in pieces:
             out[ids] = values
         return out
+
+
+class DistributedRelaxation:
+    """Dynamic relaxation (§2.5) of a :class:`DistributedStatic` problem: the damped motion
+    M ü + η M u̇ = −F(u) with lumped masses, integrated by snede's central-difference TS
+    (snede_ss22) on all ranks; ``run(rtol, max_steps)`` stops at criterion (6.9)
+    ‖F(u)‖ ≤ rtol·√(‖f_ext‖² + ‖f_react‖²). ``dt`` None takes the CFL estimate (2.61) of the
+    whole mesh. Options under ``options_prefix`` (``drelax_``): ``-drelax_ts_monitor`` and so
+    on. Collective."""
+
+    def __init__(self, problem: DistributedStatic, damping: float, dt: float | None = None, *,
+                 options_prefix: str = "drelax_"):
+        if dt is not None and not (np.isfinite(dt) and dt > 0):
+            raise ValueError(f"dt must be positive and finite (or None for the CFL estimate), got {dt}")
+        self.problem = problem
+        self._impl = _snede.DistributedRelaxation(problem._impl, float(damping), float(dt or 0.0), options_prefix)
+
+    @property
+    def dt(self) -> float:
+        return self._impl.dt
+
+    def run(self, rtol: float = 1e-3, max_steps: int = 100000) -> SolveResult:
+        """Steps until (6.9) or ``max_steps`` (``DIVERGED_MAX_IT``); a blow-up, NaN or an
+        inverted element ends the run with that reason, not converged."""
+        return SolveResult._from_engine(self._impl.run(float(rtol), _checks.count(max_steps, "max_steps")))

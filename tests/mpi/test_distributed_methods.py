@@ -1,0 +1,119 @@
+"""The other solvers of a DistributedStatic on 1, 2 and 3 ranks: nonlinear CG, GAMG, and
+dynamic relaxation (DistributedRelaxation). Each is compared with the same solve on every
+rank alone (COMM_SELF, the whole mesh) and with snede's serial solvers."""
+import numpy as np
+import pytest
+from mpi4py import MPI
+
+import snede
+from cantilever_problems import cantilever, conditions, linear_cantilever_problem, serial_solution
+
+COMM = MPI.COMM_WORLD
+
+
+def relative_difference(u, v):
+    return np.abs(u - v).max() / np.abs(v).max()
+
+
+@pytest.mark.parametrize("dim", [3, 2])
+def test_nonlinear_cg_gives_the_serial_newton_displacement(dim):
+    """A neo-Hookean cantilever by nonlinear CG (secant line search, §4.4.2) on this
+    communicator: converged, and the serial Newton solution to 1e-7 relative."""
+    serial, thickness = cantilever(dim)
+    fixed, tip, force = conditions(serial)
+    part = snede.distribute(serial if COMM.rank == 0 else None)
+    material = snede.NeoHookean(1e5, 0.3)
+    problem = snede.DistributedStatic(part, material, thickness=thickness, fixed=fixed,
+                                      forces={int(v): force for v in tip})
+    result = problem.solve("ncg", rtol=1e-11, max_iterations=20000)
+    assert result.converged, result
+    assert set(COMM.allgather(result.reason)) == {result.reason}
+    expected = serial_solution(cantilever(dim)[0], material, thickness, "newton")
+    assert relative_difference(problem.gathered_displacement(), expected) <= 1e-7
+
+
+def test_nonlinear_cg_refuses_a_preconditioner():
+    problem = linear_cantilever_problem(COMM)
+    with pytest.raises(ValueError, match="takes no preconditioner"):
+        problem.solve("ncg", preconditioner="jacobi")
+
+
+def test_gamg_converges_in_fewer_iterations_than_jacobi_to_the_same_displacement():
+    """CG preconditioned by GAMG on the assembled MPIAIJ tangent (its rigid-body near null
+    space from the owned coordinates): fewer iterations than Jacobi, the serial solution.
+    GAMG's aggregates depend on the partition, so its count may differ between rank counts."""
+    gamg = linear_cantilever_problem(COMM)
+    result = gamg.solve("cg", rtol=1e-10, preconditioner="gamg", options_prefix="gamg_")
+    jacobi = linear_cantilever_problem(COMM).solve("cg", rtol=1e-10, preconditioner="jacobi")
+    assert result.converged, result
+    assert result.iterations < jacobi.iterations
+    expected = serial_solution(cantilever(3)[0], snede.LinearElastic(1e5, 0.3), None, "cg")
+    assert relative_difference(gamg.gathered_displacement(), expected) <= 1e-7
+
+
+def test_newton_with_gamg_on_a_neo_hookean_cantilever():
+    serial, _ = cantilever(3)
+    fixed, tip, force = conditions(serial)
+    part = snede.distribute(serial if COMM.rank == 0 else None)
+    material = snede.NeoHookean(1e5, 0.3)
+    problem = snede.DistributedStatic(part, material, fixed=fixed, forces={int(v): force for v in tip})
+    result = problem.solve("newton", rtol=1e-11, preconditioner="gamg", options_prefix="gamg_newton_")
+    assert result.converged, result
+    expected = serial_solution(cantilever(3)[0], material, None, "newton")
+    assert relative_difference(problem.gathered_displacement(), expected) <= 1e-7
+
+
+def test_dynamic_relaxation_takes_the_same_steps_on_every_rank_count():
+    """Dynamic relaxation of the linear cantilever (η near 2ω₁, the CFL step): on this
+    communicator and on each rank alone, the same time step, the same number of steps and
+    the same displacement to 1e-10 relative (only the order of the ghosts' sums differs);
+    (6.9) met, and the static solution to within what rtol allows."""
+    together, alone = linear_cantilever_problem(COMM), linear_cantilever_problem(MPI.COMM_SELF)
+    relax_together = snede.DistributedRelaxation(together, damping=1.5)
+    relax_alone = snede.DistributedRelaxation(alone, damping=1.5, options_prefix="alone_")
+    assert relax_together.dt == relax_alone.dt
+    shared = relax_together.run(rtol=1e-6, max_steps=20000)
+    single = relax_alone.run(rtol=1e-6, max_steps=20000)
+    assert shared.converged and single.converged, (shared, single)
+    assert shared.reason == "CONVERGED_FNORM_ABS" and shared.residual_norm <= shared.tolerance
+    assert shared.iterations == single.iterations > 100
+    u = together.gathered_displacement()
+    assert relative_difference(u, alone.gathered_displacement()) <= 1e-10
+    expected = serial_solution(cantilever(3)[0], snede.LinearElastic(1e5, 0.3), None, "cg")
+    assert relative_difference(u, expected) <= 1e-3
+
+
+def test_dynamic_relaxation_matches_the_serial_dynamic_relaxation():
+    """The serial DynamicRelaxation on the same body, η and step: the same number of steps and
+    the same displacement (the two implementations share the integrator and (6.9))."""
+    problem = linear_cantilever_problem(COMM)
+    relaxation = snede.DistributedRelaxation(problem, damping=1.5)
+    result = relaxation.run(rtol=1e-6, max_steps=20000)
+    serial, _ = cantilever(3)
+    fixed, tip, force = conditions(serial)
+    body = snede.Body(serial, snede.LinearElastic(1e5, 0.3), density=1000.0)
+    body.fix(fixed)
+    body.add_nodal_force(tip, force)
+    reference = snede.DynamicRelaxation(body, damping=1.5, dt=relaxation.dt).run(rtol=1e-6, max_steps=20000)
+    assert reference.converged and result.converged
+    assert result.iterations == reference.iterations
+    assert relative_difference(problem.gathered_displacement(), body.displacement) <= 1e-10
+
+
+def test_dynamic_relaxation_reports_a_blow_up_on_every_rank():
+    """Three times the CFL step is unstable: DIVERGED_BLOW_UP on every rank, not converged."""
+    problem = linear_cantilever_problem(COMM)
+    cfl = snede.DistributedRelaxation(problem, damping=0.0).dt
+    result = snede.DistributedRelaxation(problem, damping=0.0, dt=3 * cfl, options_prefix="unstable_").run(
+        rtol=1e-6, max_steps=20000)
+    assert not result.converged
+    assert set(COMM.allgather(result.reason)) == {"DIVERGED_BLOW_UP"}
+
+
+def test_dynamic_relaxation_refuses_bad_parameters_everywhere():
+    problem = linear_cantilever_problem(COMM)
+    with pytest.raises(ValueError, match="dt must be positive"):
+        snede.DistributedRelaxation(problem, damping=1.0, dt=-1.0)
+    with pytest.raises(ValueError, match="damping"):
+        snede.DistributedRelaxation(problem, damping=-1.0)
+    assert COMM.allreduce(1) == COMM.size
