@@ -78,11 +78,14 @@ def engine_sum(earlier, later, engine_report):
     return total
 
 
-def body_and_mesh(body_or_mesh):
-    """(body or None, mesh, the body's engine model or None) for a cutter's target."""
+def body_and_mesh(body_or_mesh, cutter: str):
+    """(body or None, mesh, the body's engine model or None) for a cutter's target; refused on
+    a distributed mesh's part (cuts are serial for now)."""
     if isinstance(body_or_mesh, Mesh):
+        body_or_mesh.require_serial(cutter)
         return None, body_or_mesh, None
     if hasattr(body_or_mesh, "_model") and isinstance(getattr(body_or_mesh, "mesh", None), Mesh):
+        body_or_mesh.mesh.require_serial(cutter)
         return body_or_mesh, body_or_mesh.mesh, body_or_mesh._model
     raise TypeError(f"expected a snede.Body or snede.Mesh, got {type(body_or_mesh).__name__}")
 
@@ -129,7 +132,7 @@ class TetrahedralCutter:
 
     def __init__(self, body_or_mesh, *, snap: bool = True, remove_degeneracies: bool = True,
                  min_aspect_ratio: float = 0.01, large_angle: float = 0.99 * math.pi, fix_free_pieces: bool = True):
-        self.body, self.mesh, model = body_and_mesh(body_or_mesh)
+        self.body, self.mesh, model = body_and_mesh(body_or_mesh, type(self).__name__)
         if self.mesh.cell_dim != 3:
             raise ValueError(f"TetrahedralCutter needs a tetrahedral mesh; this mesh has {self.mesh.cell_dim}-D cells")
         if not (0 < min_aspect_ratio < 1):

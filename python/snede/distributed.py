@@ -47,7 +47,9 @@ def distribute(mesh: Mesh | None, comm=None) -> DistributedMesh:
     comm = MPI.COMM_WORLD if comm is None else comm
     serial = mesh._impl if (comm.rank == 0 and isinstance(mesh, Mesh)) else None
     part = _snede.distribute_mesh(comm.py2f(), serial)
-    return DistributedMesh(comm=comm, local=Mesh._wrap(part.local), global_vertex=part.global_vertex.ravel().copy(),
+    local = Mesh._wrap(part.local)
+    local._distributed_part = f"rank {comm.rank}'s part of a mesh distributed over {comm.size} MPI ranks"
+    return DistributedMesh(comm=comm, local=local, global_vertex=part.global_vertex.ravel().copy(),
                            owned=part.owned.ravel().astype(bool), global_number=part.global_number.ravel().copy(),
                            n_global_vertices=int(part.n_global_vertices),
                            n_global_cells=int(part.n_global_cells), _impl=part)

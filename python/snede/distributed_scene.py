@@ -1,12 +1,12 @@
 """A static scene on several MPI ranks (issue 18): ``mpirun -n 2 python -m snede run
 cantilever``. Rank 0 builds the scene as usual; its mesh is distributed (snede.distribute), the
 held vertices and the external forces (nodal loads and the lumped gravity, the same whatever
-the state) become a snede.DistributedStatic (Jacobi-preconditioned CG or
-Newton), and the solution is gathered back into rank 0's body, which writes the series, the
-picture and the summary as a serial run does (the files are written by rank 0, not
-collectively). What does not run distributed yet is refused on every rank with
-NotImplementedError naming it: scenes that change their mesh or evolve in time (cuts,
-bisection, needles stay serial), membranes, and methods other than cg and newton.
+the state) become a snede.DistributedStatic, solved by GAMG-preconditioned CG or Newton,
+nonlinear CG or dynamic relaxation (with the scene's damping), and the solution is gathered
+back into rank 0's body, which writes the series, the picture and the summary as a serial run
+does (the files are written by rank 0, not collectively). What does not run distributed yet
+is refused on every rank with NotImplementedError naming it: scenes that change their mesh or
+evolve in time (cuts, bisection, needles stay serial) and membranes.
 """
 from __future__ import annotations
 
@@ -16,14 +16,16 @@ import numpy as np
 
 import snede
 
+DISTRIBUTED_METHODS = ("cg", "newton", "ncg", "dynamic")
+
 
 def unsupported(scene, method: str) -> str | None:
     """Why the scene cannot run on several ranks, or None."""
     body = scene.body
     if scene.evolve is not None:
         return "it changes its mesh or evolves in time (cuts, bisection and needle insertion stay serial)"
-    if method not in ("cg", "newton"):
-        return f"method {method!r} (distributed solves are cg and newton)"
+    if method not in DISTRIBUTED_METHODS:
+        return f"method {method!r} (distributed solves are {', '.join(DISTRIBUTED_METHODS)})"
     if body.mesh.is_surface:
         return "membranes are not distributed yet"
     if scene.fixed is None:
@@ -43,9 +45,12 @@ def solve_distributed(scene, method: str, rtol: float, writer, comm) -> dict:
         writer.write(body, time=0.0)
     start = time.perf_counter()
     part = snede.distribute(mesh if comm.rank == 0 else None, comm)
-    problem = snede.DistributedStatic(part, body.material, thickness=body.thickness, fixed=fixed,
-                                      forces={int(v): loads[v] for v in loaded})
-    result = problem.solve(method, rtol=rtol, preconditioner="jacobi")
+    problem = snede.DistributedStatic(part, body.material, density=body.density, thickness=body.thickness,
+                                      fixed=fixed, forces={int(v): loads[v] for v in loaded})
+    if method == "dynamic":
+        result = snede.DistributedRelaxation(problem, damping=scene.damping).run(rtol=rtol)
+    else:
+        result = problem.solve(method, rtol=rtol, preconditioner="none" if method == "ncg" else "gamg")
     u = problem.gathered_displacement()
     wall = time.perf_counter() - start
     if comm.rank == 0:

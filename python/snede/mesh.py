@@ -9,7 +9,7 @@ from typing import NamedTuple
 import numpy as np
 
 from snede import _checks, _snede
-from snede.mesh_edits import MeshEdits
+from snede.mesh_edits import MeshEdits, serial_only
 
 
 class MeshQuality(NamedTuple):
@@ -192,6 +192,7 @@ class Mesh(MeshEdits):
         return unique[counts == 2] if interior else unique
 
     # -- changes -----------------------------------------------------------------------
+    @serial_only
     def dissect(self, faces) -> np.ndarray:
         """Cut along interior faces (§7.3), given as ``(n, cell_dim)`` vertex indices (either
         orientation). Vertices whose star the cut splits are duplicated (same coordinates).
@@ -222,12 +223,14 @@ class Mesh(MeshEdits):
         parents = _checks.index_array(parents, "parents", self.n_points, "a vertex of the mesh")
         return parents, np.ascontiguousarray(weights)
 
+    @serial_only
     def add_vertex(self, parents, weights) -> int:
         """Add a vertex at ``Σ weights[i]·x[parents[i]]`` (barycentric: weights sum to 1) and
         return its id (a removed id is reused). Watchers (a Body) give it the interpolated
         displacement with the next mesh change."""
         return self._impl.add_vertex(*self._parents(parents, weights))
 
+    @serial_only
     def move_vertex(self, vertex: int, parents=None, weights=None, *, point=None) -> None:
         """Move ``vertex`` in the reference configuration, either to ``Σ weights[i]·x[parents[i]]``
         (``parents`` may include ``vertex``; a Body re-interpolates its displacement the same
@@ -240,6 +243,7 @@ class Mesh(MeshEdits):
         else:
             self._impl.move_vertex(self._vertex(vertex), *self._parents(parents, weights))
 
+    @serial_only
     def remove_vertex(self, vertex: int) -> None:
         """Remove a vertex that no cell uses any more (its id is reused by a later addition)."""
         self._impl.remove_vertex(self._vertex(vertex))
@@ -257,6 +261,7 @@ class Mesh(MeshEdits):
         """The engine's bisection state if the mesh was ever refined by bisection, else None."""
         return self.__dict__.get("_bisection_impl")
 
+    @serial_only
     def refine_uniform(self, levels: int = 1) -> int:
         """Bisect every cell ``levels`` times by conforming bisection (§6.5: newest-vertex in
         2D, Maubach's in 3D). On ``meshing.rectangle`` and ``meshing.box`` each level doubles
@@ -269,6 +274,7 @@ class Mesh(MeshEdits):
                                f"at most 2**31 − 1")
         return self._bisection().refine_uniform(levels)
 
+    @serial_only
     def refine_around(self, point, h: float) -> int:
         """Bisect (§6.5 refine-around) until every cell containing ``point`` (shape (dim,))
         has edges no longer than ``h``; the refinement spreads only as far as conformity
@@ -283,6 +289,7 @@ class Mesh(MeshEdits):
             raise ValueError(f"h must be positive and finite, got {h}")
         return self._bisection().refine_around(np.ascontiguousarray(point), h)
 
+    @serial_only
     def refine_near_segment(self, a, b, h: float, radius: float = 0.0) -> int:
         """Bisect until every cell that comes within ``radius`` of the segment ``a``–``b``
         (shape (dim,) each; a needle's shaft) has edges no longer than ``h``, as one mesh

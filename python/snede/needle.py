@@ -159,6 +159,7 @@ class NeedleInsertion:
                  h_ref: float | None = None, radius: float | None = None, method: str = "cg", rtol: float = 1e-3, criterion: str = "6.9",
                  round_tolerance: float = 1e-8, max_iterations: int = 10000, max_rearrangements: int = 200,
                  solves_per_update: int | None = None, extrapolate: bool = False, options_prefix: str = "needle_", petsc_options: dict | None = None):
+        body.mesh.require_serial("NeedleInsertion")
         if body.mesh.is_surface:
             raise ValueError("needle insertion needs a 2D plane-stress or a 3D tetrahedral body, not a surface mesh")
         dim = body.mesh.dim

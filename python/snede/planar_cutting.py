@@ -141,7 +141,7 @@ class DelaunayCutter(IncisionCutter):
     """
 
     def __init__(self, body_or_mesh, *, eps_edge=None, eps_entry=None, eps_exit=None, short_edge_angle=None):
-        self.body, self.mesh, model = body_and_mesh(body_or_mesh)
+        self.body, self.mesh, model = body_and_mesh(body_or_mesh, type(self).__name__)
         if self.mesh.cell_dim != 2 or self.mesh.space_dim != 2:
             raise ValueError(f"{type(self).__name__} needs a 2D triangle mesh; this one has {self.mesh.cell_dim}-D cells "
                              f"in {self.mesh.space_dim}-D")

@@ -35,6 +35,7 @@ class SubdivisionCutter:
         if mesh.cell_dim != 2 or mesh.space_dim != 2:
             raise ValueError(f"SubdivisionCutter needs a 2D triangle mesh; this one has {mesh.cell_dim}-D cells "
                              f"in {mesh.space_dim}-D")
+        mesh.require_serial("SubdivisionCutter")
         self.mesh = mesh
         self._last = None  # the scalpel's previous position
         self._end = None   # the vertex where the incision in progress ends, or None outside

@@ -41,7 +41,7 @@ class SurfaceCutter(IncisionCutter):
     """
 
     def __init__(self, body_or_mesh, *, eps_edge=None, eps_entry=None, eps_exit=None):
-        self.body, self.mesh, model = body_and_mesh(body_or_mesh)
+        self.body, self.mesh, model = body_and_mesh(body_or_mesh, type(self).__name__)
         if self.mesh.cell_dim != 2 or self.mesh.space_dim != 3:
             raise ValueError(f"{type(self).__name__} needs a surface mesh (triangles in 3D); this one has "
                              f"{self.mesh.cell_dim}-D cells in {self.mesh.space_dim}-D")

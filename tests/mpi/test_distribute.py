@@ -72,3 +72,32 @@ def test_a_problem_on_rank_0_raises_the_same_error_everywhere():
     assert len(set(messages)) == 1
     # The communicator is still usable: nothing is left waiting.
     assert COMM.allreduce(1) == COMM.size
+
+
+def test_topology_changes_on_a_part_are_refused_naming_the_operation():
+    """Cuts, bisection, needle insertion and the local edits are serial for now: on a part
+    each raises NotImplementedError naming the operation, on every rank (no rank waits), and
+    leaves the part as it was; a serial copy of the part can still be edited."""
+    serial = snede.meshing.box((2.0, 1.0, 1.0), (4, 2, 2))
+    part = snede.distribute(serial if COMM.rank == 0 else None)
+    mesh = part.local
+    cells_before = mesh.cells.copy()
+    body = snede.Body(mesh, snede.LinearElastic(1e5, 0.3))
+    friction = snede.FrictionProfile([0.0, 1.0], [1.0, 1.0])
+    attempts = {
+        "refine_uniform": lambda: mesh.refine_uniform(),
+        "refine_around": lambda: mesh.refine_around([0.5, 0.5, 0.5], 0.1),
+        "split_edge": lambda: mesh.split_edge(0, 1),
+        "dissect": lambda: mesh.dissect(np.zeros((0, 3), dtype=np.int64)),
+        "add_vertex": lambda: mesh.add_vertex([0], [1.0]),
+        "TetrahedralCutter": lambda: snede.TetrahedralCutter(body),
+        "NeedleInsertion": lambda: snede.NeedleInsertion(body, [1.0, 0.5, 1.2], [0.0, 0.0, -1.0], friction),
+    }
+    for operation, attempt in attempts.items():
+        with pytest.raises(NotImplementedError, match=rf"{operation} on rank {COMM.rank}'s part of a mesh distributed"):
+            attempt()
+    np.testing.assert_array_equal(mesh.cells, cells_before)
+    assert COMM.allreduce(1) == COMM.size
+    copy = snede.Mesh(mesh.points, mesh.cells)
+    if copy.n_cells:
+        assert copy.refine_uniform() > 0

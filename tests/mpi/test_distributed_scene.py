@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 from mpi4py import MPI
 
-from snede import StaticSolver, run_scene
+from snede import DynamicRelaxation, StaticSolver, run_scene
 from snede.scenes import cantilever, cylinder, needle
 
 COMM = MPI.COMM_WORLD
@@ -35,6 +35,28 @@ def test_cantilever_on_several_ranks_matches_the_serial_run(tmp_path_factory):
         serial = cantilever.build(options(divisions=8))
         assert StaticSolver(serial.body, "cg", preconditioner="none", rtol=1e-12).solve().converged
         assert summary["value"] == pytest.approx(serial.probe(serial.body), rel=1e-8)
+    COMM.Barrier()
+
+
+@several
+@pytest.mark.parametrize("method", ["ncg", "dynamic"])
+def test_cantilever_by_nonlinear_cg_or_dynamic_relaxation_matches_the_serial_run(method, tmp_path_factory):
+    """`--method ncg` and `--method dynamic` on several ranks: nonlinear CG gives the serial
+    static probe; dynamic relaxation (the scene's η, the CFL step) takes as many steps as the
+    serial DynamicRelaxation and gives its probe."""
+    folder = Path(COMM.bcast(str(tmp_path_factory.mktemp("mpi")) if COMM.rank == 0 else None))
+    rtol = 1e-10 if method == "ncg" else 1e-6
+    summary = run_scene.run(cantilever.build(options(divisions=8)), method, rtol, folder, progress=False)
+    assert summary["converged"] and summary["ranks"] == COMM.size
+    if COMM.rank == 0:
+        serial = cantilever.build(options(divisions=8))
+        if method == "ncg":
+            assert StaticSolver(serial.body, "cg", preconditioner="none", rtol=1e-12).solve().converged
+            assert summary["value"] == pytest.approx(serial.probe(serial.body), rel=1e-7)
+        else:
+            result = DynamicRelaxation(serial.body, damping=serial.damping).run(rtol=rtol)
+            assert result.converged and result.iterations == summary["iterations"]
+            assert summary["value"] == pytest.approx(serial.probe(serial.body), rel=1e-10)
     COMM.Barrier()
 
 
