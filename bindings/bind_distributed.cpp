@@ -27,13 +27,14 @@ void bind_distributed(py::module_& m) {
   py::class_<DistributedStatic>(m, "DistributedStatic")
       .def(py::init([](DistributedMesh& part, const py::handle& material, double density, double thickness,
                        std::vector<std::int64_t> fixed, std::vector<double> fixed_values, std::vector<std::int64_t> loaded,
-                       std::vector<double> forces) {
+                       std::vector<double> forces, std::vector<double> gravity) {
              return std::make_unique<DistributedStatic>(
                  part, material_from(material), density, thickness,
-                 DistributedConditions{std::move(fixed), std::move(fixed_values), std::move(loaded), std::move(forces)});
+                 DistributedConditions{std::move(fixed), std::move(fixed_values), std::move(loaded), std::move(forces),
+                                       std::move(gravity)});
            }),
            py::arg("part"), py::arg("material"), py::arg("density"), py::arg("thickness"), py::arg("fixed"), py::arg("fixed_values"),
-           py::arg("loaded"), py::arg("forces"), py::keep_alive<1, 2>())
+           py::arg("loaded"), py::arg("forces"), py::arg("gravity"), py::keep_alive<1, 2>())
       .def("solve", &DistributedStatic::solve, py::arg("method"), py::arg("preconditioner"), py::arg("rtol"),
            py::arg("max_iterations"), py::arg("prefix"))
       .def("energy", &DistributedStatic::energy)

@@ -31,6 +31,11 @@ void check_conditions(const DistributedConditions& c, int dim, std::int64_t n_ve
   };
   check(c.fixed, c.fixed_values.size(), "fixed");
   check(c.loaded, c.forces.size(), "loaded");
+  if (!c.gravity.empty() && c.gravity.size() != static_cast<std::size_t>(dim))
+    throw std::invalid_argument("DistributedStatic: gravity needs " + std::to_string(dim) + " components, got " +
+                                std::to_string(c.gravity.size()));
+  for (double g : c.gravity)
+    if (!std::isfinite(g)) throw std::invalid_argument("DistributedStatic: gravity must be finite");
 }
 
 PetscErrorCode residual_callback(SNES snes, Vec u, Vec F, void* context) {
@@ -123,6 +128,16 @@ DistributedStatic::DistributedStatic(DistributedMesh& part, Material material, d
   SNEDE_PETSC(MatShellSetOperation(tangent_, MATOP_MULT, reinterpret_cast<void (*)(void)>(mult_callback)));
   SNEDE_PETSC(MatShellSetOperation(tangent_, MATOP_GET_DIAGONAL, reinterpret_cast<void (*)(void)>(diagonal_callback)));
   SNEDE_PETSC(MatSetOption(tangent_, MAT_SYMMETRIC, PETSC_TRUE));
+
+  if (!conditions.gravity.empty()) {
+    // Each rank's cells load their corners; ghosts' shares go to the owners.
+    SNEDE_PETSC(VecZeroEntries(work_));
+    add_to_global(body_.gravity_forces(conditions.gravity), work_);
+    const PetscScalar* g = nullptr;
+    SNEDE_PETSC(VecGetArrayRead(work_, &g));
+    for (std::size_t k = 0; k < owned_rows_.size(); ++k) load_owned_[k] += g[owned_rows_[k] - start];
+    SNEDE_PETSC(VecRestoreArrayRead(work_, &g));
+  }
 
   // The state starts at the prescribed displacements (zero elsewhere).
   PetscScalar* u = nullptr;

@@ -9,7 +9,7 @@
 // residual through a TS (distributed_relaxation.hpp).
 //
 // Constraints and loads are given by the serial mesh's vertex ids, the same on every rank:
-// fixed vertices (all components), their displacements, and nodal forces. A fixed dof's
+// fixed vertices (all components), their displacements, nodal forces, and gravity. A fixed dof's
 // residual is u − ū and its tangent row the identity, as in the serial Model.
 #pragma once
 
@@ -32,13 +32,14 @@ struct DistributedConditions {
   std::vector<double> fixed_values;    // dim per fixed vertex
   std::vector<std::int64_t> loaded;    // serial vertex ids
   std::vector<double> forces;          // dim per loaded vertex
+  std::vector<double> gravity;         // dim components (m/s²), or empty for none
 };
 
 class DistributedStatic {
  public:
   // Collective. Throws std::invalid_argument (the same on every rank) for conditions of the
-  // wrong size or ids outside the serial mesh. The density only sets the lumped masses of
-  // dynamic relaxation (no gravity here: give it as nodal forces).
+  // wrong size or ids outside the serial mesh. The density sets gravity's load (ρ|τ|g shared
+  // by each cell's corners, as serially) and the lumped masses of dynamic relaxation.
   DistributedStatic(DistributedMesh& part, Material material, double density, double thickness,
                     const DistributedConditions& conditions);
   ~DistributedStatic();

@@ -59,17 +59,18 @@ class DistributedStatic:
     """A static solve on a :class:`DistributedMesh` (collective throughout).
 
     ``DistributedStatic(part, material, *, density=1000.0, thickness=None, fixed=(),
-    fixed_values=None, forces=None)``: ``fixed`` are serial vertex ids held at ``fixed_values``
-    ((len(fixed), dim), default zero); ``forces`` maps serial vertex ids to nodal force vectors
-    (gravity too: there is no body force here). Every rank passes the same conditions. The
-    density only sets the masses of :class:`DistributedRelaxation`.
+    fixed_values=None, forces=None, gravity=None)``: ``fixed`` are serial vertex ids held at
+    ``fixed_values`` ((len(fixed), dim), default zero); ``forces`` maps serial vertex ids to
+    nodal force vectors; ``gravity`` (m/s², dim components) loads the element masses as
+    ``Body.add_gravity`` does. Every rank passes the same conditions. The density also sets the
+    masses of :class:`DistributedRelaxation`.
 
     ``solve(method="cg" | "newton" | "ncg", rtol=1e-8, preconditioner="none" | "jacobi" |
     "gamg")`` returns a :class:`snede.SolveResult` with PETSc's reason; ``-<prefix>snes_*``/
     ``-<prefix>ksp_*``/``-<prefix>pc_*`` options apply (prefix ``dstatic_``)."""
 
     def __init__(self, part: DistributedMesh, material, *, density: float = 1000.0, thickness=None, fixed=(),
-                 fixed_values=None, forces=None):
+                 fixed_values=None, forces=None, gravity=None):
         self.part = part
         dim = part.local.dim
         fixed = np.asarray(fixed, dtype=np.int64).ravel()
@@ -86,7 +87,8 @@ class DistributedStatic:
             raise ValueError(f"forces must be {dim}-vectors, got {loads.shape[1]} components")
         self._impl = _snede.DistributedStatic(part._impl, material, float(density), float(thickness or 0.0),
                                               fixed.tolist(), values.ravel().tolist(), loaded.tolist(),
-                                              loads.ravel().tolist())
+                                              loads.ravel().tolist(),
+                                              [] if gravity is None else np.asarray(gravity, dtype=np.float64).ravel().tolist())
 
     def solve(self, method: str = "cg", rtol: float = 1e-8, max_iterations: int = 10000, preconditioner: str = "none",
               options_prefix: str = "dstatic_") -> SolveResult:

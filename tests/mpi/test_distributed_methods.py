@@ -117,3 +117,23 @@ def test_dynamic_relaxation_refuses_bad_parameters_everywhere():
     with pytest.raises(ValueError, match="damping"):
         snede.DistributedRelaxation(problem, damping=-1.0)
     assert COMM.allreduce(1) == COMM.size
+
+
+def test_gravity_loads_the_element_masses_as_serially():
+    """A neo-Hookean cantilever sagging under its own weight (ρ = 1000, g = 9.81 down), Newton
+    with GAMG: the serial Body.add_gravity solve's displacement to 1e-7 relative; a gravity of
+    the wrong length is refused on every rank."""
+    serial, _ = cantilever(3)
+    fixed, _, _ = conditions(serial)
+    part = snede.distribute(serial if COMM.rank == 0 else None)
+    material = snede.NeoHookean(1e5, 0.3)
+    problem = snede.DistributedStatic(part, material, density=1000.0, fixed=fixed, gravity=(0.0, 0.0, -9.81))
+    result = problem.solve("newton", rtol=1e-11, preconditioner="gamg")
+    assert result.converged, result
+    body = snede.Body(cantilever(3)[0], material, density=1000.0)
+    body.fix(fixed)
+    body.add_gravity((0.0, 0.0, -9.81))
+    assert snede.StaticSolver(body, "newton", rtol=1e-12).solve().converged
+    assert relative_difference(problem.gathered_displacement(), body.displacement) <= 1e-7
+    with pytest.raises(ValueError, match="gravity needs 3 components"):
+        snede.DistributedStatic(part, material, fixed=fixed, gravity=(0.0, -9.81))
