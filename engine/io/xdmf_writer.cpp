@@ -1,15 +1,51 @@
 #include "io/xdmf_writer.hpp"
 
+#include <algorithm>
 #include <fstream>
+#include <numeric>
 #include <stdexcept>
 
 #include "core/error.hpp"
+#include "mesh/distributed_mesh.hpp"
+
+#ifndef H5_HAVE_PARALLEL
+#error "XdmfWriter needs the MPI build of HDF5 (Debian's libhdf5-openmpi-dev)"
+#endif
 
 namespace snede {
+
+// How this rank's data of a step maps to the file's rows. A serial mesh is written whole, in
+// its own order; a distributed part writes its owned vertices and its cells.
+struct XdmfWriter::Layout {
+  const DistributedMesh* part = nullptr;  // nullptr: a serial mesh
+  Rows points, cells;
+  std::vector<std::int64_t> point_rows;     // the local point written at each of this rank's point rows
+  std::vector<std::int64_t> point_numbers;  // each local point's row in the file (for the cells)
+  std::vector<PointField> mesh_point_fields;  // one value per local point, stored with the mesh
+  std::string problem;                        // "" when the layout is usable
+};
+
 namespace {
 
 void check_hdf5(herr_t status, const std::string& what) {
   if (status < 0) throw FileError("HDF5 failed to " + what);
+}
+
+// An HDF5 identifier closed when it goes out of scope.
+struct Hdf5Id {
+  hid_t id;
+  herr_t (*close)(hid_t);
+  ~Hdf5Id() {
+    if (id >= 0) close(id);
+  }
+  operator hid_t() const { return id; }
+};
+
+void broadcast(std::string& text, int root, MPI_Comm comm) {
+  int length = static_cast<int>(text.size());
+  MPI_Bcast(&length, 1, MPI_INT, root, comm);
+  text.resize(static_cast<std::size_t>(length));
+  MPI_Bcast(text.data(), length, MPI_CHAR, root, comm);
 }
 
 // Text as it may stand in an XML attribute value or element.
@@ -28,22 +64,33 @@ std::string xml_escaped(const std::string& text) {
   return out;
 }
 
-// Each field must name one HDF5 dataset of the step (not empty, no '/', not a name taken)
-// and hold one value per cell or point; `taken` collects the names.
+// What is wrong with the fields ("" if nothing): each must name one HDF5 dataset of the step
+// (not empty, no '/', not a name taken) and hold one value per cell or point; `taken`
+// collects the names.
 template <class Field>
-void check_fields(const std::vector<Field>& fields, const char* kind, std::int64_t n, const char* what,
-                  std::vector<std::string>& taken) {
+std::string field_problem(const std::vector<Field>& fields, const char* kind, std::int64_t n, const char* what,
+                          std::vector<std::string>& taken) {
   for (const Field& field : fields) {
     const std::string& name = field.name;
     if (name.empty() || name.find('/') != std::string::npos || name == "." || name == "..")
-      throw std::invalid_argument("field name '" + name + "' is not usable: give a non-empty name without '/'");
-    for (const std::string& other : taken)
-      if (other == name) throw std::invalid_argument("field name '" + name + "' is used twice in one step");
+      return "field name '" + name + "' is not usable: give a non-empty name without '/'";
+    if (std::find(taken.begin(), taken.end(), name) != taken.end())
+      return "field name '" + name + "' is used twice in one step";
     taken.push_back(name);
     if (field.values.size() != static_cast<std::size_t>(n))
-      throw std::invalid_argument(std::string(kind) + " field '" + name + "' has " +
-                                  std::to_string(field.values.size()) + " values for " + std::to_string(n) + " " + what);
+      return std::string(kind) + " field '" + name + "' has " + std::to_string(field.values.size()) + " values for " +
+             std::to_string(n) + " " + what;
   }
+  return "";
+}
+
+// The rows `rows` of a (n, columns) array, each padded with zeros to `width` columns.
+std::vector<double> rows_of(std::span<const double> values, int columns, int width,
+                            const std::vector<std::int64_t>& rows) {
+  std::vector<double> out(rows.size() * static_cast<std::size_t>(width), 0.0);
+  for (std::size_t i = 0; i < rows.size(); ++i)
+    for (int k = 0; k < columns; ++k) out[i * width + k] = values[static_cast<std::size_t>(rows[i]) * columns + k];
+  return out;
 }
 
 std::string file_name(const std::string& path) {
@@ -53,48 +100,159 @@ std::string file_name(const std::string& path) {
 
 }  // namespace
 
-XdmfWriter::XdmfWriter(std::string base) : base_(std::move(base)) {
+XdmfWriter::XdmfWriter(std::string base, MPI_Comm comm)
+    : base_(std::move(base)), comm_(comm), shared_(comm != MPI_COMM_SELF) {
+  if (shared_) {
+    MPI_Comm_rank(comm_, &rank_);
+    MPI_Comm_size(comm_, &n_ranks_);
+  }
   H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);  // errors are reported as exceptions, not printed
-  const hid_t file = H5Fcreate(h5_path().c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
+  const hid_t file = open_file(true);
+  // Creating a shared file is collective: it fails on every rank alike.
   if (file < 0) throw FileError("cannot create " + h5_path() + " (does the folder exist and is it writable?)");
   H5Fclose(file);
-  write_xdmf();
+  publish_xdmf();
 }
 
 XdmfWriter::~XdmfWriter() = default;
 
-void XdmfWriter::write_dataset(const std::string& path, const void* data, hid_t type, hsize_t rows, hsize_t columns) {
-  const hsize_t dims[2] = {rows, columns};
-  hid_t lcpl = H5Pcreate(H5P_LINK_CREATE);
-  H5Pset_create_intermediate_group(lcpl, 1);
-  hid_t space = H5Screate_simple(columns ? 2 : 1, dims, nullptr);
-  hid_t set = H5Dcreate2(file_, path.c_str(), type, space, lcpl, H5P_DEFAULT, H5P_DEFAULT);
-  if (set < 0) {
-    H5Sclose(space);
-    H5Pclose(lcpl);
-    throw FileError("HDF5 failed to create " + path + " in " + h5_path());
+hid_t XdmfWriter::open_file(bool create) const {
+  const Hdf5Id access{H5Pcreate(H5P_FILE_ACCESS), H5Pclose};
+  if (shared_) H5Pset_fapl_mpio(access, comm_, MPI_INFO_NULL);
+  return create ? H5Fcreate(h5_path().c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, access)
+                : H5Fopen(h5_path().c_str(), H5F_ACC_RDWR, access);
+}
+
+// The problem of the lowest rank that found one ("" if none found any), the same text on
+// every rank, so that all throw it and none is left waiting in a collective call.
+std::string XdmfWriter::agreed(const std::string& problem) const {
+  if (!shared_) return problem;
+  const int mine = problem.empty() ? n_ranks_ : rank_;
+  int first = n_ranks_;
+  MPI_Allreduce(&mine, &first, 1, MPI_INT, MPI_MIN, comm_);
+  if (first == n_ranks_) return "";
+  std::string text = n_ranks_ > 1 ? "rank " + std::to_string(first) + ": " + problem : problem;
+  broadcast(text, first, comm_);
+  return text;
+}
+
+void XdmfWriter::write_rows(const std::string& path, const void* data, hid_t type, Rows rows, hsize_t columns) {
+  const int rank = columns ? 2 : 1;
+  const hsize_t dims[2] = {static_cast<hsize_t>(rows.total), columns};
+  const hsize_t start[2] = {static_cast<hsize_t>(rows.first), 0};
+  const hsize_t count[2] = {static_cast<hsize_t>(rows.count), columns};
+  const Hdf5Id links{H5Pcreate(H5P_LINK_CREATE), H5Pclose};
+  H5Pset_create_intermediate_group(links, 1);
+  const Hdf5Id file_space{H5Screate_simple(rank, dims, nullptr), H5Sclose};
+  const Hdf5Id memory_space{H5Screate_simple(rank, count, nullptr), H5Sclose};
+  const Hdf5Id set{H5Dcreate2(file_, path.c_str(), type, file_space, links, H5P_DEFAULT, H5P_DEFAULT), H5Dclose};
+  if (set < 0) throw FileError("HDF5 failed to create " + path + " in " + h5_path());
+  if (rows.count) {
+    check_hdf5(H5Sselect_hyperslab(file_space, H5S_SELECT_SET, start, nullptr, count, nullptr), "select rows of " + path);
+  } else {  // a rank with no rows still takes part in the collective write
+    H5Sselect_none(file_space);
+    H5Sselect_none(memory_space);
   }
-  const herr_t status = H5Dwrite(set, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data);
-  H5Dclose(set);
-  H5Sclose(space);
-  H5Pclose(lcpl);
-  check_hdf5(status, "write " + path);
+  const Hdf5Id transfer{H5Pcreate(H5P_DATASET_XFER), H5Pclose};
+  if (shared_) H5Pset_dxpl_mpio(transfer, H5FD_MPIO_COLLECTIVE);
+  static const double nothing = 0.0;  // HDF5 wants a buffer even for no rows
+  check_hdf5(H5Dwrite(set, type, memory_space, file_space, transfer, data ? data : &nothing), "write " + path);
 }
 
 void XdmfWriter::write_step(double time, const Mesh& mesh, std::span<const double> displacement,
                             const std::vector<CellField>& cell_fields, const std::vector<PointField>& point_fields) {
+  if (n_ranks_ > 1)
+    throw std::invalid_argument("write_step writes a serial mesh, but this writer is shared by " +
+                                std::to_string(n_ranks_) +
+                                " ranks: write each rank's part of a distributed mesh instead");
+  const auto n_points = static_cast<std::int64_t>(mesh.n_points());
+  const auto n_cells = static_cast<std::int64_t>(mesh.n_cells());
+  Layout layout;
+  layout.points = {n_points, 0, n_points};
+  layout.cells = {n_cells, 0, n_cells};
+  layout.point_rows.resize(static_cast<std::size_t>(n_points));
+  std::iota(layout.point_rows.begin(), layout.point_rows.end(), std::int64_t{0});
+  layout.point_numbers = layout.point_rows;
+  write(time, mesh, layout, displacement, cell_fields, point_fields);
+}
+
+void XdmfWriter::write_distributed_step(double time, const DistributedMesh& part,
+                                        std::span<const double> local_displacement,
+                                        const std::vector<CellField>& cell_fields,
+                                        const std::vector<PointField>& point_fields) {
+  int relation = MPI_UNEQUAL;
+  MPI_Comm_compare(part.comm, comm_, &relation);
+  // Every rank compares the same two groups, so all throw or none.
+  if (relation != MPI_IDENT && relation != MPI_CONGRUENT)
+    throw std::invalid_argument("write_distributed_step: the part is distributed over other ranks than the writer's; "
+                                "give the writer the part's communicator");
+  const Mesh& mesh = *part.local;
+  const auto n_local = static_cast<std::size_t>(mesh.n_points());
+  const auto n_owned = static_cast<std::int64_t>(std::count(part.owned.begin(), part.owned.end(), 1));
+  const std::int64_t mine[2] = {n_owned, static_cast<std::int64_t>(mesh.n_cells())};
+  std::vector<std::int64_t> counts(2 * static_cast<std::size_t>(n_ranks_));
+  MPI_Allgather(mine, 2, MPI_INT64_T, counts.data(), 2, MPI_INT64_T, comm_);
+  Layout layout;
+  layout.part = &part;
+  layout.points.count = mine[0];
+  layout.cells.count = mine[1];
+  for (int r = 0; r < n_ranks_; ++r) {
+    if (r < rank_) layout.points.first += counts[2 * r], layout.cells.first += counts[2 * r + 1];
+    layout.points.total += counts[2 * r];
+    layout.cells.total += counts[2 * r + 1];
+  }
+  if (layout.points.total != part.n_global_vertices || layout.cells.total != part.n_global_cells)
+    layout.problem = "write_distributed_step: the parts hold " + std::to_string(layout.points.total) + " vertices and " +
+                     std::to_string(layout.cells.total) + " cells, the distributed mesh has " +
+                     std::to_string(part.n_global_vertices) + " and " + std::to_string(part.n_global_cells);
+  // PETSc numbers each rank's owned vertices contiguously, in rank order: they are this
+  // rank's block of rows.
+  layout.point_rows.assign(static_cast<std::size_t>(n_owned), -1);
+  for (std::size_t v = 0; v < n_local; ++v) {
+    if (!part.owned[v]) continue;
+    const std::int64_t row = part.global_number[v] - layout.points.first;
+    if (row < 0 || row >= n_owned || layout.point_rows[row] >= 0) {
+      layout.problem = "write_distributed_step: the owned vertices are not numbered " +
+                       std::to_string(layout.points.first) + " to " + std::to_string(layout.points.first + n_owned - 1);
+      break;
+    }
+    layout.point_rows[row] = static_cast<std::int64_t>(v);
+  }
+  layout.point_numbers = part.global_number;
+  layout.mesh_point_fields.push_back({"serial_vertex", {part.global_vertex.begin(), part.global_vertex.end()}});
+  write(time, mesh, layout, local_displacement, cell_fields, point_fields);
+}
+
+void XdmfWriter::write(double time, const Mesh& mesh, const Layout& layout, std::span<const double> displacement,
+                       const std::vector<CellField>& cell_fields, const std::vector<PointField>& point_fields) {
   const int dim = mesh.dim();
   const auto n_points = static_cast<std::int64_t>(mesh.n_points());
   const auto n_cells = static_cast<std::int64_t>(mesh.n_cells());
-  if (displacement.size() != static_cast<std::size_t>(n_points * dim))
-    throw std::invalid_argument("displacement has " + std::to_string(displacement.size()) + " values, expected " +
-                                std::to_string(n_points * dim));
+  std::string problem = layout.problem;
+  if (problem.empty() && displacement.size() != static_cast<std::size_t>(n_points * dim))
+    problem = "displacement has " + std::to_string(displacement.size()) + " values, expected " +
+              std::to_string(n_points * dim);
   std::vector<std::string> names{"displacement"};
-  check_fields(cell_fields, "cell", n_cells, "cells", names);
-  check_fields(point_fields, "point", n_points, "points", names);
+  for (const PointField& field : layout.mesh_point_fields) names.push_back(field.name);
+  if (problem.empty()) problem = field_problem(cell_fields, "cell", n_cells, "cells", names);
+  if (problem.empty()) problem = field_problem(point_fields, "point", n_points, "points", names);
+  if (shared_) {  // every rank must create the same datasets
+    std::string fields;
+    for (const CellField& field : cell_fields) fields += " cell '" + field.name + "'";
+    for (const PointField& field : point_fields) fields += " point '" + field.name + "'";
+    std::string first_fields = fields;
+    broadcast(first_fields, 0, comm_);
+    if (problem.empty() && fields != first_fields)
+      problem = "the fields differ from rank 0's (here:" + fields + "; on rank 0:" + first_fields + ")";
+  }
+  if (problem = agreed(problem); !problem.empty()) throw std::invalid_argument(problem);
+
+  int new_mesh = last_mesh_ != &mesh || last_part_ != layout.part || mesh.connectivity().revision() != last_revision_ ||
+                 mesh.n_points() != last_n_points_ || n_meshes_ == 0;
+  if (shared_) MPI_Allreduce(MPI_IN_PLACE, &new_mesh, 1, MPI_INT, MPI_LOR, comm_);
   // The file is open only while a step is written, so readers (ParaView, h5py) can open it
   // between steps.
-  file_ = H5Fopen(h5_path().c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
+  file_ = open_file(false);
   if (file_ < 0) throw FileError("cannot open " + h5_path() + " for writing (was its folder removed?)");
   struct CloseOnExit {
     hid_t& file;
@@ -103,38 +261,51 @@ void XdmfWriter::write_step(double time, const Mesh& mesh, std::span<const doubl
       file = -1;
     }
   } close_on_exit{file_};
-  const bool new_mesh = last_mesh_ != &mesh || mesh.connectivity().revision() != last_revision_ ||
-                        mesh.n_points() != last_n_points_ || n_meshes_ == 0;
   if (new_mesh) {
     const std::string group = "/mesh/" + std::to_string(n_meshes_);
-    std::vector<double> points(static_cast<std::size_t>(n_points) * 3, 0.0);
-    for (std::int64_t v = 0; v < n_points; ++v)
-      for (int k = 0; k < dim; ++k) points[v * 3 + k] = mesh.points()[v * dim + k];
-    write_dataset(group + "/points", points.data(), H5T_NATIVE_DOUBLE, n_points, 3);
-    const std::vector<VertexId> cells32 = mesh.cells();
-    const std::vector<std::int64_t> cells(cells32.begin(), cells32.end());
-    write_dataset(group + "/cells", cells.data(), H5T_NATIVE_INT64, n_cells, mesh.cell_dim() + 1);
+    write_rows(group + "/points", rows_of(mesh.points(), dim, 3, layout.point_rows).data(), H5T_NATIVE_DOUBLE,
+               layout.points, 3);
+    std::vector<std::int64_t> cells;
+    for (VertexId v : mesh.cells()) cells.push_back(layout.point_numbers[static_cast<std::size_t>(v)]);
+    write_rows(group + "/cells", cells.data(), H5T_NATIVE_INT64, layout.cells, mesh.cell_dim() + 1);
+    for (const PointField& field : layout.mesh_point_fields)
+      write_rows(group + "/" + field.name, rows_of(field.values, 1, 1, layout.point_rows).data(), H5T_NATIVE_DOUBLE,
+                 layout.points, 0);
     ++n_meshes_;
     last_mesh_ = &mesh;
+    last_part_ = layout.part;
     last_revision_ = mesh.connectivity().revision();
     last_n_points_ = mesh.n_points();
   }
   const std::string group = "/step/" + std::to_string(steps_.size());
-  std::vector<double> u(static_cast<std::size_t>(n_points) * 3, 0.0);
-  for (std::int64_t v = 0; v < n_points; ++v)
-    for (int k = 0; k < dim; ++k) u[v * 3 + k] = displacement[v * dim + k];
-  write_dataset(group + "/displacement", u.data(), H5T_NATIVE_DOUBLE, n_points, 3);
-  Step step{time, n_meshes_ - 1, n_points, n_cells, mesh.cell_dim(), {}, {}};
+  write_rows(group + "/displacement", rows_of(displacement, dim, 3, layout.point_rows).data(), H5T_NATIVE_DOUBLE,
+             layout.points, 3);
+  Step step{time, n_meshes_ - 1, layout.points.total, layout.cells.total, mesh.cell_dim(), {}, {}, {}};
   for (const CellField& field : cell_fields) {
-    write_dataset(group + "/" + field.name, field.values.data(), H5T_NATIVE_DOUBLE, n_cells, 0);
+    write_rows(group + "/" + field.name, field.values.data(), H5T_NATIVE_DOUBLE, layout.cells, 0);
     step.fields.push_back(field.name);
   }
   for (const PointField& field : point_fields) {
-    write_dataset(group + "/" + field.name, field.values.data(), H5T_NATIVE_DOUBLE, n_points, 0);
+    write_rows(group + "/" + field.name, rows_of(field.values, 1, 1, layout.point_rows).data(), H5T_NATIVE_DOUBLE,
+               layout.points, 0);
     step.point_fields.push_back(field.name);
   }
+  for (const PointField& field : layout.mesh_point_fields) step.mesh_point_fields.push_back(field.name);
   steps_.push_back(std::move(step));
-  write_xdmf();
+  publish_xdmf();
+}
+
+// Rank 0 writes the XDMF file; when it cannot, every rank throws.
+void XdmfWriter::publish_xdmf() const {
+  std::string problem;
+  if (rank_ == 0) {
+    try {
+      write_xdmf();
+    } catch (const FileError& error) {
+      problem = error.what();
+    }
+  }
+  if (problem = agreed(problem); !problem.empty()) throw FileError(problem);
 }
 
 void XdmfWriter::write_xdmf() const {
@@ -160,13 +331,14 @@ void XdmfWriter::write_xdmf() const {
         << "  <Attribute Name=\"displacement\" AttributeType=\"Vector\" Center=\"Node\">\n   <DataItem Dimensions=\""
         << s.n_points << " 3\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">" << h5 << ":" << step
         << "/displacement</DataItem>\n  </Attribute>\n";
-    auto scalar = [&](const std::string& field, const char* center, std::int64_t n) {
+    auto scalar = [&](const std::string& group, const std::string& field, const char* center, std::int64_t n) {
       out << "  <Attribute Name=\"" << xml_escaped(field) << "\" AttributeType=\"Scalar\" Center=\"" << center
           << "\">\n   <DataItem Dimensions=\"" << n << "\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">" << h5
-          << ":" << step << "/" << xml_escaped(field) << "</DataItem>\n  </Attribute>\n";
+          << ":" << group << "/" << xml_escaped(field) << "</DataItem>\n  </Attribute>\n";
     };
-    for (const std::string& field : s.fields) scalar(field, "Cell", s.n_cells);
-    for (const std::string& field : s.point_fields) scalar(field, "Node", s.n_points);
+    for (const std::string& field : s.fields) scalar(step, field, "Cell", s.n_cells);
+    for (const std::string& field : s.point_fields) scalar(step, field, "Node", s.n_points);
+    for (const std::string& field : s.mesh_point_fields) scalar(mesh, field, "Node", s.n_points);
     out << " </Grid>\n";
   }
   out << "</Grid>\n</Domain>\n</Xdmf>\n";

@@ -3,7 +3,12 @@
 Each step stores the displacement and per-cell fields: ``aspect_ratio`` (reference shape,
 §3.2.3) and ``inverted`` (1 where det F ≤ 0), and any extra point fields. When the mesh changes
 between steps (a cut, a refinement) the new mesh is written and the step points to it.
-``read_series`` reads such a series back, each step with its own mesh."""
+``read_series`` reads such a series back, each step with its own mesh.
+
+``SeriesWriter(base, comm)`` writes one series from the parts of a distributed mesh
+(``snede.distribute``): every rank of ``comm`` writes its part into the shared HDF5 file
+(MPI-IO) and rank 0 the XDMF file, which reads back like a serial series; the point field
+``serial_vertex`` gives each point's id in the serial mesh."""
 from __future__ import annotations
 
 import contextlib
@@ -21,12 +26,30 @@ __all__ = ["SeriesWriter", "SeriesStep", "read_series"]
 
 
 class SeriesWriter:
-    """``SeriesWriter("out/scene/cantilever")`` writes ``cantilever.xdmf`` and ``cantilever.h5``."""
+    """``SeriesWriter("out/scene/cantilever")`` writes ``cantilever.xdmf`` and ``cantilever.h5``.
 
-    def __init__(self, base):
+    With ``comm`` (an mpi4py communicator) the writer is shared by its ranks: creating it and
+    every ``write_part`` are collective, every rank passes the same ``base``."""
+
+    def __init__(self, base, comm=None):
         base = Path(base)
-        base.parent.mkdir(parents=True, exist_ok=True)
-        self._impl = _snede.XdmfWriter(str(base))
+        self.comm = comm
+        if comm is None:
+            base.parent.mkdir(parents=True, exist_ok=True)
+            self._impl = _snede.XdmfWriter(str(base))
+            return
+        # Rank 0 makes the folder; every rank learns whether it could, so none waits for the
+        # others in the collective file creation.
+        problem = None
+        if comm.rank == 0:
+            try:
+                base.parent.mkdir(parents=True, exist_ok=True)
+            except OSError as error:
+                problem = error
+        problem = comm.bcast(problem, root=0)
+        if problem is not None:
+            raise problem
+        self._impl = _snede.XdmfWriter(str(base), comm.py2f())
 
     @property
     def xdmf_path(self) -> Path:
@@ -60,12 +83,32 @@ class SeriesWriter:
         ``aspect_ratio`` and ``min_angle`` (radians; the smallest dihedral angle for tetrahedra)
         cell fields, an optional (n_points, dim) ``displacement``, extra cell fields and
         ``point_fields``."""
-        u = np.zeros((mesh.n_points, mesh.dim)) if displacement is None else np.asarray(displacement, dtype=np.float64)
-        points = {name: np.asarray(values, dtype=np.float64).ravel() for name, values in (point_fields or {}).items()}
-        quality = mesh.quality()
-        fields = {"aspect_ratio": quality.aspect_ratio, "min_angle": quality.min_dihedral}
-        fields.update({name: np.asarray(values, dtype=np.float64) for name, values in cell_fields.items()})
-        self._impl.write_step(float(time), mesh._impl, np.ascontiguousarray(u), fields, points)
+        u, points, fields = _step_arrays(mesh, displacement, point_fields, cell_fields)
+        self._impl.write_step(float(time), mesh._impl, u, fields, points)
+
+    def write_part(self, part, time: float = 0.0, displacement=None, point_fields: dict | None = None,
+                   **cell_fields) -> None:
+        """Collective: write this rank's part of a distributed mesh (a ``snede.DistributedMesh``
+        over the writer's communicator) with the cell fields of ``write_mesh``, all given for
+        the rank's local mesh: ``displacement`` (n_local_vertices, dim) for its vertices, owned
+        and ghosts (``DistributedStatic.local_displacement()``), ``point_fields`` one value per
+        local vertex, extra cell fields one per local cell. Every rank passes the same field
+        names; bad input raises the same ValueError on every rank. The file holds the owned
+        vertices' values, in PETSc's global vertex order, and the point field ``serial_vertex``."""
+        u, points, fields = _step_arrays(part.local, displacement, point_fields, cell_fields)
+        self._impl.write_distributed_step(float(time), part._impl, u, fields, points)
+
+
+def _step_arrays(mesh, displacement, point_fields, cell_fields):
+    """The arrays of one step of ``mesh`` as the engine takes them: the displacement (zero when
+    None), the point fields and the cell fields with ``aspect_ratio`` and ``min_angle`` first.
+    Sizes are the engine's to check (on every rank at once for a distributed part)."""
+    u = np.zeros((mesh.n_points, mesh.dim)) if displacement is None else np.asarray(displacement, dtype=np.float64)
+    points = {name: np.asarray(values, dtype=np.float64).ravel() for name, values in (point_fields or {}).items()}
+    quality = mesh.quality()
+    fields = {"aspect_ratio": quality.aspect_ratio, "min_angle": quality.min_dihedral}
+    fields.update({name: np.asarray(values, dtype=np.float64) for name, values in cell_fields.items()})
+    return np.ascontiguousarray(u), points, fields
 
 
 # -- reading a series back ----------------------------------------------------------------------
