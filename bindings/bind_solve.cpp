@@ -107,6 +107,20 @@ void bind_solve(py::module_& m) {
       .def("external_forces", [](Model& s) { return to_array(s.external_forces(), s.dim()); })
       .def("reaction_forces", &reactions_of)
       .def_property_readonly("n_constrained", [](const Model& s) { return s.constraints().n_constrained(); })
+      // (fixed vertices, their anchors (n, dim), sliding vertices): what a distributed solve
+      // takes over from the serial body.
+      .def("constraint_table", [](const Model& s) {
+             const Constraints& c = s.constraints();
+             std::vector<std::int64_t> fixed, sliding;
+             std::vector<double> anchors;
+             for (VertexId v = 0; v < c.n_points(); ++v) {
+               if (c[v].kind == ConstraintKind::slide) sliding.push_back(v);
+               if (c[v].kind != ConstraintKind::fixed) continue;
+               fixed.push_back(v);
+               anchors.insert(anchors.end(), c[v].anchor.begin(), c[v].anchor.begin() + s.dim());
+             }
+             return py::make_tuple(to_array(fixed, 1), to_array(anchors, s.dim()), to_array(sliding, 1));
+           })
       .def_property_readonly("generation", &Model::generation)
       .def_property("displacement", [](const Model& s) { return vec_to_array(s.displacement(), s.dim()); },
                     [](Model& s, const DoubleArray& u) { array_to_vec(u, s.displacement()); })

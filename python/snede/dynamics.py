@@ -13,6 +13,8 @@ import numpy as np
 
 from snede import _checks, _snede
 from snede._petsc import option_list
+from snede.distributed import DistributedRelaxation
+from snede.distributed_body import DistributedBody
 from snede.result import SolveResult
 
 
@@ -33,21 +35,48 @@ class DynamicRelaxation:
     """
 
     def __init__(self, body, damping: float, dt: float | None = None, *, options_prefix: str = "dynamic_",
-                 petsc_options: dict | None = None):
+                 petsc_options: dict | None = None, comm=None):
         if dt is not None and not (math.isfinite(dt) and dt > 0):
             raise ValueError(f"dt must be positive and finite (or None for the CFL estimate), got {dt}")
         self.body = body
+        self._distributed = None
+        if comm is not None:
+            if petsc_options:
+                raise NotImplementedError(f"petsc_options on MPI ranks (comm): give -{options_prefix}ts_* "
+                                          "options on the command line")
+            self._distributed = DistributedBody(body, comm)
+            self._problem = self._distributed.problem()
+            self._relaxation = DistributedRelaxation(self._problem, damping, dt, options_prefix=options_prefix)
+            self._impl = None
+            return
         self._impl = _snede.DynamicRelaxation(body._model, float(damping), float(dt or 0.0), options_prefix,
                                               option_list(petsc_options))
+
+    @property
+    def part(self):
+        """This rank's :class:`snede.DistributedMesh` when solving over several ranks (after
+        the first solve), else None."""
+        return None if self._distributed is None else self._distributed.part
+
+    @property
+    def _engine(self):
+        if self._impl is None:
+            raise NotImplementedError("this relaxation runs on MPI ranks (comm): only run(), dt and part are "
+                                      "available")
+        return self._impl
 
     def step(self, n: int = 1) -> SolveResult:
         """Take ``n`` time steps. ``converged`` is False only on divergence (blow-up, NaN,
         inverted elements); ``residual_norm`` is ‖F(u)‖ at the final state."""
-        return SolveResult._from_engine(self._impl.step(_checks.count(n, "n")))
+        return SolveResult._from_engine(self._engine.step(_checks.count(n, "n")))
 
     def run(self, rtol: float = 1e-3, max_steps: int = 100000) -> SolveResult:
         """Step until ‖F(u)‖ ≤ rtol·√(‖f_ext‖² + ‖f_react‖²) (criterion (6.9)), or
         ``max_steps`` (``reason == "DIVERGED_MAX_IT"``)."""
+        if self._distributed is not None:
+            result = self._relaxation.run(rtol, max_steps)
+            self._distributed.gather_into_body(self._problem)
+            return result
         return SolveResult._from_engine(self._impl.run(float(rtol), _checks.count(max_steps, "max_steps")))
 
     def critical_time_step(self, flop_budget: float = 50e6, initial: float | None = None,
@@ -56,37 +85,37 @@ class DynamicRelaxation:
         blow up (‖u‖ > 1e15 or NaN) within ``flop_budget`` flops (and at least ``min_steps``
         steps, which large meshes need), searched from ``initial`` (None: the CFL estimate) in
         factors of (1 − ``reduction``). The state is restored."""
-        return self._impl.critical_time_step(float(flop_budget), float(initial or 0.0), float(reduction),
+        return self._engine.critical_time_step(float(flop_budget), float(initial or 0.0), float(reduction),
                                              _checks.count(min_steps, "min_steps", 1))
 
     @property
     def cfl_time_step(self) -> float:
         """(2.61): (2/√3)·h/c, h the smallest inscribed-sphere diameter, c the dilatational
         wave speed √((λ+2μ)/ρ) (plane stress: √(E/((1−ν²)ρ)))."""
-        return self._impl.cfl_time_step()
+        return self._engine.cfl_time_step()
 
     @property
     def dt(self) -> float:
-        return self._impl.dt
+        return self._relaxation.dt if self._distributed is not None else self._impl.dt
 
     @dt.setter
     def dt(self, value: float) -> None:
-        self._impl.dt = float(value)
+        self._engine.dt = float(value)
 
     @property
     def damping(self) -> float:
-        return self._impl.damping
+        return self._engine.damping
 
     @property
     def velocity(self) -> np.ndarray:
         """Velocity (m/s) at the half step behind the displacement, (n_points, dim) (a copy)."""
-        return self._impl.velocity
+        return self._engine.velocity
 
     @velocity.setter
     def velocity(self, v) -> None:
-        self._impl.velocity = np.ascontiguousarray(self.body._field("velocity", v))
+        self._engine.velocity = np.ascontiguousarray(self.body._field("velocity", v))
 
     @property
     def ts(self):
         """The petsc4py TS (type ``snede_ss22``)."""
-        return self._impl.ts
+        return self._engine.ts

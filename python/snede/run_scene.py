@@ -106,14 +106,14 @@ def run(scene, method: str | None, rtol: float | None, out: Path, progress: bool
     folder = Path(out) / scene.name
     comm = _world()
     if comm is not None:
-        # Several MPI ranks (issue 18): a static solve over all of them, rank 0 writes.
+        # Several MPI ranks (issue 18): a static solve and the series over all of them.
         from snede.distributed_scene import solve_distributed, unsupported
 
         if (why := unsupported(scene, method)) is not None:
             raise NotImplementedError(f"{scene.name} on {comm.size} MPI ranks: {why}")
         if comm.rank == 0:
             folder.mkdir(parents=True, exist_ok=True)
-        writer = SeriesWriter(folder / scene.name) if comm.rank == 0 else None
+        writer = SeriesWriter(folder / scene.name, comm=comm)
         outcome = solve_distributed(scene, method, rtol, writer, comm)
         if comm.rank != 0:
             return {"scene": scene.name, "rank": comm.rank, **outcome}

@@ -7,9 +7,11 @@ from __future__ import annotations
 
 from snede import _checks, _snede
 from snede._petsc import option_list
+from snede.distributed_body import DistributedBody
 from snede.result import SolveResult
 
 METHODS = ("cg", "ncg", "newton")
+DISTRIBUTED_PRECONDITIONERS = (None, "none", "jacobi", "gamg")
 LINE_SEARCHES = ("cp", "snede_newton", "snede_secant", "bt", "l2", "basic")
 
 
@@ -47,6 +49,15 @@ class StaticSolver:
       None (default): ``-static_pc_type`` if given, else ``"none"``. ``-static_pc_type`` on the
       command line wins over the argument. The shell stays the operator in every case.
 
+    * ``comm`` (an mpi4py communicator): ``solve()`` is collective and runs over all its ranks
+      (issue 18, ``snede.distributed_body``), one included: rank 0's body is
+      distributed, its fixed vertices and external forces become a
+      :class:`snede.DistributedStatic` solved from the prescribed displacements, and the
+      result is gathered into ``body.displacement`` on every rank. There the nonlinear
+      methods stop at ‖F‖ ≤ rtol·‖F(u₀)‖ and CG at ‖r‖ ≤ rtol·‖b‖ (PETSc's relative tests, not
+      ``criterion``); the preconditioner is ``"gamg"`` (default), ``"jacobi"`` or ``"none"``;
+      ``part`` is this rank's part. None (default): the serial solver.
+
     Every method solves the system divided by the force scale E·t·H (E·H² in 3D), so that the
     answer does not depend on the units (E from 1e-3 to 1e155 Pa give the same displacement);
     ``-static_ksp_monitor`` prints residual norms divided by it, while ``SolveResult``
@@ -56,7 +67,7 @@ class StaticSolver:
     def __init__(self, body, method: str = "newton", rtol: float = 1e-6, *, criterion: str = "6.9",
                  round_tolerance: float = 1e-12, max_iterations: int = 10000, line_search: str | None = None,
                  ncg_type: str | None = None, options_prefix: str = "static_", petsc_options: dict | None = None,
-                 preconditioner: str | None = None):
+                 preconditioner: str | None = None, comm=None):
         if method not in METHODS:
             raise ValueError(f"method must be one of {METHODS}, got {method!r}")
         if not (rtol > 0):
@@ -78,30 +89,62 @@ class StaticSolver:
                              f"got {preconditioner!r}")
         self.body = body
         self.method = method
+        self._distributed = None
+        if comm is not None:
+            if preconditioner not in DISTRIBUTED_PRECONDITIONERS:
+                raise NotImplementedError(f"preconditioner {preconditioner!r} on MPI ranks (comm): distributed "
+                                          f"solves take {DISTRIBUTED_PRECONDITIONERS}")
+            self._distributed = DistributedBody(body, comm)
+            self._distributed_settings = (method, rtol, max_iterations, preconditioner, options_prefix)
+            self._impl = None
+            return
         self._impl = _snede.StaticSolver(body._model, method, float(rtol), criterion, float(round_tolerance),
                                          max_iterations, options_prefix, option_list(options), preconditioner or "",
                                          body.mesh._bisection_if_any())
 
     def solve(self) -> SolveResult:
+        if self._distributed is not None:
+            return self._solve_distributed()
         return SolveResult._from_engine(self._impl.solve())
+
+    def _solve_distributed(self) -> SolveResult:
+        method, rtol, max_iterations, preconditioner, prefix = self._distributed_settings
+        problem = self._distributed.problem()
+        chosen = "none" if method == "ncg" else (preconditioner or "gamg")
+        result = problem.solve(method, rtol=rtol, max_iterations=max_iterations, preconditioner=chosen,
+                               options_prefix=prefix)
+        self._distributed.gather_into_body(problem)
+        return result
+
+    @property
+    def part(self):
+        """This rank's :class:`snede.DistributedMesh` when solving over several ranks (after
+        the first solve), else None."""
+        return None if self._distributed is None else self._distributed.part
+
+    @property
+    def _engine(self):
+        if self._impl is None:
+            raise NotImplementedError("this solver runs on MPI ranks (comm): only solve() and part are available")
+        return self._impl
 
     @property
     def preconditioner(self) -> str:
         """The PETSc PC type the CG uses ("none" for ncg)."""
-        return self._impl.preconditioner
+        return self._engine.preconditioner
 
     @property
     def multigrid_levels(self) -> list[int]:
         """Elements per level of the ``"mg"`` preconditioner, coarsest first, the body's mesh
         last (empty for other preconditioners); rebuilt at the first solve after a mesh change."""
-        return list(self._impl.multigrid_levels)
+        return list(self._engine.multigrid_levels)
 
     @property
     def ksp(self):
         """The petsc4py KSP: linear CG's, or Newton's inner one."""
-        return self._impl.ksp
+        return self._engine.ksp
 
     @property
     def snes(self):
         """The petsc4py SNES (None for linear CG)."""
-        return self._impl.snes
+        return self._engine.snes

@@ -10,6 +10,7 @@ import pytest
 from mpi4py import MPI
 
 from snede import DynamicRelaxation, StaticSolver, run_scene
+from snede.output import read_series
 from snede.scenes import cantilever, cylinder, needle
 
 COMM = MPI.COMM_WORLD
@@ -31,7 +32,11 @@ def test_cantilever_on_several_ranks_matches_the_serial_run(tmp_path_factory):
         # Rank 0 wrote what a serial run writes, and its probe is the serial solve's.
         written = json.loads((folder / "cantilever" / "summary.json").read_text())
         assert written["value"] == pytest.approx(summary["value"])
-        assert (folder / "cantilever" / "cantilever.xdmf").exists() and (folder / "cantilever" / "cantilever.png").exists()
+        assert (folder / "cantilever" / "cantilever.png").exists()
+        # The ranks wrote one series together: the unloaded and the solved state on one mesh.
+        unloaded, solved = read_series(folder / "cantilever" / "cantilever.xdmf")
+        assert unloaded.mesh is solved.mesh and solved.mesh.n_cells == 8 * 2 * 2 * 6
+        assert not unloaded.point_fields["displacement"].any() and solved.point_fields["displacement"].any()
         serial = cantilever.build(options(divisions=8))
         assert StaticSolver(serial.body, "cg", preconditioner="none", rtol=1e-12).solve().converged
         assert summary["value"] == pytest.approx(serial.probe(serial.body), rel=1e-8)

@@ -1,0 +1,52 @@
+"""A serial Body solved over MPI ranks (issue 18): what ``StaticSolver(body, ..., comm=...)``
+and ``DynamicRelaxation(body, ..., comm=...)`` do, on any number of ranks.
+
+Every rank runs the same script and holds the same serial Body; rank 0's is the one used. Its
+mesh is distributed (``snede.distribute``), its fixed vertices and external forces (gravity and
+the nodal-force channels, which do not depend on the state) become a
+:class:`snede.DistributedStatic`, the solve runs on all ranks, and the displacement is
+gathered back into the Body on every rank, so the script goes on as serially. The
+distribution is kept while the mesh is unchanged (a cut or a refinement of the serial body,
+done on every rank, makes the next solve distribute anew). What cannot be taken over raises
+NotImplementedError on every rank: sliding constraints and membranes.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from snede.distributed import DistributedStatic, distribute
+
+
+class DistributedBody:
+    """The distributed copy of a serial ``body`` over ``comm`` (collective); ``part`` is this
+    rank's part of the latest distribution (None before the first)."""
+
+    def __init__(self, body, comm):
+        self.body, self.comm = body, comm
+        self.part, self._revision = None, None
+
+    def problem(self) -> DistributedStatic:
+        """A DistributedStatic with the body's current conditions, on the mesh as it is now."""
+        body, comm = self.body, self.comm
+        why = None
+        if comm.rank == 0:
+            fixed, anchors, sliding = body._model.constraint_table()
+            loads = body.external_forces()
+            loaded = np.flatnonzero(np.any(loads != 0, axis=1))
+            if body.mesh.is_surface:
+                why = "membranes (surface meshes) are not distributed yet"
+            elif len(sliding):
+                why = f"sliding constraints ({len(sliding)} vertices) are not distributed yet; fix them instead"
+            conditions = (why, fixed, anchors, loaded, loads[loaded], body.mesh._impl.revision)
+        why, fixed, anchors, loaded, loads, revision = comm.bcast(conditions if comm.rank == 0 else None, root=0)
+        if why is not None:
+            raise NotImplementedError(f"a solve on {comm.size} MPI ranks: {why}")
+        if self.part is None or revision != self._revision:
+            self.part = distribute(body.mesh if comm.rank == 0 else None, comm)
+            self._revision = revision
+        return DistributedStatic(self.part, body.material, density=body.density, thickness=body.thickness,
+                                 fixed=fixed, fixed_values=anchors,
+                                 forces={int(v): f for v, f in zip(loaded, loads)})
+
+    def gather_into_body(self, problem: DistributedStatic) -> None:
+        self.body.displacement = problem.gathered_displacement()

@@ -1,0 +1,101 @@
+"""A serial script's solvers given a communicator (StaticSolver(..., comm=),
+DynamicRelaxation(..., comm=)): on several ranks they distribute rank 0's body and gather the
+answer back into it on every rank, so the script is the same on 1 or N ranks (on one rank
+the distributed path runs too). Compared with the serial solvers on the same body."""
+import numpy as np
+import pytest
+from mpi4py import MPI
+
+import snede
+from snede.output import SeriesWriter, read_series
+from cantilever_problems import cantilever, conditions
+
+COMM = MPI.COMM_WORLD
+
+
+def loaded_body(material, refine=False):
+    mesh, _ = cantilever(3)
+    if refine:
+        mesh.refine_uniform()
+    fixed, tip, force = conditions(mesh)
+    body = snede.Body(mesh, material)
+    body.fix(fixed)
+    body.add_nodal_force(tip, force)
+    body.add_gravity((0.0, 0.0, -1.0))
+    return body
+
+
+def relative_difference(u, v):
+    return np.abs(u - v).max() / np.abs(v).max()
+
+
+def test_static_solver_with_comm_gives_the_serial_displacement_on_every_rank():
+    material = snede.NeoHookean(1e5, 0.3)
+    body = loaded_body(material)
+    result = snede.StaticSolver(body, "newton", rtol=1e-11, comm=COMM).solve()
+    assert result.converged, result
+    reference = loaded_body(material)
+    assert snede.StaticSolver(reference, "newton", rtol=1e-12).solve().converged
+    assert relative_difference(body.displacement, reference.displacement) <= 1e-7
+    # Every rank holds the same answer.
+    assert len({arr.tobytes() for arr in COMM.allgather(body.displacement)}) == 1
+
+
+def test_dynamic_relaxation_with_comm_takes_the_serial_steps():
+    material = snede.LinearElastic(1e5, 0.3)
+    body = loaded_body(material)
+    relaxation = snede.DynamicRelaxation(body, damping=1.5, comm=COMM)
+    result = relaxation.run(rtol=1e-6, max_steps=20000)
+    reference = loaded_body(material)
+    expected = snede.DynamicRelaxation(reference, damping=1.5, dt=relaxation.dt).run(rtol=1e-6, max_steps=20000)
+    assert result.converged and expected.converged
+    assert result.iterations == expected.iterations
+    assert relative_difference(body.displacement, reference.displacement) <= 1e-10
+
+
+def test_a_refined_body_is_distributed_anew():
+    """The serial body refined on every rank between two solves: the second solve distributes
+    the refined mesh and matches the serial solve of the refined body."""
+    material = snede.LinearElastic(1e5, 0.3)
+    body = loaded_body(material)
+    solver = snede.StaticSolver(body, "cg", rtol=1e-12, comm=COMM)
+    assert solver.solve().converged
+    cells_before = solver.part.n_global_cells
+    body.mesh.refine_uniform()
+    assert solver.solve().converged
+    assert solver.part.n_global_cells == 2 * cells_before == body.mesh.n_cells  # one bisection each
+    reference = loaded_body(material, refine=True)
+    assert snede.StaticSolver(reference, "cg", rtol=1e-12).solve().converged
+    assert relative_difference(body.displacement, reference.displacement) <= 1e-7
+
+
+def test_what_is_not_distributed_is_refused_on_every_rank():
+    body = loaded_body(snede.LinearElastic(1e5, 0.3))
+    body.slide([0], (1.0, 0.0, 0.0))
+    with pytest.raises(NotImplementedError, match=r"on \d MPI ranks: sliding constraints \(1 vertices\)"):
+        snede.StaticSolver(body, "cg", comm=COMM).solve()
+    with pytest.raises(NotImplementedError, match="preconditioner 'mg'"):
+        snede.StaticSolver(body, "cg", preconditioner="mg", comm=COMM)
+    solver = snede.StaticSolver(loaded_body(snede.LinearElastic(1e5, 0.3)), "cg", comm=COMM)
+    with pytest.raises(NotImplementedError, match="only solve"):
+        solver.ksp
+    assert COMM.allreduce(1) == COMM.size
+
+
+def test_a_collective_series_reads_back_as_the_serial_mesh(tmp_path_factory):
+    """SeriesWriter(comm=) and write_part after a distributed solve: rank 0 reads one series
+    whose points, mapped by serial_vertex, carry the solved displacement."""
+    folder = COMM.bcast(str(tmp_path_factory.mktemp("series")) if COMM.rank == 0 else None)
+    body = loaded_body(snede.LinearElastic(1e5, 0.3))
+    part = snede.distribute(body.mesh if COMM.rank == 0 else None, COMM)
+    assert snede.StaticSolver(body, "cg", rtol=1e-10, comm=COMM).solve().converged
+    writer = SeriesWriter(f"{folder}/cantilever", comm=COMM)
+    writer.write_part(part, time=1.0, displacement=body.displacement[part.global_vertex])
+    COMM.Barrier()
+    if COMM.rank == 0:
+        (step,) = read_series(writer.xdmf_path)
+        serial = step.point_fields["serial_vertex"].astype(np.int64)
+        np.testing.assert_array_equal(np.sort(serial), np.arange(body.mesh.n_points))
+        np.testing.assert_allclose(step.mesh.points, body.mesh.points[serial])
+        np.testing.assert_allclose(step.point_fields["displacement"], body.displacement[serial])
+    COMM.Barrier()
