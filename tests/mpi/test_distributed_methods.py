@@ -137,3 +137,19 @@ def test_gravity_loads_the_element_masses_as_serially():
     assert relative_difference(problem.gathered_displacement(), body.displacement) <= 1e-7
     with pytest.raises(ValueError, match="gravity needs 3 components"):
         snede.DistributedStatic(part, material, fixed=fixed, gravity=(0.0, -9.81))
+
+
+@pytest.mark.parametrize("material, method", [(snede.LinearElastic(1e5, 0.3), "cg"),
+                                              (snede.NeoHookean(1e5, 0.3), "newton")], ids=["linear-cg", "neohookean-newton"])
+def test_the_displacement_does_not_depend_on_the_rank_count(material, method):
+    """The issue's equality: this communicator against every rank alone, to 1e-10 relative
+    (both solved to rtol 1e-12; only the order of the ghosts' sums differs)."""
+    serial, _ = cantilever(3)
+    fixed, tip, force = conditions(serial)
+    solutions = []
+    for comm, prefix in ((COMM, "together_"), (MPI.COMM_SELF, "alone_")):
+        part = snede.distribute(serial if comm.rank == 0 else None, comm)
+        problem = snede.DistributedStatic(part, material, fixed=fixed, forces={int(v): force for v in tip})
+        assert problem.solve(method, rtol=1e-12, options_prefix=prefix).converged
+        solutions.append(problem.gathered_displacement())
+    assert relative_difference(*solutions) <= 1e-10
