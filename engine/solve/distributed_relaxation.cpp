@@ -14,7 +14,6 @@ DistributedRelaxation::DistributedRelaxation(DistributedStatic& problem, double 
     : problem_(problem) {
   require_valid_damping(damping);
   require(dt == 0 || positive_finite(dt), "dt", "positive and finite (or 0 for the CFL estimate)", dt);
-  register_ts_ss22();
   Vec u = problem.state();
   SNEDE_PETSC(VecDuplicate(u, velocity_.out()));
   SNEDE_PETSC(VecZeroEntries(velocity_));
@@ -24,24 +23,7 @@ DistributedRelaxation::DistributedRelaxation(DistributedStatic& problem, double 
   const double step = dt > 0 ? dt : problem.cfl_time_step();
   require(positive_finite(step), "the CFL time step", "positive and finite (is the mesh empty?)", step);
   SNEDE_PETSC(TSCreate(problem.comm(), ts_.out()));
-  SNEDE_PETSC(TSSetOptionsPrefix(ts_, options_prefix.c_str()));
-  SNEDE_PETSC(TSSetType(ts_, ts_ss22));
-  set_ss22_damping(ts_, damping);
-  SNEDE_PETSC(TSSetApplicationContext(ts_, this));
-  SNEDE_PETSC(TSSetRHSFunction(ts_, nullptr, acceleration_callback, this));
-  SNEDE_PETSC(TSSetPostStep(ts_, post_step_callback));
-  SNEDE_PETSC(TS2SetSolution(ts_, u, velocity_));
-  SNEDE_PETSC(TSSetTime(ts_, 0.0));
-  SNEDE_PETSC(TSSetTimeStep(ts_, step));
-  SNEDE_PETSC(TSSetMaxTime(ts_, PETSC_MAX_REAL));
-  SNEDE_PETSC(TSSetExactFinalTime(ts_, TS_EXACTFINALTIME_STEPOVER));
-  SNEDE_PETSC(TSSetFromOptions(ts_));
-  PetscBool is_ss22 = PETSC_FALSE;
-  SNEDE_PETSC(PetscObjectTypeCompare(reinterpret_cast<PetscObject>(ts_.get()), ts_ss22, &is_ss22));
-  if (!is_ss22)
-    throw std::invalid_argument("dynamic relaxation integrates with the TS type " + std::string(ts_ss22) + "; -" +
-                                options_prefix + "ts_type must not change it");
-  require(positive_finite(time_step()), "-" + options_prefix + "ts_dt", "positive and finite", time_step());
+  set_up_ss22(ts_, {options_prefix, damping, step, this, acceleration_callback, post_step_callback, u, velocity_});
   stopping_.criterion = StoppingCriterion::with_reactions;
   stopping_.force_scale = problem.force_scale();
   stopping_.n_dofs = static_cast<double>(problem.n_global_dofs());
@@ -101,11 +83,7 @@ void DistributedRelaxation::acceleration(Vec u, Vec a) {
 
 void DistributedRelaxation::after_step() {
   Vec u = problem_.state();
-  if (failure_.empty()) {
-    const double norm = vec_norm(u);
-    if (!std::isfinite(norm)) failure_ = "DIVERGED_NONFINITE_STATE";
-    else if (norm > blow_up_norm) failure_ = "DIVERGED_BLOW_UP";
-  }
+  if (failure_.empty()) failure_ = blow_up_failure(u);
   if (!failure_.empty()) {
     SNEDE_PETSC(TSSetConvergedReason(ts_, TS_DIVERGED_STEP_REJECTED));
     return;

@@ -46,6 +46,12 @@ double dilatational_modulus(const Material& material, int dim) {
 
 }  // namespace
 
+std::string blow_up_failure(Vec u) {
+  const double norm = vec_norm(u);
+  if (!std::isfinite(norm)) return "DIVERGED_NONFINITE_STATE";
+  return norm > 1e15 ? "DIVERGED_BLOW_UP" : "";
+}
+
 // h: with the shortest edge (the h of the text around (2.61)) the estimate exceeded the
 // stability limit 2/√λ_max(M⁻¹K) by 1.4–1.8× on structured boxes and gmsh cylinders, so the
 // default step would blow up. The inscribed diameter is the element length in 1D and gave
@@ -67,7 +73,6 @@ DynamicRelaxation::DynamicRelaxation(Model& model, double damping_eta, double dt
     throw std::invalid_argument("dynamic relaxation of membranes (surface meshes) is not implemented yet: its CFL "
                                 "time step assumes volume elements; use StaticSolver with method 'newton'");
   require(dt == 0 || positive_finite(dt), "dt", "positive and finite (or 0 for the CFL estimate)", dt);
-  register_ts_ss22();
   try {
     generation_ = model_.generation();
     Vec u = model_.displacement();
@@ -84,27 +89,10 @@ DynamicRelaxation::DynamicRelaxation(Model& model, double damping_eta, double dt
     SNES snes = nullptr;  // unused by SS22, but TSSetFromOptions creates and configures it
     SNEDE_PETSC(TSGetSNES(ts_, &snes));
     option_database_.use_for(snes);
-    SNEDE_PETSC(TSSetOptionsPrefix(ts_, options_prefix.c_str()));
-    SNEDE_PETSC(TSSetType(ts_, ts_ss22));
-    set_ss22_damping(ts_, damping_eta);
-    SNEDE_PETSC(TSSetApplicationContext(ts_, this));
-    SNEDE_PETSC(TSSetRHSFunction(ts_, nullptr, acceleration_callback, this));
-    SNEDE_PETSC(TSSetPostStep(ts_, post_step_callback));
-    SNEDE_PETSC(TS2SetSolution(ts_, u, velocity_));
     const double default_dt = dt > 0 ? dt : cfl_time_step();
-    SNEDE_PETSC(TSSetTime(ts_, 0.0));
-    SNEDE_PETSC(TSSetTimeStep(ts_, default_dt));
-    SNEDE_PETSC(TSSetMaxSteps(ts_, PETSC_MAX_INT));  // no cap unless -<prefix>ts_max_steps
-    SNEDE_PETSC(TSSetMaxTime(ts_, PETSC_MAX_REAL));
-    SNEDE_PETSC(TSSetExactFinalTime(ts_, TS_EXACTFINALTIME_STEPOVER));
-    SNEDE_PETSC(TSSetFromOptions(ts_));
+    set_up_ss22(ts_, {options_prefix, damping_eta, default_dt, this, acceleration_callback, post_step_callback, u,
+                      velocity_});
     option_database_.mark_read_options_used();
-    PetscBool is_ss22 = PETSC_FALSE;
-    SNEDE_PETSC(PetscObjectTypeCompare(reinterpret_cast<PetscObject>(ts_.get()), ts_ss22, &is_ss22));
-    if (!is_ss22)
-      throw std::invalid_argument("dynamic relaxation integrates with the TS type " + std::string(ts_ss22) + "; -" +
-                                  options_prefix + "ts_type must not change it");
-    require(positive_finite(time_step()), "-" + options_prefix + "ts_dt", "positive and finite", time_step());
     follows_cfl_ = dt == 0 && time_step() == default_dt;
   } catch (...) {
     model_.remove_carried_field(velocity_.slot());  // the handles release the PETSc objects
@@ -274,11 +262,7 @@ bool DynamicRelaxation::converged_at(Vec u) {
 void DynamicRelaxation::after_step() {
   Vec u = model_.displacement();
   if (mode_ != Mode::stability_trial) history_.push_back(last_residual_norm_);
-  if (failure_.empty()) {
-    const double norm = vec_norm(u);
-    if (!std::isfinite(norm)) failure_ = "DIVERGED_NONFINITE_STATE";
-    else if (norm > blow_up_norm) failure_ = "DIVERGED_BLOW_UP";
-  }
+  if (failure_.empty()) failure_ = blow_up_failure(u);
   if (!failure_.empty()) {
     SNEDE_PETSC(TSSetConvergedReason(ts_, TS_DIVERGED_STEP_REJECTED));
     return;

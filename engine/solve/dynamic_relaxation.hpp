@@ -27,8 +27,9 @@
 
 namespace snede {
 
-// A blown-up state (§4.4.1): ‖u‖ beyond this.
-inline constexpr double blow_up_norm = 1e15;
+// §4.4.1: "DIVERGED_NONFINITE_STATE" or "DIVERGED_BLOW_UP" (‖u‖ > 10¹⁵) for a state the
+// motion has left behind, else empty.
+std::string blow_up_failure(Vec u);
 
 // (2.61): Δt = (2/√3) h/c, c = √((λ+2μ)/ρ) (plane stress: √(E/((1−ν²)ρ))), h the smallest
 // element size, taken as the diameter of the smallest inscribed sphere (circle); ∞ without cells.

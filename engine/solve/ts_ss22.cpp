@@ -136,4 +136,29 @@ double ss22_damping(TS ts) {
   return data_of(ts).damping;
 }
 
+void set_up_ss22(TS ts, const Ss22Setup& setup) {
+  register_ts_ss22();
+  SNEDE_PETSC(TSSetOptionsPrefix(ts, setup.options_prefix.c_str()));
+  SNEDE_PETSC(TSSetType(ts, ts_ss22));
+  set_ss22_damping(ts, setup.damping);
+  SNEDE_PETSC(TSSetApplicationContext(ts, setup.context));
+  SNEDE_PETSC(TSSetRHSFunction(ts, nullptr, setup.acceleration, setup.context));
+  SNEDE_PETSC(TSSetPostStep(ts, setup.post_step));
+  SNEDE_PETSC(TS2SetSolution(ts, setup.displacement, setup.velocity));
+  SNEDE_PETSC(TSSetTime(ts, 0.0));
+  SNEDE_PETSC(TSSetTimeStep(ts, setup.dt));
+  SNEDE_PETSC(TSSetMaxSteps(ts, PETSC_MAX_INT));  // no cap unless -<prefix>ts_max_steps
+  SNEDE_PETSC(TSSetMaxTime(ts, PETSC_MAX_REAL));
+  SNEDE_PETSC(TSSetExactFinalTime(ts, TS_EXACTFINALTIME_STEPOVER));
+  SNEDE_PETSC(TSSetFromOptions(ts));
+  PetscBool is_ss22 = PETSC_FALSE;
+  SNEDE_PETSC(PetscObjectTypeCompare(reinterpret_cast<PetscObject>(ts), ts_ss22, &is_ss22));
+  if (!is_ss22)
+    throw std::invalid_argument("dynamic relaxation integrates with the TS type " + std::string(ts_ss22) + "; -" +
+                                setup.options_prefix + "ts_type must not change it");
+  PetscReal dt = 0;
+  SNEDE_PETSC(TSGetTimeStep(ts, &dt));
+  require(positive_finite(dt), "-" + setup.options_prefix + "ts_dt", "positive and finite", dt);
+}
+
 }  // namespace snede

@@ -50,3 +50,24 @@ class DistributedBody:
 
     def gather_into_body(self, problem: DistributedStatic) -> None:
         self.body.displacement = problem.gathered_displacement()
+
+
+class RunsOnRanks:
+    """Mixed into the serial solvers: ``part``, and a guard on what only the serial solver has.
+    The solver sets ``_distributed`` (a DistributedBody or None) and ``_impl`` (None when
+    distributed); ``_on_ranks`` names what remains available then."""
+
+    _on_ranks = "solve() and part"
+
+    @property
+    def part(self):
+        """This rank's :class:`snede.DistributedMesh` when given a communicator (after the
+        first solve), else None."""
+        return None if self._distributed is None else self._distributed.part
+
+    @property
+    def _engine(self):
+        if self._impl is None:
+            raise NotImplementedError(f"this {type(self).__name__} runs on MPI ranks (comm): only {self._on_ranks} "
+                                      "are available")
+        return self._impl

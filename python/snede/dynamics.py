@@ -14,11 +14,11 @@ import numpy as np
 from snede import _checks, _snede
 from snede._petsc import option_list
 from snede.distributed import DistributedRelaxation
-from snede.distributed_body import DistributedBody
+from snede.distributed_body import DistributedBody, RunsOnRanks
 from snede.result import SolveResult
 
 
-class DynamicRelaxation:
+class DynamicRelaxation(RunsOnRanks):
     """``DynamicRelaxation(body, damping, dt=None)``: relax ``body.displacement`` in time.
 
     * ``damping``: η (1/s) of the damping C = η M, ≥ 0. §4.1: the fastest relaxation has
@@ -29,10 +29,17 @@ class DynamicRelaxation:
     * ``petsc_options``: PETSc options without the prefix, e.g. ``{"ts_monitor": None}``, for
       this solver only; the command line (PETSc's global options, as they are when the solver
       is made) still wins.
+    * ``comm`` (an mpi4py communicator): ``run()`` is collective over its ranks (issue 18):
+      rank 0's body is distributed with its fixed vertices and external forces as they are
+      now, relaxed by :class:`snede.DistributedRelaxation` (the same steps and displacement as
+      serially), and the result gathered into ``body.displacement`` on every rank; ``run``,
+      ``dt`` and ``part`` are available. None (default): the serial solver.
 
     The state is ``body.displacement`` and ``velocity`` (both (n_points, dim)); it starts at
     rest. After a cut or refinement the velocity is carried over like the displacement.
     """
+
+    _on_ranks = "run(), dt and part"
 
     def __init__(self, body, damping: float, dt: float | None = None, *, options_prefix: str = "dynamic_",
                  petsc_options: dict | None = None, comm=None):
@@ -51,19 +58,6 @@ class DynamicRelaxation:
             return
         self._impl = _snede.DynamicRelaxation(body._model, float(damping), float(dt or 0.0), options_prefix,
                                               option_list(petsc_options))
-
-    @property
-    def part(self):
-        """This rank's :class:`snede.DistributedMesh` when solving over several ranks (after
-        the first solve), else None."""
-        return None if self._distributed is None else self._distributed.part
-
-    @property
-    def _engine(self):
-        if self._impl is None:
-            raise NotImplementedError("this relaxation runs on MPI ranks (comm): only run(), dt and part are "
-                                      "available")
-        return self._impl
 
     def step(self, n: int = 1) -> SolveResult:
         """Take ``n`` time steps. ``converged`` is False only on divergence (blow-up, NaN,

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 from snede import _checks, _snede
 from snede._petsc import option_list
-from snede.distributed_body import DistributedBody
+from snede.distributed_body import DistributedBody, RunsOnRanks
 from snede.result import SolveResult
 
 METHODS = ("cg", "ncg", "newton")
@@ -15,7 +15,7 @@ DISTRIBUTED_PRECONDITIONERS = (None, "none", "jacobi", "gamg")
 LINE_SEARCHES = ("cp", "snede_newton", "snede_secant", "bt", "l2", "basic")
 
 
-class StaticSolver:
+class StaticSolver(RunsOnRanks):
     """``StaticSolver(body, method="newton", rtol=1e-6, ...)``; ``solve()`` relaxes
     ``body.displacement`` in place and returns a :class:`snede.SolveResult`.
 
@@ -115,18 +115,6 @@ class StaticSolver:
                                options_prefix=prefix)
         self._distributed.gather_into_body(problem)
         return result
-
-    @property
-    def part(self):
-        """This rank's :class:`snede.DistributedMesh` when solving over several ranks (after
-        the first solve), else None."""
-        return None if self._distributed is None else self._distributed.part
-
-    @property
-    def _engine(self):
-        if self._impl is None:
-            raise NotImplementedError("this solver runs on MPI ranks (comm): only solve() and part are available")
-        return self._impl
 
     @property
     def preconditioner(self) -> str:
