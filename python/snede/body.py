@@ -22,7 +22,7 @@ class LockingWarning(UserWarning):
 
 
 class Body:
-    """``Body(mesh, material, density=1000.0, thickness=None)``.
+    """``Body(mesh, material, density=1000.0, thickness=None, comm=None)``.
 
     ``material`` is one of ``snede.LinearElastic(E, nu)``, ``snede.StVenantKirchhoff(E, nu)``,
     ``snede.NeoHookean(E, nu)``, ``snede.VerondaWestmann(E, nu, gamma)``. A 2D mesh is a
@@ -39,9 +39,14 @@ class Body:
     leave those elements out of forces and tangent actions; St. Venant-Kirchhoff and linear
     evaluate them as usual. ``inverted_elements(u)`` lists them either way. An exponential
     overflow (Veronda-Westmann at large strain) raises ``snede.DomainError``.
+
+    ``comm`` (an mpi4py communicator, issue 18): the communicator its solvers run on when they
+    are not given one (``StaticSolver``, ``DynamicRelaxation``: rank 0's body is distributed
+    and the answer gathered back into every rank's). The body itself stays a serial
+    description, the same on every rank; None (default): serial solves.
     """
 
-    def __init__(self, mesh: Mesh, material, density: float = 1000.0, thickness: float | None = None):
+    def __init__(self, mesh: Mesh, material, density: float = 1000.0, thickness: float | None = None, comm=None):
         if not isinstance(mesh, Mesh):
             raise TypeError(f"mesh must be a snede.Mesh, got {type(mesh).__name__}")
         if mesh.is_surface and thickness is None:
@@ -57,8 +62,11 @@ class Body:
             warnings.warn(f"Poisson's ratio {poisson:.4g} is close to 1/2: linear {'tetrahedra' if mesh.cell_dim == 3 else 'triangles'} "
                           "lock (volumetric locking) and the body will deform too little; see docs/results/extremes.md",
                           LockingWarning, stacklevel=2)
+        if comm is not None and not (hasattr(comm, "rank") and hasattr(comm, "size") and hasattr(comm, "bcast")):
+            raise TypeError(f"comm must be an mpi4py communicator (or None), got {type(comm).__name__}")
         self.mesh = mesh
         self.material = material
+        self.comm = comm
         self._impl = _snede.ElasticBody(mesh._impl, material, float(density), float(thickness or 0.0))
         self._model = _snede.Model(self._impl)
 

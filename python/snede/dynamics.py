@@ -33,7 +33,8 @@ class DynamicRelaxation(RunsOnRanks):
       rank 0's body is distributed with its fixed vertices and external forces as they are
       now, relaxed by :class:`snede.DistributedRelaxation` (the same steps and displacement as
       serially), and the result gathered into ``body.displacement`` on every rank; ``run``,
-      ``dt`` and ``part`` are available. None (default): the serial solver.
+      ``dt`` and ``part`` are available. None (default): the body's ``comm``, and without one
+      the serial solver.
 
     The state is ``body.displacement`` and ``velocity`` (both (n_points, dim)); it starts at
     rest. After a cut or refinement the velocity is carried over like the displacement.
@@ -47,6 +48,7 @@ class DynamicRelaxation(RunsOnRanks):
             raise ValueError(f"dt must be positive and finite (or None for the CFL estimate), got {dt}")
         self.body = body
         self._distributed = None
+        comm = getattr(body, "comm", None) if comm is None else comm
         if comm is not None:
             if petsc_options:
                 raise NotImplementedError(f"petsc_options on MPI ranks (comm): give -{options_prefix}ts_* "

@@ -56,7 +56,8 @@ class StaticSolver(RunsOnRanks):
       result is gathered into ``body.displacement`` on every rank. There the nonlinear
       methods stop at ‖F‖ ≤ rtol·‖F(u₀)‖ and CG at ‖r‖ ≤ rtol·‖b‖ (PETSc's relative tests, not
       ``criterion``); the preconditioner is ``"gamg"`` (default), ``"jacobi"`` or ``"none"``;
-      ``part`` is this rank's part. None (default): the serial solver.
+      ``part`` is this rank's part. None (default): the body's ``comm``, and without one the
+      serial solver.
 
     Every method solves the system divided by the force scale E·t·H (E·H² in 3D), so that the
     answer does not depend on the units (E from 1e-3 to 1e155 Pa give the same displacement);
@@ -90,6 +91,7 @@ class StaticSolver(RunsOnRanks):
         self.body = body
         self.method = method
         self._distributed = None
+        comm = getattr(body, "comm", None) if comm is None else comm
         if comm is not None:
             if preconditioner not in DISTRIBUTED_PRECONDITIONERS:
                 raise NotImplementedError(f"preconditioner {preconditioner!r} on MPI ranks (comm): distributed "

@@ -99,3 +99,23 @@ def test_a_collective_series_reads_back_as_the_serial_mesh(tmp_path_factory):
         np.testing.assert_allclose(step.mesh.points, body.mesh.points[serial])
         np.testing.assert_allclose(step.point_fields["displacement"], body.displacement[serial])
     COMM.Barrier()
+
+
+def test_a_body_given_a_communicator_hands_it_to_its_solvers():
+    """Body(..., comm=) makes StaticSolver(body) distributed (part set, the serial answer);
+    a communicator that is not one is refused."""
+    material = snede.LinearElastic(1e5, 0.3)
+    mesh, _ = cantilever(3)
+    fixed, tip, force = conditions(mesh)
+    body = snede.Body(mesh, material, comm=COMM)
+    body.fix(fixed)
+    body.add_nodal_force(tip, force)
+    body.add_gravity((0.0, 0.0, -1.0))
+    solver = snede.StaticSolver(body, "cg", rtol=1e-12)
+    assert solver.solve().converged
+    assert solver.part is not None and solver.part.comm is COMM
+    reference = loaded_body(material)
+    assert snede.StaticSolver(reference, "cg", rtol=1e-12).solve().converged
+    assert relative_difference(body.displacement, reference.displacement) <= 1e-7
+    with pytest.raises(TypeError, match="mpi4py communicator"):
+        snede.Body(cantilever(3)[0], material, comm=0)
