@@ -84,6 +84,10 @@ DistributedMesh distribute_mesh(MPI_Comm comm, const Mesh* serial) {
   std::vector<PetscInt> serial_id(static_cast<std::size_t>(chart_end - chart_start), -1);
   for (PetscInt v = 0; v < n_vertices; ++v) serial_id[static_cast<std::size_t>(n_cells + v)] = v;
 
+  // -petscpartitioner_type (and its options) choose how the cells are split.
+  PetscPartitioner partitioner = nullptr;
+  SNEDE_PETSC(DMPlexGetPartitioner(dm, &partitioner));
+  SNEDE_PETSC(PetscPartitionerSetFromOptions(partitioner));
   SfHandle migration;
   DmHandle distributed;
   SNEDE_PETSC(DMPlexDistribute(dm, 0, migration.out(), distributed.out()));
