@@ -3,10 +3,13 @@
 #include <petscsnes.h>
 
 #include <cmath>
+#include <cstdint>
 #include <limits>
+#include <span>
 #include <stdexcept>
 #include <string>
 #include <unordered_map>
+#include <variant>
 
 #include "core/error.hpp"
 #include "core/petsc_util.hpp"
@@ -36,6 +39,43 @@ void check_conditions(const DistributedConditions& c, int dim, std::int64_t n_ve
                                 std::to_string(c.gravity.size()));
   for (double g : c.gravity)
     if (!std::isfinite(g)) throw std::invalid_argument("DistributedStatic: gravity must be finite");
+}
+
+// FNV-1a over the bytes of every value: equal on every rank exactly when the inputs are.
+class InputDigest {
+ public:
+  template <class T>
+  void add(std::span<const T> values) {
+    const auto* bytes = reinterpret_cast<const unsigned char*>(values.data());
+    for (std::size_t i = 0; i < values.size_bytes(); ++i) hash_ = (hash_ ^ bytes[i]) * 1099511628211ULL;
+    const std::uint64_t size = values.size();  // separates [a][b, c] from [a, b][c]
+    for (int shift = 0; shift < 64; shift += 8) hash_ = (hash_ ^ ((size >> shift) & 0xff)) * 1099511628211ULL;
+  }
+  std::uint64_t value() const { return hash_; }
+
+ private:
+  std::uint64_t hash_ = 14695981039346656037ULL;
+};
+
+// The same material, density, thickness and conditions on every rank, or the same error on
+// every rank: a rank with other loads would silently solve another problem.
+void require_same_inputs_everywhere(MPI_Comm comm, const Material& material, double density, double thickness,
+                                    const DistributedConditions& c) {
+  const Lame lame = std::visit([](const auto& m) { return m.lame; }, material);
+  const double scalars[] = {lame.lambda, lame.mu, density, thickness, static_cast<double>(material.index())};
+  InputDigest digest;
+  digest.add(std::span<const double>(scalars));
+  digest.add(std::span<const std::int64_t>(c.fixed));
+  digest.add(std::span<const double>(c.fixed_values));
+  digest.add(std::span<const std::int64_t>(c.loaded));
+  digest.add(std::span<const double>(c.forces));
+  digest.add(std::span<const double>(c.gravity));
+  std::uint64_t low = digest.value(), high = digest.value();
+  MPI_Allreduce(MPI_IN_PLACE, &low, 1, MPI_UINT64_T, MPI_MIN, comm);
+  MPI_Allreduce(MPI_IN_PLACE, &high, 1, MPI_UINT64_T, MPI_MAX, comm);
+  if (low != high)
+    throw std::invalid_argument("DistributedStatic: the ranks were given different inputs (material, density, "
+                                "thickness, fixed vertices and values, forces or gravity); every rank must pass the same");
 }
 
 PetscErrorCode residual_callback(SNES snes, Vec u, Vec F, void* context) {
@@ -75,6 +115,7 @@ DistributedStatic::DistributedStatic(DistributedMesh& part, Material material, d
                                      const DistributedConditions& conditions)
     : part_(part), body_(*part.local, material, density, thickness),
       dim_(part.local->dim()) {
+  require_same_inputs_everywhere(part.comm, material, density, thickness, conditions);  // first: no rank throws alone
   check_conditions(conditions, dim_, part.n_global_vertices);
   const MPI_Comm comm = part.comm;
   const std::size_t n_local = static_cast<std::size_t>(part.local->n_points());

@@ -80,6 +80,22 @@ def test_bad_conditions_raise_the_same_error_everywhere():
     assert COMM.allreduce(1) == COMM.size
 
 
+@pytest.mark.skipif(COMM.size == 1, reason="needs ranks that disagree")
+@pytest.mark.parametrize("disagreement", ["fixed", "forces", "material", "gravity"])
+def test_ranks_given_different_inputs_raise_the_same_error(disagreement):
+    """Each rank passes its own fixed vertex, force, stiffness or gravity: the same ValueError
+    everywhere (a rank left out would otherwise solve another problem, or wait)."""
+    serial, _ = cantilever(3)
+    part = snede.distribute(serial if COMM.rank == 0 else None)
+    own = 1.0 + COMM.rank  # differs between ranks
+    inputs = {"material": snede.LinearElastic(1e5, 0.3), "fixed": [0], "forces": {5: (0.0, 0.0, -1.0)}, "gravity": None}
+    inputs[disagreement] = {"fixed": [0, COMM.rank + 1], "forces": {5: (0.0, 0.0, -own)},
+                            "material": snede.LinearElastic(1e5 * own, 0.3), "gravity": (0.0, 0.0, -9.81 * own)}[disagreement]
+    with pytest.raises(ValueError, match="the ranks were given different inputs"):
+        snede.DistributedStatic(part, **inputs)
+    assert COMM.allreduce(1) == COMM.size
+
+
 def test_parts_touching_at_a_single_vertex():
     """Two tetrahedra sharing only a vertex (one per rank on 2 ranks): the shared vertex is
     owned once, and a solve with both far faces held and the free corners pulled gives the
