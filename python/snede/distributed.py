@@ -25,6 +25,21 @@ from snede.mesh import Mesh
 from snede.result import SolveResult
 
 
+def agreed(comm, check):
+    """``check()`` on every rank of ``comm`` (collective): its value, or, if it raised a
+    ValueError or TypeError on any rank, the same exception on every rank (the lowest such
+    rank's, named), so that no rank goes on alone into a collective call."""
+    try:
+        value, problem = check(), None
+    except (ValueError, TypeError) as error:
+        value, problem = None, (type(error), str(error))
+    for rank, found in enumerate(comm.allgather(problem)):
+        if found is not None:
+            kind, text = found
+            raise kind(text if comm.size == 1 else f"rank {rank}: {text}")
+    return value
+
+
 @dataclass
 class DistributedMesh:
     """This rank's part of a distributed mesh (see :func:`distribute`)."""
@@ -73,22 +88,25 @@ class DistributedStatic:
                  fixed_values=None, forces=None, gravity=None):
         self.part = part
         dim = part.local.dim
-        fixed = np.asarray(fixed, dtype=np.int64).ravel()
-        values = np.zeros((len(fixed), dim)) if fixed_values is None else np.asarray(fixed_values, dtype=np.float64)
-        if values.shape != (len(fixed), dim):
-            raise ValueError(f"fixed_values must be ({len(fixed)}, {dim}), got shape {values.shape}")
-        if not (np.isfinite(density) and density > 0):
-            raise ValueError(f"density must be positive and finite, got {density}")
-        forces = forces or {}
-        loaded = np.array(list(forces), dtype=np.int64)
-        loads = np.array([np.asarray(f, dtype=np.float64) for f in forces.values()]).reshape(len(loaded), -1) \
-            if forces else np.zeros((0, dim))
-        if len(loaded) and loads.shape[1] != dim:
-            raise ValueError(f"forces must be {dim}-vectors, got {loads.shape[1]} components")
-        self._impl = _snede.DistributedStatic(part._impl, material, float(density), float(thickness or 0.0),
-                                              fixed.tolist(), values.ravel().tolist(), loaded.tolist(),
-                                              loads.ravel().tolist(),
-                                              [] if gravity is None else np.asarray(gravity, dtype=np.float64).ravel().tolist())
+
+        def conditions():
+            ids = np.asarray(fixed, dtype=np.int64).ravel()
+            values = np.zeros((len(ids), dim)) if fixed_values is None else np.asarray(fixed_values, dtype=np.float64)
+            if values.shape != (len(ids), dim):
+                raise ValueError(f"fixed_values must be ({len(ids)}, {dim}), got shape {values.shape}")
+            if not (np.isfinite(density) and density > 0):
+                raise ValueError(f"density must be positive and finite, got {density}")
+            loaded = np.array(list(forces or {}), dtype=np.int64)
+            loads = np.array([np.asarray(f, dtype=np.float64) for f in forces.values()]).reshape(len(loaded), -1) \
+                if forces else np.zeros((0, dim))
+            if len(loaded) and loads.shape[1] != dim:
+                raise ValueError(f"forces must be {dim}-vectors, got {loads.shape[1]} components")
+            g = [] if gravity is None else np.asarray(gravity, dtype=np.float64).ravel().tolist()
+            return ids.tolist(), values.ravel().tolist(), loaded.tolist(), loads.ravel().tolist(), g
+
+        ids, values, loaded, loads, g = agreed(part.comm, conditions)
+        self._impl = _snede.DistributedStatic(part._impl, material, float(density), float(thickness or 0.0), ids, values,
+                                              loaded, loads, g)
 
     def solve(self, method: str = "cg", rtol: float = 1e-8, max_iterations: int = 10000, preconditioner: str = "none",
               options_prefix: str = "dstatic_") -> SolveResult:

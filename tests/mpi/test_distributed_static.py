@@ -96,6 +96,18 @@ def test_ranks_given_different_inputs_raise_the_same_error(disagreement):
     assert COMM.allreduce(1) == COMM.size
 
 
+@pytest.mark.skipif(COMM.size == 1, reason="needs a rank that differs")
+def test_a_python_argument_error_on_one_rank_reaches_every_rank():
+    """fixed_values of the wrong shape on the last rank only: every rank raises its ValueError,
+    naming that rank, instead of the others waiting for it in the engine."""
+    serial, _ = cantilever(3)
+    part = snede.distribute(serial if COMM.rank == 0 else None)
+    rows = 3 if COMM.rank == COMM.size - 1 else 2
+    with pytest.raises(ValueError, match=rf"rank {COMM.size - 1}: fixed_values must be \(2, 3\)"):
+        snede.DistributedStatic(part, snede.LinearElastic(1e5, 0.3), fixed=[0, 1], fixed_values=np.zeros((rows, 3)))
+    assert COMM.allreduce(1) == COMM.size
+
+
 def test_parts_touching_at_a_single_vertex():
     """Two tetrahedra sharing only a vertex (one per rank on 2 ranks): the shared vertex is
     owned once, and a solve with both far faces held and the free corners pulled gives the
