@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "core/error.hpp"
+#include "core/rank_agreement.hpp"
 #include "core/petsc_util.hpp"
 #include "solve/dynamic_relaxation.hpp"
 #include "solve/ts_ss22.hpp"
@@ -12,6 +13,8 @@ namespace snede {
 DistributedRelaxation::DistributedRelaxation(DistributedStatic& problem, double damping, double dt,
                                              const std::string& options_prefix)
     : problem_(problem) {
+  require_same_on_every_rank(problem.comm(), InputDigest().add(damping).add(dt).add(options_prefix),
+                             "DistributedRelaxation", "damping, dt or prefix");
   require_valid_damping(damping);
   require(dt == 0 || positive_finite(dt), "dt", "positive and finite (or 0 for the CFL estimate)", dt);
   Vec u = problem.state();
@@ -39,6 +42,8 @@ double DistributedRelaxation::time_step() const {
 }
 
 SolveResult DistributedRelaxation::run(double rtol, int max_steps) {
+  require_same_on_every_rank(problem_.comm(), InputDigest().add(rtol).add(max_steps), "DistributedRelaxation.run",
+                             "rtol or max_steps");
   require(positive_finite(rtol), "rtol", "positive and finite", rtol);
   require(max_steps >= 0, "max_steps", "≥ 0", max_steps);
   const double start = wall_seconds();

@@ -12,6 +12,7 @@
 #include <variant>
 
 #include "core/error.hpp"
+#include "core/rank_agreement.hpp"
 #include "core/petsc_util.hpp"
 #include "mesh/element_quality.hpp"
 #include "solve/dynamic_relaxation.hpp"
@@ -41,41 +42,22 @@ void check_conditions(const DistributedConditions& c, int dim, std::int64_t n_ve
     if (!std::isfinite(g)) throw std::invalid_argument("DistributedStatic: gravity must be finite");
 }
 
-// FNV-1a over the bytes of every value: equal on every rank exactly when the inputs are.
-class InputDigest {
- public:
-  template <class T>
-  void add(std::span<const T> values) {
-    const auto* bytes = reinterpret_cast<const unsigned char*>(values.data());
-    for (std::size_t i = 0; i < values.size_bytes(); ++i) hash_ = (hash_ ^ bytes[i]) * 1099511628211ULL;
-    const std::uint64_t size = values.size();  // separates [a][b, c] from [a, b][c]
-    for (int shift = 0; shift < 64; shift += 8) hash_ = (hash_ ^ ((size >> shift) & 0xff)) * 1099511628211ULL;
-  }
-  std::uint64_t value() const { return hash_; }
-
- private:
-  std::uint64_t hash_ = 14695981039346656037ULL;
-};
-
 // The same material, density, thickness and conditions on every rank, or the same error on
 // every rank: a rank with other loads would silently solve another problem.
-void require_same_inputs_everywhere(MPI_Comm comm, const Material& material, double density, double thickness,
+bool require_same_inputs_everywhere(MPI_Comm comm, const Material& material, double density, double thickness,
                                     const DistributedConditions& c) {
   const Lame lame = std::visit([](const auto& m) { return m.lame; }, material);
   const double scalars[] = {lame.lambda, lame.mu, density, thickness, static_cast<double>(material.index())};
   InputDigest digest;
-  digest.add(std::span<const double>(scalars));
-  digest.add(std::span<const std::int64_t>(c.fixed));
-  digest.add(std::span<const double>(c.fixed_values));
-  digest.add(std::span<const std::int64_t>(c.loaded));
-  digest.add(std::span<const double>(c.forces));
-  digest.add(std::span<const double>(c.gravity));
-  std::uint64_t low = digest.value(), high = digest.value();
-  MPI_Allreduce(MPI_IN_PLACE, &low, 1, MPI_UINT64_T, MPI_MIN, comm);
-  MPI_Allreduce(MPI_IN_PLACE, &high, 1, MPI_UINT64_T, MPI_MAX, comm);
-  if (low != high)
-    throw std::invalid_argument("DistributedStatic: the ranks were given different inputs (material, density, "
-                                "thickness, fixed vertices and values, forces or gravity); every rank must pass the same");
+  digest.add(std::span<const double>(scalars))
+      .add(std::span<const std::int64_t>(c.fixed))
+      .add(std::span<const double>(c.fixed_values))
+      .add(std::span<const std::int64_t>(c.loaded))
+      .add(std::span<const double>(c.forces))
+      .add(std::span<const double>(c.gravity));
+  require_same_on_every_rank(comm, digest, "DistributedStatic",
+                             "material, density, thickness, fixed vertices and values, forces or gravity");
+  return true;
 }
 
 PetscErrorCode residual_callback(SNES snes, Vec u, Vec F, void* context) {
@@ -113,9 +95,10 @@ PetscErrorCode mult_callback(Mat A, Vec d, Vec out) {
 
 DistributedStatic::DistributedStatic(DistributedMesh& part, Material material, double density, double thickness,
                                      const DistributedConditions& conditions)
-    : part_(part), body_(*part.local, material, density, thickness),
+    : part_(part),
+      inputs_agreed_(require_same_inputs_everywhere(part.comm, material, density, thickness, conditions)),
+      body_(*part.local, material, density, thickness),
       dim_(part.local->dim()) {
-  require_same_inputs_everywhere(part.comm, material, density, thickness, conditions);  // first: no rank throws alone
   check_conditions(conditions, dim_, part.n_global_vertices);
   const MPI_Comm comm = part.comm;
   const std::size_t n_local = static_cast<std::size_t>(part.local->n_points());
@@ -357,6 +340,9 @@ void DistributedStatic::tangent_diagonal(Vec diagonal) {
 
 SolveResult DistributedStatic::solve(const std::string& method, const std::string& preconditioner, double rtol,
                                      int max_iterations, const std::string& prefix) {
+  require_same_on_every_rank(part_.comm,
+                             InputDigest().add(method).add(preconditioner).add(rtol).add(max_iterations).add(prefix),
+                             "DistributedStatic.solve", "method, preconditioner, rtol, max_iterations or prefix");
   if (method != "cg" && method != "newton" && method != "ncg")
     throw std::invalid_argument("DistributedStatic.solve: method must be \"cg\", \"newton\" or \"ncg\", got \"" +
                                 method + "\"");

@@ -96,6 +96,7 @@ class DistributedStatic {
   void set_fixed_rows(Vec out, Vec source, double value);
 
   DistributedMesh& part_;
+  bool inputs_agreed_;  // checked across the ranks before anything below can throw on one alone
   ElasticBody body_;
   int dim_;
   std::vector<std::uint8_t> fixed_local_;   // per local dof

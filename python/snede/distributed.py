@@ -24,6 +24,8 @@ from snede import _checks, _snede
 from snede.mesh import Mesh
 from snede.result import SolveResult
 
+MATERIALS = (_snede.LinearElastic, _snede.StVenantKirchhoff, _snede.NeoHookean, _snede.VerondaWestmann)
+
 
 def agreed(comm, check):
     """``check()`` on every rank of ``comm`` (collective): its value, or, if it raised a
@@ -94,7 +96,10 @@ class DistributedStatic:
             values = np.zeros((len(ids), dim)) if fixed_values is None else np.asarray(fixed_values, dtype=np.float64)
             if values.shape != (len(ids), dim):
                 raise ValueError(f"fixed_values must be ({len(ids)}, {dim}), got shape {values.shape}")
-            if not (np.isfinite(density) and density > 0):
+            if not isinstance(material, MATERIALS):
+                raise TypeError(f"material must be LinearElastic, StVenantKirchhoff, NeoHookean or VerondaWestmann, "
+                                f"got {type(material).__name__}")
+            if not (np.isfinite(float(density)) and density > 0):
                 raise ValueError(f"density must be positive and finite, got {density}")
             loaded = np.array(list(forces or {}), dtype=np.int64)
             loads = np.array([np.asarray(f, dtype=np.float64) for f in forces.values()]).reshape(len(loaded), -1) \
@@ -102,19 +107,19 @@ class DistributedStatic:
             if len(loaded) and loads.shape[1] != dim:
                 raise ValueError(f"forces must be {dim}-vectors, got {loads.shape[1]} components")
             g = [] if gravity is None else np.asarray(gravity, dtype=np.float64).ravel().tolist()
-            return ids.tolist(), values.ravel().tolist(), loaded.tolist(), loads.ravel().tolist(), g
+            return (float(density), float(thickness or 0.0), ids.tolist(), values.ravel().tolist(), loaded.tolist(),
+                    loads.ravel().tolist(), g)
 
-        ids, values, loaded, loads, g = agreed(part.comm, conditions)
-        self._impl = _snede.DistributedStatic(part._impl, material, float(density), float(thickness or 0.0), ids, values,
-                                              loaded, loads, g)
+        self._impl = _snede.DistributedStatic(part._impl, material, *agreed(part.comm, conditions))
 
     def solve(self, method: str = "cg", rtol: float = 1e-8, max_iterations: int = 10000, preconditioner: str = "none",
               options_prefix: str = "dstatic_") -> SolveResult:
         """``method`` "cg" (linear), "newton" or "ncg" (nonlinear CG, no preconditioner);
         ``preconditioner`` "none", "jacobi" (the tangent's diagonal, summed across the ranks) or
         "gamg" (PETSc's algebraic multigrid on the assembled tangent, MPIAIJ)."""
-        return SolveResult._from_engine(self._impl.solve(method, preconditioner, float(rtol), int(max_iterations),
-                                                         options_prefix))
+        arguments = agreed(self.part.comm, lambda: (str(method), str(preconditioner), float(rtol),
+                                                    _checks.count(max_iterations, "max_iterations"), str(options_prefix)))
+        return SolveResult._from_engine(self._impl.solve(*arguments))
 
     def energy(self) -> float:
         """Π(u) = Π_int(u) − f_extᵀu of the whole body."""
@@ -147,7 +152,8 @@ class DistributedRelaxation:
         if dt is not None and not (np.isfinite(dt) and dt > 0):
             raise ValueError(f"dt must be positive and finite (or None for the CFL estimate), got {dt}")
         self.problem = problem
-        self._impl = _snede.DistributedRelaxation(problem._impl, float(damping), float(dt or 0.0), options_prefix)
+        arguments = agreed(problem.part.comm, lambda: (float(damping), float(dt or 0.0), str(options_prefix)))
+        self._impl = _snede.DistributedRelaxation(problem._impl, *arguments)
 
     @property
     def dt(self) -> float:
@@ -156,4 +162,5 @@ class DistributedRelaxation:
     def run(self, rtol: float = 1e-3, max_steps: int = 100000) -> SolveResult:
         """Steps until (6.9) or ``max_steps`` (``DIVERGED_MAX_IT``); a blow-up, NaN or an
         inverted element ends the run with that reason, not converged."""
-        return SolveResult._from_engine(self._impl.run(float(rtol), _checks.count(max_steps, "max_steps")))
+        arguments = agreed(self.problem.part.comm, lambda: (float(rtol), _checks.count(max_steps, "max_steps")))
+        return SolveResult._from_engine(self._impl.run(*arguments))

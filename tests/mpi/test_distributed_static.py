@@ -81,16 +81,18 @@ def test_bad_conditions_raise_the_same_error_everywhere():
 
 
 @pytest.mark.skipif(COMM.size == 1, reason="needs ranks that disagree")
-@pytest.mark.parametrize("disagreement", ["fixed", "forces", "material", "gravity"])
+@pytest.mark.parametrize("disagreement", ["fixed", "forces", "material", "gravity", "thickness"])
 def test_ranks_given_different_inputs_raise_the_same_error(disagreement):
     """Each rank passes its own fixed vertex, force, stiffness or gravity: the same ValueError
     everywhere (a rank left out would otherwise solve another problem, or wait)."""
     serial, _ = cantilever(3)
     part = snede.distribute(serial if COMM.rank == 0 else None)
     own = 1.0 + COMM.rank  # differs between ranks
-    inputs = {"material": snede.LinearElastic(1e5, 0.3), "fixed": [0], "forces": {5: (0.0, 0.0, -1.0)}, "gravity": None}
+    inputs = {"material": snede.LinearElastic(1e5, 0.3), "fixed": [0], "forces": {5: (0.0, 0.0, -1.0)}, "gravity": None,
+              "thickness": None}
     inputs[disagreement] = {"fixed": [0, COMM.rank + 1], "forces": {5: (0.0, 0.0, -own)},
-                            "material": snede.LinearElastic(1e5 * own, 0.3), "gravity": (0.0, 0.0, -9.81 * own)}[disagreement]
+                            "material": snede.LinearElastic(1e5 * own, 0.3), "gravity": (0.0, 0.0, -9.81 * own),
+                            "thickness": None if COMM.rank == 0 else 0.1}[disagreement]
     with pytest.raises(ValueError, match="the ranks were given different inputs"):
         snede.DistributedStatic(part, **inputs)
     assert COMM.allreduce(1) == COMM.size
@@ -105,6 +107,23 @@ def test_a_python_argument_error_on_one_rank_reaches_every_rank():
     rows = 3 if COMM.rank == COMM.size - 1 else 2
     with pytest.raises(ValueError, match=rf"rank {COMM.size - 1}: fixed_values must be \(2, 3\)"):
         snede.DistributedStatic(part, snede.LinearElastic(1e5, 0.3), fixed=[0, 1], fixed_values=np.zeros((rows, 3)))
+    assert COMM.allreduce(1) == COMM.size
+
+
+@pytest.mark.skipif(COMM.size == 1, reason="needs ranks that disagree")
+def test_solver_arguments_that_differ_between_ranks_raise_everywhere():
+    """A tolerance, a method or a damping that differs between ranks would make the ranks leave
+    CG at different iterations and wait for each other: the same ValueError instead."""
+    problem = linear_cantilever_problem(COMM)
+    with pytest.raises(ValueError, match="DistributedStatic.solve: the ranks were given different inputs"):
+        problem.solve("cg", rtol=1e-8 * (1 + COMM.rank))
+    with pytest.raises(ValueError, match="the ranks were given different inputs"):
+        problem.solve("cg" if COMM.rank == 0 else "bicg")
+    with pytest.raises(ValueError, match="DistributedRelaxation: the ranks were given different inputs"):
+        snede.DistributedRelaxation(problem, damping=1.0 + COMM.rank)
+    with pytest.raises(TypeError, match="rank 0: material must be"):
+        snede.DistributedStatic(problem.part, "rubber" if COMM.rank == 0 else snede.LinearElastic(1e5, 0.3))
+    assert problem.solve("cg", rtol=1e-8).converged  # and the problem still solves
     assert COMM.allreduce(1) == COMM.size
 
 
