@@ -17,6 +17,7 @@ import argparse
 import logging
 import runpy
 import sys
+import traceback
 from pathlib import Path
 
 METHODS = ("cg", "ncg", "newton", "dynamic")
@@ -171,5 +172,25 @@ def _command(parser, args, unknown, petsc) -> int:
     return 0 if summary["converged"] else 1
 
 
+def _end_every_rank(code: int) -> None:
+    """Under ``mpirun -n N`` an error on one rank alone (a scene script's, an engine's) would
+    leave the other ranks waiting in a collective call for ever (issue 18): with several ranks,
+    a failed command ends the whole job with MPI_Abort, as ``python -m mpi4py`` does."""
+    from mpi4py import MPI
+
+    if MPI.COMM_WORLD.size > 1:
+        sys.stdout.flush()
+        sys.stderr.flush()
+        MPI.COMM_WORLD.Abort(code)
+
+
 if __name__ == "__main__":
-    sys.exit(main())
+    try:
+        exit_code = main()
+    except Exception:
+        traceback.print_exc()
+        exit_code = 1
+        _end_every_rank(exit_code)
+    if exit_code == 2:  # bad input or a PETSc error, reported above
+        _end_every_rank(exit_code)
+    sys.exit(exit_code)

@@ -149,10 +149,13 @@ class DistributedRelaxation:
 
     def __init__(self, problem: DistributedStatic, damping: float, dt: float | None = None, *,
                  options_prefix: str = "drelax_"):
-        if dt is not None and not (np.isfinite(dt) and dt > 0):
-            raise ValueError(f"dt must be positive and finite (or None for the CFL estimate), got {dt}")
+        def checked():
+            if dt is not None and not (np.isfinite(dt) and dt > 0):
+                raise ValueError(f"dt must be positive and finite (or None for the CFL estimate), got {dt}")
+            return float(damping), float(dt or 0.0), str(options_prefix)
+
         self.problem = problem
-        arguments = agreed(problem.part.comm, lambda: (float(damping), float(dt or 0.0), str(options_prefix)))
+        arguments = agreed(problem.part.comm, checked)
         self._impl = _snede.DistributedRelaxation(problem._impl, *arguments)
 
     @property

@@ -121,6 +121,8 @@ def test_solver_arguments_that_differ_between_ranks_raise_everywhere():
         problem.solve("cg" if COMM.rank == 0 else "bicg")
     with pytest.raises(ValueError, match="DistributedRelaxation: the ranks were given different inputs"):
         snede.DistributedRelaxation(problem, damping=1.0 + COMM.rank)
+    with pytest.raises(ValueError, match=f"rank {COMM.size - 1}: dt must be positive"):
+        snede.DistributedRelaxation(problem, damping=1.0, dt=-1.0 if COMM.rank == COMM.size - 1 else None)
     with pytest.raises(TypeError, match="rank 0: material must be"):
         snede.DistributedStatic(problem.part, "rubber" if COMM.rank == 0 else snede.LinearElastic(1e5, 0.3))
     assert problem.solve("cg", rtol=1e-8).converged  # and the problem still solves

@@ -1,0 +1,49 @@
+"""An error on one MPI rank alone ends the whole ``mpirun`` job instead of leaving the other
+ranks waiting in a collective call (issue 18). Runs ``mpirun -n 2`` in a subprocess with a
+time limit: a hang fails the test instead of blocking the suite."""
+import os
+import shutil
+import subprocess
+import sys
+import textwrap
+
+import pytest
+
+pytestmark = pytest.mark.skipif(shutil.which("mpirun") is None, reason="needs mpirun")
+
+MPI_ROOT = {"OMPI_ALLOW_RUN_AS_ROOT": "1", "OMPI_ALLOW_RUN_AS_ROOT_CONFIRM": "1",
+            "OMPI_MCA_rmaps_base_oversubscribe": "1"}
+
+
+def run_on_two_ranks(tmp_path, body: str) -> subprocess.CompletedProcess:
+    script = tmp_path / "scene.py"
+    script.write_text(textwrap.dedent(body))
+    return subprocess.run(["mpirun", "-n", "2", sys.executable, "-m", "snede", "run", str(script)],
+                          capture_output=True, text=True, timeout=120, env={**os.environ, **MPI_ROOT})
+
+
+@pytest.mark.parametrize("error", ["ValueError('bad input on rank 1 only')", "RuntimeError('a bug on rank 1 only')"])
+def test_an_error_on_one_rank_ends_every_rank(tmp_path, error):
+    """Rank 1 raises before a collective reduction that rank 0 enters: the job ends, non-zero,
+    with rank 1's message, instead of rank 0 waiting for ever."""
+    run = run_on_two_ranks(tmp_path, f"""
+        from mpi4py import MPI
+        if MPI.COMM_WORLD.rank == 1:
+            raise {error}
+        MPI.COMM_WORLD.allreduce(1)
+        print("rank 0 went on alone")
+        """)
+    assert run.returncode != 0, (run.stdout, run.stderr)
+    assert "on rank 1 only" in run.stderr, run.stderr
+    assert "went on alone" not in run.stdout
+
+
+def test_a_scene_that_succeeds_on_every_rank_exits_cleanly(tmp_path):
+    """The abort is only for failures: a script that finishes on both ranks exits with 0."""
+    run = run_on_two_ranks(tmp_path, """
+        from mpi4py import MPI
+        assert MPI.COMM_WORLD.allreduce(1) == 2
+        print("both ranks done")
+        """)
+    assert run.returncode == 0, (run.stdout, run.stderr)
+    assert run.stdout.count("both ranks done") == 2
