@@ -62,9 +62,7 @@ StaticOptions static_options(const std::string& method, double rtol, const std::
   else if (method == "ncg") options.method = StaticMethod::nonlinear_cg;
   else if (method == "newton") options.method = StaticMethod::newton;
   else throw std::invalid_argument("method must be 'cg', 'ncg' or 'newton', got '" + method + "'");
-  if (criterion == "6.9") options.stopping.criterion = StoppingCriterion::with_reactions;
-  else if (criterion == "6.8") options.stopping.criterion = StoppingCriterion::load_relative;
-  else throw std::invalid_argument("criterion must be '6.8' or '6.9', got '" + criterion + "'");
+  options.stopping.criterion = stopping_criterion(criterion);
   options.stopping.rtol = rtol;
   options.stopping.round_tolerance = round_tolerance;
   options.max_iterations = max_iterations;

@@ -75,6 +75,28 @@ PetscErrorCode jacobian_callback(SNES, Vec u, Mat J, Mat P, void* context) {
   });
 }
 
+// The (6.8)/(6.9) rule on the true residual, as the serial StaticSolver's tests; PETSc's default
+// test first catches NaN norms and the iteration limit.
+PetscErrorCode snes_rule_callback(SNES snes, PetscInt it, PetscReal xnorm, PetscReal snorm, PetscReal fnorm,
+                                  SNESConvergedReason* reason, void* context) {
+  return petsc_callback("snede distributed stopping criterion", [&] {
+    SNEDE_PETSC(SNESConvergedDefault(snes, it, xnorm, snorm, fnorm, reason, nullptr));
+    if (*reason < 0) return;
+    const double tolerance = static_cast<DistributedStatic*>(context)->stopping_tolerance();
+    if (!std::isfinite(tolerance)) *reason = SNES_DIVERGED_FNORM_NAN;
+    else *reason = fnorm <= tolerance ? SNES_CONVERGED_FNORM_ABS : SNES_CONVERGED_ITERATING;
+  });
+}
+
+// For a linear problem CG's residual b − Jδ is −F(u₀ + δ), so the rule applies to it directly.
+PetscErrorCode ksp_rule_callback(KSP, PetscInt, PetscReal rnorm, KSPConvergedReason* reason, void* context) {
+  return petsc_callback("snede distributed stopping criterion", [&] {
+    const double tolerance = static_cast<DistributedStatic*>(context)->stopping_tolerance();
+    if (!std::isfinite(rnorm) || !std::isfinite(tolerance)) *reason = KSP_DIVERGED_NANORINF;
+    else *reason = rnorm <= tolerance ? KSP_CONVERGED_ATOL : KSP_CONVERGED_ITERATING;
+  });
+}
+
 PetscErrorCode diagonal_callback(Mat A, Vec diagonal) {
   return petsc_callback("snede distributed tangent MatGetDiagonal", [&] {
     void* context = nullptr;
@@ -163,16 +185,34 @@ DistributedStatic::DistributedStatic(DistributedMesh& part, Material material, d
     SNEDE_PETSC(VecRestoreArrayRead(work_, &g));
   }
 
-  // The state starts at the prescribed displacements (zero elsewhere).
-  PetscScalar* u = nullptr;
-  SNEDE_PETSC(VecGetArray(u_, &u));
-  for (std::size_t k = 0; k < owned_rows_.size(); ++k)
-    u[owned_rows_[k] - start] = fixed_value_local_[static_cast<std::size_t>(owned_local_dof_[k])];
-  SNEDE_PETSC(VecRestoreArray(u_, &u));
+  set_displacement({});
   u_local_.assign(n_dofs, 0.0);
   u_linearization_.assign(n_dofs, 0.0);
   d_local_.assign(n_dofs, 0.0);
   out_local_.assign(n_dofs, 0.0);
+}
+
+void DistributedStatic::set_displacement(std::span<const double> serial) {
+  require_same_on_every_rank(part_.comm, InputDigest().add(serial), "DistributedStatic.set_displacement",
+                             "displacements");
+  const auto expected = static_cast<std::size_t>(part_.n_global_vertices * dim_);
+  if (!serial.empty() && serial.size() != expected)
+    throw std::invalid_argument("DistributedStatic.set_displacement: needs " + std::to_string(expected) +
+                                " values (n_global_vertices × dim), got " + std::to_string(serial.size()));
+  for (double x : serial)
+    if (!std::isfinite(x)) throw std::invalid_argument("DistributedStatic.set_displacement: values must be finite");
+  PetscInt start = 0, end = 0;
+  SNEDE_PETSC(VecGetOwnershipRange(u_, &start, &end));
+  PetscScalar* u = nullptr;
+  SNEDE_PETSC(VecGetArray(u_, &u));
+  for (std::size_t k = 0; k < owned_rows_.size(); ++k) {
+    const auto dof = static_cast<std::size_t>(owned_local_dof_[k]);
+    const auto vertex = static_cast<std::size_t>(part_.global_vertex[dof / dim_]);
+    u[owned_rows_[k] - start] = fixed_local_[dof] ? fixed_value_local_[dof]
+                                : serial.empty()  ? 0.0
+                                                  : serial[vertex * dim_ + dof % dim_];
+  }
+  SNEDE_PETSC(VecRestoreArray(u_, &u));
 }
 
 DistributedStatic::~DistributedStatic() {
@@ -339,10 +379,19 @@ void DistributedStatic::tangent_diagonal(Vec diagonal) {
 }
 
 SolveResult DistributedStatic::solve(const std::string& method, const std::string& preconditioner, double rtol,
-                                     int max_iterations, const std::string& prefix) {
+                                     int max_iterations, const std::string& prefix, const std::string& criterion,
+                                     double round_tolerance) {
   require_same_on_every_rank(part_.comm,
-                             InputDigest().add(method).add(preconditioner).add(rtol).add(max_iterations).add(prefix),
-                             "DistributedStatic.solve", "method, preconditioner, rtol, max_iterations or prefix");
+                             InputDigest()
+                                 .add(method)
+                                 .add(preconditioner)
+                                 .add(rtol)
+                                 .add(max_iterations)
+                                 .add(prefix)
+                                 .add(criterion)
+                                 .add(round_tolerance),
+                             "DistributedStatic.solve",
+                             "method, preconditioner, rtol, max_iterations, prefix, criterion or round_tolerance");
   if (method != "cg" && method != "newton" && method != "ncg")
     throw std::invalid_argument("DistributedStatic.solve: method must be \"cg\", \"newton\" or \"ncg\", got \"" +
                                 method + "\"");
@@ -353,7 +402,23 @@ SolveResult DistributedStatic::solve(const std::string& method, const std::strin
     throw std::invalid_argument("DistributedStatic.solve: nonlinear CG ('ncg') takes no preconditioner, got \"" +
                                 preconditioner + "\"");
   if (!(rtol > 0)) throw std::invalid_argument("DistributedStatic.solve: rtol must be positive");
+  if (criterion != "relative" && criterion != "6.9" && criterion != "6.8")
+    throw std::invalid_argument("DistributedStatic.solve: criterion must be \"relative\", \"6.9\" or \"6.8\", got \"" +
+                                criterion + "\"");
+  stopping_.reset();
+  if (criterion != "relative") {
+    if (!(round_tolerance >= 0) || !std::isfinite(round_tolerance))
+      throw std::invalid_argument("DistributedStatic.solve: round_tolerance must be ≥ 0 and finite");
+    stopping_ = StoppingRule{stopping_criterion(criterion), rtol, round_tolerance, force_scale(),
+                             static_cast<double>(n_global_dofs())};
+    stopping_external_norm_ = external_force_norm();
+  }
   const double start = wall_seconds();
+  SolveResult result;
+  residual(u_, work_);
+  result.initial_residual_norm = vec_norm(work_);
+  stopping_reaction_norm_.reset();
+  if (method == "cg") stopping_reaction_norm_ = last_reaction_norm_;
   SnesHandle snes;
   SNEDE_PETSC(SNESCreate(part_.comm, snes.out()));
   SNEDE_PETSC(SNESSetOptionsPrefix(snes, prefix.c_str()));
@@ -383,8 +448,14 @@ SolveResult DistributedStatic::solve(const std::string& method, const std::strin
     SNEDE_PETSC(SNESLineSearchSetType(line_search, "snede_secant"));
     SNEDE_PETSC(SNESSetTolerances(snes, 0.0, rtol, 0.0, max_iterations, PETSC_DEFAULT));
   }
+  if (stopping_) {
+    SNEDE_PETSC(SNESSetConvergenceTest(snes, snes_rule_callback, this, nullptr));
+    if (method == "cg") {
+      SNEDE_PETSC(KSPSetNormType(ksp, KSP_NORM_UNPRECONDITIONED));
+      SNEDE_PETSC(KSPSetConvergenceTest(ksp, ksp_rule_callback, this, nullptr));
+    }
+  }
   SNEDE_PETSC(SNESSetFromOptions(snes));
-  SolveResult result;
   SNEDE_PETSC(SNESSolve(snes, nullptr, u_));
   SNESConvergedReason reason = SNES_CONVERGED_ITERATING;
   SNEDE_PETSC(SNESGetConvergedReason(snes, &reason));
@@ -404,12 +475,17 @@ SolveResult DistributedStatic::solve(const std::string& method, const std::strin
     result.iterations = static_cast<int>(iterations);
     result.linear_iterations = static_cast<int>(linear);
   }
-  // An inverted element or a non-finite state is never converged.
+  // An inverted element or a non-finite state is never converged, and a rule is checked on
+  // the final state (the factor allows CG's recursive residual to differ by round-off).
   const bool admissible = residual(u_, work_);
-  PetscReal norm = 0;
-  SNEDE_PETSC(VecNorm(work_, NORM_2, &norm));
-  result.residual_norm = norm;
-  if (!admissible || !std::isfinite(norm)) result.converged = false;
+  result.residual_norm = vec_norm(work_);
+  result.tolerance = stopping_ ? stopping_tolerance() : rtol * result.initial_residual_norm;
+  if (!admissible || !std::isfinite(result.residual_norm)) result.converged = false;
+  if (result.converged && stopping_ && result.residual_norm > 2 * result.tolerance) {
+    result.converged = false;
+    result.reason = "DIVERGED_RESIDUAL_ABOVE_TOLERANCE (PETSc: " + result.reason + ")";
+  }
+  stopping_.reset();
   result.energy = energy();
   result.seconds = wall_seconds() - start;
   return result;

@@ -15,6 +15,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -24,6 +25,7 @@
 #include "mesh/distributed_mesh.hpp"
 #include "solve/distributed_assembly.hpp"
 #include "solve/solve_result.hpp"
+#include "solve/stopping.hpp"
 
 namespace snede {
 
@@ -47,12 +49,24 @@ class DistributedStatic {
   DistributedStatic& operator=(const DistributedStatic&) = delete;
 
   // Collective. "cg": one Newton step solved by CG (linear problems); "newton": Newton with
-  // CG inside; "ncg": nonlinear CG (Polak-Ribière) with the secant line search of §4.4.2. Both
-  // nonlinear methods stop when ‖F‖ ≤ rtol ‖F(u₀)‖. Preconditioner (cg and newton) "none",
-  // "jacobi" (the tangent's diagonal, assembled across the ranks) or "gamg" (on the assembled
-  // tangent); options under `prefix`.
+  // CG inside; "ncg": nonlinear CG (Polak-Ribière) with the secant line search of §4.4.2.
+  // Preconditioner (cg and newton) "none", "jacobi" (the tangent's diagonal, assembled across
+  // the ranks) or "gamg" (on the assembled tangent); options under `prefix`. Stopping:
+  // criterion "relative" is PETSc's relative test (‖F‖ ≤ rtol ‖F(u₀)‖; CG ‖r‖ ≤ rtol ‖b‖ in
+  // its preconditioned norm); "6.9" and "6.8" are the serial StaticSolver's (§6.6,
+  // stopping.hpp), on the true residual, with the same round-off floor.
   SolveResult solve(const std::string& method, const std::string& preconditioner, double rtol, int max_iterations,
-                    const std::string& prefix);
+                    const std::string& prefix, const std::string& criterion = "relative",
+                    double round_tolerance = 1e-12);
+  // Collective: the state from a displacement in the serial mesh's vertex order
+  // (n_global_vertices × dim, the same on every rank), a solve's starting point; the fixed
+  // vertices keep their prescribed displacements. Empty: zero.
+  void set_displacement(std::span<const double> serial_displacement);
+  // The threshold of the running solve's (6.8)/(6.9) rule at the latest residual.
+  double stopping_tolerance() const {
+    return stopping_->tolerance(stopping_external_norm_, stopping_reaction_norm_.value_or(last_reaction_norm_));
+  }
+  bool stops_by_rule() const { return stopping_.has_value(); }
   // Π(u) = Π_int(u) − f_extᵀu over the whole body (collective).
   double energy();
   // The displacement of this rank's vertices (owned and ghosts), (n_local_vertices, dim).
@@ -112,6 +126,12 @@ class DistributedStatic {
   std::unique_ptr<DistributedAssembledTangent> assembled_;
   double last_reaction_norm_ = 0;
   std::string last_failure_;
+  // The (6.8)/(6.9) rule of the running solve, or none for PETSc's relative tests.
+  std::optional<StoppingRule> stopping_;
+  double stopping_external_norm_ = 0;
+  // Linear CG's reactions, fixed at the starting state as the serial solver's (its KSP
+  // evaluates no residual); the nonlinear methods use the latest residual's.
+  std::optional<double> stopping_reaction_norm_;
   std::vector<double> u_local_, u_linearization_, d_local_, out_local_;
 };
 

@@ -5,6 +5,8 @@
 #pragma once
 
 #include <cmath>
+#include <stdexcept>
+#include <string>
 
 namespace snede {
 
@@ -15,6 +17,13 @@ inline double force_scale(double young_modulus, int cell_dim, double thickness, 
 }
 
 enum class StoppingCriterion { load_relative /* (6.8) */, with_reactions /* (6.9) */ };
+
+// "6.8" or "6.9"; anything else is a std::invalid_argument naming the value.
+inline StoppingCriterion stopping_criterion(const std::string& name) {
+  if (name == "6.9") return StoppingCriterion::with_reactions;
+  if (name == "6.8") return StoppingCriterion::load_relative;
+  throw std::invalid_argument("criterion must be '6.8' or '6.9', got '" + name + "'");
+}
 
 struct StoppingRule {
   StoppingCriterion criterion = StoppingCriterion::with_reactions;

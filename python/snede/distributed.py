@@ -113,13 +113,39 @@ class DistributedStatic:
         self._impl = _snede.DistributedStatic(part._impl, material, *agreed(part.comm, conditions))
 
     def solve(self, method: str = "cg", rtol: float = 1e-8, max_iterations: int = 10000, preconditioner: str = "none",
-              options_prefix: str = "dstatic_") -> SolveResult:
+              options_prefix: str = "dstatic_", criterion: str = "relative",
+              round_tolerance: float = 1e-12) -> SolveResult:
         """``method`` "cg" (linear), "newton" or "ncg" (nonlinear CG, no preconditioner);
         ``preconditioner`` "none", "jacobi" (the tangent's diagonal, summed across the ranks) or
-        "gamg" (PETSc's algebraic multigrid on the assembled tangent, MPIAIJ)."""
+        "gamg" (PETSc's algebraic multigrid on the assembled tangent, MPIAIJ). Starts from the
+        current state (the previous solve's answer, or :meth:`set_displacement`'s).
+
+        ``criterion`` "relative" (default): PETSc's relative tests, ‖F‖ ≤ rtol·‖F(u₀)‖ (CG:
+        ‖r‖ ≤ rtol·‖b‖ in its preconditioned norm). "6.9" or "6.8": the serial
+        :class:`snede.StaticSolver`'s criteria (§6.6) on the true residual, ‖F‖ ≤
+        rtol·√(‖f_ext‖² + ‖f_react‖²) plus ``round_tolerance``'s floor, or ‖F‖ ≤ rtol·‖f_ext‖;
+        ``tolerance`` in the result is the threshold."""
         arguments = agreed(self.part.comm, lambda: (str(method), str(preconditioner), float(rtol),
-                                                    _checks.count(max_iterations, "max_iterations"), str(options_prefix)))
+                                                    _checks.count(max_iterations, "max_iterations"), str(options_prefix),
+                                                    str(criterion), float(round_tolerance)))
         return SolveResult._from_engine(self._impl.solve(*arguments))
+
+    def set_displacement(self, displacement) -> None:
+        """Start the next solve (or relaxation) from ``displacement``, (n_global_vertices, dim) in
+        the serial mesh's vertex order, the same on every rank; fixed vertices keep their
+        prescribed displacements. Collective."""
+        part = self.part
+
+        def checked():
+            u = np.asarray(displacement, dtype=np.float64)
+            if u.shape != (part.n_global_vertices, part.local.dim):
+                raise ValueError(f"displacement must be ({part.n_global_vertices}, {part.local.dim}) (the serial "
+                                 f"mesh's vertices), got shape {u.shape}")
+            if not np.all(np.isfinite(u)):
+                raise ValueError("displacement must be finite")
+            return u.ravel()
+
+        self._impl.set_displacement(agreed(part.comm, checked))
 
     def energy(self) -> float:
         """Π(u) = Π_int(u) − f_extᵀu of the whole body."""

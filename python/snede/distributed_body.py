@@ -4,9 +4,9 @@ and ``DynamicRelaxation(body, ..., comm=...)`` do, on any number of ranks.
 Every rank runs the same script and holds the same serial Body; rank 0's is the one used. Its
 mesh is distributed (``snede.distribute``), its fixed vertices and external forces (gravity and
 the nodal-force channels, which do not depend on the state) become a
-:class:`snede.DistributedStatic`, the solve runs on all ranks, and the displacement is
-gathered back into the Body on every rank, so the script goes on as serially. The
-distribution is kept while the mesh is unchanged (a cut or a refinement of the serial body,
+:class:`snede.DistributedStatic` that starts from the body's displacement, the solve runs on all
+ranks to the serial solver's criterion, and the displacement is gathered back into the Body on
+every rank, so the script goes on as serially. The distribution is kept while the mesh is unchanged (a cut or a refinement of the serial body,
 done on every rank, makes the next solve distribute anew). What cannot be taken over raises
 NotImplementedError on every rank: sliding constraints and membranes.
 """
@@ -37,16 +37,17 @@ class DistributedBody:
                 why = "membranes (surface meshes) are not distributed yet"
             elif len(sliding):
                 why = f"sliding constraints ({len(sliding)} vertices) are not distributed yet; fix them instead"
-            conditions = (why, fixed, anchors, loaded, loads[loaded], body.mesh._impl.revision)
-        why, fixed, anchors, loaded, loads, revision = comm.bcast(conditions if comm.rank == 0 else None, root=0)
+            conditions = (why, fixed, anchors, loaded, loads[loaded], body.mesh._impl.revision, body.displacement)
+        why, fixed, anchors, loaded, loads, revision, start = comm.bcast(conditions if comm.rank == 0 else None, root=0)
         if why is not None:
             raise NotImplementedError(f"a solve on {comm.size} MPI ranks: {why}")
         if self.part is None or revision != self._revision:
             self.part = distribute(body.mesh if comm.rank == 0 else None, comm)
             self._revision = revision
-        return DistributedStatic(self.part, body.material, density=body.density, thickness=body.thickness,
-                                 fixed=fixed, fixed_values=anchors,
-                                 forces={int(v): f for v, f in zip(loaded, loads)})
+        problem = DistributedStatic(self.part, body.material, density=body.density, thickness=body.thickness,
+                                    fixed=fixed, fixed_values=anchors, forces={int(v): f for v, f in zip(loaded, loads)})
+        problem.set_displacement(start)  # where the serial solve would start
+        return problem
 
     def gather_into_body(self, problem: DistributedStatic) -> None:
         self.body.displacement = problem.gathered_displacement()

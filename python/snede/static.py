@@ -52,10 +52,9 @@ class StaticSolver(RunsOnRanks):
     * ``comm`` (an mpi4py communicator): ``solve()`` is collective and runs over all its ranks
       (issue 18, ``snede.distributed_body``), one included: rank 0's body is
       distributed, its fixed vertices and external forces become a
-      :class:`snede.DistributedStatic` solved from the prescribed displacements, and the
-      result is gathered into ``body.displacement`` on every rank. There the nonlinear
-      methods stop at ‖F‖ ≤ rtol·‖F(u₀)‖ and CG at ‖r‖ ≤ rtol·‖b‖ (PETSc's relative tests, not
-      ``criterion``); the preconditioner is ``"gamg"`` (default), ``"jacobi"`` or ``"none"``;
+      :class:`snede.DistributedStatic` solved from the body's displacement, to the same
+      ``criterion``, and the result is gathered into ``body.displacement`` on every rank. The
+      preconditioner is ``"gamg"`` (default), ``"jacobi"`` or ``"none"``;
       ``part`` is this rank's part. None (default): the body's ``comm``, and without one the
       serial solver.
 
@@ -97,7 +96,8 @@ class StaticSolver(RunsOnRanks):
                 raise NotImplementedError(f"preconditioner {preconditioner!r} on MPI ranks (comm): distributed "
                                           f"solves take {DISTRIBUTED_PRECONDITIONERS}")
             self._distributed = DistributedBody(body, comm)
-            self._distributed_settings = (method, rtol, max_iterations, preconditioner, options_prefix)
+            self._distributed_settings = (method, rtol, max_iterations, preconditioner, options_prefix, criterion,
+                                          round_tolerance)
             self._impl = None
             return
         self._impl = _snede.StaticSolver(body._model, method, float(rtol), criterion, float(round_tolerance),
@@ -110,11 +110,11 @@ class StaticSolver(RunsOnRanks):
         return SolveResult._from_engine(self._impl.solve())
 
     def _solve_distributed(self) -> SolveResult:
-        method, rtol, max_iterations, preconditioner, prefix = self._distributed_settings
+        method, rtol, max_iterations, preconditioner, prefix, criterion, round_tolerance = self._distributed_settings
         problem = self._distributed.problem()
         chosen = "none" if method == "ncg" else (preconditioner or "gamg")
         result = problem.solve(method, rtol=rtol, max_iterations=max_iterations, preconditioner=chosen,
-                               options_prefix=prefix)
+                               options_prefix=prefix, criterion=criterion, round_tolerance=round_tolerance)
         self._distributed.gather_into_body(problem)
         return result
 

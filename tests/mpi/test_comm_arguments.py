@@ -41,6 +41,41 @@ def test_static_solver_with_comm_gives_the_serial_displacement_on_every_rank():
     assert len({arr.tobytes() for arr in COMM.allgather(body.displacement)}) == 1
 
 
+def test_static_solver_with_comm_stops_at_the_serial_criterion():
+    """Unpreconditioned CG to criterion (6.9) with rtol 1e-6: the same threshold and, in exact
+    arithmetic, the same iterates as the serial CG (which scales the system by E·H², a
+    round-off difference only). After ~150 iterations the round-off of another summation order
+    moves CG's residual history enough that the threshold may be crossed one iteration apart."""
+    material = snede.LinearElastic(1e5, 0.3)
+    body, reference = loaded_body(material), loaded_body(material)
+    result = snede.StaticSolver(body, "cg", rtol=1e-6, preconditioner="none", comm=COMM).solve()
+    expected = snede.StaticSolver(reference, "cg", rtol=1e-6, preconditioner="none").solve()
+    assert result.converged and expected.converged, (result, expected)
+    assert result.tolerance == pytest.approx(expected.tolerance, rel=1e-12)
+    assert abs(result.iterations - expected.iterations) <= 1
+    assert result.residual_norm <= 2 * result.tolerance  # the recomputed residual, as serially
+    assert relative_difference(body.displacement, reference.displacement) <= 1e-8  # 1-2e-10 measured, 1-4 ranks
+
+
+@pytest.mark.parametrize("method", ["cg", "newton"])
+def test_a_solve_starts_from_the_body_as_the_serial_one_does(method):
+    """Solved once, the body is in equilibrium: the next solve starts there and stops at once.
+    Set half way (u*/2) instead, the linear body's residual is F(u*/2) = F(0)/2 (K u* = f on
+    the free dofs): the solve starts from there, not from zero, and ends at u* again."""
+    body = loaded_body(snede.LinearElastic(1e5, 0.3))
+    solver = snede.StaticSolver(body, method, rtol=1e-10, comm=COMM)
+    first = solver.solve()
+    assert first.converged, first
+    again = solver.solve()
+    assert again.converged and again.iterations == 0, again
+    answer = body.displacement.copy()
+    body.displacement = 0.5 * answer
+    restarted = solver.solve()
+    assert restarted.converged, restarted
+    assert restarted.initial_residual_norm == pytest.approx(0.5 * first.initial_residual_norm, rel=1e-6)
+    assert relative_difference(body.displacement, answer) <= 1e-8
+
+
 def test_dynamic_relaxation_with_comm_takes_the_serial_steps():
     material = snede.LinearElastic(1e5, 0.3)
     body = loaded_body(material)

@@ -153,3 +153,37 @@ def test_the_displacement_does_not_depend_on_the_rank_count(material, method):
         assert problem.solve(method, rtol=1e-12, options_prefix=prefix).converged
         solutions.append(problem.gathered_displacement())
     assert relative_difference(*solutions) <= 1e-10
+
+
+@pytest.mark.parametrize("method, preconditioner", [("cg", "jacobi"), ("newton", "gamg")])
+def test_the_serial_criteria_apply_to_the_true_residual(method, preconditioner):
+    """criterion "6.8": ‖F‖ ≤ rtol·‖f_ext‖ on the recomputed residual whatever the
+    preconditioner's norm; the threshold is rtol times the tip loads' norm (200 N over the tip
+    vertices)."""
+    serial, _ = cantilever(3)
+    _, tip, force = conditions(serial)
+    external = np.sqrt(len(tip)) * np.linalg.norm(force)
+    problem = linear_cantilever_problem(COMM)
+    result = problem.solve(method, rtol=1e-7, preconditioner=preconditioner, criterion="6.8")
+    assert result.converged, result
+    assert result.tolerance == pytest.approx(1e-7 * external, rel=1e-12)
+    assert result.residual_norm <= 2 * result.tolerance
+    expected = serial_solution(serial, snede.LinearElastic(1e5, 0.3), None, "cg")
+    assert relative_difference(problem.gathered_displacement(), expected) <= 1e-5
+
+
+def test_a_solve_starts_from_a_displacement_set_on_every_rank():
+    """set_displacement(u*) with the answer: the next solve stops at once; bad shapes or
+    criteria raise the same ValueError on every rank."""
+    problem = linear_cantilever_problem(COMM)
+    assert problem.solve("cg", rtol=1e-10, criterion="6.9").converged
+    answer = problem.gathered_displacement()
+    fresh = linear_cantilever_problem(COMM)
+    fresh.set_displacement(answer)
+    result = fresh.solve("cg", rtol=1e-9, criterion="6.9")
+    assert result.converged and result.iterations == 0, result
+    with pytest.raises(ValueError, match=r"displacement must be \(\d+, 3\)"):
+        fresh.set_displacement(answer[:-1])
+    with pytest.raises(ValueError, match="criterion must be"):
+        fresh.solve("cg", criterion="6.10")
+    assert COMM.allreduce(1) == COMM.size
