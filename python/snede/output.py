@@ -20,6 +20,7 @@ import h5py
 import numpy as np
 
 from snede import _snede
+from snede.distributed import agreed
 from snede.mesh import Mesh
 
 __all__ = ["SeriesWriter", "SeriesStep", "read_series"]
@@ -95,7 +96,7 @@ class SeriesWriter:
         local vertex, extra cell fields one per local cell. Every rank passes the same field
         names; bad input raises the same ValueError on every rank. The file holds the owned
         vertices' values, in PETSc's global vertex order, and the point field ``serial_vertex``."""
-        u, points, fields = _step_arrays(part.local, displacement, point_fields, cell_fields)
+        u, points, fields = agreed(part.comm, lambda: _step_arrays(part.local, displacement, point_fields, cell_fields))
         self._impl.write_distributed_step(float(time), part._impl, u, fields, points)
 
 

@@ -114,12 +114,15 @@ def wrong_on_the_last_rank(part, kind):
     u = np.zeros((local.n_points + (kind == "displacement" and wrong), local.dim))
     cell_fields = {"label": np.zeros(local.n_cells + (kind == "cell field" and wrong))}
     point_fields = {"height": np.zeros(local.n_points + (kind == "point field" and wrong))}
+    if kind == "not numbers" and wrong:
+        cell_fields["label"] = ["soft"] * local.n_cells  # numpy cannot make floats of it
     return u, point_fields, cell_fields
 
 
 @pytest.mark.parametrize("kind, message", [("displacement", "displacement has"),
                                            ("cell field", "cell field 'label' has"),
-                                           ("point field", "point field 'height' has")])
+                                           ("point field", "point field 'height' has"),
+                                           ("not numbers", "could not convert string to float")])
 def test_bad_input_on_one_rank_raises_the_same_error_on_every_rank(kind, message, tmp_path_factory):
     serial = serial_meshes()["box"]
     part = snede.distribute(serial if COMM.rank == 0 else None)
