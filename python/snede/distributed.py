@@ -42,6 +42,12 @@ def agreed(comm, check):
     return value
 
 
+def _world():
+    from mpi4py import MPI
+
+    return MPI.COMM_WORLD
+
+
 @dataclass
 class DistributedMesh:
     """This rank's part of a distributed mesh (see :func:`distribute`)."""
@@ -59,9 +65,7 @@ class DistributedMesh:
 def distribute(mesh: Mesh | None, comm=None) -> DistributedMesh:
     """Partition rank 0's ``mesh`` over ``comm`` (default ``MPI.COMM_WORLD``) with DMPlex;
     every rank returns its part. Collective."""
-    from mpi4py import MPI
-
-    comm = MPI.COMM_WORLD if comm is None else comm
+    comm = _world() if comm is None else comm
     serial = mesh._impl if (comm.rank == 0 and isinstance(mesh, Mesh)) else None
     part = _snede.distribute_mesh(comm.py2f(), serial)
     local = Mesh._wrap(part.local)
@@ -89,9 +93,11 @@ class DistributedStatic:
     def __init__(self, part: DistributedMesh, material, *, density: float = 1000.0, thickness=None, fixed=(),
                  fixed_values=None, forces=None, gravity=None):
         self.part = part
-        dim = part.local.dim
 
         def conditions():
+            if not isinstance(part, DistributedMesh):
+                raise TypeError(f"part must be a DistributedMesh (from snede.distribute), got {type(part).__name__}")
+            dim = part.local.dim
             ids = np.asarray(fixed, dtype=np.int64).ravel()
             values = np.zeros((len(ids), dim)) if fixed_values is None else np.asarray(fixed_values, dtype=np.float64)
             if values.shape != (len(ids), dim):
@@ -110,7 +116,11 @@ class DistributedStatic:
             return (float(density), float(thickness or 0.0), ids.tolist(), values.ravel().tolist(), loaded.tolist(),
                     loads.ravel().tolist(), g)
 
-        self._impl = _snede.DistributedStatic(part._impl, material, *agreed(part.comm, conditions))
+        # A rank given no part has no communicator: it reports on the world's, which is the
+        # part's unless the script distributed over a sub-communicator.
+        comm = part.comm if isinstance(part, DistributedMesh) else _world()
+        arguments = agreed(comm, conditions)
+        self._impl = _snede.DistributedStatic(part._impl, material, *arguments)
 
     def solve(self, method: str = "cg", rtol: float = 1e-8, max_iterations: int = 10000, preconditioner: str = "none",
               options_prefix: str = "dstatic_", criterion: str = "relative",

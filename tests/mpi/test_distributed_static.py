@@ -110,6 +110,18 @@ def test_a_python_argument_error_on_one_rank_reaches_every_rank():
     assert COMM.allreduce(1) == COMM.size
 
 
+@pytest.mark.skipif(COMM.size == 1, reason="needs a rank that differs")
+def test_a_rank_given_no_part_raises_on_every_rank():
+    """The last rank passes None for its part (it has no communicator to report on): it
+    reports on the world's, which is the part's, and every rank raises its TypeError."""
+    serial, _ = cantilever(3)
+    part = snede.distribute(serial if COMM.rank == 0 else None)
+    mine = None if COMM.rank == COMM.size - 1 else part
+    with pytest.raises(TypeError, match=rf"rank {COMM.size - 1}: part must be a DistributedMesh"):
+        snede.DistributedStatic(mine, snede.LinearElastic(1e5, 0.3), fixed=[0, 1, 2])
+    assert COMM.allreduce(1) == COMM.size
+
+
 @pytest.mark.skipif(COMM.size == 1, reason="needs ranks that disagree")
 def test_solver_arguments_that_differ_between_ranks_raise_everywhere():
     """A tolerance, a method or a damping that differs between ranks would make the ranks leave
