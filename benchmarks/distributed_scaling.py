@@ -74,7 +74,7 @@ def main() -> None:
         print(f"(x spans {x[:, 0].min():.2f}..{x[:, 0].max():.2f} on rank 0)")
 
 
-PRECONDITIONERS = ("none", "jacobi", "gamg")
+PRECONDITIONERS = ("none", "jacobi", "gamg", "bjacobi", "sor", "lu")
 
 
 def compare_preconditioners(problem, comm, part) -> None:

@@ -395,9 +395,11 @@ SolveResult DistributedStatic::solve(const std::string& method, const std::strin
   if (method != "cg" && method != "newton" && method != "ncg")
     throw std::invalid_argument("DistributedStatic.solve: method must be \"cg\", \"newton\" or \"ncg\", got \"" +
                                 method + "\"");
-  if (preconditioner != "none" && preconditioner != "jacobi" && preconditioner != "gamg")
-    throw std::invalid_argument("DistributedStatic.solve: preconditioner must be \"none\", \"jacobi\" or \"gamg\", got \"" +
-                                preconditioner + "\"");
+  if (preconditioner != "none" && preconditioner != "jacobi" && preconditioner != "gamg" &&
+      preconditioner != "bjacobi" && preconditioner != "sor" && preconditioner != "lu")
+    throw std::invalid_argument(
+        "DistributedStatic.solve: preconditioner must be \"none\", \"jacobi\", \"gamg\", \"bjacobi\", \"sor\" or "
+        "\"lu\", got \"" + preconditioner + "\"");
   if (method == "ncg" && preconditioner != "none")
     throw std::invalid_argument("DistributedStatic.solve: nonlinear CG ('ncg') takes no preconditioner, got \"" +
                                 preconditioner + "\"");
@@ -425,14 +427,18 @@ SolveResult DistributedStatic::solve(const std::string& method, const std::strin
   SNEDE_PETSC(SNESSetFunction(snes, work_, residual_callback, this));
   // The shell needs no assembly: SNES's Jacobian step sets the linearisation point (and fills
   // GAMG's assembled copy). Nonlinear CG's line search takes K(x)d from it too.
-  const bool assembled = preconditioner == "gamg";
+  // none and Jacobi need no matrix; GAMG, block Jacobi (ILU(0) on each rank's block), SOR
+  // (symmetric sweeps over each rank's rows, PETSc's default on MPIAIJ) and LU (MUMPS, the
+  // parallel direct solver in Debian's PETSc) take the assembled one.
+  const bool assembled = preconditioner != "none" && preconditioner != "jacobi";
   SNEDE_PETSC(SNESSetJacobian(snes, tangent_, assembled ? assembled_tangent() : tangent_.get(), jacobian_callback, this));
   KSP ksp = nullptr;
   PC pc = nullptr;
   SNEDE_PETSC(SNESGetKSP(snes, &ksp));
   SNEDE_PETSC(KSPSetType(ksp, KSPCG));
   SNEDE_PETSC(KSPGetPC(ksp, &pc));
-  SNEDE_PETSC(PCSetType(pc, preconditioner == "jacobi" ? PCJACOBI : assembled ? PCGAMG : PCNONE));
+  SNEDE_PETSC(PCSetType(pc, preconditioner.c_str()));  // PETSc's names
+  if (preconditioner == "lu") SNEDE_PETSC(PCFactorSetMatSolverType(pc, MATSOLVERMUMPS));
   if (method == "cg") {
     SNEDE_PETSC(SNESSetType(snes, SNESKSPONLY));
     SNEDE_PETSC(KSPSetTolerances(ksp, rtol, 0.0, PETSC_DEFAULT, max_iterations));

@@ -51,7 +51,8 @@ class DistributedStatic {
   // Collective. "cg": one Newton step solved by CG (linear problems); "newton": Newton with
   // CG inside; "ncg": nonlinear CG (Polak-Ribière) with the secant line search of §4.4.2.
   // Preconditioner (cg and newton) "none", "jacobi" (the tangent's diagonal, assembled across
-  // the ranks) or "gamg" (on the assembled tangent); options under `prefix`. Stopping:
+  // the ranks), or on the assembled tangent "gamg", "bjacobi" (ILU(0) per rank), "sor" (local
+  // symmetric sweeps) or "lu" (MUMPS); options under `prefix`. Stopping:
   // criterion "relative" is PETSc's relative test (‖F‖ ≤ rtol ‖F(u₀)‖; CG ‖r‖ ≤ rtol ‖b‖ in
   // its preconditioned norm); "6.9" and "6.8" are the serial StaticSolver's (§6.6,
   // stopping.hpp), on the true residual, with the same round-off floor.

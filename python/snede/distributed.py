@@ -87,7 +87,7 @@ class DistributedStatic:
     masses of :class:`DistributedRelaxation`.
 
     ``solve(method="cg" | "newton" | "ncg", rtol=1e-8, preconditioner="none" | "jacobi" |
-    "gamg")`` returns a :class:`snede.SolveResult` with PETSc's reason; ``-<prefix>snes_*``/
+    "gamg" | "bjacobi" | "sor" | "lu")`` returns a :class:`snede.SolveResult` with PETSc's reason; ``-<prefix>snes_*``/
     ``-<prefix>ksp_*``/``-<prefix>pc_*`` options apply (prefix ``dstatic_``)."""
 
     def __init__(self, part: DistributedMesh, material, *, density: float = 1000.0, thickness=None, fixed=(),
@@ -127,7 +127,10 @@ class DistributedStatic:
               round_tolerance: float = 1e-12) -> SolveResult:
         """``method`` "cg" (linear), "newton" or "ncg" (nonlinear CG, no preconditioner);
         ``preconditioner`` "none", "jacobi" (the tangent's diagonal, summed across the ranks) or
-        "gamg" (PETSc's algebraic multigrid on the assembled tangent, MPIAIJ). Starts from the
+        "gamg" (PETSc's algebraic multigrid on the assembled tangent, MPIAIJ), "bjacobi" (block
+        Jacobi, ILU(0) on each rank's block of it; ``-dstatic_sub_pc_type icc`` for ICC), "sor"
+        (symmetric SOR sweeps over each rank's rows of it) or "lu" (its LU factors by MUMPS, a
+        direct solve: one CG iteration for a linear body). Starts from the
         current state (the previous solve's answer, or :meth:`set_displacement`'s).
 
         ``criterion`` "relative" (default): PETSc's relative tests, ‖F‖ ≤ rtol·‖F(u₀)‖ (CG:

@@ -11,7 +11,7 @@ from snede.distributed_body import DistributedBody, RunsOnRanks
 from snede.result import SolveResult
 
 METHODS = ("cg", "ncg", "newton")
-DISTRIBUTED_PRECONDITIONERS = (None, "none", "jacobi", "gamg")
+DISTRIBUTED_PRECONDITIONERS = (None, "none", "jacobi", "gamg", "bjacobi", "sor", "lu")
 LINE_SEARCHES = ("cp", "snede_newton", "snede_secant", "bt", "l2", "basic")
 
 
@@ -54,7 +54,8 @@ class StaticSolver(RunsOnRanks):
       distributed, its fixed vertices and external forces become a
       :class:`snede.DistributedStatic` solved from the body's displacement, to the same
       ``criterion``, and the result is gathered into ``body.displacement`` on every rank. The
-      preconditioner is ``"gamg"`` (default), ``"jacobi"`` or ``"none"``;
+      preconditioner is ``"gamg"`` (default), ``"jacobi"``, ``"none"``, ``"bjacobi"`` (ILU(0)
+      on each rank's block), ``"sor"`` (each rank's rows) or ``"lu"`` (MUMPS);
       ``part`` is this rank's part. None (default): the body's ``comm``, and without one the
       serial solver.
 

@@ -187,3 +187,27 @@ def test_a_solve_starts_from_a_displacement_set_on_every_rank():
     with pytest.raises(ValueError, match="criterion must be"):
         fresh.solve("cg", criterion="6.10")
     assert COMM.allreduce(1) == COMM.size
+
+
+@pytest.mark.parametrize("preconditioner", ["bjacobi", "sor"])
+def test_local_preconditioners_on_the_assembled_tangent(preconditioner):
+    """Block Jacobi (ILU(0) on each rank's block) and SOR (symmetric sweeps over each rank's
+    rows) of the MPIAIJ tangent: fewer CG iterations than none, the serial solution; on one
+    rank they are the serial ILU(0) and SSOR."""
+    problem = linear_cantilever_problem(COMM)
+    result = problem.solve("cg", rtol=1e-10, preconditioner=preconditioner, criterion="6.9")
+    plain = linear_cantilever_problem(COMM).solve("cg", rtol=1e-10, criterion="6.9")
+    assert result.converged and plain.converged, (result, plain)
+    assert result.iterations < plain.iterations
+    expected = serial_solution(cantilever(3)[0], snede.LinearElastic(1e5, 0.3), None, "cg")
+    assert relative_difference(problem.gathered_displacement(), expected) <= 1e-7
+
+
+def test_lu_by_mumps_solves_the_linear_body_in_one_iteration():
+    """LU factors of the assembled tangent (MUMPS, in parallel): CG preconditioned by the exact
+    inverse converges in one iteration, to the serial solution."""
+    problem = linear_cantilever_problem(COMM)
+    result = problem.solve("cg", rtol=1e-10, preconditioner="lu", criterion="6.9")
+    assert result.converged and result.iterations == 1, result
+    expected = serial_solution(cantilever(3)[0], snede.LinearElastic(1e5, 0.3), None, "cg")
+    assert relative_difference(problem.gathered_displacement(), expected) <= 1e-8
