@@ -4,6 +4,7 @@
 #include <petscsf.h>
 
 #include <algorithm>
+#include <cstdlib>
 #include <stdexcept>
 #include <string>
 
@@ -88,6 +89,10 @@ DistributedMesh distribute_mesh(MPI_Comm comm, const Mesh* serial) {
   PetscPartitioner partitioner = nullptr;
   SNEDE_PETSC(DMPlexGetPartitioner(dm, &partitioner));
   SNEDE_PETSC(PetscPartitionerSetFromOptions(partitioner));
+  // PT-Scotch 7 partitions with threads, and its threads make the partition differ from call
+  // to call (so would GAMG's and block Jacobi's iteration counts): one thread makes it the
+  // same in every run. A user's SCOTCH_PTHREAD_NUMBER wins.
+  setenv("SCOTCH_PTHREAD_NUMBER", "1", /*overwrite=*/0);
   SfHandle migration;
   DmHandle distributed;
   SNEDE_PETSC(DMPlexDistribute(dm, 0, migration.out(), distributed.out()));

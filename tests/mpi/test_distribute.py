@@ -55,6 +55,16 @@ def test_each_part_is_a_valid_positively_oriented_mesh(name):
         assert min(counts) > 0  # PETSc's partitioner gives every rank some of 48 or 80 cells
 
 
+def test_the_same_mesh_is_split_the_same_way_every_time():
+    """PT-Scotch runs on one thread (its threads made the parts differ from call to call, and
+    with them the iteration counts of partition-dependent preconditioners)."""
+    mesh = snede.meshing.box((4.0, 1.0, 1.0), (16, 4, 4)) if COMM.rank == 0 else None
+    parts = [snede.distribute(mesh) for _ in range(3)]
+    for part in parts[1:]:
+        assert np.array_equal(part.global_vertex, parts[0].global_vertex)
+        assert np.array_equal(part.owned, parts[0].owned)
+
+
 def test_a_rank_may_get_no_cells():
     """One triangle on every rank count: the ranks beyond the first hold nothing."""
     serial = snede.Mesh([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]], [[0, 1, 2]])
