@@ -5,7 +5,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 APT_PACKAGES=(
-  petsc-dev libhdf5-openmpi-dev libeigen3-dev libcgal-dev pkg-config ninja-build libgtest-dev
+  petsc-dev libptscotch-dev libhdf5-openmpi-dev libeigen3-dev libcgal-dev pkg-config ninja-build libgtest-dev
   # system libraries the gmsh and VTK wheels load
   libglu1-mesa libxcursor1 libxft2 libxinerama1 libegl1 libgl1-mesa-dri
 )

@@ -11,8 +11,23 @@
 #include "core/error.hpp"
 #include "core/petsc_handle.hpp"
 
+#ifdef SNEDE_HAVE_PTSCOTCH
+extern "C" void SCOTCH_randomReset(void);  // scotch.h's, which needs SCOTCH_Num's width
+#endif
+
 namespace snede {
 namespace {
+
+// PT-Scotch 7 splits a mesh differently from call to call, so would GAMG's and block Jacobi's
+// iteration counts: its threads race, and its random generator goes on from the previous
+// call. One thread (unless the user set SCOTCH_PTHREAD_NUMBER) and a reset generator make
+// the same mesh split the same way every time.
+void make_scotch_reproducible() {
+  setenv("SCOTCH_PTHREAD_NUMBER", "1", /*overwrite=*/0);
+#ifdef SNEDE_HAVE_PTSCOTCH
+  SCOTCH_randomReset();
+#endif
+}
 
 // Rank 0's verdict on its input, the same string on every rank ("" when it is fine).
 std::string agreed_problem(MPI_Comm comm, const Mesh* serial) {
@@ -89,10 +104,7 @@ DistributedMesh distribute_mesh(MPI_Comm comm, const Mesh* serial) {
   PetscPartitioner partitioner = nullptr;
   SNEDE_PETSC(DMPlexGetPartitioner(dm, &partitioner));
   SNEDE_PETSC(PetscPartitionerSetFromOptions(partitioner));
-  // PT-Scotch 7 partitions with threads, and its threads make the partition differ from call
-  // to call (so would GAMG's and block Jacobi's iteration counts): one thread makes it the
-  // same in every run. A user's SCOTCH_PTHREAD_NUMBER wins.
-  setenv("SCOTCH_PTHREAD_NUMBER", "1", /*overwrite=*/0);
+  make_scotch_reproducible();
   SfHandle migration;
   DmHandle distributed;
   SNEDE_PETSC(DMPlexDistribute(dm, 0, migration.out(), distributed.out()));
