@@ -22,6 +22,17 @@ namespace {
 // iteration counts: its threads race, and its random generator goes on from the previous
 // call. One thread (unless the user set SCOTCH_PTHREAD_NUMBER) and a reset generator make
 // the same mesh split the same way every time.
+// PETSc keeps an inner duplicate of a communicator while objects on it live and frees it with
+// the last one; the next object then duplicates the communicator again, a collective call.
+// Python destroys objects when its garbage collector runs, at different times on different
+// ranks: one rank would duplicate while another, still holding an object, would not, and both
+// would wait for ever. A reference taken at the first distribution, and never given back, keeps
+// the duplicate for the life of the process (later calls find it: no communication).
+void keep_petsc_communicator(MPI_Comm comm) {
+  MPI_Comm inner = MPI_COMM_NULL;
+  SNEDE_PETSC(PetscCommDuplicate(comm, &inner, nullptr));
+}
+
 void make_scotch_reproducible() {
   setenv("SCOTCH_PTHREAD_NUMBER", "1", /*overwrite=*/0);
 #ifdef SNEDE_HAVE_PTSCOTCH
@@ -69,6 +80,7 @@ double orientation(const std::vector<double>& points, int space_dim, const std::
 }  // namespace
 
 DistributedMesh distribute_mesh(MPI_Comm comm, const Mesh* serial) {
+  keep_petsc_communicator(comm);
   if (const std::string problem = agreed_problem(comm, serial); !problem.empty()) throw std::invalid_argument(problem);
   int rank = 0;
   MPI_Comm_rank(comm, &rank);

@@ -403,7 +403,10 @@ SolveResult DistributedStatic::solve(const std::string& method, const std::strin
   if (method == "ncg" && preconditioner != "none")
     throw std::invalid_argument("DistributedStatic.solve: nonlinear CG ('ncg') takes no preconditioner, got \"" +
                                 preconditioner + "\"");
-  if (!(rtol > 0)) throw std::invalid_argument("DistributedStatic.solve: rtol must be positive");
+  if (!(rtol > 0) || !std::isfinite(rtol))
+    throw std::invalid_argument("DistributedStatic.solve: rtol must be positive and finite, got " + std::to_string(rtol));
+  if (criterion == "relative" && !(rtol < 1))
+    throw std::invalid_argument("DistributedStatic.solve: a relative rtol must be below 1, got " + std::to_string(rtol));
   if (criterion != "relative" && criterion != "6.9" && criterion != "6.8")
     throw std::invalid_argument("DistributedStatic.solve: criterion must be \"relative\", \"6.9\" or \"6.8\", got \"" +
                                 criterion + "\"");
@@ -439,12 +442,14 @@ SolveResult DistributedStatic::solve(const std::string& method, const std::strin
   SNEDE_PETSC(KSPGetPC(ksp, &pc));
   SNEDE_PETSC(PCSetType(pc, preconditioner.c_str()));  // PETSc's names
   if (preconditioner == "lu") SNEDE_PETSC(PCFactorSetMatSolverType(pc, MATSOLVERMUMPS));
+  // PETSc's relative tolerance (< 1), or its default when a rule (whose rtol may be ≥ 1) stops.
+  const double relative = stopping_ ? PETSC_DEFAULT : rtol;
   if (method == "cg") {
     SNEDE_PETSC(SNESSetType(snes, SNESKSPONLY));
-    SNEDE_PETSC(KSPSetTolerances(ksp, rtol, 0.0, PETSC_DEFAULT, max_iterations));
+    SNEDE_PETSC(KSPSetTolerances(ksp, relative, 0.0, PETSC_DEFAULT, max_iterations));
   } else if (method == "newton") {
     SNEDE_PETSC(SNESSetType(snes, SNESNEWTONLS));
-    SNEDE_PETSC(SNESSetTolerances(snes, 0.0, rtol, 0.0, max_iterations, PETSC_DEFAULT));
+    SNEDE_PETSC(SNESSetTolerances(snes, 0.0, relative, 0.0, max_iterations, PETSC_DEFAULT));
   } else {
     register_line_searches();
     SNEDE_PETSC(SNESSetType(snes, SNESNCG));
@@ -452,7 +457,7 @@ SolveResult DistributedStatic::solve(const std::string& method, const std::strin
     SNESLineSearch line_search = nullptr;
     SNEDE_PETSC(SNESGetLineSearch(snes, &line_search));
     SNEDE_PETSC(SNESLineSearchSetType(line_search, "snede_secant"));
-    SNEDE_PETSC(SNESSetTolerances(snes, 0.0, rtol, 0.0, max_iterations, PETSC_DEFAULT));
+    SNEDE_PETSC(SNESSetTolerances(snes, 0.0, relative, 0.0, max_iterations, PETSC_DEFAULT));
   }
   if (stopping_) {
     SNEDE_PETSC(SNESSetConvergenceTest(snes, snes_rule_callback, this, nullptr));
@@ -482,7 +487,8 @@ SolveResult DistributedStatic::solve(const std::string& method, const std::strin
     result.linear_iterations = static_cast<int>(linear);
   }
   // An inverted element or a non-finite state is never converged, and a rule is checked on
-  // the final state (the factor allows CG's recursive residual to differ by round-off).
+  // the final state (the factor allows CG's recursive residual to differ by round-off). The
+  // relative tests stay PETSc's verdict: preconditioned CG measures another norm.
   const bool admissible = residual(u_, work_);
   result.residual_norm = vec_norm(work_);
   result.tolerance = stopping_ ? stopping_tolerance() : rtol * result.initial_residual_norm;

@@ -28,17 +28,23 @@ MATERIALS = (_snede.LinearElastic, _snede.StVenantKirchhoff, _snede.NeoHookean, 
 
 
 def agreed(comm, check):
-    """``check()`` on every rank of ``comm`` (collective): its value, or, if it raised a
-    ValueError or TypeError on any rank, the same exception on every rank (the lowest such
-    rank's, named), so that no rank goes on alone into a collective call."""
+    """``check()`` on every rank of ``comm`` (collective): its value, or, if it raised on any
+    rank, the same exception on every rank (the lowest such rank's, named; a RuntimeError
+    naming its type if that type cannot be made from a message), so that no rank goes on alone
+    into a collective call."""
     try:
         value, problem = check(), None
-    except (ValueError, TypeError) as error:
+    except Exception as error:  # any: one rank leaving alone would leave the others waiting
         value, problem = None, (type(error), str(error))
     for rank, found in enumerate(comm.allgather(problem)):
         if found is not None:
             kind, text = found
-            raise kind(text if comm.size == 1 else f"rank {rank}: {text}")
+            text = text if comm.size == 1 else f"rank {rank}: {text}"
+            try:
+                same = kind(text)
+            except Exception:
+                same = RuntimeError(f"{kind.__name__}: {text}")
+            raise same
     return value
 
 
@@ -133,8 +139,10 @@ class DistributedStatic:
         direct solve: one CG iteration for a linear body). Starts from the
         current state (the previous solve's answer, or :meth:`set_displacement`'s).
 
-        ``criterion`` "relative" (default): PETSc's relative tests, ‖F‖ ≤ rtol·‖F(u₀)‖ (CG:
-        ‖r‖ ≤ rtol·‖b‖ in its preconditioned norm). "6.9" or "6.8": the serial
+        ``criterion`` "relative" (default): PETSc's relative tests and verdict, ‖F‖ ≤
+        rtol·‖F(u₀)‖ (CG: ‖r‖ ≤ rtol·‖b‖ in its preconditioned norm, on its recursive
+        residual; ``tolerance`` in the result is rtol·‖F(u₀)‖, which a solve started at
+        equilibrium cannot reach below round-off). "6.9" or "6.8": the serial
         :class:`snede.StaticSolver`'s criteria (§6.6) on the true residual, ‖F‖ ≤
         rtol·√(‖f_ext‖² + ‖f_react‖²) plus ``round_tolerance``'s floor, or ‖F‖ ≤ rtol·‖f_ext‖;
         ``tolerance`` in the result is the threshold."""

@@ -47,3 +47,30 @@ def test_a_scene_that_succeeds_on_every_rank_exits_cleanly(tmp_path):
         """)
     assert run.returncode == 0, (run.stdout, run.stderr)
     assert run.stdout.count("both ranks done") == 2
+
+
+def test_petsc_objects_freed_at_different_times_on_the_ranks(tmp_path):
+    """Python frees PETSc objects when its garbage collector runs, at different times on
+    different ranks. Rank 0 keeps a distributed problem alive while rank 1 frees its own, then
+    both distribute and solve again: PETSc's communicator duplicate must not be made on one
+    rank only (it hung: rank 1 duplicated the communicator while rank 0 found it cached)."""
+    run = run_on_two_ranks(tmp_path, """
+        import gc
+        from mpi4py import MPI
+        import snede
+        comm = MPI.COMM_WORLD
+        mesh = snede.meshing.box((4.0, 1.0, 1.0), (8, 2, 2)) if comm.rank == 0 else None
+
+        def problem():
+            return snede.DistributedStatic(snede.distribute(mesh), snede.LinearElastic(1e5, 0.3), fixed=[0, 1, 2, 3],
+                                           forces={80: (0.0, 0.0, -1.0)})
+
+        first = problem()
+        kept = first if comm.rank == 0 else None
+        del first
+        gc.collect()
+        result = problem().solve("cg", rtol=1e-8)
+        print("converged", result.converged, flush=True)
+        """)
+    assert run.returncode == 0, (run.stdout, run.stderr)
+    assert run.stdout.count("converged True") == 2
