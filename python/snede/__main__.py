@@ -185,12 +185,18 @@ def _end_every_rank(code: int) -> None:
 
 
 if __name__ == "__main__":
+    # Not converged (1, from the collective summary) ends every rank alike; an error, an
+    # interrupt or a script's sys.exit may have happened on this rank alone.
     try:
-        exit_code = main()
+        exit_code, alone = main(), False
+    except SystemExit as stop:  # sys.exit in a scene script, or a usage error
+        exit_code = stop.code if isinstance(stop.code, int) else (0 if stop.code is None else 1)
+        if not isinstance(stop.code, (int, type(None))):
+            print(stop.code, file=sys.stderr)  # as Python prints it
+        alone = True
     except Exception:
         traceback.print_exc()
-        exit_code = 1
-        _end_every_rank(exit_code)
-    if exit_code == 2:  # bad input or a PETSc error, reported above
+        exit_code, alone = 1, True
+    if exit_code != 0 and (alone or exit_code in (2, 130)):
         _end_every_rank(exit_code)
     sys.exit(exit_code)

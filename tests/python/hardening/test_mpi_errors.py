@@ -22,10 +22,14 @@ def run_on_two_ranks(tmp_path, body: str) -> subprocess.CompletedProcess:
                           capture_output=True, text=True, timeout=120, env={**os.environ, **MPI_ROOT})
 
 
-@pytest.mark.parametrize("error", ["ValueError('bad input on rank 1 only')", "RuntimeError('a bug on rank 1 only')"])
-def test_an_error_on_one_rank_ends_every_rank(tmp_path, error):
-    """Rank 1 raises before a collective reduction that rank 0 enters: the job ends, non-zero,
-    with rank 1's message, instead of rank 0 waiting for ever."""
+@pytest.mark.parametrize("error, message", [("ValueError('bad input on rank 1 only')", "on rank 1 only"),
+                                            ("RuntimeError('a bug on rank 1 only')", "on rank 1 only"),
+                                            ("KeyboardInterrupt()", "interrupted"),
+                                            ("SystemExit('stopped on rank 1 only')", "on rank 1 only")])
+def test_an_error_on_one_rank_ends_every_rank(tmp_path, error, message):
+    """Rank 1 raises (or is interrupted, or calls sys.exit) before a collective reduction that
+    rank 0 enters: the job ends, non-zero, with rank 1's message, instead of rank 0 waiting
+    for ever."""
     run = run_on_two_ranks(tmp_path, f"""
         from mpi4py import MPI
         if MPI.COMM_WORLD.rank == 1:
@@ -34,7 +38,7 @@ def test_an_error_on_one_rank_ends_every_rank(tmp_path, error):
         print("rank 0 went on alone")
         """)
     assert run.returncode != 0, (run.stdout, run.stderr)
-    assert "on rank 1 only" in run.stderr, run.stderr
+    assert message in run.stderr, run.stderr
     assert "went on alone" not in run.stdout
 
 
