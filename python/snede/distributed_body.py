@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from snede.distributed import DistributedStatic, distribute
+from snede.distributed import DistributedStatic, agreed, distribute
 
 
 class DistributedBody:
@@ -23,7 +23,7 @@ class DistributedBody:
 
     def __init__(self, body, comm):
         self.body, self.comm = body, comm
-        self.part, self._revision = None, None
+        self.part, self._revision, self._last = None, None, None
 
     def problem(self) -> DistributedStatic:
         """A DistributedStatic with the body's current conditions, on the mesh as it is now."""
@@ -47,10 +47,31 @@ class DistributedBody:
         problem = DistributedStatic(self.part, body.material, density=body.density, thickness=body.thickness,
                                     fixed=fixed, fixed_values=anchors, forces={int(v): f for v, f in zip(loaded, loads)})
         problem.set_displacement(start)  # where the serial solve would start
+        self._last = self._state() if comm.rank == 0 else None
         return problem
 
     def gather_into_body(self, problem: DistributedStatic) -> None:
-        self.body.displacement = problem.gathered_displacement()
+        """The answer into the body on every rank; a rank whose body is not rank 0's (edited on
+        one rank only) makes every rank raise."""
+        u = problem.gathered_displacement()
+
+        def assign():
+            self.body.displacement = u
+
+        agreed(self.comm, assign)
+        self._last = self._state() if self.comm.rank == 0 else None
+
+    def changed(self) -> bool:
+        """Collective: whether the body's mesh, conditions or displacement changed since the
+        latest problem() or gather_into_body() (rank 0's body decides)."""
+        now = self._state() if self.comm.rank == 0 else None
+        return bool(self.comm.bcast(now != self._last if self.comm.rank == 0 else None, root=0))
+
+    def _state(self):
+        body = self.body
+        fixed, anchors, _ = body._model.constraint_table()
+        return (body.mesh._impl.revision, fixed.tobytes(), anchors.tobytes(), body.external_forces().tobytes(),
+                body.displacement.tobytes())
 
 
 class RunsOnRanks:

@@ -30,10 +30,11 @@ class DynamicRelaxation(RunsOnRanks):
       this solver only; the command line (PETSc's global options, as they are when the solver
       is made) still wins.
     * ``comm`` (an mpi4py communicator): ``run()`` is collective over its ranks (issue 18):
-      rank 0's body is distributed with its fixed vertices and external forces as they are
-      now, relaxed by :class:`snede.DistributedRelaxation` (the same steps and displacement as
-      serially), and the result gathered into ``body.displacement`` on every rank; ``run``,
-      ``dt`` and ``part`` are available. None (default): the body's ``comm``, and without one
+      rank 0's body is distributed with its fixed vertices, external forces and displacement,
+      relaxed by :class:`snede.DistributedRelaxation` (the same steps and displacement as
+      serially), and the result gathered into ``body.displacement`` on every rank; a body
+      refined, loaded or moved between runs is taken up anew, at rest. ``run``, ``dt`` and
+      ``part`` are available. None (default): the body's ``comm``, and without one
       the serial solver.
 
     The state is ``body.displacement`` and ``velocity`` (both (n_points, dim)); it starts at
@@ -54,12 +55,17 @@ class DynamicRelaxation(RunsOnRanks):
                 raise NotImplementedError(f"petsc_options on MPI ranks (comm): give -{options_prefix}ts_* "
                                           "options on the command line")
             self._distributed = DistributedBody(body, comm)
-            self._problem = self._distributed.problem()
-            self._relaxation = DistributedRelaxation(self._problem, damping, dt, options_prefix=options_prefix)
+            self._settings = (damping, dt, options_prefix)
+            self._start_relaxation()
             self._impl = None
             return
         self._impl = _snede.DynamicRelaxation(body._model, float(damping), float(dt or 0.0), options_prefix,
                                               option_list(petsc_options))
+
+    def _start_relaxation(self) -> None:
+        damping, dt, prefix = self._settings
+        self._problem = self._distributed.problem()
+        self._relaxation = DistributedRelaxation(self._problem, damping, dt, options_prefix=prefix)
 
     def step(self, n: int = 1) -> SolveResult:
         """Take ``n`` time steps. ``converged`` is False only on divergence (blow-up, NaN,
@@ -70,6 +76,8 @@ class DynamicRelaxation(RunsOnRanks):
         """Step until ‖F(u)‖ ≤ rtol·√(‖f_ext‖² + ‖f_react‖²) (criterion (6.9)), or
         ``max_steps`` (``reason == "DIVERGED_MAX_IT"``)."""
         if self._distributed is not None:
+            if self._distributed.changed():  # refined, loaded or moved since: start from the body at rest
+                self._start_relaxation()
             result = self._relaxation.run(rtol, max_steps)
             self._distributed.gather_into_body(self._problem)
             return result

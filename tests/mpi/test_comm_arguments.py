@@ -154,3 +154,37 @@ def test_a_body_given_a_communicator_hands_it_to_its_solvers():
     assert relative_difference(body.displacement, reference.displacement) <= 1e-7
     with pytest.raises(TypeError, match="mpi4py communicator"):
         snede.Body(cantilever(3)[0], material, comm=0)
+
+
+def test_dynamic_relaxation_takes_up_a_body_changed_between_runs():
+    """Relaxed, then moved back to rest (u = 0) or refined, the body is taken up anew by the
+    next run (it used to relax the old state again): the run takes steps and ends at the
+    static answer of the body as it is now."""
+    material = snede.LinearElastic(1e5, 0.3)
+    body = loaded_body(material)
+    relaxation = snede.DynamicRelaxation(body, damping=1.5, comm=COMM)
+    assert relaxation.run(rtol=1e-6, max_steps=20000).converged
+    answer = body.displacement.copy()
+    body.displacement = np.zeros_like(answer)
+    again = relaxation.run(rtol=1e-6, max_steps=20000)
+    assert again.converged and again.iterations > 0, again
+    assert relative_difference(body.displacement, answer) <= 1e-4  # both within (6.9) at 1e-6
+    body.mesh.refine_uniform()
+    refined = relaxation.run(rtol=1e-6, max_steps=40000)
+    assert refined.converged and refined.iterations > 0, refined
+    reference = loaded_body(material, refine=True)
+    assert snede.StaticSolver(reference, "cg", rtol=1e-10).solve().converged
+    assert body.displacement.shape == reference.displacement.shape
+    assert relative_difference(body.displacement, reference.displacement) <= 1e-4
+
+
+@pytest.mark.skipif(COMM.size == 1, reason="needs a rank whose body differs")
+def test_a_body_edited_on_one_rank_only_raises_on_every_rank():
+    """The last rank refines its body alone: the answer (rank 0's mesh) does not fit its body,
+    and every rank raises, naming it, instead of that rank alone."""
+    body = loaded_body(snede.LinearElastic(1e5, 0.3))
+    if COMM.rank == COMM.size - 1:
+        body.mesh.refine_uniform()
+    with pytest.raises(ValueError, match=f"rank {COMM.size - 1}: "):
+        snede.StaticSolver(body, "cg", rtol=1e-8, comm=COMM).solve()
+    assert COMM.allreduce(1) == COMM.size
