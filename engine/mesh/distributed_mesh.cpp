@@ -18,10 +18,6 @@ extern "C" void SCOTCH_randomReset(void);  // scotch.h's, which needs SCOTCH_Num
 namespace snede {
 namespace {
 
-// PT-Scotch 7 splits a mesh differently from call to call, so would GAMG's and block Jacobi's
-// iteration counts: its threads race, and its random generator goes on from the previous
-// call. One thread (unless the user set SCOTCH_PTHREAD_NUMBER) and a reset generator make
-// the same mesh split the same way every time.
 // PETSc keeps an inner duplicate of a communicator while objects on it live and frees it with
 // the last one; the next object then duplicates the communicator again, a collective call.
 // Python destroys objects when its garbage collector runs, at different times on different
@@ -33,6 +29,10 @@ void keep_petsc_communicator(MPI_Comm comm) {
   SNEDE_PETSC(PetscCommDuplicate(comm, &inner, nullptr));
 }
 
+// PT-Scotch 7 splits a mesh differently from call to call, so would GAMG's and block Jacobi's
+// iteration counts: its threads race, and its random generator goes on from the previous
+// call. One thread (unless the user set SCOTCH_PTHREAD_NUMBER) and a reset generator make
+// the same mesh split the same way every time.
 void make_scotch_reproducible() {
   setenv("SCOTCH_PTHREAD_NUMBER", "1", /*overwrite=*/0);
 #ifdef SNEDE_HAVE_PTSCOTCH

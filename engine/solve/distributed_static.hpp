@@ -67,7 +67,6 @@ class DistributedStatic {
   double stopping_tolerance() const {
     return stopping_->tolerance(stopping_external_norm_, stopping_reaction_norm_.value_or(last_reaction_norm_));
   }
-  bool stops_by_rule() const { return stopping_.has_value(); }
   // Π(u) = Π_int(u) − f_extᵀu over the whole body (collective).
   double energy();
   // The displacement of this rank's vertices (owned and ghosts), (n_local_vertices, dim).

@@ -6,8 +6,9 @@ mesh is distributed (``snede.distribute``), its fixed vertices and external forc
 the nodal-force channels, which do not depend on the state) become a
 :class:`snede.DistributedStatic` that starts from the body's displacement, the solve runs on all
 ranks to the serial solver's criterion, and the displacement is gathered back into the Body on
-every rank, so the script goes on as serially. The distribution is kept while the mesh is unchanged (a cut or a refinement of the serial body,
-done on every rank, makes the next solve distribute anew). What cannot be taken over raises
+every rank, so the script goes on as serially. The distribution is kept while the mesh is
+unchanged (a cut or a refinement of the serial body, done on every rank, makes the next solve
+distribute anew). What cannot be taken over raises
 NotImplementedError on every rank: sliding constraints and membranes.
 """
 from __future__ import annotations
@@ -38,6 +39,7 @@ class DistributedBody:
             elif len(sliding):
                 why = f"sliding constraints ({len(sliding)} vertices) are not distributed yet; fix them instead"
             conditions = (why, fixed, anchors, loaded, loads[loaded], body.mesh._impl.revision, body.displacement)
+            self._last = _fingerprint(body.mesh._impl.revision, fixed, anchors, loads, body.displacement)
         why, fixed, anchors, loaded, loads, revision, start = comm.bcast(conditions if comm.rank == 0 else None, root=0)
         if why is not None:
             raise NotImplementedError(f"a solve on {comm.size} MPI ranks: {why}")
@@ -47,7 +49,6 @@ class DistributedBody:
         problem = DistributedStatic(self.part, body.material, density=body.density, thickness=body.thickness,
                                     fixed=fixed, fixed_values=anchors, forces={int(v): f for v, f in zip(loaded, loads)})
         problem.set_displacement(start)  # where the serial solve would start
-        self._last = self._state() if comm.rank == 0 else None
         return problem
 
     def gather_into_body(self, problem: DistributedStatic) -> None:
@@ -70,8 +71,12 @@ class DistributedBody:
     def _state(self):
         body = self.body
         fixed, anchors, _ = body._model.constraint_table()
-        return (body.mesh._impl.revision, fixed.tobytes(), anchors.tobytes(), body.external_forces().tobytes(),
-                body.displacement.tobytes())
+        return _fingerprint(body.mesh._impl.revision, fixed, anchors, body.external_forces(), body.displacement)
+
+
+def _fingerprint(revision, fixed, anchors, loads, displacement):
+    """What a problem is made of, to tell whether the body changed since."""
+    return revision, fixed.tobytes(), anchors.tobytes(), loads.tobytes(), displacement.tobytes()
 
 
 class RunsOnRanks:
