@@ -133,6 +133,9 @@ void bind_solve(py::module_& m) {
            py::arg("preconditioner"), py::arg("bisection"), py::keep_alive<1, 2>(), py::keep_alive<1, 11>())
       .def_property_readonly("preconditioner", &StaticSolver::preconditioner)
       .def_property_readonly("multigrid_levels", &StaticSolver::multigrid_levels)
+      .def_property_readonly("multigrid_unknowns", &StaticSolver::multigrid_unknowns)
+      .def_property_readonly("multigrid_source", &StaticSolver::multigrid_source)
+      .def_property_readonly("follow_seconds", &StaticSolver::follow_seconds)
       .def("solve", &StaticSolver::solve)
       .def_property_readonly("ksp", [](const StaticSolver& s) { return to_petsc4py(s.ksp()); })
       .def_property_readonly("snes", [](const StaticSolver& s) {

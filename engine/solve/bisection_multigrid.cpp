@@ -18,10 +18,6 @@ namespace {
 constexpr double coarsening_slack = 1.5;
 // Relative tolerance of the conformity check (sums of element measures in floating point).
 constexpr double measure_tolerance = 1e-10;
-// Reused Chebyshev bounds: the estimate times this (PETSc's own estimate-based default is
-// 1.1), and the lower end of the smoothed interval as a fraction of the upper (PETSc's 0.1).
-constexpr double reused_bound_safety = 1.2;
-constexpr double chebyshev_lower_fraction = 0.1;
 
 double total_measure(const Mesh& mesh) {
   double sum = 0;
@@ -146,7 +142,14 @@ bool BisectionMultigrid::matches(const Model& fine) const {
          fine.constraints().projection_fingerprint() == constraints_;
 }
 
-std::vector<std::size_t> BisectionMultigrid::level_cells() const {
+std::vector<std::size_t> BisectionMultigrid::level_unknowns() const {
+  std::vector<std::size_t> unknowns;
+  for (const auto& level : coarse_) unknowns.push_back(static_cast<std::size_t>(level->model->n_dofs()));
+  unknowns.push_back(static_cast<std::size_t>(fine_.n_dofs()));
+  return unknowns;
+}
+
+std::vector<std::size_t> BisectionMultigrid::level_sizes() const {
   std::vector<std::size_t> cells;
   for (const auto& level : coarse_) cells.push_back(level->mesh->n_cells());
   cells.push_back(fine_.body().mesh().n_cells());
@@ -298,52 +301,14 @@ void BisectionMultigrid::configure(PC pc, const SolverOptions& options, const st
     // The finest level's operator is the PC's own (the fine shell).
     if (l < n - 1)
       SNEDE_PETSC(KSPSetOperators(smoother, coarse_[l]->model->tangent(), coarse_[l]->model->tangent()));
-    SNEDE_PETSC(KSPSetType(smoother, KSPCHEBYSHEV));
-    if (smoother_bounds.size() == static_cast<std::size_t>(n - 1)) {
-      // The spectrum of the Jacobi-scaled operator hardly depends on h, the state or the
-      // constraints: bounds estimated once serve later set-ups (a needle's every update and
-      // stick-slip change), which then skip the estimate's products on every level.
-      const double largest = reused_bound_safety * smoother_bounds[l - 1];
-      SNEDE_PETSC(KSPChebyshevEstEigSet(smoother, 0, 0, 0, 0));
-      SNEDE_PETSC(KSPChebyshevSetEigenvalues(smoother, largest, chebyshev_lower_fraction * largest));
-    } else {
-      SNEDE_PETSC(KSPChebyshevEstEigSet(smoother, PETSC_DECIDE, PETSC_DECIDE, PETSC_DECIDE, PETSC_DECIDE));
-    }
-    PC jacobi = nullptr;
-    SNEDE_PETSC(KSPGetPC(smoother, &jacobi));
-    options.use_for(jacobi);
-    SNEDE_PETSC(PCSetType(jacobi, PCJACOBI));  // from the shell's diagonal: no matrix
+    set_chebyshev_jacobi_smoother(smoother, options,
+                                  smoother_bounds.size() == static_cast<std::size_t>(n - 1) ? smoother_bounds[l - 1] : 0.0);
   }
+  set_direct_coarse_solve(pc, options);
   KSP coarse = nullptr;
   SNEDE_PETSC(PCMGGetCoarseSolve(pc, &coarse));
-  options.use_for(coarse);
   coarsest_matrix_ = std::make_unique<AssembledTangent>(*coarse_[0]->model, MatrixFormat::aij);
   SNEDE_PETSC(KSPSetOperators(coarse, coarse_[0]->model->tangent(), coarsest_matrix_->mat()));
-  SNEDE_PETSC(KSPSetType(coarse, KSPPREONLY));
-  PC direct = nullptr;
-  SNEDE_PETSC(KSPGetPC(coarse, &direct));
-  options.use_for(direct);
-  SNEDE_PETSC(PCSetType(direct, PCLU));
-}
-
-std::vector<double> BisectionMultigrid::chebyshev_estimates(PC pc) {
-  PetscInt n = 0;
-  SNEDE_PETSC(PCMGGetLevels(pc, &n));
-  std::vector<double> largest;
-  for (PetscInt l = 1; l < n; ++l) {
-    KSP smoother = nullptr, estimator = nullptr;
-    SNEDE_PETSC(PCMGGetSmoother(pc, l, &smoother));
-    PetscBool chebyshev = PETSC_FALSE;
-    SNEDE_PETSC(PetscObjectTypeCompare(reinterpret_cast<PetscObject>(smoother), KSPCHEBYSHEV, &chebyshev));
-    if (!chebyshev) return {};
-    SNEDE_PETSC(KSPChebyshevEstEigGetKSP(smoother, &estimator));
-    if (!estimator) return {};
-    PetscReal emax = 0, emin = 0;
-    SNEDE_PETSC(KSPComputeExtremeSingularValues(estimator, &emax, &emin));
-    if (!(emax > 0) || !std::isfinite(emax)) return {};
-    largest.push_back(emax);
-  }
-  return largest;
 }
 
 void BisectionMultigrid::update(Vec u) {

@@ -22,14 +22,13 @@
 #include <vector>
 
 #include "core/petsc_handle.hpp"
-#include "core/solver_options.hpp"
-#include "solve/model.hpp"
+#include "solve/multigrid.hpp"
 #include "solve/tangent_assembly.hpp"
 #include "topology/refinement_hierarchy.hpp"
 
 namespace snede {
 
-class BisectionMultigrid {
+class BisectionMultigrid final : public Multigrid {
  public:
   // Builds the coarse levels of `fine`'s mesh from `hierarchy` (which must watch that mesh):
   // all it allows, or the finest `max_levels` (counting the fine one; 0: no limit).
@@ -41,36 +40,24 @@ class BisectionMultigrid {
   BisectionMultigrid(const BisectionMultigrid&) = delete;
   BisectionMultigrid& operator=(const BisectionMultigrid&) = delete;
 
-  // Whether the fine mesh and its constraints' projections are still those the levels were
-  // made for (no edit, no vertex fixed, released or made to slide since: a needle's stick-slip
-  // changes them between solves, and stale projections make the cycle indefinite).
-  bool matches(const Model& fine) const;
-  // Whether only the mesh is still the same (the constraints may have changed).
-  bool matches_mesh(const Model& fine) const;
-  // Levels including the finest (the fine model itself).
-  int n_levels() const { return static_cast<int>(coarse_.size()) + 1; }
+  const char* source() const override { return "bisection"; }
+  bool matches(const Model& fine) const override;
+  bool matches_mesh(const Model& fine) const override;
+  int n_levels() const override { return static_cast<int>(coarse_.size()) + 1; }
   // Elements per level, coarsest first, the fine mesh last.
-  std::vector<std::size_t> level_cells() const;
-
-  // After the fine constraints changed (not the mesh): the coarse levels take them over and the
-  // interpolations are rebuilt, without rebuilding the levels' meshes. False if a level is no
-  // longer held by its constraints (then the levels must be made anew).
-  bool follow_constraints();
-
-  // Makes `pc` a PCMG over these levels: interpolations, coarse operators, Chebyshev/Jacobi
-  // smoothers, LU on the coarsest. Call before PCSetFromOptions, which may override them
-  // (-<prefix>mg_levels_ksp_type, -<prefix>mg_coarse_pc_type, ...).
-  // `options` is the solver's database, which every level's KSP and PC read. `smoother_bounds`:
-  // Chebyshev's largest eigenvalue of the Jacobi-scaled operator per smoothed level (finest
-  // last), as chebyshev_estimates gave them on an earlier configuration with as many levels;
-  // they are used (with a safety factor) instead of estimating again. Empty: estimate.
-  void configure(PC pc, const SolverOptions& options, const std::vector<double>& smoother_bounds = {});
-  // The largest eigenvalues Chebyshev estimated on the smoothed levels of a PCMG set up by
-  // configure (finest last); empty if a level did not estimate (fixed bounds, other smoother).
-  static std::vector<double> chebyshev_estimates(PC pc);
+  std::vector<std::size_t> level_sizes() const override;
+  std::vector<std::size_t> level_unknowns() const override;
+  bool needs_assembled_tangent() const override { return false; }
+  // The coarse levels take the new constraints over and the interpolations are rebuilt,
+  // without rebuilding the levels' meshes; false if a level is no longer held.
+  bool follow_constraints() override;
+  // PCMG over these levels: interpolations, the levels' own shells, Chebyshev/Jacobi
+  // smoothers, LU on the coarsest level's assembled tangent. Call before PCSetFromOptions,
+  // which may override them (-<prefix>mg_levels_ksp_type, -<prefix>mg_coarse_pc_type, ...).
+  void configure(PC pc, const SolverOptions& options, const std::vector<double>& smoother_bounds = {}) override;
   // Linearises every coarse level at u (the fine state, injected) with the fine model's
   // operator scale, and refills the coarsest level's matrix.
-  void update(Vec u);
+  void update(Vec u) override;
 
  private:
   struct Level;

@@ -12,6 +12,8 @@
 #include "core/interrupt.hpp"
 #include "core/norms.hpp"
 #include "core/petsc_util.hpp"
+#include "solve/aggregation_multigrid.hpp"
+#include "solve/bisection_multigrid.hpp"
 #include "solve/tangent_assembly.hpp"
 
 namespace snede {
@@ -64,12 +66,10 @@ StaticSolver::StaticSolver(Model& model, StaticOptions options, const Refinement
   if (model.body().mesh().is_surface() && pc_type_ != PCNONE)
     throw std::invalid_argument("preconditioner '" + pc_type_ + "' is not implemented for membranes (surface meshes): "
                                 "the tangent's diagonal and assembly assume volume elements; use 'none'");
-  if (pc_type_ == PCMG && !hierarchy_)
-    throw std::invalid_argument("preconditioner 'mg' coarsens along the mesh's bisection hierarchy: refine the mesh "
-                                "by bisection (mesh.refine_uniform or refine_around) before making the solver");
-  // Jacobi reads the shell's diagonal (MatGetDiagonal), mg builds its own levels; every other
-  // PC needs entries.
-  needs_matrix_ = pc_type_ != PCNONE && pc_type_ != PCJACOBI && pc_type_ != PCMG;
+  // Jacobi reads the shell's diagonal (MatGetDiagonal), mg builds its own levels (and needs
+  // entries only for Galerkin levels); every other PC needs entries.
+  pc_needs_matrix_ = pc_type_ != PCNONE && pc_type_ != PCJACOBI && pc_type_ != PCMG;
+  needs_matrix_ = pc_needs_matrix_;
   register_line_searches();
   create_objects();  // on a bad option the handles release what was made
 }
@@ -98,6 +98,7 @@ KSP StaticSolver::ksp() const {
 
 void StaticSolver::create_objects() {
   generation_ = model_.generation();
+  build_multigrid();  // before the operators: Galerkin levels need the assembled tangent
   SNEDE_PETSC(VecDuplicate(model_.displacement(), residual_.out()));
   const char* prefix = options_.options_prefix.c_str();
   if (options_.method == StaticMethod::linear_cg) {
@@ -110,7 +111,7 @@ void StaticSolver::create_objects() {
     option_database_.use_for(pc);
     SNEDE_PETSC(PCSetType(pc, pc_type_.c_str()));
     SNEDE_PETSC(PCSetUseAmat(pc, PETSC_FALSE));  // see the Newton branch
-    set_up_multigrid(pc);
+    if (multigrid_) configure_multigrid(pc);
     SNEDE_PETSC(KSPSetOperators(ksp_, model_.tangent(), preconditioning_matrix()));
     SNEDE_PETSC(KSPSetTolerances(ksp_, 0.0, 0.0, PETSC_DEFAULT, options_.max_iterations));
     SNEDE_PETSC(KSPSetConvergenceTest(ksp_, ksp_converged_callback, this, nullptr));
@@ -153,7 +154,7 @@ void StaticSolver::create_objects() {
     // A multigrid PC smooths its finest level with the assembled matrix, not the shell (each
     // shell product costs several assembled ones); -<prefix>pc_use_amat turns it back.
     SNEDE_PETSC(PCSetUseAmat(pc, PETSC_FALSE));
-    set_up_multigrid(pc);
+    if (multigrid_) configure_multigrid(pc);
     // Truncated Newton (§2.4.3): the inner CG stops early, tightening as the outer converges,
     // and where the tangent is indefinite (far from the solution of a soft body) CG stops at
     // the negative curvature and its iterate so far is used as the search direction.
@@ -199,6 +200,7 @@ void StaticSolver::follow_mesh_changes() {
   if (resized) SNEDE_PETSC(VecDuplicate(model_.displacement(), residual_.out()));
   assembled_.reset();  // its sparsity was the old mesh's (a flip or a cut changes it)
   multigrid_.reset();
+  build_multigrid();
   if (ksp_) {
     SNEDE_PETSC(KSPReset(ksp_));
     SNEDE_PETSC(KSPSetOperators(ksp_, model_.tangent(), preconditioning_matrix()));
@@ -221,7 +223,7 @@ void StaticSolver::follow_mesh_changes() {
     SNEDE_PETSC(KSPGetPC(ksp(), &pc));
     SNEDE_PETSC(PCSetType(pc, PCNONE));
     SNEDE_PETSC(PCSetType(pc, pc_type_.c_str()));
-    set_up_multigrid(pc);
+    if (multigrid_) configure_multigrid(pc);
     SNEDE_PETSC(PCSetFromOptions(pc));
   }
 }
@@ -236,13 +238,13 @@ Mat StaticSolver::preconditioning_matrix() {
   return assembled_->mat();
 }
 
-void StaticSolver::set_up_multigrid(PC pc) {
+void StaticSolver::build_multigrid() {
   if (pc_type_ != PCMG) return;
+  const std::string prefix = "-" + options_.options_prefix;
   const std::optional<std::string> galerkin = option_database_.string_option(options_.options_prefix + "pc_mg_galerkin");
   if (galerkin && *galerkin != "none" && *galerkin != "false" && *galerkin != "0")
-    throw std::invalid_argument("-" + options_.options_prefix + "pc_mg_galerkin: 'mg' gives every level its own "
-                                "matrix-free operator from the element kernels; Galerkin products need assembled "
-                                "matrices (use 'gamg')");
+    throw std::invalid_argument(prefix + "pc_mg_galerkin: 'mg' chooses its coarse operators itself (the levels' "
+                                "own shells on a bisection hierarchy, Galerkin products on aggregates)");
   // PCMG's own -pc_mg_levels would replace the levels configured here: it limits them instead.
   const std::optional<std::string> levels = option_database_.string_option(options_.options_prefix + "pc_mg_levels");
   int max_levels = 0;
@@ -252,10 +254,32 @@ void StaticSolver::set_up_multigrid(PC pc) {
       max_levels = std::stoi(*levels, &used);
       if (used != levels->size()) throw std::invalid_argument(*levels);
     } catch (const std::exception&) {
-      throw std::invalid_argument("-" + options_.options_prefix + "pc_mg_levels must be an integer, got '" + *levels + "'");
+      throw std::invalid_argument(prefix + "pc_mg_levels must be an integer, got '" + *levels + "'");
     }
   }
-  multigrid_ = std::make_unique<BisectionMultigrid>(model_, *hierarchy_, max_levels);
+  const std::string coarsening =
+      option_database_.string_option(options_.options_prefix + "mg_coarsening").value_or("auto");
+  if (coarsening != "auto" && coarsening != "bisection" && coarsening != "aggregation")
+    throw std::invalid_argument(prefix + "mg_coarsening must be auto, bisection or aggregation, got '" + coarsening + "'");
+  if (coarsening == "bisection" && !hierarchy_)
+    throw std::invalid_argument(prefix + "mg_coarsening bisection: this mesh has no bisection hierarchy (refine it "
+                                "with mesh.refine_uniform or refine_around first, or use aggregation)");
+  multigrid_.reset();
+  if (coarsening != "aggregation" && hierarchy_) {
+    try {
+      multigrid_ = std::make_unique<BisectionMultigrid>(model_, *hierarchy_, max_levels);
+    } catch (const std::invalid_argument&) {
+      // No conforming coarser cut (a mesh never refined, or one that was cut or flipped since):
+      // aggregation coarsens any mesh.
+      if (coarsening == "bisection") throw;
+    }
+  }
+  if (!multigrid_) multigrid_ = std::make_unique<AggregationMultigrid>(model_, max_levels);
+  needs_matrix_ = pc_needs_matrix_ || multigrid_->needs_assembled_tangent();
+}
+
+void StaticSolver::set_up_multigrid(PC pc) {
+  build_multigrid();
   configure_multigrid(pc);
 }
 
@@ -263,6 +287,9 @@ void StaticSolver::configure_multigrid(PC pc) {
   // Bounds from another number of levels do not apply.
   if (smoother_bounds_.size() + 1 != static_cast<std::size_t>(multigrid_->n_levels())) smoother_bounds_.clear();
   multigrid_->configure(pc, option_database_, smoother_bounds_);
+  // The finest level smooths with the PC's matrix: the assembled tangent for Galerkin levels
+  // (their products need entries), else the shell (see create_objects).
+  SNEDE_PETSC(PCSetUseAmat(pc, PETSC_FALSE));
   // The levels come with their own operators and interpolations: PCMG must not coarsen the
   // SNES's shell DM (which it would try after a mesh change, when the PC gets that DM).
   SNEDE_PETSC(PCSetDM(pc, nullptr));
@@ -275,7 +302,7 @@ void StaticSolver::remember_smoother_bounds() {
   SNEDE_PETSC(KSPGetPC(ksp(), &pc));
   PetscBool is_mg = PETSC_FALSE;
   SNEDE_PETSC(PetscObjectTypeCompare(reinterpret_cast<PetscObject>(pc), PCMG, &is_mg));
-  if (is_mg) smoother_bounds_ = BisectionMultigrid::chebyshev_estimates(pc);  // called after a solve: set up
+  if (is_mg) smoother_bounds_ = chebyshev_estimates(pc);  // called after a solve: set up
 }
 
 void StaticSolver::refill_preconditioner(SNES snes, Vec x) {
@@ -295,7 +322,9 @@ double StaticSolver::current_tolerance() const {
 }
 
 SolveResult StaticSolver::solve() {
+  const double follow_start = wall_seconds();
   follow_mesh_changes();
+  follow_seconds_ = wall_seconds() - follow_start;
   history_.clear();
   external_norm_ = euclidean_norm(model_.external_forces());
   // The force scale is a scan of the mesh: once per solve, not once per iteration.

@@ -16,7 +16,8 @@
 #include "core/solver_options.hpp"
 #include <memory>
 
-#include "solve/bisection_multigrid.hpp"
+#include "solve/multigrid.hpp"
+#include "topology/refinement_hierarchy.hpp"
 #include "solve/model.hpp"
 #include "solve/tangent_assembly.hpp"
 #include "solve/solve_result.hpp"
@@ -33,8 +34,10 @@ struct StaticOptions {
   std::string options_prefix = "static_";
   // The PETSc PC type of the CG (linear, or Newton's inner one): "none", "jacobi" (from the
   // shell's diagonal, no matrix), "gamg" (on an assembled tangent with the rigid-body near null
-  // space), "mg" (geometric multigrid on the bisection hierarchy, matrix-free on every level;
-  // needs the hierarchy) or any PETSc PC that works on an assembled matrix ("ilu", "icc", ...).
+  // space), "mg" (multigrid for any volume mesh: on the bisection hierarchy, matrix-free on
+  // every level, when the mesh has one whose coarser levels are conforming; else by
+  // aggregation, Galerkin levels from an assembled tangent; -<prefix>mg_coarsening bisection|
+  // aggregation chooses) or any PETSc PC that works on an assembled matrix ("ilu", "icc", ...).
   // Empty: -<prefix>pc_type if given, else "none". -<prefix>pc_type on the command line wins.
   std::string preconditioner;
   OptionList petsc_options;  // this solver's PETSc options, without the prefix
@@ -42,8 +45,8 @@ struct StaticOptions {
 
 class StaticSolver {
  public:
-  // hierarchy: the mesh's bisection hierarchy, for the "mg" preconditioner (may be null
-  // otherwise); it must outlive the solver.
+  // hierarchy: the mesh's bisection hierarchy, which "mg" coarsens along when it can (may be
+  // null); it must outlive the solver.
   StaticSolver(Model& model, StaticOptions options, const RefinementHierarchy* hierarchy = nullptr);
   ~StaticSolver();
   StaticSolver(const StaticSolver&) = delete;
@@ -57,12 +60,21 @@ class StaticSolver {
   // The PC type in use, and the assembled matrix it is built from (null without one).
   const std::string& preconditioner() const { return pc_type_; }
   Mat preconditioner_matrix() const { return assembled_ ? assembled_->mat() : nullptr; }
-  // Elements per multigrid level, coarsest first (empty unless the PC is "mg" and a solve or
-  // the construction has built the levels).
+  // Per multigrid level, coarsest first, the mesh last: elements (bisection levels) or
+  // aggregates (aggregation levels; the mesh's cells last). Empty unless the PC is "mg".
   std::vector<std::size_t> multigrid_levels() const {
-    return multigrid_ ? multigrid_->level_cells() : std::vector<std::size_t>{};
+    return multigrid_ ? multigrid_->level_sizes() : std::vector<std::size_t>{};
   }
+  // Unknowns per multigrid level, coarsest first; and what made the levels ("bisection",
+  // "aggregation"; empty unless the PC is "mg").
+  std::vector<std::size_t> multigrid_unknowns() const {
+    return multigrid_ ? multigrid_->level_unknowns() : std::vector<std::size_t>{};
+  }
+  std::string multigrid_source() const { return multigrid_ ? multigrid_->source() : ""; }
   Model& model() { return model_; }
+  // Seconds the last solve spent following mesh and constraint changes before iterating: new
+  // vectors, the assembled tangent's sparsity, the multigrid levels (0 when nothing changed).
+  double follow_seconds() const { return follow_seconds_; }
 
  private:
   void create_objects();
@@ -71,7 +83,10 @@ class StaticSolver {
   void follow_mesh_changes();
   // The matrix the PC is built from: the shell, or an assembled tangent for the current mesh.
   Mat preconditioning_matrix();
-  // The multigrid levels for the current mesh, configured on `pc` (PC "mg").
+  // PC "mg": the levels for the current mesh (bisection when the hierarchy gives them, else
+  // aggregation), and whether the PC then needs the assembled tangent.
+  void build_multigrid();
+  // The levels built anew and configured on `pc`.
   void set_up_multigrid(PC pc);
   // Configures `pc` as a PCMG over the current levels.
   void configure_multigrid(PC pc);
@@ -98,10 +113,11 @@ class StaticSolver {
   SnesHandle snes_;  // nonlinear methods only
   VecHandle residual_;
   std::string pc_type_;
-  bool needs_matrix_ = false;          // the PC needs entries: an assembled tangent
+  bool pc_needs_matrix_ = false;       // the PC type needs entries (not none, jacobi or mg)
+  bool needs_matrix_ = false;          // the PC needs an assembled tangent (that, or Galerkin mg)
   std::unique_ptr<AssembledTangent> assembled_;  // that tangent, for the current mesh
   const RefinementHierarchy* hierarchy_ = nullptr;
-  std::unique_ptr<BisectionMultigrid> multigrid_;  // PC "mg": the levels for the current mesh
+  std::unique_ptr<Multigrid> multigrid_;  // PC "mg": the levels for the current mesh
   std::vector<double> smoother_bounds_;  // mg: Chebyshev's estimates from an earlier set-up, reused
   // mg: remembers Chebyshev's estimates once the PC has made them (after a solve).
   void remember_smoother_bounds();
@@ -112,6 +128,7 @@ class StaticSolver {
   double system_scale_ = 1;  // CG and SNES see J, F and the energy divided by it (the force scale)
   double reaction_norm_ = 0;  // reactions used by the KSP test (at the start of a linear solve)
   std::vector<double> history_;
+  double follow_seconds_ = 0;
 };
 
 // Registers snede's line searches with PETSc (idempotent): snede_newton, snede_secant.

@@ -131,6 +131,23 @@ class StaticSolver(RunsOnRanks):
         return list(self._engine.multigrid_levels)
 
     @property
+    def multigrid_unknowns(self) -> list[int]:
+        """Unknowns per level of the ``"mg"`` preconditioner, coarsest first, the body's last."""
+        return list(self._engine.multigrid_unknowns)
+
+    @property
+    def multigrid_source(self) -> str:
+        """What made the ``"mg"`` levels: ``"bisection"`` (the mesh's refinement tree) or
+        ``"aggregation"`` (any mesh); empty for other preconditioners."""
+        return self._engine.multigrid_source
+
+    @property
+    def follow_seconds(self) -> float:
+        """Seconds the last ``solve()`` spent following a change of the mesh or of the
+        constraints before iterating (new vectors, assembled tangent, multigrid levels)."""
+        return self._engine.follow_seconds
+
+    @property
     def ksp(self):
         """The petsc4py KSP: linear CG's, or Newton's inner one."""
         return self._engine.ksp

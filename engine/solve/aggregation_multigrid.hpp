@@ -1,0 +1,67 @@
+// Multigrid for any mesh, by aggregation (smoothed-aggregation AMG's tentative prolongator,
+// Vaněk, Mandel & Brezina 1996, with geometric aggregates): the thesis's meshes change under
+// cuts, flips and needles (§3.2, §6.5, §7.3) and organ meshes come without a bisection history,
+// so the coarse levels cannot be coarser meshes. Instead each coarse unknown is a rigid motion
+// of an aggregate: a set of nodes that lie in one cell of a grid over the reference
+// configuration *and* are connected by the mesh's edges inside it. A cut that separates an
+// aggregate's nodes splits it in one per connected piece (the virtual node idea of Molino et al.
+// 2004), so the coarse space never couples the two lips, and a piece cut free never moves with
+// the rest. Coarser levels aggregate the aggregates on a grid twice as coarse.
+//
+// Each aggregate's rigid modes, projected by the constraints of its vertices (so that a coarse
+// correction never moves a support), are orthonormalised (QR); the orthonormal columns are the
+// interpolation's columns, the triangular factor the aggregate's rigid modes on the next level.
+// PCMG forms the coarse operators as Galerkin products with the assembled fine tangent
+// (symbolically once per mesh, numerically whenever the tangent is refilled), smooths with
+// Chebyshev/Jacobi and factors the coarsest level. Building the levels costs O(n) and needs
+// neither the state nor the material: after a cut it is the only thing rebuilt.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "core/petsc_handle.hpp"
+#include "solve/multigrid.hpp"
+
+namespace snede {
+
+class AggregationMultigrid final : public Multigrid {
+ public:
+  // Levels for `fine`'s mesh (volume meshes: triangles in 2D, tetrahedra in 3D): coarsened
+  // until the coarsest level has few enough unknowns for a direct solve, or to `max_levels`
+  // counting the fine one (0: no limit). Throws std::invalid_argument for max_levels 1 or
+  // negative, or more levels than the mesh can give, and for a surface mesh.
+  explicit AggregationMultigrid(Model& fine, int max_levels = 0);
+  ~AggregationMultigrid() override;
+
+  const char* source() const override { return "aggregation"; }
+  bool matches(const Model& fine) const override;
+  bool matches_mesh(const Model& fine) const override;
+  // The constraints are part of the interpolation: new constraints need new levels.
+  bool follow_constraints() override { return false; }
+  int n_levels() const override { return static_cast<int>(coarse_.size()) + 1; }
+  // Aggregates per coarse level, coarsest first, then the fine mesh's cells.
+  std::vector<std::size_t> level_sizes() const override;
+  std::vector<std::size_t> level_unknowns() const override;
+  bool needs_assembled_tangent() const override { return true; }
+  void configure(PC pc, const SolverOptions& options, const std::vector<double>& smoother_bounds = {}) override;
+  void update(Vec) override {}
+
+  // Per fine-mesh vertex, the first level's aggregate holding it (-1 for a removed vertex).
+  const std::vector<std::int32_t>& vertex_aggregates() const { return vertex_aggregate_; }
+
+ private:
+  struct Level {
+    std::size_t n_aggregates = 0;
+    PetscInt n_unknowns = 0;
+    MatHandle interpolation;  // from this level to the next finer one
+  };
+
+  Model& fine_;
+  std::uint64_t revision_;
+  std::uint64_t constraints_;
+  std::vector<std::int32_t> vertex_aggregate_;
+  std::vector<Level> coarse_;  // coarsest first
+};
+
+}  // namespace snede

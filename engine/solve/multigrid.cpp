@@ -1,0 +1,66 @@
+#include "solve/multigrid.hpp"
+
+#include <cmath>
+
+#include "core/error.hpp"
+
+namespace snede {
+namespace {
+
+// Reused Chebyshev bounds: the estimate times this (PETSc's own estimate-based default is
+// 1.1), and the lower end of the smoothed interval as a fraction of the upper (PETSc's 0.1).
+constexpr double reused_bound_safety = 1.2;
+constexpr double chebyshev_lower_fraction = 0.1;
+
+}  // namespace
+
+void set_chebyshev_jacobi_smoother(KSP smoother, const SolverOptions& options, double largest_bound) {
+  options.use_for(smoother);
+  SNEDE_PETSC(KSPSetType(smoother, KSPCHEBYSHEV));
+  if (largest_bound > 0) {
+    // The spectrum of the Jacobi-scaled operator hardly depends on h, the state or the
+    // constraints: bounds estimated once serve later set-ups, which then skip the estimate.
+    const double largest = reused_bound_safety * largest_bound;
+    SNEDE_PETSC(KSPChebyshevEstEigSet(smoother, 0, 0, 0, 0));
+    SNEDE_PETSC(KSPChebyshevSetEigenvalues(smoother, largest, chebyshev_lower_fraction * largest));
+  } else {
+    SNEDE_PETSC(KSPChebyshevEstEigSet(smoother, PETSC_DECIDE, PETSC_DECIDE, PETSC_DECIDE, PETSC_DECIDE));
+  }
+  PC jacobi = nullptr;
+  SNEDE_PETSC(KSPGetPC(smoother, &jacobi));
+  options.use_for(jacobi);
+  SNEDE_PETSC(PCSetType(jacobi, PCJACOBI));
+}
+
+std::vector<double> chebyshev_estimates(PC pc) {
+  PetscInt n = 0;
+  SNEDE_PETSC(PCMGGetLevels(pc, &n));
+  std::vector<double> largest;
+  for (PetscInt l = 1; l < n; ++l) {
+    KSP smoother = nullptr, estimator = nullptr;
+    SNEDE_PETSC(PCMGGetSmoother(pc, l, &smoother));
+    PetscBool chebyshev = PETSC_FALSE;
+    SNEDE_PETSC(PetscObjectTypeCompare(reinterpret_cast<PetscObject>(smoother), KSPCHEBYSHEV, &chebyshev));
+    if (!chebyshev) return {};
+    SNEDE_PETSC(KSPChebyshevEstEigGetKSP(smoother, &estimator));
+    if (!estimator) return {};
+    PetscReal emax = 0, emin = 0;
+    SNEDE_PETSC(KSPComputeExtremeSingularValues(estimator, &emax, &emin));
+    if (!(emax > 0) || !std::isfinite(emax)) return {};
+    largest.push_back(emax);
+  }
+  return largest;
+}
+
+void set_direct_coarse_solve(PC pc, const SolverOptions& options) {
+  KSP coarse = nullptr;
+  SNEDE_PETSC(PCMGGetCoarseSolve(pc, &coarse));
+  options.use_for(coarse);
+  SNEDE_PETSC(KSPSetType(coarse, KSPPREONLY));
+  PC direct = nullptr;
+  SNEDE_PETSC(KSPGetPC(coarse, &direct));
+  options.use_for(direct);
+  SNEDE_PETSC(PCSetType(direct, PCLU));
+}
+
+}  // namespace snede

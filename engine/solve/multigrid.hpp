@@ -1,0 +1,56 @@
+// What the static solver needs from a multigrid hierarchy, whatever made it: the bisection
+// tree (bisection_multigrid.hpp: coarse meshes, matrix-free levels) or aggregation of any mesh
+// (aggregation_multigrid.hpp: Galerkin levels from an assembled tangent).
+#pragma once
+
+#include <petscksp.h>
+
+#include <cstddef>
+#include <vector>
+
+#include "core/solver_options.hpp"
+#include "solve/model.hpp"
+
+namespace snede {
+
+class Multigrid {
+ public:
+  virtual ~Multigrid() = default;
+  // "bisection" or "aggregation".
+  virtual const char* source() const = 0;
+  // Whether the fine mesh and its constraints' projections are still those the levels were
+  // made for (no edit, no vertex fixed, released or made to slide since).
+  virtual bool matches(const Model& fine) const = 0;
+  // Whether only the mesh is still the same (the constraints may have changed).
+  virtual bool matches_mesh(const Model& fine) const = 0;
+  // After the fine constraints changed (not the mesh): the levels take them over. False if
+  // they cannot (then the levels must be made anew).
+  virtual bool follow_constraints() = 0;
+  // Levels including the finest.
+  virtual int n_levels() const = 0;
+  // Per level, coarsest first, the fine mesh last: elements (bisection levels) or nodes
+  // (aggregates; the fine level's cells last).
+  virtual std::vector<std::size_t> level_sizes() const = 0;
+  // Unknowns per level, coarsest first, the fine level last.
+  virtual std::vector<std::size_t> level_unknowns() const = 0;
+  // Whether the PC's preconditioning matrix must be the assembled fine tangent (Galerkin
+  // levels are products with it) rather than the shell.
+  virtual bool needs_assembled_tangent() const = 0;
+  // Makes `pc` a PCMG over these levels. `smoother_bounds`: Chebyshev's largest eigenvalue per
+  // smoothed level (finest last) from an earlier set-up with as many levels; empty: estimate.
+  virtual void configure(PC pc, const SolverOptions& options, const std::vector<double>& smoother_bounds) = 0;
+  // Relinearises matrix-free levels at the fine state u (a no-op for Galerkin levels, which
+  // PCMG recomputes from the refilled fine matrix).
+  virtual void update(Vec u) = 0;
+};
+
+// Chebyshev/Jacobi on one smoothed level: with `largest_bound` > 0 the bounds are fixed from
+// it (an earlier estimate, with a safety factor), else Chebyshev estimates them.
+void set_chebyshev_jacobi_smoother(KSP smoother, const SolverOptions& options, double largest_bound);
+// The largest eigenvalues Chebyshev estimated on the smoothed levels of a PCMG (finest last);
+// empty if a level did not estimate (fixed bounds, another smoother).
+std::vector<double> chebyshev_estimates(PC pc);
+// The coarsest level's solve: a direct factorisation of its assembled matrix.
+void set_direct_coarse_solve(PC pc, const SolverOptions& options);
+
+}  // namespace snede

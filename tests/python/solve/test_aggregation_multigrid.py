@@ -1,0 +1,246 @@
+"""Multigrid for any mesh by aggregation (preconditioner "mg" without a usable bisection
+hierarchy, issue 31).
+
+Checked against independent facts: the interpolation's columns are orthonormal and its range
+holds the body's rigid motions as the constraints allow them (what an aggregation coarse space
+must carry for elasticity); separated pieces share no coarse unknown, so one V-cycle applied to
+a load on one piece leaves the other exactly still; every preconditioned solve reaches the
+unpreconditioned answer, on meshes made by gmsh and after random sequences of cuts, flips,
+collapses, splits and refinements, in fewer iterations; misuse raises ValueError naming it."""
+import numpy as np
+import pytest
+
+import snede
+
+
+def held_body(mesh, material=None, thickness=None):
+    body = snede.Body(mesh, material or snede.LinearElastic(1e5, 0.3), density=1000.0, thickness=thickness)
+    x = mesh.points
+    body.fix(np.isclose(x[:, 0], x[:, 0].min()))
+    body.add_gravity((0.0, -9.81) if mesh.dim == 2 else (0.0, 0.0, -9.81))
+    return body
+
+
+def solve(body, method="cg", rtol=1e-8, **options):
+    body.displacement = np.zeros_like(body.displacement)
+    solver = snede.StaticSolver(body, method, rtol=rtol, **options)
+    result = solver.solve()
+    return solver, result, body.displacement.copy()
+
+
+def relative_difference(a, b):
+    return np.linalg.norm(a - b) / np.linalg.norm(b)
+
+
+def as_dense(mat):
+    rows, columns = mat.getSize()
+    result = np.zeros((rows, columns))
+    for i in range(rows):
+        cols, values = mat.getRow(i)
+        result[i, cols] = values
+    return result
+
+
+def rigid_modes(points):
+    """(n_points · dim, 3 or 6) translations and rotations about the origin."""
+    n, dim = points.shape
+    modes = []
+    for k in range(dim):
+        mode = np.zeros((n, dim))
+        mode[:, k] = 1.0
+        modes.append(mode.ravel())
+    rotations = [(0, 1)] if dim == 2 else [(1, 2), (2, 0), (0, 1)]
+    for i, j in rotations:
+        mode = np.zeros((n, dim))
+        mode[:, i], mode[:, j] = -points[:, j], points[:, i]
+        modes.append(mode.ravel())
+    return np.array(modes).T
+
+
+@pytest.fixture(scope="module")
+def gmsh_cylinder():
+    return snede.meshing.cylinder(length=0.1, radius=0.02, h=0.006, seed=3)
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_a_mesh_without_bisection_history_gets_aggregation_levels_and_the_plain_answer(dim, gmsh_cylinder):
+    mesh = snede.meshing.rectangle((0.4, 0.1), (40, 10)) if dim == 2 else gmsh_cylinder
+    body = held_body(mesh, thickness=0.01 if dim == 2 else None)
+    solver, result, u = solve(body, preconditioner="mg")
+    assert result.converged, result.reason
+    assert solver.multigrid_source == "aggregation"
+    unknowns = solver.multigrid_unknowns
+    assert unknowns[-1] == body.displacement.size and unknowns == sorted(unknowns) and len(unknowns) >= 2
+    _, plain, reference = solve(body)
+    assert plain.converged
+    assert relative_difference(u, reference) < 1e-6
+    assert result.iterations < plain.iterations / 3, (result.iterations, plain.iterations)
+
+
+def test_newton_on_a_gmsh_mesh_reaches_the_plain_answer(gmsh_cylinder):
+    body = held_body(gmsh_cylinder, snede.NeoHookean(2e4, 0.4))
+    _, plain, reference = solve(body, "newton", rtol=1e-9)
+    solver, result, u = solve(body, "newton", rtol=1e-9, preconditioner="mg")
+    assert plain.converged and result.converged, (plain.reason, result.reason)
+    assert np.abs(reference).max() > 1e-3  # a large deflection: the state matters
+    assert relative_difference(u, reference) < 1e-6
+    assert result.linear_iterations < plain.linear_iterations / 3
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_interpolation_is_orthonormal_and_carries_the_allowed_rigid_motions(dim, gmsh_cylinder):
+    mesh = snede.meshing.rectangle((0.4, 0.1), (16, 4)) if dim == 2 else gmsh_cylinder
+    body = held_body(mesh, thickness=0.01 if dim == 2 else None)
+    x = mesh.points
+    body.slide(np.flatnonzero(np.isclose(x[:, 0], x[:, 0].max())), (0.0, 1.0) if dim == 2 else (0.0, 0.0, 1.0))
+    solver = snede.StaticSolver(body, "cg", preconditioner="mg")
+    P = as_dense(solver.ksp.getPC().getMGInterpolation(1))
+    assert P.shape == (body.displacement.size, solver.multigrid_unknowns[-2])
+    np.testing.assert_allclose(P.T @ P, np.eye(P.shape[1]), atol=1e-12)
+    # The rigid motions, projected vertex by vertex on what the constraints allow (fixed: no
+    # motion, sliding: along the direction), lie in the coarse space: P Pᵀ m = m.
+    modes = rigid_modes(x - x.mean(axis=0))
+    fixed = np.isclose(x[:, 0], x[:, 0].min())
+    sliding = np.isclose(x[:, 0], x[:, 0].max())
+    direction = np.zeros(dim)
+    direction[-1] = 1.0
+    projection = np.tile(np.eye(dim), (len(x), 1, 1))
+    projection[fixed] = 0.0
+    projection[sliding] = np.outer(direction, direction)
+    for mode in modes.T:
+        allowed = np.einsum("nij,nj->ni", projection, mode.reshape(-1, dim)).ravel()
+        np.testing.assert_allclose(P @ (P.T @ allowed), allowed, atol=1e-10 * np.abs(allowed).max())
+
+
+def two_pieces():
+    """A box cut in two through x = 0.5 (§7.3 dissection), each half fixed at its far end; the
+    vertex masks of the two halves."""
+    mesh = snede.meshing.box((1.0, 0.3, 0.3), (10, 3, 3))
+    pairs = mesh.dissect(mesh.faces_where(lambda c: np.isclose(c[:, 0], 0.5)))
+    assert len(pairs) > 0
+    count, labels = mesh.connected_components()
+    assert count == 2
+    cells = mesh.cells
+    left = np.zeros(mesh.n_points, dtype=bool)
+    left[np.unique(cells[labels == labels[np.argmin(mesh.points[cells[:, 0], 0])]])] = True
+    right = np.zeros(mesh.n_points, dtype=bool)
+    right[np.unique(cells)] = True
+    right &= ~left
+    body = snede.Body(mesh, snede.LinearElastic(1e5, 0.3))
+    x = mesh.points
+    body.fix(np.isclose(x[:, 0], 0.0) | np.isclose(x[:, 0], 1.0))
+    return body, left, right
+
+
+def test_separated_pieces_share_no_coarse_unknown():
+    body, left, right = two_pieces()
+    x = body.mesh.points
+    loaded = np.flatnonzero(left & np.isclose(x[:, 0], 0.5))
+    body.add_nodal_force(loaded, (0.0, 0.0, -1.0))
+    solver, result, u = solve(body, preconditioner="mg", petsc_options={"mg_coarsening": "aggregation"})
+    assert result.converged, result.reason
+    assert np.abs(u[left]).max() > 0
+    assert not u[right].any()  # the solution: the unloaded piece does not move
+    pc = solver.ksp.getPC()
+    for level in range(1, pc.getMGLevels()):
+        P = as_dense(pc.getMGInterpolation(level))
+        if level == pc.getMGLevels() - 1:
+            rows_left = np.repeat(left, 3)
+            rows_right = np.repeat(right, 3)
+            touches_left = np.abs(P[rows_left]).sum(axis=0) > 0
+            touches_right = np.abs(P[rows_right]).sum(axis=0) > 0
+            assert touches_left.any() and touches_right.any()
+            assert not (touches_left & touches_right).any()  # no coarse function spans the cut
+    # One V-cycle applied to a load on the left piece leaves the right one exactly still.
+    b, y = solver.ksp.getOperators()[0].createVecs()
+    load = np.zeros_like(u)
+    load[left] = np.random.default_rng(1).standard_normal((left.sum(), 3))
+    load[np.isclose(x[:, 0], 0.0)] = 0.0
+    b.setArray(load.ravel())
+    pc.apply(b, y)
+    correction = y.getArray().reshape(-1, 3)
+    assert np.abs(correction[left]).max() > 0
+    assert not correction[right].any()
+
+
+def random_edit(mesh, rng):
+    """One random local edit of the mesh (flip, split, collapse or refinement); whether it was done."""
+    cells = mesh.cells
+    cell = cells[rng.integers(len(cells))]
+    a, b = rng.choice(cell, 2, replace=False)
+    kind = rng.integers(4)
+    try:
+        if kind == 0:
+            result = mesh.flip_edge(int(a), int(b))
+        elif kind == 1:
+            result = mesh.split_edge(int(a), int(b), 0.5)
+        elif kind == 2:
+            result = mesh.collapse_edge(int(a), int(b), 0.5)
+        else:
+            return mesh.refine_around(mesh.points[a], 0.5 * np.linalg.norm(mesh.points[a] - mesh.points[b])) > 0
+    except ValueError:
+        return False
+    return result.done
+
+
+def test_random_edits_and_cuts_keep_the_plain_answer_in_bounded_iterations(gmsh_cylinder):
+    rng = np.random.default_rng(7)
+    mesh = snede.Mesh(gmsh_cylinder.points, gmsh_cylinder.cells)
+    body = held_body(mesh)
+    solver = snede.StaticSolver(body, "cg", rtol=1e-8, preconditioner="mg")
+    cutter = snede.TetrahedralCutter(body)
+    counts, edits = [], 0
+    for step in range(8):
+        if step % 2:
+            x = 0.02 + 0.06 * rng.random()
+            y = -0.03 + 0.03 * rng.random()
+            cutter.lift()
+            cutter.move([(x, y, -0.03), (x, y, 0.03)])
+            cutter.move([(x + 0.002, y + 0.02, -0.03), (x + 0.002, y + 0.02, 0.03)])
+        else:
+            edits += sum(random_edit(mesh, rng) for _ in range(5))
+        mesh.validate()
+        body.displacement = np.zeros_like(body.displacement)
+        result = solver.solve()
+        assert result.converged, (step, result.reason)
+        assert solver.multigrid_source == "aggregation"
+        u = body.displacement.copy()
+        _, plain, reference = solve(body)
+        assert plain.converged
+        assert relative_difference(u, reference) < 1e-6, step
+        assert result.iterations < plain.iterations / 2, (step, result.iterations, plain.iterations)
+        counts.append(result.iterations)
+    assert edits > 0
+    assert max(counts) <= 2 * min(counts), counts
+
+
+def test_mg_continues_through_a_cut_of_a_bisected_mesh():
+    # Bisection levels before the cut; the cut takes elements out of the refinement tree, and
+    # the next solve coarsens by aggregation instead of refusing.
+    mesh = snede.meshing.box((0.4, 0.1, 0.1), (4, 1, 1))
+    mesh.refine_uniform(6)
+    body = held_body(mesh)
+    solver, first, _ = solve(body, preconditioner="mg")
+    assert first.converged and solver.multigrid_source == "bisection"
+    body.displacement = np.zeros_like(body.displacement)  # the blade is placed in the reference
+    cutter = snede.TetrahedralCutter(body)
+    report = cutter.cut_triangle([[0.2, -0.5, 0.6], [0.2, 0.6, 0.6], [0.2, 0.05, 0.05]])
+    assert report.faces_dissected > 0
+    body.displacement = np.zeros_like(body.displacement)
+    result = solver.solve()
+    assert result.converged, result.reason
+    assert solver.multigrid_source == "aggregation"
+    u = body.displacement.copy()
+    _, plain, reference = solve(body)
+    assert relative_difference(u, reference) < 1e-6
+    assert result.iterations < plain.iterations / 3
+
+
+def test_bad_coarsening_options_are_refused_naming_them(gmsh_cylinder):
+    body = held_body(gmsh_cylinder)
+    with pytest.raises(ValueError, match="mg_coarsening must be auto, bisection or aggregation, got 'tree'"):
+        snede.StaticSolver(body, "cg", preconditioner="mg", petsc_options={"mg_coarsening": "tree"})
+    with pytest.raises(ValueError, match="no bisection hierarchy"):
+        snede.StaticSolver(body, "cg", preconditioner="mg", petsc_options={"mg_coarsening": "bisection"})
+    with pytest.raises(ValueError, match="gives 2 levels|gives [0-9]+ levels"):
+        snede.StaticSolver(body, "cg", preconditioner="mg", petsc_options={"pc_mg_levels": 12})
