@@ -117,7 +117,12 @@ def main() -> None:
                         help="PC names; mg:aggregation forces aggregation levels where bisection levels exist")
     parser.add_argument("--moves", type=int, default=24)
     parser.add_argument("--quick", action="store_true", help="block24k and organ20k, 8 moves, none and mg")
-    arguments = parser.parse_args()
+    # Options starting with a single '-' are PETSc's (-static_snes_lag_preconditioner 2, -log_view).
+    arguments, petsc_arguments = parser.parse_known_args()
+    if any(not a.startswith("-") or a.startswith("--") for a in petsc_arguments[:1]):
+        parser.error(f"unrecognized arguments: {' '.join(petsc_arguments)}")
+    from petsc4py import PETSc
+    PETSc.Options().insertString(" ".join(petsc_arguments))
     meshes, preconditioners, moves = arguments.meshes, arguments.preconditioners, arguments.moves
     if arguments.quick:
         meshes, preconditioners, moves = ["block24k", "organ20k"], ["none", "mg"], 8

@@ -379,7 +379,7 @@ std::vector<std::size_t> AggregationMultigrid::level_unknowns() const {
   return unknowns;
 }
 
-void AggregationMultigrid::configure(PC pc, const SolverOptions& options, const std::vector<double>& smoother_bounds) {
+void AggregationMultigrid::configure(PC pc, const SolverOptions& options, const std::vector<double>&) {
   const auto n = static_cast<PetscInt>(n_levels());
   SNEDE_PETSC(PCSetType(pc, PCMG));
   SNEDE_PETSC(PCMGSetLevels(pc, n, nullptr));
@@ -390,8 +390,10 @@ void AggregationMultigrid::configure(PC pc, const SolverOptions& options, const 
     SNEDE_PETSC(PCMGSetInterpolation(pc, l, coarse_[l - 1].interpolation));
     KSP smoother = nullptr;
     SNEDE_PETSC(PCMGGetSmoother(pc, l, &smoother));
-    set_chebyshev_jacobi_smoother(smoother, options,
-                                  smoother_bounds.size() == static_cast<std::size_t>(n - 1) ? smoother_bounds[l - 1] : 0.0);
+    // Bounds from earlier levels are not reused: a cut leaves slivers beside the lips and
+    // changes the Galerkin levels, and Chebyshev with a stale bound diverges (measured: Newton
+    // stalled after the third move through the liver). The estimate costs a few products.
+    set_chebyshev_jacobi_smoother(smoother, options, 0.0);
   }
   set_direct_coarse_solve(pc, options);
 }

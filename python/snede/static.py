@@ -40,12 +40,21 @@ class StaticSolver(RunsOnRanks):
       rigid-body modes as near null space; refilled at every Newton iteration unless
       ``-static_snes_lag_preconditioner k`` lags it, rebuilt after a cut or refinement); or any
       PETSc PC that works on an assembled matrix (``"ilu"``, ``"icc"``, ``"sor"``, ``"lu"``);
-      or ``"mg"``: geometric multigrid on the mesh's bisection hierarchy (§6.5), for a mesh
-      refined with ``mesh.refine_uniform`` or ``refine_around``. Its coarse levels are cuts
-      through the refinement tree, each with its own matrix-free tangent shell over the same
-      element kernels (linearised at the injected state), Chebyshev/Jacobi smoothing and LU on
-      the coarsest level; ``multigrid_levels`` lists their sizes. ``-static_mg_levels_ksp_type``
-      and the other ``-static_mg_*`` options of PETSc's PCMG tune it.
+      or ``"mg"``: multigrid for any volume mesh. On a mesh refined with ``mesh.refine_uniform``
+      or ``refine_around`` whose coarser cuts through the refinement tree are conforming (§6.5),
+      the levels are those coarser meshes, each with its own matrix-free tangent shell over the
+      same element kernels (linearised at the injected state), Chebyshev/Jacobi smoothing and LU
+      on the coarsest level. On any other mesh — made by gmsh, read from a file, or cut, flipped
+      or collapsed since its refinement — the levels come from aggregation: each coarse unknown
+      is a rigid motion of a set of vertices that lie in one cell of a grid over the reference
+      configuration and are joined by the mesh's edges inside it (a cut splits such a set per
+      piece, so the coarse space never couples the lips), with Galerkin coarse operators from
+      the tangent assembled by the element kernels. Levels are rebuilt at the first solve after
+      a mesh or constraint change; ``follow_seconds`` says what that cost. ``multigrid_source``
+      says which kind is in use, ``multigrid_levels`` and ``multigrid_unknowns`` the levels'
+      sizes; ``-static_mg_coarsening aggregation|bisection`` chooses (default ``auto``: bisection
+      when it applies). ``-static_mg_levels_ksp_type``, ``-static_pc_mg_levels`` and the other
+      ``-static_mg_*`` options of PETSc's PCMG tune it (docs/results/interactive.md).
       None (default): ``-static_pc_type`` if given, else ``"none"``. ``-static_pc_type`` on the
       command line wins over the argument. The shell stays the operator in every case.
 
