@@ -35,7 +35,8 @@ if method == "dynamic":
     solver = snede.DynamicRelaxation(body, damping=20.0)
     solver.step(1)
 elif method != "baseline":
-    solver = snede.StaticSolver(body, method, rtol=1e-6, max_iterations=1, options_prefix="memory_")
+    solver = snede.StaticSolver(body, method, rtol=1e-6, max_iterations=1, options_prefix="memory_",
+                                preconditioner="none")  # the methods' own memory (§4.4)
     solver.solve()
 print(json.dumps({"rss": rss() - before, "petsc": snede._snede.petsc_allocated_bytes() - petsc_before,
                   "cells": mesh.n_cells, "dofs": mesh.n_points * 3}))

@@ -13,10 +13,6 @@
 namespace snede {
 namespace {
 
-// The first level's aggregates are grid cells this many mean edge lengths wide: on a
-// structured tetrahedral mesh about 3 vertices per direction (benchmarks/interactive_cut.py
-// measured 2, 2.5 and 3; 2.5 solved fastest).
-constexpr double first_span = 2.5;
 // Each coarser level's cells are this much wider.
 constexpr double span_growth = 2.0;
 // Coarsening stops once a level has at most this many unknowns: its LU is then cheap...
@@ -314,13 +310,75 @@ NodeLevel coarsen(const NodeLevel& fine, const std::vector<std::int32_t>& aggreg
   return coarse;
 }
 
+// The first level's interpolation smoothed by one damped Jacobi step of the mesh's graph
+// Laplacian (smoothed aggregation with a filtered operator): P = Π (I − ω D⁻¹ L) T, L = L_graph ⊗ I
+// with an edge's weight the number of cells that share it, ω = 2/3 (λ_max(D⁻¹L) ≤ 2), Π the
+// constraints' projection. The coarse functions then overlap and decay across aggregate
+// borders instead of jumping, which is what makes the coarse correction good; L is the mesh's own
+// (no edge across a cut), so they still never reach across the lips, and it does not depend
+// on the state, so P is made once per mesh and kept through Newton iterations.
+MatHandle smoothed_interpolation(const Model& model, const NodeLevel& vertices, Mat tentative) {
+  constexpr double omega = 2.0 / 3.0;
+  const int d = vertices.dim;
+  const std::size_t n = vertices.size();
+  std::vector<std::pair<std::int32_t, std::int32_t>> arcs;
+  arcs.reserve(2 * vertices.edges.size());
+  for (const auto& [i, j] : vertices.edges)
+    if (i != j && vertices.active[i] && vertices.active[j]) {
+      arcs.emplace_back(i, j);
+      arcs.emplace_back(j, i);
+    }
+  std::sort(arcs.begin(), arcs.end());
+  std::vector<std::size_t> start(n + 1, 0);
+  for (const auto& arc : arcs) ++start[arc.first + 1];
+  std::partial_sum(start.begin(), start.end(), start.begin());
+  std::vector<PetscInt> nonzeros(n * d, 0);
+  std::vector<std::pair<std::int32_t, double>> row;
+  for (std::size_t v = 0; v < n; ++v) {
+    if (!vertices.active[v]) continue;
+    std::size_t distinct = 1;
+    for (std::size_t a = start[v]; a < start[v + 1]; ++a) distinct += a == start[v] || arcs[a].second != arcs[a - 1].second;
+    for (int k = 0; k < d; ++k) nonzeros[v * d + k] = static_cast<PetscInt>(distinct) * d;
+  }
+  MatHandle S;
+  SNEDE_PETSC(MatCreateSeqAIJ(PETSC_COMM_SELF, static_cast<PetscInt>(n * d), static_cast<PetscInt>(n * d), 0,
+                              nonzeros.data(), S.out()));
+  std::vector<double> P(static_cast<std::size_t>(d) * d), block(P.size());
+  std::vector<PetscInt> rows(d), columns(d);
+  for (std::size_t v = 0; v < n; ++v) {
+    if (!vertices.active[v]) continue;
+    model.constraints().projection_block(static_cast<VertexId>(v), P);
+    row.clear();
+    for (std::size_t a = start[v]; a < start[v + 1]; ++a) {
+      if (row.empty() || row.back().first != arcs[a].second) row.emplace_back(arcs[a].second, 0.0);
+      row.back().second += 1.0;
+    }
+    double degree = 0;
+    for (const auto& entry : row) degree += entry.second;
+    row.emplace_back(static_cast<std::int32_t>(v), degree);  // the diagonal: 1 − ω after scaling
+    for (int k = 0; k < d; ++k) rows[k] = static_cast<PetscInt>(v * d + k);
+    for (const auto& [w, weight] : row) {
+      const double factor = degree > 0 ? (w == static_cast<std::int32_t>(v) ? 1.0 - omega : omega * weight / degree)
+                                       : (w == static_cast<std::int32_t>(v) ? 1.0 : 0.0);
+      for (int i = 0; i < d * d; ++i) block[i] = factor * P[i];
+      for (int k = 0; k < d; ++k) columns[k] = static_cast<PetscInt>(w) * d + k;
+      SNEDE_PETSC(MatSetValues(S, d, rows.data(), d, columns.data(), block.data(), INSERT_VALUES));
+    }
+  }
+  SNEDE_PETSC(MatAssemblyBegin(S, MAT_FINAL_ASSEMBLY));
+  SNEDE_PETSC(MatAssemblyEnd(S, MAT_FINAL_ASSEMBLY));
+  MatHandle smoothed;
+  SNEDE_PETSC(MatMatMult(S, tentative, MAT_INITIAL_MATRIX, PETSC_DEFAULT, smoothed.out()));
+  return smoothed;
+}
+
 std::size_t count_active(const NodeLevel& level) {
   return static_cast<std::size_t>(std::count(level.active.begin(), level.active.end(), 1));
 }
 
 }  // namespace
 
-AggregationMultigrid::AggregationMultigrid(Model& fine, int max_levels)
+AggregationMultigrid::AggregationMultigrid(Model& fine, int max_levels, bool smooth_first_level, double aggregate_width)
     : fine_(fine),
       revision_(fine.body().mesh().connectivity().revision()),
       constraints_(fine.constraints().projection_fingerprint()) {
@@ -332,7 +390,10 @@ AggregationMultigrid::AggregationMultigrid(Model& fine, int max_levels)
                                 "not on a surface mesh");
   double mean_edge = 0;
   NodeLevel current = vertex_level(fine, mean_edge);
-  double span = first_span * mean_edge;
+  if (!(aggregate_width > 0) || !std::isfinite(aggregate_width))
+    throw std::invalid_argument("mg_aggregate_width must be positive (mean edge lengths), got " +
+                                std::to_string(aggregate_width));
+  double span = aggregate_width * mean_edge;
   std::vector<Level> finest_first;
   while (max_levels == 0 || static_cast<int>(finest_first.size()) + 1 < max_levels) {
     std::size_t n_aggregates = 0;
@@ -343,7 +404,10 @@ AggregationMultigrid::AggregationMultigrid(Model& fine, int max_levels)
     level.n_aggregates = n_aggregates;
     NodeLevel coarser = coarsen(current, aggregate_of, n_aggregates, level.interpolation);
     level.n_unknowns = coarser.first.back();
-    if (finest_first.empty()) vertex_aggregate_ = std::move(aggregate_of);
+    if (finest_first.empty()) {
+      if (smooth_first_level) level.interpolation = smoothed_interpolation(fine, current, level.interpolation);
+      vertex_aggregate_ = std::move(aggregate_of);
+    }
     finest_first.push_back(std::move(level));
     current = std::move(coarser);
     if (current.first.back() <= direct_unknowns) break;

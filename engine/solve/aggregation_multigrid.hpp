@@ -31,7 +31,13 @@ class AggregationMultigrid final : public Multigrid {
   // until the coarsest level has few enough unknowns for a direct solve, or to `max_levels`
   // counting the fine one (0: no limit). Throws std::invalid_argument for max_levels 1 or
   // negative, or more levels than the mesh can give, and for a surface mesh.
-  explicit AggregationMultigrid(Model& fine, int max_levels = 0);
+  // smooth_first_level: the first level's interpolation is smoothed (smoothed_interpolation).
+  // aggregate_width: the first level's grid cells, in mean edge lengths.
+  explicit AggregationMultigrid(Model& fine, int max_levels = 0, bool smooth_first_level = false,
+                                double aggregate_width = default_aggregate_width);
+  // On a structured tetrahedral mesh about 3 vertices per direction (benchmarks/interactive_cut.py
+  // measured widths 2 to 4; see docs/results/interactive.md).
+  static constexpr double default_aggregate_width = 2.5;
   ~AggregationMultigrid() override;
 
   const char* source() const override { return "aggregation"; }

@@ -39,6 +39,18 @@ constexpr PetscInt newton_finish_steps = 10;
 // ‖F‖ changed by less than this fraction over a Newton iteration: a stalled line search.
 constexpr double newton_stall = 1e-6;
 
+// "auto": multigrid where it pays. On the cantilever block (benchmarks/static_solve_scaling.py
+// and docs/results/interactive.md) mg and no preconditioner cost the same at about 650 cells,
+// mg is 1.3× faster at 1 500, 2–3× at 5 000–40 000; nonlinear CG takes no preconditioner and
+// membranes have none yet.
+constexpr std::size_t multigrid_from_cells = 1000;
+
+std::string automatic_preconditioner(const Model& model, StaticMethod method) {
+  const Mesh& mesh = model.body().mesh();
+  if (method == StaticMethod::nonlinear_cg || mesh.is_surface() || mesh.n_cells() < multigrid_from_cells) return PCNONE;
+  return PCMG;
+}
+
 }  // namespace
 
 StaticSolver::StaticSolver(Model& model, StaticOptions options, const RefinementHierarchy* hierarchy)
@@ -59,7 +71,8 @@ StaticSolver::StaticSolver(Model& model, StaticOptions options, const Refinement
         "nonlinear materials");
   // The command line (copied into the solver's database) wins over the argument.
   pc_type_ = option_database_.string_option(options_.options_prefix + "pc_type")
-                 .value_or(options_.preconditioner.empty() ? std::string(PCNONE) : options_.preconditioner);
+                 .value_or(options_.preconditioner.empty() ? std::string("auto") : options_.preconditioner);
+  if (pc_type_ == "auto") pc_type_ = automatic_preconditioner(model, options_.method);
   if (options_.method == StaticMethod::nonlinear_cg && pc_type_ != PCNONE)
     throw std::invalid_argument("a preconditioner ('" + pc_type_ + "') applies to the CG of methods 'cg' and 'newton'; "
                                 "nonlinear CG ('ncg') takes none");
@@ -274,7 +287,21 @@ void StaticSolver::build_multigrid() {
       if (coarsening == "bisection") throw;
     }
   }
-  if (!multigrid_) multigrid_ = std::make_unique<AggregationMultigrid>(model_, max_levels);
+  const std::string smoothing =
+      option_database_.string_option(options_.options_prefix + "mg_aggregation_smoothing").value_or("false");
+  if (smoothing != "true" && smoothing != "false")
+    throw std::invalid_argument(prefix + "mg_aggregation_smoothing must be true or false, got '" + smoothing + "'");
+  const std::string width_text = option_database_.string_option(options_.options_prefix + "mg_aggregate_width")
+                                     .value_or(std::to_string(AggregationMultigrid::default_aggregate_width));
+  double width = 0;
+  try {
+    std::size_t used = 0;
+    width = std::stod(width_text, &used);
+    if (used != width_text.size()) throw std::invalid_argument(width_text);
+  } catch (const std::exception&) {
+    throw std::invalid_argument(prefix + "mg_aggregate_width must be a number, got '" + width_text + "'");
+  }
+  if (!multigrid_) multigrid_ = std::make_unique<AggregationMultigrid>(model_, max_levels, smoothing == "true", width);
   needs_matrix_ = pc_needs_matrix_ || multigrid_->needs_assembled_tangent();
 }
 

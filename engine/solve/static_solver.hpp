@@ -38,7 +38,8 @@ struct StaticOptions {
   // every level, when the mesh has one whose coarser levels are conforming; else by
   // aggregation, Galerkin levels from an assembled tangent; -<prefix>mg_coarsening bisection|
   // aggregation chooses) or any PETSc PC that works on an assembled matrix ("ilu", "icc", ...).
-  // Empty: -<prefix>pc_type if given, else "none". -<prefix>pc_type on the command line wins.
+  // "auto": "mg" for cg and newton on volume meshes of 1 000 cells or more, else "none".
+  // Empty: -<prefix>pc_type if given, else "auto". -<prefix>pc_type on the command line wins.
   std::string preconditioner;
   OptionList petsc_options;  // this solver's PETSc options, without the prefix
 };

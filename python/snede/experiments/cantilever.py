@@ -100,7 +100,8 @@ def tip_deflections(body, tip) -> np.ndarray:
 
 def linear_cg(body, label: str):
     """Table 3.1's solve: linear CG until ‖r‖ < 1e-8‖f_ext‖ (criterion (6.8))."""
-    return run_solve(lambda: snede.StaticSolver(body, "cg", rtol=1e-8, criterion="6.8", max_iterations=100000,
+    return run_solve(lambda: snede.StaticSolver(body, "cg", preconditioner="none",
+                                                rtol=1e-8, criterion="6.8", max_iterations=100000,
                                                 options_prefix=options_prefix(label)).solve())
 
 
@@ -155,8 +156,8 @@ def nonlinear_rows(sizes, loads) -> list[dict]:
             equivalent_per_newton = tip_deflections(equivalent_body, tip).mean() / LOAD
             for load in loads:
                 body, _ = cantilever_body(n, make(), load)
-                outcome = run_solve(lambda: snede.StaticSolver(
-                    body, "newton", rtol=1e-8, criterion="6.8", max_iterations=500,
+                outcome = run_solve(lambda: snede.StaticSolver(body, "newton", preconditioner="none",
+                                                               rtol=1e-8, criterion="6.8", max_iterations=500,
                     options_prefix=options_prefix(f"nonlinear_{n}"), petsc_options=NEWTON_OPTIONS).solve())
                 deflection = float(tip_deflections(body, tip).mean())
                 rows.append({

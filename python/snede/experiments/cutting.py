@@ -102,7 +102,7 @@ def cube_body(divisions: int = DIVISIONS):
 
 
 def cg(body, label: str):
-    return snede.StaticSolver(body, "cg", rtol=RTOL, criterion="6.8", max_iterations=100000,
+    return snede.StaticSolver(body, "cg", preconditioner="none", rtol=RTOL, criterion="6.8", max_iterations=100000,
                               options_prefix=options_prefix(label))
 
 

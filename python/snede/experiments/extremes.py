@@ -29,7 +29,7 @@ TABLE_4_4_DAMPING = {"NeoHookean": 21.0, "VerondaWestmann": 27.0}  # η (1/s) fo
 
 def static(body, method: str, label: str, rtol: float = 1e-8, criterion: str = "6.9", max_iterations: int = 20000,
            petsc_options=None):
-    return run_solve(lambda: snede.StaticSolver(body, method, rtol=rtol, criterion=criterion,
+    return run_solve(lambda: snede.StaticSolver(body, method, preconditioner="none", rtol=rtol, criterion=criterion,
                                                 max_iterations=max_iterations, options_prefix=options_prefix(label),
                                                 petsc_options=petsc_options).solve())
 

@@ -216,7 +216,8 @@ def reference_body(fine: int, degrees: float = 0.0, relocated: bool = False):
 
 
 def solve(body, rtol: float, label: str):
-    result = snede.StaticSolver(body, "cg", rtol=rtol, round_tolerance=ROUND_TOLERANCE, max_iterations=100000,
+    result = snede.StaticSolver(body, "cg", preconditioner="none",
+                                rtol=rtol, round_tolerance=ROUND_TOLERANCE, max_iterations=100000,
                                 options_prefix=options_prefix(label)).solve()
     if not result.converged:
         raise RuntimeError(f"{label}: static solve did not converge: {result}")
@@ -650,7 +651,7 @@ def describe(settings: Settings, quick: bool, minutes: float, results: dict) -> 
         "is evaluated there by barycentric interpolation in the coarse cell containing the vertex "
         "(matplotlib.tri trapezoid-map point location + `LinearTriInterpolator`, i.e. the coarse P1 field itself). "
         "'mean' and 'max' are the mean and maximum of |u − u_ref| over those vertices (area-uniform sampling), in mm.",
-        f"* **Solves.** Linear CG (`snede.StaticSolver(body, \"cg\", rtol=ε, round_tolerance={ROUND_TOLERANCE:g})`, "
+        f"* **Solves.** Linear CG (`snede.StaticSolver(body, \"cg\", preconditioner=\"none\", rtol=ε, round_tolerance={ROUND_TOLERANCE:g})`, "
         f"stopping criterion (6.9)). Insertions: `needle_for(slab_body(h_start), h_ref, rtol={WORKING_TOLERANCE:g}, "
         f"round_tolerance={ROUND_TOLERANCE:g})` (static friction threshold 2 × dynamic).",
         f"* **Working tolerance ε = {WORKING_TOLERANCE:g}** for Table 6.2 and all insertions: the thesis does not say "

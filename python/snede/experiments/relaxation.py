@@ -152,7 +152,8 @@ def newton_reference(mesh: CylinderMesh, case: Case) -> Reference:
     rtol = 1e-12 if case.material == "LinearElastic" else 1e-10
     snede.StaticSolver(body, "ncg", rtol=1e-2, criterion="6.8", options_prefix=options_prefix("reference_ncg")).solve()
     for line_search in ("bt", "cp"):
-        result = snede.StaticSolver(body, "newton", rtol=rtol, criterion="6.8", max_iterations=200,
+        result = snede.StaticSolver(body, "newton", preconditioner="none",
+                                    rtol=rtol, criterion="6.8", max_iterations=200,
                                     options_prefix=options_prefix("reference_newton"),
                                     petsc_options={"snes_linesearch_type": line_search,
                                                    "snes_linesearch_atol": 0.0}).solve()
@@ -238,7 +239,8 @@ def static_curve(mesh: CylinderMesh, case: Case, reference: Reference, method: S
     body = mesh.body(case.make_material())
     curve = Curve(method.label if method else "linear CG")
     if method is None:
-        solver = snede.StaticSolver(body, "cg", rtol=rtol, max_iterations=100000, options_prefix=options_prefix("cg"))
+        solver = snede.StaticSolver(body, "cg", preconditioner="none",
+                                    rtol=rtol, max_iterations=100000, options_prefix=options_prefix("cg"))
         recorder = CostRecorder(reference, curve, every, offset=body.displacement)
         solver.ksp.setMonitor(recorder.ksp_monitor)
     else:
@@ -364,7 +366,7 @@ def throughput(mesh: CylinderMesh, case: Case, method: str, eta: float, dt: floa
         result = snede.DynamicRelaxation(body, damping=eta, dt=dt, options_prefix=options_prefix("rate")).run(
             rtol=rtol, max_steps=300000)
     elif method == "linear CG":
-        result = snede.StaticSolver(body, "cg", rtol=rtol, max_iterations=100000,
+        result = snede.StaticSolver(body, "cg", preconditioner="none", rtol=rtol, max_iterations=100000,
                                     options_prefix=options_prefix("rate")).solve()
     else:
         line_search = {"NCG secant": "snede_secant", "NCG Newton": "snede_newton"}[method]

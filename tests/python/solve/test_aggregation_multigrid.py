@@ -22,6 +22,8 @@ def held_body(mesh, material=None, thickness=None):
 
 
 def solve(body, method="cg", rtol=1e-8, **options):
+    """A solve from rest; without a preconditioner unless one is given (the plain reference)."""
+    options.setdefault("preconditioner", "none")
     body.displacement = np.zeros_like(body.displacement)
     solver = snede.StaticSolver(body, method, rtol=rtol, **options)
     result = solver.solve()
