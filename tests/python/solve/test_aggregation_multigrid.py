@@ -134,12 +134,14 @@ def two_pieces():
     return body, left, right
 
 
-def test_separated_pieces_share_no_coarse_unknown():
+@pytest.mark.parametrize("smoothing", ["false", "true"])
+def test_separated_pieces_share_no_coarse_unknown(smoothing):
     body, left, right = two_pieces()
     x = body.mesh.points
     loaded = np.flatnonzero(left & np.isclose(x[:, 0], 0.5))
     body.add_nodal_force(loaded, (0.0, 0.0, -1.0))
-    solver, result, u = solve(body, preconditioner="mg", petsc_options={"mg_coarsening": "aggregation"})
+    solver, result, u = solve(body, preconditioner="mg", petsc_options={"mg_coarsening": "aggregation",
+                                                                        "mg_aggregation_smoothing": smoothing})
     assert result.converged, result.reason
     assert np.abs(u[left]).max() > 0
     assert not u[right].any()  # the solution: the unloaded piece does not move
@@ -238,11 +240,45 @@ def test_mg_continues_through_a_cut_of_a_bisected_mesh():
     assert result.iterations < plain.iterations / 3
 
 
+@pytest.mark.parametrize("options", [{"mg_aggregation_smoothing": "true"}, {"mg_aggregate_width": 4.0}])
+def test_smoothed_or_wider_aggregates_reach_the_plain_answer(options, gmsh_cylinder):
+    body = held_body(gmsh_cylinder)
+    solver, result, u = solve(body, preconditioner="mg", petsc_options=options)
+    _, plain, reference = solve(body)
+    assert result.converged and plain.converged
+    assert relative_difference(u, reference) < 1e-6
+    assert result.iterations < plain.iterations / 3
+    # Fixed vertices stay fixed under every coarse correction: their rows of P are zero.
+    P = as_dense(solver.ksp.getPC().getMGInterpolation(solver.ksp.getPC().getMGLevels() - 1))
+    fixed = np.repeat(np.isclose(gmsh_cylinder.points[:, 0], 0.0), 3)
+    assert fixed.any() and not P[fixed].any()
+
+
+def test_auto_takes_multigrid_where_it_pays():
+    def body_of(divisions):
+        return held_body(snede.meshing.box((0.4, 0.1, 0.1), divisions))
+    small, large = body_of((8, 2, 2)), body_of((16, 4, 4))
+    assert small.mesh.n_cells < 1000 <= large.mesh.n_cells
+    assert snede.StaticSolver(small, "cg").preconditioner == "none"
+    assert snede.StaticSolver(large, "cg").preconditioner == "mg"
+    assert snede.StaticSolver(large, "newton", preconditioner="auto").preconditioner == "mg"
+    assert snede.StaticSolver(large, "ncg").preconditioner == "none"
+    surface, _ = snede.meshing.boundary_surface(snede.meshing.box((0.4, 0.1, 0.1), (24, 6, 6)))
+    assert surface.n_cells >= 1000
+    membrane = snede.Body(surface, snede.NeoHookean(1e5, 0.3), thickness=0.001)
+    assert snede.StaticSolver(membrane, "newton").preconditioner == "none"
+
+
 def test_bad_coarsening_options_are_refused_naming_them(gmsh_cylinder):
     body = held_body(gmsh_cylinder)
     with pytest.raises(ValueError, match="mg_coarsening must be auto, bisection or aggregation, got 'tree'"):
         snede.StaticSolver(body, "cg", preconditioner="mg", petsc_options={"mg_coarsening": "tree"})
     with pytest.raises(ValueError, match="no bisection hierarchy"):
         snede.StaticSolver(body, "cg", preconditioner="mg", petsc_options={"mg_coarsening": "bisection"})
-    with pytest.raises(ValueError, match="gives 2 levels|gives [0-9]+ levels"):
+    for options, message in (({"mg_aggregation_smoothing": "yes"}, "mg_aggregation_smoothing must be true or false"),
+                             ({"mg_aggregate_width": "wide"}, "mg_aggregate_width must be a number, got 'wide'"),
+                             ({"mg_aggregate_width": -1}, "mg_aggregate_width must be positive")):
+        with pytest.raises(ValueError, match=message):
+            snede.StaticSolver(body, "cg", preconditioner="mg", petsc_options=options)
+    with pytest.raises(ValueError, match="gives [0-9]+ levels"):
         snede.StaticSolver(body, "cg", preconditioner="mg", petsc_options={"pc_mg_levels": 12})
