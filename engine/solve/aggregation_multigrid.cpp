@@ -9,6 +9,7 @@
 #include <string>
 
 #include "core/error.hpp"
+#include "solve/coarse_basis.hpp"
 
 namespace snede {
 namespace {
@@ -20,10 +21,6 @@ constexpr PetscInt direct_unknowns = 1500;
 // ...or when aggregating would keep more than this fraction of the nodes (a level that hardly
 // coarsens costs a smoother without reducing the problem).
 constexpr double least_reduction = 0.6;
-// A rigid mode whose norm, after orthogonalisation against the aggregate's other modes, falls
-// below this fraction of its own is dependent (a lone vertex has no rotation, a fixed vertex
-// no motion at all).
-constexpr double rank_tolerance = 1e-8;
 // Grid cells are numbered in 21 bits per direction.
 constexpr double max_cells_per_direction = 1 << 20;
 
@@ -48,30 +45,9 @@ struct NodeLevel {
   }
 };
 
-class DisjointSets {
- public:
-  explicit DisjointSets(std::size_t n) : parent_(n) { std::iota(parent_.begin(), parent_.end(), 0); }
-  std::int32_t find(std::int32_t i) {
-    while (parent_[i] != i) i = parent_[i] = parent_[parent_[i]];
-    return i;
-  }
-  // Joins the sets of a and b; returns the root of the union.
-  std::int32_t unite(std::int32_t a, std::int32_t b) {
-    a = find(a);
-    b = find(b);
-    if (a == b) return a;
-    if (b < a) std::swap(a, b);
-    parent_[b] = a;
-    return a;
-  }
-
- private:
-  std::vector<std::int32_t> parent_;
-};
-
 // The mesh's vertices as the finest level: the constraints' projection P_v gives the
 // translations a vertex can make; about its own position a rotation does not move it.
-NodeLevel vertex_level(const Model& model, double& mean_edge) {
+NodeLevel vertex_level(const Model& model) {
   const Mesh& mesh = model.body().mesh();
   const int d = mesh.dim();
   NodeLevel level;
@@ -98,20 +74,12 @@ NodeLevel vertex_level(const Model& model, double& mean_edge) {
   const std::vector<VertexId> cells = mesh.cells();
   const int nv = mesh.cell_dim() + 1;
   level.edges.reserve(cells.size() / nv * nv * (nv - 1) / 2);
-  double length = 0;
   for (std::size_t c = 0; c < cells.size(); c += nv)
     for (int a = 0; a < nv; ++a)
       for (int b = a + 1; b < nv; ++b) {
         const VertexId i = cells[c + a], j = cells[c + b];
         level.edges.emplace_back(std::min(i, j), std::max(i, j));
-        double squared = 0;
-        for (int k = 0; k < d; ++k) {
-          const double delta = level.position[static_cast<std::size_t>(i) * d + k] - level.position[static_cast<std::size_t>(j) * d + k];
-          squared += delta * delta;
-        }
-        length += std::sqrt(squared);
       }
-  mean_edge = level.edges.empty() ? 0.0 : length / static_cast<double>(level.edges.size());
   return level;
 }
 
@@ -189,41 +157,6 @@ void append_shifted_modes(const NodeLevel& level, std::size_t i, std::span<const
   }
 }
 
-// Orthonormalises the columns of `block` (rows × m, column-major) in order, dropping the
-// dependent ones (Gram-Schmidt, twice for stability). Returns the orthonormal columns Q
-// (rows × k, column-major) and sets R = Qᵀ block (k × m, row-major).
-std::vector<double> orthonormal_modes(const std::vector<double>& block, std::size_t rows, int m, std::vector<double>& R) {
-  std::vector<double> Q;
-  for (int j = 0; j < m; ++j) {
-    std::vector<double> w(block.begin() + static_cast<std::ptrdiff_t>(j * rows),
-                          block.begin() + static_cast<std::ptrdiff_t>((j + 1) * rows));
-    double original = 0;
-    for (double x : w) original += x * x;
-    if (original == 0) continue;
-    const std::size_t k = Q.size() / rows;
-    for (int pass = 0; pass < 2; ++pass)
-      for (std::size_t p = 0; p < k; ++p) {
-        double dot = 0;
-        for (std::size_t r = 0; r < rows; ++r) dot += Q[p * rows + r] * w[r];
-        for (std::size_t r = 0; r < rows; ++r) w[r] -= dot * Q[p * rows + r];
-      }
-    double norm = 0;
-    for (double x : w) norm += x * x;
-    if (norm <= rank_tolerance * rank_tolerance * original) continue;
-    norm = std::sqrt(norm);
-    for (double& x : w) Q.push_back(x / norm);
-  }
-  const std::size_t k = Q.size() / rows;
-  R.assign(k * m, 0.0);
-  for (std::size_t p = 0; p < k; ++p)
-    for (int j = 0; j < m; ++j) {
-      double dot = 0;
-      for (std::size_t r = 0; r < rows; ++r) dot += Q[p * rows + r] * block[static_cast<std::size_t>(j) * rows + r];
-      R[p * m + j] = dot;
-    }
-  return Q;
-}
-
 // The next coarser level, whose node a is aggregate a of `fine`, and the interpolation from it
 // to `fine` (zero rows for inactive nodes and for motions the constraints forbid).
 NodeLevel coarsen(const NodeLevel& fine, const std::vector<std::int32_t>& aggregate_of, std::size_t n_aggregates,
@@ -264,7 +197,7 @@ NodeLevel coarsen(const NodeLevel& fine, const std::vector<std::int32_t>& aggreg
       append_shifted_modes(fine, i, std::span<const double>(offset.data(), d), row, rows, block);
       row += static_cast<std::size_t>(fine.n_unknowns(i));
     }
-    Q[a] = orthonormal_modes(block, rows, m, R);
+    Q[a] = orthonormal_columns(block, rows, m, R);
     rows_of[a] = rows;
     const std::size_t k = rows ? Q[a].size() / rows : 0;
     coarse.first[a + 1] = coarse.first[a] + static_cast<PetscInt>(k);
@@ -388,8 +321,8 @@ AggregationMultigrid::AggregationMultigrid(Model& fine, int max_levels, bool smo
   if (fine.body().mesh().is_surface())
     throw std::invalid_argument("preconditioner 'mg' works on volume meshes (triangles in 2D, tetrahedra in 3D), "
                                 "not on a surface mesh");
-  double mean_edge = 0;
-  NodeLevel current = vertex_level(fine, mean_edge);
+  const double mean_edge = mean_edge_length(fine.body().mesh());
+  NodeLevel current = vertex_level(fine);
   if (!(aggregate_width > 0) || !std::isfinite(aggregate_width))
     throw std::invalid_argument("mg_aggregate_width must be positive (mean edge lengths), got " +
                                 std::to_string(aggregate_width));
@@ -444,22 +377,9 @@ std::vector<std::size_t> AggregationMultigrid::level_unknowns() const {
 }
 
 void AggregationMultigrid::configure(PC pc, const SolverOptions& options, const std::vector<double>&) {
-  const auto n = static_cast<PetscInt>(n_levels());
-  SNEDE_PETSC(PCSetType(pc, PCMG));
-  SNEDE_PETSC(PCMGSetLevels(pc, n, nullptr));
-  SNEDE_PETSC(PCMGSetType(pc, PC_MG_MULTIPLICATIVE));
-  // Coarse operators R A P from the PC's assembled matrix, recomputed when it is refilled.
-  SNEDE_PETSC(PCMGSetGalerkin(pc, PC_MG_GALERKIN_BOTH));
-  for (PetscInt l = 1; l < n; ++l) {
-    SNEDE_PETSC(PCMGSetInterpolation(pc, l, coarse_[l - 1].interpolation));
-    KSP smoother = nullptr;
-    SNEDE_PETSC(PCMGGetSmoother(pc, l, &smoother));
-    // Bounds from earlier levels are not reused: a cut leaves slivers beside the lips and
-    // changes the Galerkin levels, and Chebyshev with a stale bound diverges (measured: Newton
-    // stalled after the third move through the liver). The estimate costs a few products.
-    set_chebyshev_jacobi_smoother(smoother, options, 0.0);
-  }
-  set_direct_coarse_solve(pc, options);
+  std::vector<Mat> interpolations;
+  for (const Level& level : coarse_) interpolations.push_back(level.interpolation);
+  configure_galerkin_levels(pc, interpolations, options);
 }
 
 }  // namespace snede

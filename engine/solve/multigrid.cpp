@@ -63,4 +63,21 @@ void set_direct_coarse_solve(PC pc, const SolverOptions& options) {
   SNEDE_PETSC(PCSetType(direct, PCLU));
 }
 
+void configure_galerkin_levels(PC pc, const std::vector<Mat>& interpolations, const SolverOptions& options) {
+  const auto n = static_cast<PetscInt>(interpolations.size()) + 1;
+  SNEDE_PETSC(PCSetType(pc, PCMG));
+  SNEDE_PETSC(PCMGSetLevels(pc, n, nullptr));
+  SNEDE_PETSC(PCMGSetType(pc, PC_MG_MULTIPLICATIVE));
+  SNEDE_PETSC(PCMGSetGalerkin(pc, PC_MG_GALERKIN_BOTH));
+  for (PetscInt l = 1; l < n; ++l) {
+    SNEDE_PETSC(PCMGSetInterpolation(pc, l, interpolations[l - 1]));
+    KSP smoother = nullptr;
+    SNEDE_PETSC(PCMGGetSmoother(pc, l, &smoother));
+    // Bounds from earlier levels are not reused: Chebyshev with a stale bound diverged (Newton
+    // stalled after the third move through the liver). The estimate costs a few products.
+    set_chebyshev_jacobi_smoother(smoother, options, 0.0);
+  }
+  set_direct_coarse_solve(pc, options);
+}
+
 }  // namespace snede

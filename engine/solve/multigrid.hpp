@@ -52,5 +52,11 @@ void set_chebyshev_jacobi_smoother(KSP smoother, const SolverOptions& options, d
 std::vector<double> chebyshev_estimates(PC pc);
 // The coarsest level's solve: a direct factorisation of its assembled matrix.
 void set_direct_coarse_solve(PC pc, const SolverOptions& options);
+// Makes `pc` a PCMG with Galerkin coarse operators R A P from the PC's assembled matrix
+// (recomputed whenever it is refilled): `interpolations` from each level to the next finer one,
+// coarsest first; Chebyshev/Jacobi smoothers that estimate their bounds (the levels of a
+// changing mesh are rebuilt after every edit, and a cut's slivers change the spectrum); LU on
+// the coarsest level.
+void configure_galerkin_levels(PC pc, const std::vector<Mat>& interpolations, const SolverOptions& options);
 
 }  // namespace snede

@@ -14,6 +14,7 @@
 #include "core/petsc_util.hpp"
 #include "solve/aggregation_multigrid.hpp"
 #include "solve/bisection_multigrid.hpp"
+#include "solve/grid_multigrid.hpp"
 #include "solve/tangent_assembly.hpp"
 
 namespace snede {
@@ -269,39 +270,59 @@ void StaticSolver::build_multigrid() {
     } catch (const std::exception&) {
       throw std::invalid_argument(prefix + "pc_mg_levels must be an integer, got '" + *levels + "'");
     }
+    if (max_levels < 2)
+      throw std::invalid_argument("mg needs at least 2 levels (the mesh and a coarser one), got " + prefix +
+                                  "pc_mg_levels " + *levels);
   }
   const std::string coarsening =
       option_database_.string_option(options_.options_prefix + "mg_coarsening").value_or("auto");
-  if (coarsening != "auto" && coarsening != "bisection" && coarsening != "aggregation")
-    throw std::invalid_argument(prefix + "mg_coarsening must be auto, bisection or aggregation, got '" + coarsening + "'");
+  if (coarsening != "auto" && coarsening != "bisection" && coarsening != "aggregation" && coarsening != "grid")
+    throw std::invalid_argument(prefix + "mg_coarsening must be auto, bisection, aggregation or grid, got '" +
+                                coarsening + "'");
   if (coarsening == "bisection" && !hierarchy_)
     throw std::invalid_argument(prefix + "mg_coarsening bisection: this mesh has no bisection hierarchy (refine it "
                                 "with mesh.refine_uniform or refine_around first, or use aggregation)");
+  auto number_option = [&](const std::string& name, double fallback) {
+    const std::optional<std::string> text = option_database_.string_option(options_.options_prefix + name);
+    if (!text) return fallback;
+    try {
+      std::size_t used = 0;
+      const double value = std::stod(*text, &used);
+      if (used != text->size()) throw std::invalid_argument(*text);
+      return value;
+    } catch (const std::exception&) {
+      throw std::invalid_argument(prefix + name + " must be a number, got '" + *text + "'");
+    }
+  };
   multigrid_.reset();
-  if (coarsening != "aggregation" && hierarchy_) {
+  if (coarsening != "aggregation" && coarsening != "grid" && hierarchy_) {
     try {
       multigrid_ = std::make_unique<BisectionMultigrid>(model_, *hierarchy_, max_levels);
     } catch (const std::invalid_argument&) {
       // No conforming coarser cut (a mesh never refined, or one that was cut or flipped since):
-      // aggregation coarsens any mesh.
+      // any mesh can be coarsened on its own.
       if (coarsening == "bisection") throw;
     }
+  }
+  if (!multigrid_ && coarsening != "aggregation") {
+    if (max_levels > 2) throw std::invalid_argument(prefix + "pc_mg_levels: grid coarsening gives 2 levels");
+    multigrid_ = std::make_unique<GridMultigrid>(model_, number_option("mg_grid_width", GridMultigrid::default_grid_width));
   }
   const std::string smoothing =
       option_database_.string_option(options_.options_prefix + "mg_aggregation_smoothing").value_or("false");
   if (smoothing != "true" && smoothing != "false")
     throw std::invalid_argument(prefix + "mg_aggregation_smoothing must be true or false, got '" + smoothing + "'");
-  const std::string width_text = option_database_.string_option(options_.options_prefix + "mg_aggregate_width")
-                                     .value_or(std::to_string(AggregationMultigrid::default_aggregate_width));
-  double width = 0;
-  try {
-    std::size_t used = 0;
-    width = std::stod(width_text, &used);
-    if (used != width_text.size()) throw std::invalid_argument(width_text);
-  } catch (const std::exception&) {
-    throw std::invalid_argument(prefix + "mg_aggregate_width must be a number, got '" + width_text + "'");
-  }
-  if (!multigrid_) multigrid_ = std::make_unique<AggregationMultigrid>(model_, max_levels, smoothing == "true", width);
+  if (!multigrid_)
+    multigrid_ = std::make_unique<AggregationMultigrid>(
+        model_, max_levels, smoothing == "true",
+        number_option("mg_aggregate_width", AggregationMultigrid::default_aggregate_width));
+  // An option for another kind of levels than those made is a mistake the user should hear of.
+  const std::string source = multigrid_->source();
+  for (const auto& [name, applies_to] : {std::pair<std::string, std::string>{"mg_aggregate_width", "aggregation"},
+                                         {"mg_aggregation_smoothing", "aggregation"}, {"mg_grid_width", "grid"}})
+    if (source != applies_to && option_database_.string_option(options_.options_prefix + name))
+      throw std::invalid_argument(prefix + name + " applies to " + applies_to + " levels; these are " + source +
+                                  " levels (-" + options_.options_prefix + "mg_coarsening chooses)");
   needs_matrix_ = pc_needs_matrix_ || multigrid_->needs_assembled_tangent();
 }
 
@@ -336,7 +357,8 @@ void StaticSolver::refill_preconditioner(SNES snes, Vec x) {
   PetscInt lag = 1, iteration = 0;
   SNEDE_PETSC(SNESGetLagPreconditioner(snes, &lag));
   SNEDE_PETSC(SNESGetIterationNumber(snes, &iteration));
-  // As SNES decides whether to rebuild the PC: -1 never again, k > 1 every k-th iteration.
+  // As SNES decides whether to rebuild the PC: -1 never again (-2 becomes -1 once built), k > 1
+  // every k-th iteration.
   const bool lagged = (lag == -1 || (lag > 1 && iteration % lag != 0)) && preconditioner_filled_;
   if (lagged) return;
   if (assembled_) assembled_->assemble(model_, x);
@@ -422,6 +444,15 @@ SolveResult StaticSolver::solve_nonlinear() {
   SNESConvergedReason reason;
   PetscInt iterations = 0, linear = 0;
   const ScaledOperator scaled(model_, system_scale_);
+  // Galerkin levels (an assembled tangent, its products with the interpolation, a coarse
+  // factorisation) are built at the first Newton iteration of each solve — after each tool
+  // move — and kept through the solve's other iterations, unless the options lag otherwise:
+  // rebuilding them cost more than the CG iterations they save (docs/results/interactive.md).
+  if (multigrid_ && multigrid_->needs_assembled_tangent() &&
+      !option_database_.string_option(options_.options_prefix + "snes_lag_preconditioner")) {
+    SNEDE_PETSC(SNESSetLagPreconditioner(snes_, -2));
+    preconditioner_filled_ = false;
+  }
   auto run = [&] {
     SNEDE_PETSC(SNESSolve(snes_, nullptr, u));
     PetscInt its = 0, lits = 0;

@@ -183,11 +183,11 @@ def test_misuse_is_refused_with_a_reason():
         snede.StaticSolver(body, "ncg", preconditioner="mg")
 
 
-def test_an_unrefined_mesh_is_coarsened_by_aggregation_instead():
-    # Without bisection levels (tests/python/solve/test_aggregation_multigrid.py covers them).
+def test_an_unrefined_mesh_is_coarsened_on_a_grid_instead():
+    # Without bisection levels (tests/python/solve/test_multigrid_any_mesh.py covers them).
     unrefined = cantilever(3, 0)
     solver = snede.StaticSolver(unrefined, "cg", preconditioner="mg")
-    assert solver.multigrid_source == "aggregation"
+    assert solver.multigrid_source == "grid"
     assert solver.solve().converged
 
 

@@ -1,9 +1,9 @@
-"""Multigrid for any mesh by aggregation (preconditioner "mg" without a usable bisection
-hierarchy, issue 31).
+"""Multigrid for any mesh (preconditioner "mg" without a usable bisection hierarchy, issue 31):
+a background grid with virtual nodes (the default) or aggregation.
 
-Checked against independent facts: the interpolation's columns are orthonormal and its range
-holds the body's rigid motions as the constraints allow them (what an aggregation coarse space
-must carry for elasticity); separated pieces share no coarse unknown, so one V-cycle applied to
+Checked against independent facts: the interpolation's range holds the body's rigid motions as
+the constraints allow them (what a coarse space must carry for elasticity; aggregation's columns
+are moreover orthonormal); separated pieces share no coarse unknown, so one V-cycle applied to
 a load on one piece leaves the other exactly still; every preconditioned solve reaches the
 unpreconditioned answer, on meshes made by gmsh and after random sequences of cuts, flips,
 collapses, splits and refinements, in fewer iterations; misuse raises ValueError naming it."""
@@ -64,13 +64,18 @@ def gmsh_cylinder():
     return snede.meshing.cylinder(length=0.1, radius=0.02, h=0.006, seed=3)
 
 
+COARSENINGS = ["grid", "aggregation"]
+
+
+@pytest.mark.parametrize("coarsening", COARSENINGS)
 @pytest.mark.parametrize("dim", [2, 3])
-def test_a_mesh_without_bisection_history_gets_aggregation_levels_and_the_plain_answer(dim, gmsh_cylinder):
+def test_a_mesh_without_bisection_history_gets_levels_and_the_plain_answer(dim, coarsening, gmsh_cylinder):
     mesh = snede.meshing.rectangle((0.4, 0.1), (40, 10)) if dim == 2 else gmsh_cylinder
     body = held_body(mesh, thickness=0.01 if dim == 2 else None)
-    solver, result, u = solve(body, preconditioner="mg")
+    options = {} if coarsening == "grid" else {"mg_coarsening": coarsening}  # grid: the default
+    solver, result, u = solve(body, preconditioner="mg", petsc_options=options)
     assert result.converged, result.reason
-    assert solver.multigrid_source == "aggregation"
+    assert solver.multigrid_source == coarsening
     unknowns = solver.multigrid_unknowns
     assert unknowns[-1] == body.displacement.size and unknowns == sorted(unknowns) and len(unknowns) >= 2
     _, plain, reference = solve(body)
@@ -89,16 +94,21 @@ def test_newton_on_a_gmsh_mesh_reaches_the_plain_answer(gmsh_cylinder):
     assert result.linear_iterations < plain.linear_iterations / 3
 
 
+@pytest.mark.parametrize("coarsening", COARSENINGS)
 @pytest.mark.parametrize("dim", [2, 3])
-def test_interpolation_is_orthonormal_and_carries_the_allowed_rigid_motions(dim, gmsh_cylinder):
+def test_interpolation_carries_the_allowed_rigid_motions(dim, coarsening, gmsh_cylinder):
     mesh = snede.meshing.rectangle((0.4, 0.1), (16, 4)) if dim == 2 else gmsh_cylinder
     body = held_body(mesh, thickness=0.01 if dim == 2 else None)
     x = mesh.points
     body.slide(np.flatnonzero(np.isclose(x[:, 0], x[:, 0].max())), (0.0, 1.0) if dim == 2 else (0.0, 0.0, 1.0))
-    solver = snede.StaticSolver(body, "cg", preconditioner="mg")
-    P = as_dense(solver.ksp.getPC().getMGInterpolation(1))
+    solver = snede.StaticSolver(body, "cg", preconditioner="mg", petsc_options={"mg_coarsening": coarsening,
+                                                                                "pc_mg_levels": 2})
+    pc = solver.ksp.getPC()
+    P = as_dense(pc.getMGInterpolation(pc.getMGLevels() - 1))
     assert P.shape == (body.displacement.size, solver.multigrid_unknowns[-2])
-    np.testing.assert_allclose(P.T @ P, np.eye(P.shape[1]), atol=1e-12)
+    assert np.linalg.matrix_rank(P) == P.shape[1]  # no dependent (or empty) coarse unknown
+    if coarsening == "aggregation":
+        np.testing.assert_allclose(P.T @ P, np.eye(P.shape[1]), atol=1e-12)
     # The rigid motions, projected vertex by vertex on what the constraints allow (fixed: no
     # motion, sliding: along the direction), lie in the coarse space: P Pᵀ m = m.
     modes = rigid_modes(x - x.mean(axis=0))
@@ -111,7 +121,8 @@ def test_interpolation_is_orthonormal_and_carries_the_allowed_rigid_motions(dim,
     projection[sliding] = np.outer(direction, direction)
     for mode in modes.T:
         allowed = np.einsum("nij,nj->ni", projection, mode.reshape(-1, dim)).ravel()
-        np.testing.assert_allclose(P @ (P.T @ allowed), allowed, atol=1e-10 * np.abs(allowed).max())
+        coefficients = np.linalg.lstsq(P, allowed, rcond=None)[0]
+        np.testing.assert_allclose(P @ coefficients, allowed, atol=1e-9 * np.abs(allowed).max())
 
 
 def two_pieces():
@@ -134,14 +145,14 @@ def two_pieces():
     return body, left, right
 
 
-@pytest.mark.parametrize("smoothing", ["false", "true"])
-def test_separated_pieces_share_no_coarse_unknown(smoothing):
+@pytest.mark.parametrize("options", [{"mg_coarsening": "grid"}, {"mg_coarsening": "aggregation"},
+                                     {"mg_coarsening": "aggregation", "mg_aggregation_smoothing": "true"}])
+def test_separated_pieces_share_no_coarse_unknown(options):
     body, left, right = two_pieces()
     x = body.mesh.points
     loaded = np.flatnonzero(left & np.isclose(x[:, 0], 0.5))
     body.add_nodal_force(loaded, (0.0, 0.0, -1.0))
-    solver, result, u = solve(body, preconditioner="mg", petsc_options={"mg_coarsening": "aggregation",
-                                                                        "mg_aggregation_smoothing": smoothing})
+    solver, result, u = solve(body, preconditioner="mg", petsc_options=options)
     assert result.converged, result.reason
     assert np.abs(u[left]).max() > 0
     assert not u[right].any()  # the solution: the unloaded piece does not move
@@ -187,13 +198,14 @@ def random_edit(mesh, rng):
     return result.done
 
 
-def test_random_edits_and_cuts_keep_the_plain_answer_in_bounded_iterations(gmsh_cylinder):
+@pytest.mark.parametrize("coarsening", COARSENINGS)
+def test_random_edits_and_cuts_keep_the_plain_answer_in_bounded_iterations(coarsening, gmsh_cylinder):
     rng = np.random.default_rng(7)
     mesh = snede.Mesh(gmsh_cylinder.points, gmsh_cylinder.cells)
     body = held_body(mesh)
-    solver = snede.StaticSolver(body, "cg", rtol=1e-8, preconditioner="mg")
+    solver = snede.StaticSolver(body, "cg", rtol=1e-8, preconditioner="mg", petsc_options={"mg_coarsening": coarsening})
     cutter = snede.TetrahedralCutter(body)
-    counts, edits = [], 0
+    edits = 0
     for step in range(8):
         if step % 2:
             x = 0.02 + 0.06 * rng.random()
@@ -207,15 +219,15 @@ def test_random_edits_and_cuts_keep_the_plain_answer_in_bounded_iterations(gmsh_
         body.displacement = np.zeros_like(body.displacement)
         result = solver.solve()
         assert result.converged, (step, result.reason)
-        assert solver.multigrid_source == "aggregation"
+        assert solver.multigrid_source == coarsening
         u = body.displacement.copy()
         _, plain, reference = solve(body)
         assert plain.converged
         assert relative_difference(u, reference) < 1e-6, step
-        assert result.iterations < plain.iterations / 2, (step, result.iterations, plain.iterations)
-        counts.append(result.iterations)
+        # The edits make the problem harder (plain CG: 363 → 797 iterations here); multigrid
+        # keeps its advantage at every step (measured 1/17 to 1/14).
+        assert result.iterations < plain.iterations / 8, (step, result.iterations, plain.iterations)
     assert edits > 0
-    assert max(counts) <= 2 * min(counts), counts
 
 
 def test_mg_continues_through_a_cut_of_a_bisected_mesh():
@@ -233,14 +245,16 @@ def test_mg_continues_through_a_cut_of_a_bisected_mesh():
     body.displacement = np.zeros_like(body.displacement)
     result = solver.solve()
     assert result.converged, result.reason
-    assert solver.multigrid_source == "aggregation"
+    assert solver.multigrid_source == "grid"
     u = body.displacement.copy()
     _, plain, reference = solve(body)
     assert relative_difference(u, reference) < 1e-6
     assert result.iterations < plain.iterations / 3
 
 
-@pytest.mark.parametrize("options", [{"mg_aggregation_smoothing": "true"}, {"mg_aggregate_width": 4.0}])
+@pytest.mark.parametrize("options", [{"mg_coarsening": "aggregation", "mg_aggregation_smoothing": "true"},
+                                     {"mg_coarsening": "aggregation", "mg_aggregate_width": 4.0},
+                                     {"mg_grid_width": 2.0}])
 def test_smoothed_or_wider_aggregates_reach_the_plain_answer(options, gmsh_cylinder):
     body = held_body(gmsh_cylinder)
     solver, result, u = solve(body, preconditioner="mg", petsc_options=options)
@@ -271,13 +285,19 @@ def test_auto_takes_multigrid_where_it_pays():
 
 def test_bad_coarsening_options_are_refused_naming_them(gmsh_cylinder):
     body = held_body(gmsh_cylinder)
-    with pytest.raises(ValueError, match="mg_coarsening must be auto, bisection or aggregation, got 'tree'"):
+    with pytest.raises(ValueError, match="mg_coarsening must be auto, bisection, aggregation or grid, got 'tree'"):
         snede.StaticSolver(body, "cg", preconditioner="mg", petsc_options={"mg_coarsening": "tree"})
     with pytest.raises(ValueError, match="no bisection hierarchy"):
         snede.StaticSolver(body, "cg", preconditioner="mg", petsc_options={"mg_coarsening": "bisection"})
-    for options, message in (({"mg_aggregation_smoothing": "yes"}, "mg_aggregation_smoothing must be true or false"),
-                             ({"mg_aggregate_width": "wide"}, "mg_aggregate_width must be a number, got 'wide'"),
-                             ({"mg_aggregate_width": -1}, "mg_aggregate_width must be positive")):
+    aggregation = {"mg_coarsening": "aggregation"}
+    for options, message in (({**aggregation, "mg_aggregation_smoothing": "yes"},
+                              "mg_aggregation_smoothing must be true or false"),
+                             ({**aggregation, "mg_aggregate_width": "wide"}, "mg_aggregate_width must be a number, got 'wide'"),
+                             ({**aggregation, "mg_aggregate_width": -1}, "mg_aggregate_width must be positive"),
+                             ({"mg_aggregate_width": 3}, "mg_aggregate_width applies to aggregation levels; these are grid"),
+                             ({**aggregation, "mg_grid_width": 3}, "mg_grid_width applies to grid levels; these are aggregation"),
+                             ({"mg_grid_width": 0}, "mg_grid_width must be positive"),
+                             ({"mg_coarsening": "grid", "pc_mg_levels": 3}, "grid coarsening gives 2 levels")):
         with pytest.raises(ValueError, match=message):
             snede.StaticSolver(body, "cg", preconditioner="mg", petsc_options=options)
     with pytest.raises(ValueError, match="gives [0-9]+ levels"):
