@@ -1,6 +1,7 @@
 // What the static solver needs from a multigrid hierarchy, whatever made it: the bisection
-// tree (bisection_multigrid.hpp: coarse meshes, matrix-free levels) or aggregation of any mesh
-// (aggregation_multigrid.hpp: Galerkin levels from an assembled tangent).
+// tree (bisection_multigrid.hpp: coarse meshes, matrix-free levels), a background grid with
+// virtual nodes (grid_multigrid.hpp) or aggregation (aggregation_multigrid.hpp), both of any
+// mesh, with Galerkin levels from an assembled tangent.
 #pragma once
 
 #include <petscksp.h>
@@ -16,7 +17,7 @@ namespace snede {
 class Multigrid {
  public:
   virtual ~Multigrid() = default;
-  // "bisection" or "aggregation".
+  // "bisection", "grid" or "aggregation".
   virtual const char* source() const = 0;
   // Whether the fine mesh and its constraints' projections are still those the levels were
   // made for (no edit, no vertex fixed, released or made to slide since).

@@ -35,9 +35,10 @@ struct StaticOptions {
   // The PETSc PC type of the CG (linear, or Newton's inner one): "none", "jacobi" (from the
   // shell's diagonal, no matrix), "gamg" (on an assembled tangent with the rigid-body near null
   // space), "mg" (multigrid for any volume mesh: on the bisection hierarchy, matrix-free on
-  // every level, when the mesh has one whose coarser levels are conforming; else by
-  // aggregation, Galerkin levels from an assembled tangent; -<prefix>mg_coarsening bisection|
-  // aggregation chooses) or any PETSc PC that works on an assembled matrix ("ilu", "icc", ...).
+  // every level, when the mesh has one whose coarser levels are conforming; else on a
+  // background grid with virtual nodes or by aggregation, Galerkin levels from an assembled
+  // tangent; -<prefix>mg_coarsening auto|bisection|grid|aggregation chooses) or any PETSc PC
+  // that works on an assembled matrix ("ilu", "icc", ...).
   // "auto": "mg" for cg and newton on volume meshes of 1 000 cells or more, else "none".
   // Empty: -<prefix>pc_type if given, else "auto". -<prefix>pc_type on the command line wins.
   std::string preconditioner;
@@ -61,13 +62,13 @@ class StaticSolver {
   // The PC type in use, and the assembled matrix it is built from (null without one).
   const std::string& preconditioner() const { return pc_type_; }
   Mat preconditioner_matrix() const { return assembled_ ? assembled_->mat() : nullptr; }
-  // Per multigrid level, coarsest first, the mesh last: elements (bisection levels) or
-  // aggregates (aggregation levels; the mesh's cells last). Empty unless the PC is "mg".
+  // Per multigrid level, coarsest first, the mesh last: elements (bisection levels), grid node
+  // copies or aggregates (the mesh's cells last). Empty unless the PC is "mg".
   std::vector<std::size_t> multigrid_levels() const {
     return multigrid_ ? multigrid_->level_sizes() : std::vector<std::size_t>{};
   }
   // Unknowns per multigrid level, coarsest first; and what made the levels ("bisection",
-  // "aggregation"; empty unless the PC is "mg").
+  // "grid", "aggregation"; empty unless the PC is "mg").
   std::vector<std::size_t> multigrid_unknowns() const {
     return multigrid_ ? multigrid_->level_unknowns() : std::vector<std::size_t>{};
   }
@@ -84,8 +85,8 @@ class StaticSolver {
   void follow_mesh_changes();
   // The matrix the PC is built from: the shell, or an assembled tangent for the current mesh.
   Mat preconditioning_matrix();
-  // PC "mg": the levels for the current mesh (bisection when the hierarchy gives them, else
-  // aggregation), and whether the PC then needs the assembled tangent.
+  // PC "mg": the levels for the current mesh (bisection when the hierarchy gives them, else a
+  // grid or aggregation), and whether the PC then needs the assembled tangent.
   void build_multigrid();
   // The levels built anew and configured on `pc`.
   void set_up_multigrid(PC pc);

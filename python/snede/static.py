@@ -45,15 +45,18 @@ class StaticSolver(RunsOnRanks):
       the levels are those coarser meshes, each with its own matrix-free tangent shell over the
       same element kernels (linearised at the injected state), Chebyshev/Jacobi smoothing and LU
       on the coarsest level. On any other mesh — made by gmsh, read from a file, or cut, flipped
-      or collapsed since its refinement — the levels come from aggregation: each coarse unknown
-      is a rigid motion of a set of vertices that lie in one cell of a grid over the reference
-      configuration and are joined by the mesh's edges inside it (a cut splits such a set per
-      piece, so the coarse space never couples the lips), with Galerkin coarse operators from
-      the tangent assembled by the element kernels. Levels are rebuilt at the first solve after
-      a mesh or constraint change; ``follow_seconds`` says what that cost. ``multigrid_source``
-      says which kind is in use, ``multigrid_levels`` and ``multigrid_unknowns`` the levels'
-      sizes; ``-static_mg_coarsening aggregation|bisection`` chooses (default ``auto``: bisection
-      when it applies). ``-static_mg_levels_ksp_type``, ``-static_pc_mg_levels`` and the other
+      or collapsed since its refinement — the coarse level is the piecewise linear space of a
+      background grid over the reference configuration, with one copy of a grid node per
+      connected piece of the fine vertices it reaches (virtual nodes: a cut never ties the
+      lips), and a Galerkin coarse operator from the tangent assembled by the element kernels,
+      built once per solve; ``-static_mg_coarsening aggregation`` takes rigid-motion aggregates
+      instead. Levels are rebuilt at the first solve after a mesh or constraint change;
+      ``follow_seconds`` says what that cost. ``multigrid_source`` says which kind is in use
+      (``"bisection"``, ``"grid"``, ``"aggregation"``), ``multigrid_levels`` and
+      ``multigrid_unknowns`` the levels' sizes; ``-static_mg_coarsening`` chooses (default
+      ``auto``: bisection when it applies, else grid), ``-static_mg_grid_width``,
+      ``-static_mg_aggregate_width`` and ``-static_mg_aggregation_smoothing`` tune the coarse
+      spaces. ``-static_mg_levels_ksp_type``, ``-static_pc_mg_levels`` and the other
       ``-static_mg_*`` options of PETSc's PCMG tune it (docs/results/interactive.md).
       ``"auto"``: ``"mg"`` for cg and newton on volume meshes of 1 000 cells or more (where it
       measured faster than no preconditioner), else ``"none"``. None (default):

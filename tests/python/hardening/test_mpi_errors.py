@@ -74,7 +74,11 @@ def test_petsc_objects_freed_at_different_times_on_the_ranks(tmp_path):
         del first
         gc.collect()
         result = problem().solve("cg", rtol=1e-8)
-        print("converged", result.converged, flush=True)
+        # Rank 0 alone reports both ranks' results: two ranks printing at once interleaved their
+        # output and failed a count at random (issue 38).
+        converged = comm.gather(result.converged)
+        if comm.rank == 0:
+            print(f"converged on ranks: {converged}", flush=True)
         """)
     assert run.returncode == 0, (run.stdout, run.stderr)
-    assert run.stdout.count("converged True") == 2
+    assert "converged on ranks: [True, True]" in run.stdout, run.stdout
