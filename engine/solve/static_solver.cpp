@@ -357,6 +357,17 @@ void StaticSolver::refill_preconditioner(SNES snes, Vec x) {
   PetscInt lag = 1, iteration = 0;
   SNEDE_PETSC(SNESGetLagPreconditioner(snes, &lag));
   SNEDE_PETSC(SNESGetIterationNumber(snes, &iteration));
+  // Galerkin levels kept through a solve (solve_nonlinear) are rebuilt when the last linear
+  // solve failed with them: kept levels made Newton's line search fail on the 63k liver.
+  if (keeps_levels_through_solve_ && iteration > 0 && lag == -1) {
+    KSPConvergedReason last = KSP_CONVERGED_ITERATING;
+    SNEDE_PETSC(KSPGetConvergedReason(ksp(), &last));
+    if (last < 0) {
+      SNEDE_PETSC(SNESSetLagPreconditioner(snes, -2));
+      lag = -2;
+      preconditioner_filled_ = false;
+    }
+  }
   // As SNES decides whether to rebuild the PC: -1 never again (-2 becomes -1 once built), k > 1
   // every k-th iteration.
   const bool lagged = (lag == -1 || (lag > 1 && iteration % lag != 0)) && preconditioner_filled_;
@@ -448,8 +459,9 @@ SolveResult StaticSolver::solve_nonlinear() {
   // factorisation) are built at the first Newton iteration of each solve — after each tool
   // move — and kept through the solve's other iterations, unless the options lag otherwise:
   // rebuilding them cost more than the CG iterations they save (docs/results/interactive.md).
-  if (multigrid_ && multigrid_->needs_assembled_tangent() &&
-      !option_database_.string_option(options_.options_prefix + "snes_lag_preconditioner")) {
+  keeps_levels_through_solve_ = multigrid_ && multigrid_->needs_assembled_tangent() &&
+                                !option_database_.string_option(options_.options_prefix + "snes_lag_preconditioner");
+  if (keeps_levels_through_solve_) {
     SNEDE_PETSC(SNESSetLagPreconditioner(snes_, -2));
     preconditioner_filled_ = false;
   }

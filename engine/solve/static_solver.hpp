@@ -124,6 +124,7 @@ class StaticSolver {
   // mg: remembers Chebyshev's estimates once the PC has made them (after a solve).
   void remember_smoother_bounds();
   bool preconditioner_filled_ = false;  // filled since it was made (for lagging)
+  bool keeps_levels_through_solve_ = false;  // Galerkin levels built once per solve (solve_nonlinear)
   std::uint64_t generation_ = 0;
   StoppingRule rule_;  // the stopping rule of the current solve, scaled to the model
   double external_norm_ = 0;

@@ -1,6 +1,8 @@
 #include "solve/tangent_assembly.hpp"
 
 #include <algorithm>
+#include <numeric>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -81,21 +83,40 @@ AssembledTangent::AssembledTangent(const Model& model, MatrixFormat format)
   const Connectivity& c = mesh.connectivity();
   const int d = model.dim();
   const VertexId n = mesh.n_points();
-  std::vector<std::vector<VertexId>> neighbours(n);
-  for (VertexId v = 0; v < n; ++v) neighbours[v].push_back(v);
+  // Each vertex's neighbours (itself included), sorted, in one flat array (CSR): a cut or a
+  // refinement rebuilds this for every solve that follows, so no per-vertex allocations.
   const std::vector<ElementId> elements = mesh.cell_ids();
+  std::vector<std::size_t> start(static_cast<std::size_t>(n) + 1, 0);
+  for (VertexId v = 0; v < n; ++v) start[v + 1] = 1;
+  for (ElementId e : elements) {
+    const auto vertices = c.element(e).simplex.oriented_vertices();
+    for (int a = 0; a <= d; ++a) start[vertices[a] + 1] += d;
+  }
+  std::partial_sum(start.begin(), start.end(), start.begin());
+  std::vector<VertexId> listed(start.back());
+  std::vector<std::size_t> fill(start.begin(), start.end() - 1);
+  for (VertexId v = 0; v < n; ++v) listed[fill[v]++] = v;
   for (ElementId e : elements) {
     const auto vertices = c.element(e).simplex.oriented_vertices();
     for (int a = 0; a <= d; ++a)
       for (int b = 0; b <= d; ++b)
-        if (a != b) neighbours[vertices[a]].push_back(vertices[b]);
+        if (a != b) listed[fill[vertices[a]]++] = vertices[b];
   }
-  for (auto& list : neighbours) {
-    std::sort(list.begin(), list.end());
-    list.erase(std::unique(list.begin(), list.end()), list.end());
+  std::vector<std::size_t> row(static_cast<std::size_t>(n) + 1, 0);  // compacted offsets
+  std::vector<VertexId> neighbour_list;
+  neighbour_list.reserve(listed.size());
+  for (VertexId v = 0; v < n; ++v) {
+    const auto first = listed.begin() + static_cast<std::ptrdiff_t>(start[v]);
+    const auto last = listed.begin() + static_cast<std::ptrdiff_t>(start[v + 1]);
+    std::sort(first, last);
+    neighbour_list.insert(neighbour_list.end(), first, std::unique(first, last));
+    row[v + 1] = neighbour_list.size();
   }
+  auto neighbours = [&](VertexId v) {
+    return std::span<const VertexId>(neighbour_list.data() + row[v], row[v + 1] - row[v]);
+  };
   auto rank = [&](VertexId a, VertexId b) {
-    const auto& list = neighbours[a];
+    const std::span<const VertexId> list = neighbours(a);
     return static_cast<std::int32_t>(std::lower_bound(list.begin(), list.end(), b) - list.begin());
   };
   block_rank_.assign(static_cast<std::size_t>(c.element_capacity()) * (d + 1) * (d + 1), 0);
@@ -115,17 +136,18 @@ AssembledTangent::AssembledTangent(const Model& model, MatrixFormat format)
   SNEDE_PETSC(MatSetBlockSize(A_, d));
   if (format == MatrixFormat::baij) {
     std::vector<PetscInt> blocks_per_row(n);
-    for (VertexId v = 0; v < n; ++v) blocks_per_row[v] = static_cast<PetscInt>(neighbours[v].size());
+    for (VertexId v = 0; v < n; ++v) blocks_per_row[v] = static_cast<PetscInt>(neighbours(v).size());
     SNEDE_PETSC(MatXAIJSetPreallocation(A_, d, blocks_per_row.data(), nullptr, nullptr, nullptr));
   } else {
     // Scalar CSR with each row's columns sorted: PETSc keeps them in this order, so the value
     // of (row 3a + i, column 3b + j) lies at row_start[3a + i] + 3·rank(a, b) + j.
     row_start_.resize(static_cast<std::size_t>(rows) + 1);
     std::vector<PetscInt> columns;
+    columns.reserve(neighbour_list.size() * d * d);
     for (VertexId v = 0; v < n; ++v)
       for (int i = 0; i < d; ++i) {
         row_start_[static_cast<std::size_t>(v) * d + i] = static_cast<PetscInt>(columns.size());
-        for (VertexId w : neighbours[v])
+        for (VertexId w : neighbours(v))
           for (int j = 0; j < d; ++j) columns.push_back(static_cast<PetscInt>(w) * d + j);
       }
     row_start_.back() = static_cast<PetscInt>(columns.size());
