@@ -302,3 +302,31 @@ def test_bad_coarsening_options_are_refused_naming_them(gmsh_cylinder):
             snede.StaticSolver(body, "cg", preconditioner="mg", petsc_options=options)
     with pytest.raises(ValueError, match="gives [0-9]+ levels"):
         snede.StaticSolver(body, "cg", preconditioner="mg", petsc_options={"pc_mg_levels": 12})
+
+
+@pytest.mark.parametrize("coarsening", COARSENINGS)
+def test_random_edits_and_delaunay_cuts_in_2d_keep_the_plain_answer(coarsening):
+    rng = np.random.default_rng(11)
+    mesh = snede.meshing.rectangle((0.4, 0.1), (40, 10))
+    body = held_body(mesh, thickness=0.01)
+    solver = snede.StaticSolver(body, "cg", rtol=1e-8, preconditioner="mg", petsc_options={"mg_coarsening": coarsening})
+    cutter = snede.DelaunayCutter(body)
+    edits = 0
+    for step in range(6):
+        if step % 2:
+            x = 0.05 + 0.3 * rng.random()
+            cutter.lift()
+            cutter.cut([(x, -0.01), (x + 0.01, 0.04 + 0.03 * rng.random())])
+        else:
+            edits += sum(random_edit(mesh, rng) for _ in range(8))
+        mesh.validate()
+        body.displacement = np.zeros_like(body.displacement)
+        result = solver.solve()
+        assert result.converged, (step, result.reason)
+        assert solver.multigrid_source == coarsening
+        u = body.displacement.copy()
+        _, plain, reference = solve(body)
+        assert plain.converged
+        assert relative_difference(u, reference) < 1e-6, step
+        assert result.iterations < plain.iterations / 4, (step, result.iterations, plain.iterations)
+    assert edits > 0
