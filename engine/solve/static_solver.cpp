@@ -295,20 +295,13 @@ void StaticSolver::build_multigrid() {
     }
   };
   multigrid_.reset();
-  // A failed attempt is not repeated until the tree or the constraints change: a cut or a flip
-  // takes elements out of the tree for good, and trying again cost 11 ms per move at 24k cells.
-  const std::pair<std::size_t, std::uint64_t> tree_state =
-      hierarchy_ ? std::pair{hierarchy_->n_nodes(), model_.constraints().projection_fingerprint()}
-                 : std::pair<std::size_t, std::uint64_t>{};
-  const bool worth_trying = coarsening == "bisection" || !bisection_failed_at_ || *bisection_failed_at_ != tree_state;
-  if (coarsening != "aggregation" && coarsening != "grid" && hierarchy_ && worth_trying) {
+  if (coarsening != "aggregation" && coarsening != "grid" && hierarchy_) {
     try {
       multigrid_ = std::make_unique<BisectionMultigrid>(model_, *hierarchy_, max_levels);
     } catch (const std::invalid_argument&) {
       // No conforming coarser cut (a mesh never refined, or one that was cut or flipped since):
       // any mesh can be coarsened on its own.
       if (coarsening == "bisection") throw;
-      bisection_failed_at_ = tree_state;
     }
   }
   if (!multigrid_ && coarsening != "aggregation") {

@@ -10,9 +10,7 @@
 #include <petscksp.h>
 #include <petscsnes.h>
 
-#include <optional>
 #include <string>
-#include <utility>
 #include <vector>
 
 #include "core/solver_options.hpp"
@@ -127,8 +125,6 @@ class StaticSolver {
   void remember_smoother_bounds();
   bool preconditioner_filled_ = false;  // filled since it was made (for lagging)
   bool keeps_levels_through_solve_ = false;  // Galerkin levels built once per solve (solve_nonlinear)
-  // mg: the refinement tree's size and the constraints when bisection levels last failed.
-  std::optional<std::pair<std::size_t, std::uint64_t>> bisection_failed_at_;
   std::uint64_t generation_ = 0;
   StoppingRule rule_;  // the stopping rule of the current solve, scaled to the model
   double external_norm_ = 0;
