@@ -330,3 +330,23 @@ def test_random_edits_and_delaunay_cuts_in_2d_keep_the_plain_answer(coarsening):
         assert relative_difference(u, reference) < 1e-6, step
         assert result.iterations < plain.iterations / 4, (step, result.iterations, plain.iterations)
     assert edits > 0
+
+
+def test_a_needle_into_a_gmsh_mesh_with_mg_gives_the_plain_insertion(gmsh_cylinder):
+    # The needle's stick-slip changes constraints between solves and its refinement changes the
+    # mesh: mg (grid levels: the cylinder has no bisection levels) follows both.
+    def insertion(preconditioner):
+        mesh = snede.Mesh(gmsh_cylinder.points, gmsh_cylinder.cells)
+        body = snede.Body(mesh, snede.LinearElastic(1e4, 0.3))
+        body.fix(np.isclose(mesh.points[:, 0], 0.1))
+        needle = snede.NeedleInsertion(body, (0.0, 0.001, 0.002), (1.0, 0.0, 0.0),
+                                       snede.FrictionProfile.uniform(50.0), radius=1e-3, h_ref=0.004,
+                                       rtol=1e-8, petsc_options={"pc_type": preconditioner})
+        reports = [needle.advance(0.004) for _ in range(5)]
+        return body, reports
+
+    plain_body, plain = insertion("none")
+    body, reports = insertion("mg")
+    assert all(report.converged for report in plain + reports)
+    assert body.mesh.n_cells == plain_body.mesh.n_cells > gmsh_cylinder.n_cells  # refined alike
+    assert relative_difference(body.displacement, plain_body.displacement) < 1e-5
