@@ -15,8 +15,11 @@ from __future__ import annotations
 
 import argparse
 import logging
+import os
 import runpy
+import signal
 import sys
+import threading
 import traceback
 from pathlib import Path
 
@@ -127,6 +130,8 @@ def main(argv: list[str] | None = None) -> int:
     logger.setLevel(logging.WARNING if args.quiet else logging.INFO)
     import snede  # (initialised PETSc with the PETSc options of sys.argv)
 
+    if signal.getsignal(signal.SIGINT) is signal.default_int_handler:
+        signal.signal(signal.SIGINT, _interrupt_outside_finalizers)
     try:
         code = _command(parser, args, unknown, petsc)
     except (snede.PetscError, ValueError, OSError) as error:  # a bad PETSc option value, bad input
@@ -140,6 +145,20 @@ def main(argv: list[str] | None = None) -> int:
     if args.command != "list":
         _warn_unused(logger)
     return code
+
+
+def _interrupt_outside_finalizers(signum, frame) -> None:
+    """Ctrl-C as KeyboardInterrupt, except inside a finalizer (a weakref callback or a
+    __del__, run whenever the garbage collector frees PETSc objects): Python prints and
+    swallows an exception raised there, and the run went on to its end with status 0. There the
+    signal is sent again a moment later, once the finalizer has returned."""
+    while frame is not None:
+        code = frame.f_code
+        if code.co_name == "__del__" or code.co_filename.endswith("weakref.py"):
+            threading.Timer(0.02, os.kill, (os.getpid(), signum)).start()
+            return
+        frame = frame.f_back
+    raise KeyboardInterrupt
 
 
 def _command(parser, args, unknown, petsc) -> int:

@@ -13,6 +13,12 @@ import pytest
 
 from snede.output import read_series
 
+# A process started with SIGINT ignored (nohup, or `cmd &` from a script) passes that on to its
+# children, which then never see the Ctrl-C these tests send (issue 38): skip rather than fail.
+needs_sigint = pytest.mark.skipif(signal.getsignal(signal.SIGINT) is signal.SIG_IGN,
+                                  reason="SIGINT is ignored in this process (nohup or a background job of a "
+                                         "script): its children inherit that and cannot be interrupted")
+
 LONG_SOLVE = textwrap.dedent("""
     import numpy as np, snede
     mesh = snede.meshing.box((0.2, 0.05, 0.05), (64, 16, 16))
@@ -49,6 +55,7 @@ def interrupt_after(arguments, marker: str, delay: float = 0.3, timeout: float =
     return child.returncode, "".join(lines) + out, err
 
 
+@needs_sigint
 def test_ctrl_c_stops_a_solve_between_iterations_and_petsc_keeps_working():
     status, out, err = interrupt_after([sys.executable, "-c", LONG_SOLVE], "solving")
     assert "KeyboardInterrupt" in out and "finished" not in out, (out, err)
@@ -56,6 +63,7 @@ def test_ctrl_c_stops_a_solve_between_iterations_and_petsc_keeps_working():
     assert status == 0
 
 
+@needs_sigint
 def test_gmsh_meshing_leaves_ctrl_c_to_python():
     script = textwrap.dedent("""
         import os, signal, time, snede
@@ -70,6 +78,7 @@ def test_gmsh_meshing_leaves_ctrl_c_to_python():
     assert run.returncode == 0 and "caught" in run.stdout, (run.returncode, run.stdout, run.stderr)
 
 
+@needs_sigint
 def test_the_command_line_stops_with_one_line_and_the_series_so_far_reads_back(tmp_path):
     status, out, err = interrupt_after(
         [sys.executable, "-m", "snede", "run", "sheet-cut", "--divisions", "20", "--out", str(tmp_path)],
