@@ -337,10 +337,8 @@ AggregationMultigrid::AggregationMultigrid(Model& fine, int max_levels, bool smo
     level.n_aggregates = n_aggregates;
     NodeLevel coarser = coarsen(current, aggregate_of, n_aggregates, level.interpolation);
     level.n_unknowns = coarser.first.back();
-    if (finest_first.empty()) {
-      if (smooth_first_level) level.interpolation = smoothed_interpolation(fine, current, level.interpolation);
-      vertex_aggregate_ = std::move(aggregate_of);
-    }
+    if (finest_first.empty() && smooth_first_level)
+      level.interpolation = smoothed_interpolation(fine, current, level.interpolation);
     finest_first.push_back(std::move(level));
     current = std::move(coarser);
     if (current.first.back() <= direct_unknowns) break;

@@ -53,9 +53,6 @@ class AggregationMultigrid final : public Multigrid {
   void configure(PC pc, const SolverOptions& options, const std::vector<double>& smoother_bounds = {}) override;
   void update(Vec) override {}
 
-  // Per fine-mesh vertex, the first level's aggregate holding it (-1 for a removed vertex).
-  const std::vector<std::int32_t>& vertex_aggregates() const { return vertex_aggregate_; }
-
  private:
   struct Level {
     std::size_t n_aggregates = 0;
@@ -66,7 +63,6 @@ class AggregationMultigrid final : public Multigrid {
   Model& fine_;
   std::uint64_t revision_;
   std::uint64_t constraints_;
-  std::vector<std::int32_t> vertex_aggregate_;
   std::vector<Level> coarse_;  // coarsest first
 };
 
