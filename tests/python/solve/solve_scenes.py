@@ -26,3 +26,27 @@ def soft_beam(material=None, divisions=(8, 2, 2)):
     body.fix(np.isclose(mesh.points[:, 0], 0.0))
     body.add_gravity((0.0, 0.0, -9.81))
     return body
+
+
+def solve_from_rest(body, method="cg", rtol=1e-8, **options):
+    """A solve from rest; without a preconditioner unless one is given (the plain reference).
+    Returns (solver, result, displacement)."""
+    options.setdefault("preconditioner", "none")
+    body.displacement = np.zeros_like(body.displacement)
+    solver = snede.StaticSolver(body, method, rtol=rtol, **options)
+    result = solver.solve()
+    return solver, result, body.displacement.copy()
+
+
+def relative_difference(a, b):
+    return np.linalg.norm(a - b) / np.linalg.norm(b)
+
+
+def as_dense(mat):
+    """The entries of an assembled petsc4py Mat as a numpy array."""
+    rows, columns = mat.getSize()
+    result = np.zeros((rows, columns))
+    for i in range(rows):
+        cols, values = mat.getRow(i)
+        result[i, cols] = values
+    return result

@@ -12,6 +12,8 @@ import pytest
 from petsc4py import PETSc
 
 import snede
+from solve_scenes import as_dense, relative_difference
+from solve_scenes import solve_from_rest as solve
 
 
 def cantilever(dim, levels, material=None):
@@ -28,19 +30,6 @@ def cantilever(dim, levels, material=None):
     body.fix(np.isclose(mesh.points[:, 0], 0.0))
     body.add_gravity((0.0, -9.81) if dim == 2 else (0.0, 0.0, -9.81))
     return body
-
-
-def solve(body, method="cg", rtol=1e-8, **options):
-    """A solve from rest; without a preconditioner unless one is given (the plain reference)."""
-    options.setdefault("preconditioner", "none")
-    body.displacement = np.zeros_like(body.displacement)
-    solver = snede.StaticSolver(body, method, rtol=rtol, **options)
-    result = solver.solve()
-    return solver, result, body.displacement.copy()
-
-
-def relative_difference(a, b):
-    return np.linalg.norm(a - b) / np.linalg.norm(b)
 
 
 @pytest.mark.parametrize("dim", [2, 3])
@@ -75,15 +64,6 @@ def dense(operator, n):
         operator.mult(x, y)
         columns.append(y.getArray().copy())
     return np.array(columns).T
-
-
-def as_dense(mat):
-    rows, columns = mat.getSize()
-    result = np.zeros((rows, columns))
-    for i in range(rows):
-        cols, values = mat.getRow(i)
-        result[i, cols] = values
-    return result
 
 
 @pytest.mark.parametrize("dim", [2, 3])

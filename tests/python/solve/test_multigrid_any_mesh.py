@@ -11,6 +11,8 @@ import numpy as np
 import pytest
 
 import snede
+from solve_scenes import as_dense, relative_difference
+from solve_scenes import solve_from_rest as solve
 
 
 def held_body(mesh, material=None, thickness=None):
@@ -19,28 +21,6 @@ def held_body(mesh, material=None, thickness=None):
     body.fix(np.isclose(x[:, 0], x[:, 0].min()))
     body.add_gravity((0.0, -9.81) if mesh.dim == 2 else (0.0, 0.0, -9.81))
     return body
-
-
-def solve(body, method="cg", rtol=1e-8, **options):
-    """A solve from rest; without a preconditioner unless one is given (the plain reference)."""
-    options.setdefault("preconditioner", "none")
-    body.displacement = np.zeros_like(body.displacement)
-    solver = snede.StaticSolver(body, method, rtol=rtol, **options)
-    result = solver.solve()
-    return solver, result, body.displacement.copy()
-
-
-def relative_difference(a, b):
-    return np.linalg.norm(a - b) / np.linalg.norm(b)
-
-
-def as_dense(mat):
-    rows, columns = mat.getSize()
-    result = np.zeros((rows, columns))
-    for i in range(rows):
-        cols, values = mat.getRow(i)
-        result[i, cols] = values
-    return result
 
 
 def rigid_modes(points):
@@ -198,6 +178,21 @@ def random_edit(mesh, rng):
     return result.done
 
 
+def assert_mg_keeps_the_plain_answer(solver, body, coarsening, step, fraction):
+    """After an edit: the solver's mg solve from rest converges on levels of `coarsening`, equals
+    the unpreconditioned solve to 1e-6 and takes under `fraction` of its CG iterations."""
+    body.mesh.validate()
+    body.displacement = np.zeros_like(body.displacement)
+    result = solver.solve()
+    assert result.converged, (step, result.reason)
+    assert solver.multigrid_source == coarsening
+    u = body.displacement.copy()
+    _, plain, reference = solve(body)
+    assert plain.converged
+    assert relative_difference(u, reference) < 1e-6, step
+    assert result.iterations < fraction * plain.iterations, (step, result.iterations, plain.iterations)
+
+
 @pytest.mark.parametrize("coarsening", COARSENINGS)
 def test_random_edits_and_cuts_keep_the_plain_answer_in_bounded_iterations(coarsening, gmsh_cylinder):
     rng = np.random.default_rng(7)
@@ -215,24 +210,15 @@ def test_random_edits_and_cuts_keep_the_plain_answer_in_bounded_iterations(coars
             cutter.move([(x + 0.002, y + 0.02, -0.03), (x + 0.002, y + 0.02, 0.03)])
         else:
             edits += sum(random_edit(mesh, rng) for _ in range(5))
-        mesh.validate()
-        body.displacement = np.zeros_like(body.displacement)
-        result = solver.solve()
-        assert result.converged, (step, result.reason)
-        assert solver.multigrid_source == coarsening
-        u = body.displacement.copy()
-        _, plain, reference = solve(body)
-        assert plain.converged
-        assert relative_difference(u, reference) < 1e-6, step
         # The edits make the problem harder (plain CG: 363 → 797 iterations here); multigrid
         # keeps its advantage at every step (measured 1/17 to 1/14).
-        assert result.iterations < plain.iterations / 8, (step, result.iterations, plain.iterations)
+        assert_mg_keeps_the_plain_answer(solver, body, coarsening, step, 1 / 8)
     assert edits > 0
 
 
 def test_mg_continues_through_a_cut_of_a_bisected_mesh():
     # Bisection levels before the cut; the cut takes elements out of the refinement tree, and
-    # the next solve coarsens by aggregation instead of refusing.
+    # the next solve coarsens on a grid instead of refusing.
     mesh = snede.meshing.box((0.4, 0.1, 0.1), (4, 1, 1))
     mesh.refine_uniform(6)
     body = held_body(mesh)
@@ -319,16 +305,7 @@ def test_random_edits_and_delaunay_cuts_in_2d_keep_the_plain_answer(coarsening):
             cutter.cut([(x, -0.01), (x + 0.01, 0.04 + 0.03 * rng.random())])
         else:
             edits += sum(random_edit(mesh, rng) for _ in range(8))
-        mesh.validate()
-        body.displacement = np.zeros_like(body.displacement)
-        result = solver.solve()
-        assert result.converged, (step, result.reason)
-        assert solver.multigrid_source == coarsening
-        u = body.displacement.copy()
-        _, plain, reference = solve(body)
-        assert plain.converged
-        assert relative_difference(u, reference) < 1e-6, step
-        assert result.iterations < plain.iterations / 4, (step, result.iterations, plain.iterations)
+        assert_mg_keeps_the_plain_answer(solver, body, coarsening, step, 1 / 4)
     assert edits > 0
 
 
