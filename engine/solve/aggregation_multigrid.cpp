@@ -312,9 +312,7 @@ std::size_t count_active(const NodeLevel& level) {
 }  // namespace
 
 AggregationMultigrid::AggregationMultigrid(Model& fine, int max_levels, bool smooth_first_level, double aggregate_width)
-    : fine_(fine),
-      revision_(fine.body().mesh().connectivity().revision()),
-      constraints_(fine.constraints().projection_fingerprint()) {
+    : GalerkinMultigrid(fine) {
   if (max_levels == 1 || max_levels < 0)
     throw std::invalid_argument("mg needs at least 2 levels (the mesh and a coarser one), got pc_mg_levels " +
                                 std::to_string(max_levels));
@@ -351,14 +349,6 @@ AggregationMultigrid::AggregationMultigrid(Model& fine, int max_levels, bool smo
 }
 
 AggregationMultigrid::~AggregationMultigrid() = default;
-
-bool AggregationMultigrid::matches_mesh(const Model& fine) const {
-  return &fine == &fine_ && fine.body().mesh().connectivity().revision() == revision_;
-}
-
-bool AggregationMultigrid::matches(const Model& fine) const {
-  return matches_mesh(fine) && fine.constraints().projection_fingerprint() == constraints_;
-}
 
 std::vector<std::size_t> AggregationMultigrid::level_sizes() const {
   std::vector<std::size_t> sizes;

@@ -25,7 +25,7 @@
 
 namespace snede {
 
-class AggregationMultigrid final : public Multigrid {
+class AggregationMultigrid final : public GalerkinMultigrid {
  public:
   // Levels for `fine`'s mesh (volume meshes: triangles in 2D, tetrahedra in 3D): coarsened
   // until the coarsest level has few enough unknowns for a direct solve, or to `max_levels`
@@ -41,17 +41,11 @@ class AggregationMultigrid final : public Multigrid {
   ~AggregationMultigrid() override;
 
   const char* source() const override { return "aggregation"; }
-  bool matches(const Model& fine) const override;
-  bool matches_mesh(const Model& fine) const override;
-  // The constraints are part of the interpolation: new constraints need new levels.
-  bool follow_constraints() override { return false; }
   int n_levels() const override { return static_cast<int>(coarse_.size()) + 1; }
   // Aggregates per coarse level, coarsest first, then the fine mesh's cells.
   std::vector<std::size_t> level_sizes() const override;
   std::vector<std::size_t> level_unknowns() const override;
-  bool needs_assembled_tangent() const override { return true; }
   void configure(PC pc, const SolverOptions& options, const std::vector<double>& smoother_bounds = {}) override;
-  void update(Vec) override {}
 
  private:
   struct Level {
@@ -60,9 +54,6 @@ class AggregationMultigrid final : public Multigrid {
     MatHandle interpolation;  // from this level to the next finer one
   };
 
-  Model& fine_;
-  std::uint64_t revision_;
-  std::uint64_t constraints_;
   std::vector<Level> coarse_;  // coarsest first
 };
 

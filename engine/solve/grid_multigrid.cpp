@@ -68,9 +68,7 @@ class KuhnGrid {
 }  // namespace
 
 GridMultigrid::GridMultigrid(Model& fine, double grid_width)
-    : fine_(fine),
-      revision_(fine.body().mesh().connectivity().revision()),
-      constraints_(fine.constraints().projection_fingerprint()) {
+    : GalerkinMultigrid(fine) {
   const Mesh& mesh = fine.body().mesh();
   if (mesh.is_surface())
     throw std::invalid_argument("preconditioner 'mg' works on volume meshes (triangles in 2D, tetrahedra in 3D), "
@@ -183,14 +181,6 @@ GridMultigrid::GridMultigrid(Model& fine, double grid_width)
   }
   SNEDE_PETSC(MatAssemblyBegin(interpolation_, MAT_FINAL_ASSEMBLY));
   SNEDE_PETSC(MatAssemblyEnd(interpolation_, MAT_FINAL_ASSEMBLY));
-}
-
-bool GridMultigrid::matches_mesh(const Model& fine) const {
-  return &fine == &fine_ && fine.body().mesh().connectivity().revision() == revision_;
-}
-
-bool GridMultigrid::matches(const Model& fine) const {
-  return matches_mesh(fine) && fine.constraints().projection_fingerprint() == constraints_;
 }
 
 std::vector<std::size_t> GridMultigrid::level_sizes() const { return {n_nodes_, fine_.body().mesh().n_cells()}; }

@@ -18,7 +18,7 @@
 
 namespace snede {
 
-class GridMultigrid final : public Multigrid {
+class GridMultigrid final : public GalerkinMultigrid {
  public:
   // Two levels: `fine`'s volume mesh and a grid `grid_width` mean edge lengths wide.
   // Throws std::invalid_argument for a surface mesh or a non-positive width.
@@ -27,21 +27,13 @@ class GridMultigrid final : public Multigrid {
   static constexpr double default_grid_width = 3.0;
 
   const char* source() const override { return "grid"; }
-  bool matches(const Model& fine) const override;
-  bool matches_mesh(const Model& fine) const override;
-  bool follow_constraints() override { return false; }
   int n_levels() const override { return 2; }
   // Coarse node copies, then the fine mesh's cells.
   std::vector<std::size_t> level_sizes() const override;
   std::vector<std::size_t> level_unknowns() const override;
-  bool needs_assembled_tangent() const override { return true; }
   void configure(PC pc, const SolverOptions& options, const std::vector<double>& smoother_bounds = {}) override;
-  void update(Vec) override {}
 
  private:
-  Model& fine_;
-  std::uint64_t revision_;
-  std::uint64_t constraints_;
   std::size_t n_nodes_ = 0;
   PetscInt n_unknowns_ = 0;
   MatHandle interpolation_;

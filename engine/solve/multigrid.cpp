@@ -14,6 +14,19 @@ constexpr double chebyshev_lower_fraction = 0.1;
 
 }  // namespace
 
+GalerkinMultigrid::GalerkinMultigrid(Model& fine)
+    : fine_(fine),
+      revision_(fine.body().mesh().connectivity().revision()),
+      constraints_(fine.constraints().projection_fingerprint()) {}
+
+bool GalerkinMultigrid::matches_mesh(const Model& fine) const {
+  return &fine == &fine_ && fine.body().mesh().connectivity().revision() == revision_;
+}
+
+bool GalerkinMultigrid::matches(const Model& fine) const {
+  return matches_mesh(fine) && fine.constraints().projection_fingerprint() == constraints_;
+}
+
 void set_chebyshev_jacobi_smoother(KSP smoother, const SolverOptions& options, double largest_bound) {
   options.use_for(smoother);
   SNEDE_PETSC(KSPSetType(smoother, KSPCHEBYSHEV));

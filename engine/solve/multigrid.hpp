@@ -7,6 +7,7 @@
 #include <petscksp.h>
 
 #include <cstddef>
+#include <cstdint>
 #include <vector>
 
 #include "core/solver_options.hpp"
@@ -43,6 +44,26 @@ class Multigrid {
   // Relinearises matrix-free levels at the fine state u (a no-op for Galerkin levels, which
   // PCMG recomputes from the refilled fine matrix).
   virtual void update(Vec u) = 0;
+};
+
+// Levels of any mesh (grid_multigrid.hpp, aggregation_multigrid.hpp) whose coarse operators are
+// Galerkin products with the assembled fine tangent. Their interpolation holds the mesh and the
+// constraints' projections, so any change of either means new levels.
+class GalerkinMultigrid : public Multigrid {
+ public:
+  bool matches(const Model& fine) const override;
+  bool matches_mesh(const Model& fine) const override;
+  bool follow_constraints() override { return false; }
+  bool needs_assembled_tangent() const override { return true; }
+  void update(Vec) override {}
+
+ protected:
+  explicit GalerkinMultigrid(Model& fine);
+  Model& fine_;
+
+ private:
+  std::uint64_t revision_;
+  std::uint64_t constraints_;
 };
 
 // Chebyshev/Jacobi on one smoothed level: with `largest_bound` > 0 the bounds are fixed from
