@@ -258,7 +258,7 @@ void StaticSolver::build_multigrid() {
   const std::optional<std::string> galerkin = option_database_.string_option(options_.options_prefix + "pc_mg_galerkin");
   if (galerkin && *galerkin != "none" && *galerkin != "false" && *galerkin != "0")
     throw std::invalid_argument(prefix + "pc_mg_galerkin: 'mg' chooses its coarse operators itself (the levels' "
-                                "own shells on a bisection hierarchy, Galerkin products on aggregates)");
+                                "own shells on a bisection hierarchy, Galerkin products on grid or aggregation levels)");
   // PCMG's own -pc_mg_levels would replace the levels configured here: it limits them instead.
   const std::optional<std::string> levels = option_database_.string_option(options_.options_prefix + "pc_mg_levels");
   int max_levels = 0;
@@ -281,7 +281,7 @@ void StaticSolver::build_multigrid() {
                                 coarsening + "'");
   if (coarsening == "bisection" && !hierarchy_)
     throw std::invalid_argument(prefix + "mg_coarsening bisection: this mesh has no bisection hierarchy (refine it "
-                                "with mesh.refine_uniform or refine_around first, or use aggregation)");
+                                "with mesh.refine_uniform or refine_around first, or use grid or aggregation)");
   auto number_option = [&](const std::string& name, double fallback) {
     const std::optional<std::string> text = option_database_.string_option(options_.options_prefix + name);
     if (!text) return fallback;
