@@ -149,14 +149,20 @@ double cell_longest_edge(int cell_dim, int space_dim, std::span<const double> co
   return cell_dim == space_dim ? longest_edge(cell_dim, corners) : longest_edge(2, flattened_triangle(corners));
 }
 
+double corner_extent(int space_dim, std::span<const double> corners) {
+  double extent = 0;
+  for (std::size_t i = 0; i < corners.size(); ++i)
+    extent = std::max(extent, std::abs(corners[i] - corners[i % space_dim]));
+  return extent;
+}
+
 bool has_zero_volume(int cell_dim, int space_dim, std::span<const double> corners) {
   constexpr double tolerance = 64 * std::numeric_limits<double>::epsilon();
   // Decided on the corners relative to the first one, divided by a power of two near their
   // extent: the same doubles scaled exactly, so the decision is the same at every scale and
   // neither L^d nor the measure overflows for coordinates of 1e300.
   std::vector<double> x(corners.begin(), corners.end());
-  double extent = 0;
-  for (std::size_t i = 0; i < x.size(); ++i) extent = std::max(extent, std::abs(x[i] - corners[i % space_dim]));
+  const double extent = corner_extent(space_dim, corners);
   if (extent > 0 && std::isfinite(extent)) {
     int exponent = 0;
     std::frexp(extent, &exponent);

@@ -33,6 +33,8 @@ std::array<double, 6> flattened_triangle(std::span<const double> corners);
 // coordinates: its signed volume (area ≥ 0 for a surface triangle) and longest edge.
 double cell_measure(int cell_dim, int space_dim, std::span<const double> corners);
 double cell_longest_edge(int cell_dim, int space_dim, std::span<const double> corners);
+// The largest coordinate difference between the cell's first corner and the others (max norm).
+double corner_extent(int space_dim, std::span<const double> corners);
 // Whether the cell is degenerate: |V| ≤ 64ε·(longest edge)^cell_dim, a few ulps of its scale,
 // so that thin but real cells (aspect ratio 1e-6) are not. The mesh refuses such cells, and
 // edits refuse to make them.

@@ -45,6 +45,18 @@ std::vector<VertexId> checked_cells(int cell_dim, int space_dim, const std::vect
               << " for a longest edge of " << cell_longest_edge(cell_dim, space_dim, corners) << ")";
       throw std::invalid_argument(message.str());
     }
+    // The predicate above is exact at any scale, but the finite elements compute with the
+    // measure itself: one that underflows (to 0 or a subnormal) or overflows would make the
+    // body's kernels divide by zero or give inf, so such a mesh is refused here, not later.
+    if (!std::isnormal(volume)) {
+      std::ostringstream message;
+      const bool too_small = std::abs(volume) < std::numeric_limits<double>::min();
+      message << "cell " << c << "'s " << (cell_dim == 2 ? "area" : "volume") << " is "
+              << (too_small ? "too small" : "too large") << " for double precision (" << volume
+              << " for corners " << corner_extent(space_dim, corners) << " apart): express the "
+              << "coordinates in " << (too_small ? "smaller" : "larger") << " units";
+      throw std::invalid_argument(message.str());
+    }
     if (volume < 0) {
       std::swap(cell[0], cell[1]);
       ++n_reoriented;

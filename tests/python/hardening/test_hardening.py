@@ -1,5 +1,7 @@
 """Issue 14 items: convergence is never reported at overflow and does not depend on the units;
 solver arguments are checked; materials say what they are; XDMF names are escaped."""
+import math
+import sys
 import xml.etree.ElementTree as ElementTree
 
 import meshio
@@ -158,11 +160,27 @@ def test_fixing_one_vertex_twice_with_different_values_is_refused_and_changes_no
     assert body.displacement[3, 0] == 0.1
 
 
-@pytest.mark.parametrize("scale", [1e-150, 1.0, 1e150, 1e300])
-def test_a_mesh_is_accepted_at_any_coordinate_scale_and_a_flat_cell_refused_at_each(scale):
-    points = scale * np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0], [1.0, 1.0]])
-    mesh = snede.Mesh(points, [[0, 1, 2], [1, 3, 2]])
-    mesh.validate()
+UNIT_CELLS = {  # cell dimension: (corners, measure of the unit cell)
+    2: (np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]), 0.5),
+    3: (np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]), 1.0 / 6.0),
+}
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+@pytest.mark.parametrize("scale", [1e-310, 1e-200, 1e-150, 1e-100, 1.0, 1e100, 1e150, 1e200, 1e300])
+def test_a_mesh_is_accepted_where_its_measures_are_doubles_and_refused_with_the_reason_elsewhere(scale, dim):
+    corners, unit_measure = UNIT_CELLS[dim]
+    # Independent of the engine: whether scale^dim · unit measure is a normal double, in logarithms.
+    log_measure = dim * math.log10(scale) + math.log10(unit_measure)
+    representable = math.log10(sys.float_info.min) < log_measure < math.log10(sys.float_info.max)
+    if representable:
+        mesh = snede.Mesh(scale * corners, [list(range(dim + 1))])
+        mesh.validate()
+        assert mesh.quality().volume[0] == pytest.approx(unit_measure * scale**dim, rel=1e-12)
+    else:
+        units = "smaller" if log_measure < 0 else "larger"
+        with pytest.raises(ValueError, match=f"cell 0's (area|volume) is too .* in {units} units"):
+            snede.Mesh(scale * corners, [list(range(dim + 1))])
     flat = scale * np.array([[0.0, 0.0], [1.0, 0.0], [2.0, 0.0]])
     with pytest.raises(ValueError, match="zero"):
         snede.Mesh(flat, [[0, 1, 2]])
