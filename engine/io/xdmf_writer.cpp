@@ -1,6 +1,7 @@
 #include "io/xdmf_writer.hpp"
 
 #include <algorithm>
+#include <cstdio>
 #include <fstream>
 #include <numeric>
 #include <stdexcept>
@@ -64,16 +65,93 @@ std::string xml_escaped(const std::string& text) {
   return out;
 }
 
-// What is wrong with the fields ("" if nothing): each must name one HDF5 dataset of the step
-// (not empty, no '/', not a name taken) and hold one value per cell or point; `taken`
-// collects the names.
+// The code point whose UTF-8 encoding starts at text[at], and the number of bytes it takes;
+// 0 bytes when text[at] does not start one (a stray byte, a cut, overlong or surrogate form).
+struct CodePoint {
+  char32_t value = 0;
+  std::size_t length = 0;
+};
+
+CodePoint utf8_code_point(const std::string& text, std::size_t at) {
+  const auto lead = static_cast<unsigned char>(text[at]);
+  if (lead < 0x80) return {lead, 1};
+  const std::size_t length = lead >= 0xF0 ? 4 : lead >= 0xE0 ? 3 : lead >= 0xC0 ? 2 : 0;
+  if (length == 0 || at + length > text.size()) return {};
+  char32_t value = lead & (0x7F >> length);
+  for (std::size_t k = 1; k < length; ++k) {
+    const auto next = static_cast<unsigned char>(text[at + k]);
+    if ((next & 0xC0) != 0x80) return {};
+    value = value << 6 | (next & 0x3F);
+  }
+  static constexpr char32_t smallest[] = {0, 0, 0x80, 0x800, 0x10000};
+  if (value < smallest[length] || value > 0x10FFFF || (value >= 0xD800 && value <= 0xDFFF)) return {};
+  return {value, length};
+}
+
+// Control characters: not in XML 1.0 at all, or (tab, newline, carriage return) read back
+// by an XML parser as a space or a newline.
+bool is_control(char32_t c) { return c < 0x20; }
+// Code points XML 1.0 excludes besides the control characters.
+bool is_xml_excluded(char32_t c) { return c == 0xFFFE || c == 0xFFFF; }
+
+// A field name as a message shows it: what would not print (or is not text) escaped.
+std::string shown(const std::string& name) {
+  static const char digits[] = "0123456789abcdef";
+  std::string out;
+  for (std::size_t at = 0; at < name.size();) {
+    const CodePoint c = utf8_code_point(name, at);
+    if (c.length == 0 || is_control(c.value)) {
+      const auto byte = static_cast<unsigned char>(name[at]);
+      out += std::string("\\x") + digits[byte >> 4] + digits[byte & 0xF];
+      ++at;
+    } else if (is_xml_excluded(c.value)) {
+      out += c.value == 0xFFFE ? "\\ufffe" : "\\uffff";
+      at += c.length;
+    } else {
+      out += name.substr(at, c.length);
+      at += c.length;
+    }
+  }
+  return out;
+}
+
+std::string code_point_name(char32_t c) {
+  char text[16];
+  std::snprintf(text, sizeof text, "U+%04X", static_cast<unsigned>(c));
+  return text;
+}
+
+// Why `name` cannot be a field's ("" if it can): the name is both an HDF5 dataset's (no '/',
+// no NUL, not "." or "..") and text in the XDMF file, which must read it back unchanged:
+// UTF-8, only XML characters, none that XML turns into spaces, and no space at the end, where
+// readers trim the path to the dataset.
+std::string field_name_problem(const std::string& name) {
+  if (name.empty() || name.find('/') != std::string::npos || name == "." || name == "..")
+    return "give a non-empty name without '/', other than '.' and '..'";
+  for (std::size_t at = 0; at < name.size();) {
+    const CodePoint c = utf8_code_point(name, at);
+    if (c.length == 0) return "it is not UTF-8 text (byte " + std::to_string(at) + ")";
+    if (is_control(c.value))
+      return "it holds the control character " + code_point_name(c.value) +
+             ", which an XDMF (XML) file cannot hold or reads back as a space";
+    if (is_xml_excluded(c.value))
+      return "it holds " + code_point_name(c.value) + ", which is not an XML character";
+    at += c.length;
+  }
+  if (name.back() == ' ') return "it ends with a space, which readers trim from the path to its data";
+  return "";
+}
+
+// What is wrong with the fields ("" if nothing): each must have a name that the step's HDF5
+// dataset and the XDMF file keep as it is, not a name taken, and hold one value per cell or
+// point; `taken` collects the names.
 template <class Field>
 std::string field_problem(const std::vector<Field>& fields, const char* kind, std::int64_t n, const char* what,
                           std::vector<std::string>& taken) {
   for (const Field& field : fields) {
     const std::string& name = field.name;
-    if (name.empty() || name.find('/') != std::string::npos || name == "." || name == "..")
-      return "field name '" + name + "' is not usable: give a non-empty name without '/'";
+    if (const std::string problem = field_name_problem(name); !problem.empty())
+      return "field name '" + shown(name) + "' is not usable: " + problem;
     if (std::find(taken.begin(), taken.end(), name) != taken.end())
       return "field name '" + name + "' is used twice in one step";
     taken.push_back(name);
@@ -280,7 +358,7 @@ void XdmfWriter::write(double time, const Mesh& mesh, const Layout& layout, std:
   const std::string group = "/step/" + std::to_string(steps_.size());
   write_rows(group + "/displacement", rows_of(displacement, dim, 3, layout.point_rows).data(), H5T_NATIVE_DOUBLE,
              layout.points, 3);
-  Step step{time, n_meshes_ - 1, layout.points.total, layout.cells.total, mesh.cell_dim(), {}, {}, {}};
+  Step step{time, n_meshes_ - 1, layout.points.total, layout.cells.total, dim, mesh.cell_dim(), {}, {}, {}};
   for (const CellField& field : cell_fields) {
     write_rows(group + "/" + field.name, field.values.data(), H5T_NATIVE_DOUBLE, layout.cells, 0);
     step.fields.push_back(field.name);
@@ -321,6 +399,7 @@ void XdmfWriter::write_xdmf() const {
     const std::string step = "/step/" + std::to_string(i);
     out << " <Grid Name=\"step " << i << "\" GridType=\"Uniform\">\n"
         << "  <Time Value=\"" << s.time << "\"/>\n"
+        << "  <Information Name=\"dimension\" Value=\"" << s.dim << "\"/>\n"
         << "  <Topology TopologyType=\"" << (s.cell_dim == 3 ? "Tetrahedron" : "Triangle") << "\" NumberOfElements=\""
         << s.n_cells << "\">\n"
         << "   <DataItem Dimensions=\"" << s.n_cells << " " << s.cell_dim + 1 << "\" NumberType=\"Int\" Precision=\"8\" "

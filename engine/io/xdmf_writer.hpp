@@ -43,7 +43,10 @@ class XdmfWriter {
   XdmfWriter& operator=(const XdmfWriter&) = delete;
 
   // A serial mesh (on a writer of one rank). displacement: (n_points, dim); written as
-  // 3-component vectors (z = 0 in 2D). Field names must be distinct and not "displacement".
+  // 3-component vectors (z = 0 in 2D), so each step says its dimension in an <Information
+  // Name="dimension">. Field names must be distinct, not "displacement", and read back
+  // unchanged from HDF5 and XML: UTF-8 with no control character, no '/' and no final space.
+  // A step with a bad field throws std::invalid_argument before writing anything.
   void write_step(double time, const Mesh& mesh, std::span<const double> displacement,
                   const std::vector<CellField>& cell_fields, const std::vector<PointField>& point_fields = {});
 
@@ -68,6 +71,7 @@ class XdmfWriter {
     double time;
     int mesh;
     std::int64_t n_points, n_cells;
+    int dim;       // of the coordinates: 2 (written with z = 0) or 3
     int cell_dim;  // 2: triangles (2D or a surface), 3: tetrahedra
     std::vector<std::string> fields;        // cell fields
     std::vector<std::string> point_fields;

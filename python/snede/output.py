@@ -72,7 +72,13 @@ class SeriesWriter:
               **cell_fields) -> None:
         """Write the body's state (or ``displacement``) at ``time``, with the standard cell
         fields, extra ones given as arrays of shape (n_cells,) and ``point_fields``
-        ({name: array of shape (n_points,)})."""
+        ({name: array of shape (n_points,)}).
+
+        A field name must read back as it was written, from the HDF5 dataset it names and from
+        the XDMF (XML) file: not empty, no '/', no control character (NUL, tab, newline, ...),
+        no U+FFFE or U+FFFF, no space at the end, and not taken by another field of the step.
+        Any other name raises ValueError naming the field and the reason, before the step
+        writes anything (the series stays readable, the writer usable)."""
         u = body.displacement if displacement is None else np.asarray(displacement, dtype=np.float64)
         inverted = np.zeros(body.mesh.n_cells)
         inverted[body.inverted_elements(u)] = 1.0
@@ -83,7 +89,7 @@ class SeriesWriter:
         """Write a mesh without a body (a surface mesh, a mesh being edited) with its
         ``aspect_ratio`` and ``min_angle`` (radians; the smallest dihedral angle for tetrahedra)
         cell fields, an optional (n_points, dim) ``displacement``, extra cell fields and
-        ``point_fields``."""
+        ``point_fields`` (their names as ``write`` says)."""
         u, points, fields = _step_arrays(mesh, displacement, point_fields, cell_fields)
         self._impl.write_step(float(time), mesh._impl, u, fields, points)
 
@@ -105,11 +111,24 @@ def _step_arrays(mesh, displacement, point_fields, cell_fields):
     None), the point fields and the cell fields with ``aspect_ratio`` and ``min_angle`` first.
     Sizes are the engine's to check (on every rank at once for a distributed part)."""
     u = np.zeros((mesh.n_points, mesh.dim)) if displacement is None else np.asarray(displacement, dtype=np.float64)
+    for name in [*(point_fields or {}), *cell_fields]:
+        _check_encodable(name)
     points = {name: np.asarray(values, dtype=np.float64).ravel() for name, values in (point_fields or {}).items()}
     quality = mesh.quality()
     fields = {"aspect_ratio": quality.aspect_ratio, "min_angle": quality.min_dihedral}
     fields.update({name: np.asarray(values, dtype=np.float64) for name, values in cell_fields.items()})
     return np.ascontiguousarray(u), points, fields
+
+
+def _check_encodable(name) -> None:
+    """Refuse a field name the engine cannot receive (a lone surrogate, as from a file name that
+    was not UTF-8) with an error like the engine's, which checks every other rule."""
+    try:
+        name.encode("utf-8")
+    except UnicodeEncodeError as error:
+        shown = name.encode("utf-8", "backslashreplace").decode("utf-8")
+        raise ValueError(f"field name '{shown}' is not usable: it is not UTF-8 text ({error.reason} "
+                         f"at character {error.start})") from None
 
 
 # -- reading a series back ----------------------------------------------------------------------
@@ -136,6 +155,9 @@ class SeriesStep:
 _TOPOLOGIES = {"triangle": 3, "tetrahedron": 4}
 _GEOMETRIES = {"XYZ": 3, "XY": 2}
 _SERIES_SUFFIXES = (".xdmf", ".xmf")
+# What XML formatting puts around a DataItem's path; str.strip() would also take other
+# whitespace that a field name may end with.
+_XML_WHITESPACE = " \t\n\r"
 
 
 @dataclass(frozen=True)
@@ -150,6 +172,7 @@ class _Item:
 @dataclass
 class _StepRef:
     time: float
+    dim: int | None  # of the coordinates, as the step says it (None: a series from before it did)
     corners: int  # vertices per cell: 3 triangles, 4 tetrahedra
     cells: _Item
     points: _Item
@@ -197,7 +220,7 @@ def _data_item(path: Path, parent: ET.Element, where: str) -> _Item:
     if item.get("Format", "XML") != "HDF":
         raise ValueError(f"{path}: {where} stores its data as {item.get('Format', 'XML')}, "
                          "only HDF data items (what SeriesWriter writes) are read")
-    text = (item.text or "").strip()
+    text = (item.text or "").strip(_XML_WHITESPACE)
     name, separator, dataset = text.partition(":/")
     if not separator or not name:
         raise ValueError(f"{path}: {where} refers to {text!r}, not to 'file.h5:/dataset'")
@@ -229,6 +252,7 @@ def _step_refs(path: Path, collection: ET.Element) -> list[_StepRef]:
         columns = _GEOMETRIES.get(geometry.get("GeometryType") or geometry.get("Type") or "XYZ")
         if columns is None:
             raise ValueError(f"{path}: {where} has geometry type {geometry.get('GeometryType')!r}; XYZ or XY are read")
+        dim = _step_dimension(path, grid, where, kind)
         cells = _data_item(path, topology, f"{where} topology")
         points = _data_item(path, geometry, f"{where} geometry")
         if len(cells.shape) != 2 or cells.shape[1] != _TOPOLOGIES[kind]:
@@ -247,8 +271,22 @@ def _step_refs(path: Path, collection: ET.Element) -> list[_StepRef]:
                 raise ValueError(f"{path}: {what} has {item.shape[0]} values for {rows} "
                                  f"{'points' if center == 'Node' else 'cells'}")
             attributes.append((name, center, attribute.get("AttributeType", "Scalar"), item))
-        steps.append(_StepRef(value, _TOPOLOGIES[kind], cells, points, attributes))
+        steps.append(_StepRef(value, dim, _TOPOLOGIES[kind], cells, points, attributes))
     return steps
+
+
+def _step_dimension(path: Path, grid: ET.Element, where: str, kind: str) -> int | None:
+    """The coordinate dimension the step says it has (``<Information Name="dimension">``),
+    None if it does not say."""
+    information = grid.find("Information[@Name='dimension']")
+    if information is None:
+        return None
+    value = information.get("Value")
+    allowed = ("2", "3") if kind == "triangle" else ("3",)
+    if value not in allowed:
+        raise ValueError(f"{path}: {where} says its dimension is {value!r}; {kind} cells are in "
+                         f"{' or '.join(allowed)} dimensions")
+    return int(value)
 
 
 class _Datasets:
@@ -300,20 +338,19 @@ def _read(path, last_only: bool = False) -> list[SeriesStep]:
         return []
     with contextlib.ExitStack() as stack:
         data = _Datasets(path, stack)
-        # The file does not say whether triangles are a 2D mesh or a surface in 3D: snede pads 2D
-        # points and vectors with z = 0. Triangles are read as 2D when no triangle mesh of the
-        # series has a z ≠ 0 in its points or vector fields (a flat surface that never leaves
-        # z = 0 reads as 2D).
-        triangles = [ref for ref in refs if ref.corners == 3 and ref.points.shape[1] == 3]
+        # snede pads 2D points and vectors with z = 0, and each step says its dimension. In a
+        # series from before steps said it, triangles are 2D when no triangle mesh of the
+        # series has a z ≠ 0 in its points or vector fields (a flat surface reads as 2D).
+        guessed = [ref for ref in refs if ref.dim is None and ref.corners == 3 and ref.points.shape[1] == 3]
         planar = all(not np.any(data.read(item, z_only=True))
-                     for ref in triangles
+                     for ref in guessed
                      for item in [ref.points] + [a[3] for a in ref.attributes if a[2] == "Vector"])
         meshes: dict[tuple[_Item, _Item], Mesh] = {}
         steps = []
         for index, ref in enumerate(refs):
             if last_only and index < len(refs) - 1:
                 continue
-            dim = 2 if ref.corners == 3 and (planar or ref.points.shape[1] == 2) else 3
+            dim = ref.dim or (2 if ref.corners == 3 and (planar or ref.points.shape[1] == 2) else 3)
             key = (ref.cells, ref.points)
             if key not in meshes:
                 try:
@@ -338,8 +375,10 @@ def read_series(path) -> list[SeriesStep]:
     that share a mesh share one Mesh object, so do not edit it in place), ``point_fields``
     (``displacement`` as (n_points, dim) and the scalar point fields) and ``cell_fields``.
 
-    Triangles come back as a 2D mesh unless some step has a z ≠ 0 (then a surface in 3D), since
-    the file pads 2D with z = 0. Times are as the XDMF file holds them (the writer prints 6 significant digits).
+    Each step's mesh has the dimension it was written with (a 2D mesh, padded with z = 0 in the
+    file, comes back 2D; a surface in 3D, flat or not, as a surface). In a series written before
+    steps said their dimension, triangles come back 2D unless some step has a z ≠ 0. Times read
+    back exactly (the writer prints 17 significant digits).
     A series that is being written reads as the steps written so far (none: an empty list).
     A missing file raises FileNotFoundError; a file that is not XDMF, is cut short, or refers to
     an HDF5 file or dataset that is missing raises ValueError naming the file and the problem."""

@@ -260,3 +260,109 @@ def test_times_read_back_bit_for_bit(tmp_path):
     for t in times:
         writer.write_mesh(mesh, time=t)
     assert [step.time for step in read_series(writer.xdmf_path)] == times
+
+
+# -- field names and dimensions (issue 38, item 6) ----------------------------------------------
+def labelled_series(tmp_path):
+    """A series with one step, its cell field ``label`` and point field ``height``."""
+    mesh = meshing.rectangle((1.0, 1.0), (2, 2))
+    writer = SeriesWriter(tmp_path / "names")
+    writer.write_mesh(mesh, 0.0, point_fields={"height": mesh.points[:, 1]}, label=np.arange(mesh.n_cells))
+    return mesh, writer
+
+
+@pytest.mark.parametrize("name, shown, why", [
+    ("a\0b", r"a\x00b", r"control character U\+0000"),  # HDF5 cut the dataset name, the XML did not parse
+    ("two\nlines", r"two\x0alines", r"control character U\+000A"),  # read back with a space for the newline
+    ("tab\tstop", r"tab\x09stop", r"control character U\+0009"),
+    ("return\r", r"return\x0d", r"control character U\+000D"),  # the XML reads it as a newline
+    ("bell\x07", r"bell\x07", r"control character U\+0007"),  # not an XML character: the XML did not parse
+    ("odd\ufffe", r"odd\ufffe", r"U\+FFFE, which is not an XML character"),
+    ("trailing ", "trailing ", "ends with a space"),  # the path to its dataset lost the space
+    ("lone\ud800", r"lone\ud800", "not UTF-8"),  # a surrogate: Python holds it, UTF-8 cannot
+])
+@pytest.mark.parametrize("center", ["cell", "point"])
+def test_a_field_name_that_would_not_read_back_is_refused_before_anything_is_written(tmp_path, name, shown, why,
+                                                                                     center):
+    mesh, writer = labelled_series(tmp_path)
+    values = np.zeros(mesh.n_cells if center == "cell" else mesh.n_points)
+    fields = {name: values} if center == "cell" else {"point_fields": {name: values}}
+    with pytest.raises(ValueError, match=f"field name '{re.escape(shown)}' is not usable.*{why}"):
+        writer.write_mesh(mesh, 1.0, **fields)
+    assert writer.n_steps == 1
+    with h5py.File(writer.h5_path, "r") as f:
+        assert list(f["/step"]) == ["0"]  # nothing of the refused step in the file
+    (step,) = read_series(writer.xdmf_path)  # the earlier step still reads
+    assert set(step.cell_fields) == {"aspect_ratio", "min_angle", "label"}
+    assert set(step.point_fields) == {"displacement", "height"}
+    writer.write_mesh(mesh, 1.0)
+    assert [s.time for s in read_series(writer.xdmf_path)] == [0.0, 1.0]  # and the writer goes on
+
+
+@pytest.mark.parametrize("name", ["é ü 中", "😀", "E<1&2 'x\"", "a\x7fb", "a\x85b", "ideographic space\u3000",
+                                  "\u2028line separator", "a:∕b", " inner  spaces"])
+def test_field_names_that_xml_and_hdf5_can_hold_read_back_exactly(tmp_path, name):
+    mesh, writer = labelled_series(tmp_path)
+    writer.write_mesh(mesh, 1.0, point_fields={name: mesh.points[:, 0]}, **{name + " per cell": np.arange(mesh.n_cells)})
+    step = read_series(writer.xdmf_path)[1]
+    np.testing.assert_array_equal(step.point_fields[name], mesh.points[:, 0])
+    np.testing.assert_array_equal(step.cell_fields[name + " per cell"], np.arange(mesh.n_cells))
+
+
+def flat_surface(mesh2d):
+    """The triangles of a 2D mesh as a surface in 3D lying in z = 0."""
+    return snede.Mesh(np.column_stack([mesh2d.points, np.zeros(mesh2d.n_points)]), mesh2d.cells)
+
+
+def test_each_step_keeps_its_dimension(tmp_path):
+    """The file pads 2D with z = 0; a 2D step followed by a surface step read back as two
+    surfaces, and a surface lying in z = 0 as a 2D mesh."""
+    sheet = meshing.rectangle((2.0, 1.0), (4, 2))
+    surface, _ = meshing.boundary_surface(meshing.box((1.0, 2.0, 3.0), (1, 2, 2)))
+    flat = flat_surface(sheet)
+    meshes = [sheet, surface, flat, sheet]
+    writer = SeriesWriter(tmp_path / "mixed")
+    for time, mesh in enumerate(meshes):
+        writer.write_mesh(mesh, float(time), displacement=0.01 * mesh.points)
+    steps = read_series(writer.xdmf_path)
+    assert [s.mesh.dim for s in steps] == [2, 3, 3, 2]
+    for step, mesh in zip(steps, meshes):
+        assert_same_mesh(step.mesh, mesh)
+        np.testing.assert_array_equal(step.displacement, 0.01 * mesh.points)
+    assert_same_mesh(snede.Mesh.read(writer.xdmf_path), sheet)
+
+
+def test_a_flat_surface_series_reads_back_as_a_surface(tmp_path):
+    flat = flat_surface(meshing.rectangle((1.0, 1.0), (2, 2)))
+    writer = SeriesWriter(tmp_path / "flat")
+    writer.write_mesh(flat, 0.0)
+    (step,) = read_series(writer.xdmf_path)
+    assert step.mesh.is_surface and step.displacement.shape == (flat.n_points, 3)
+    assert snede.Mesh.read(writer.xdmf_path).is_surface
+
+
+def test_a_series_that_does_not_say_its_dimension_is_read_as_before(tmp_path):
+    """Series written before the steps said their dimension: triangles are 2D unless a step of
+    the series leaves z = 0."""
+    sheet = meshing.rectangle((2.0, 1.0), (4, 2))
+    writer = SeriesWriter(tmp_path / "old")
+    writer.write_mesh(sheet, 0.0)
+    writer.write_mesh(flat_surface(sheet), 1.0)
+    text = writer.xdmf_path.read_text()
+    old = re.sub(r" *<Information Name=\"dimension\"[^>]*/>\n", "", text)
+    assert old != text
+    writer.xdmf_path.write_text(old)
+    assert [s.mesh.dim for s in read_series(writer.xdmf_path)] == [2, 2]
+    writer.write_mesh(meshing.boundary_surface(meshing.box((1.0, 1.0, 1.0), (1, 1, 1)))[0], 2.0)
+    writer.xdmf_path.write_text(re.sub(r" *<Information Name=\"dimension\"[^>]*/>\n", "", writer.xdmf_path.read_text()))
+    assert [s.mesh.dim for s in read_series(writer.xdmf_path)] == [3, 3, 3]
+
+
+@pytest.mark.parametrize("value", ["4", "two", ""])
+def test_a_step_with_a_bad_dimension(tmp_path, value):
+    writer = small_series(tmp_path)
+    text = writer.xdmf_path.read_text()
+    writer.xdmf_path.write_text(text.replace('<Information Name="dimension" Value="2"/>',
+                                             f'<Information Name="dimension" Value="{value}"/>', 1))
+    with pytest.raises(ValueError, match=named(writer.xdmf_path, "step 0 says its dimension is")):
+        read_series(writer.xdmf_path)
