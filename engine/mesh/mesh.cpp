@@ -295,6 +295,10 @@ void Mesh::validate() const {
     if (!(measure(e) > 0))
       throw InvalidMesh("element " + std::to_string(e) + " " + s.to_string() +
                         (is_surface() ? " has zero area" : " is not positively oriented"));
+    // The test construction applies: a cell flat to rounding is not valid either.
+    if (has_zero_volume(cell_dim(), space_dim_, corners(e)))
+      throw InvalidMesh("element " + std::to_string(e) + " " + s.to_string() + " is flat to rounding (" +
+                        (cell_dim() == 2 ? "area " : "volume ") + std::to_string(measure(e)) + ")");
   }
 }
 

@@ -3,8 +3,10 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <vector>
 
 #include "core/predicates.hpp"
+#include "mesh/element_quality.hpp"
 
 namespace snede {
 
@@ -73,6 +75,13 @@ std::string RetriangulationPlane::triangle_problem(VertexId a, VertexId b, Verte
   const auto triangle = [&] { return "triangle " + vertex_list({a, b, c}); };
   if (mesh_.is_surface() && collinear_3d(mesh_.point(a).data(), mesh_.point(b).data(), mesh_.point(c).data()))
     return triangle() + " would be degenerate (its corners are collinear)";
+  // Exactly non-collinear is not enough: a triangle flat to rounding (a flip back onto the
+  // edge a bisection split) is one the mesh would refuse at construction, and its children
+  // under the next bisection come out inverted or flat.
+  std::vector<double> corners;
+  for (VertexId v : {a, b, c}) corners.insert(corners.end(), mesh_.point(v).begin(), mesh_.point(v).end());
+  if (has_zero_volume(2, mesh_.space_dim(), corners))
+    return triangle() + " would be degenerate (its corners are collinear to rounding)";
   const int orientation = orientation_2d(in_plane(a), in_plane(b), in_plane(c));
   if (orientation > 0) return "";
   if (mesh_.is_surface()) return triangle() + " would fold over (its normal points against the region's)";

@@ -204,3 +204,70 @@ def test_a_body_refined_mid_simulation_keeps_its_solution_and_solves_on():
     assert carried_over - minimum < 0.5 * (0.0 - minimum)
     assert warm.iterations < cold.iterations
     np.testing.assert_allclose(body.displacement, cold_body.displacement, atol=1e-6 * np.abs(coarse_u).max())
+
+
+# -- bisection after other edits (issue 38 item 3) ------------------------------------------
+def interior_edges(mesh) -> list[tuple[int, int]]:
+    uses: dict[tuple[int, int], int] = {}
+    for cell in mesh.cells:
+        for a, b in itertools.combinations(sorted(int(v) for v in cell), 2):
+            uses[(a, b)] = uses.get((a, b), 0) + 1
+    return [edge for edge, n in uses.items() if n == 2]
+
+
+# A triangle is flat to rounding when area ≤ 64ε·(longest edge)², the mesh's documented test.
+FLAT_TO_ROUNDING = 64 * np.finfo(float).eps
+
+
+def smallest_relative_area(mesh) -> float:
+    """min over triangles of area / (longest edge)², in numpy: 0 for a flat triangle."""
+    corners = mesh.points[mesh.cells]
+    u, w = corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]
+    doubled = np.cross(u, w)
+    area = 0.5 * (np.abs(doubled) if mesh.space_dim == 2 else np.linalg.norm(doubled, axis=1))
+    longest = np.max([np.linalg.norm(corners[:, a] - corners[:, b], axis=1) for a, b in [(0, 1), (1, 2), (2, 0)]], axis=0)
+    return float((area / longest**2).min())
+
+
+@pytest.mark.parametrize("make, edits", [
+    # The probe's sequences: each flip put a triangle back onto an edge the first refinement had
+    # split (flat to rounding but exactly non-collinear); the next refinement inverted its children.
+    (lambda: snede.meshing.gaussian_bell(divisions=10), [("refine",), ("flip", 69, 183), ("refine",)]),
+    (lambda: snede.meshing.rectangle((1, 1), (5, 6)),
+     [("split", 10, 17, 1e-12), ("refine",), ("flip", 25, 59), ("refine",)]),
+])
+def test_a_flip_onto_a_bisected_edge_is_refused_and_the_next_refinement_stays_valid(make, edits):
+    mesh = make()
+    for edit in edits:
+        if edit[0] == "refine":
+            mesh.refine_uniform(1)
+        elif edit[0] == "split":
+            mesh.split_edge(*edit[1:])
+        else:
+            result = mesh.flip_edge(*edit[1:])
+            assert not result and "collinear to rounding" in result.reason
+        mesh.validate()
+        assert smallest_relative_area(mesh) > FLAT_TO_ROUNDING
+
+
+@pytest.mark.parametrize("make", [lambda: snede.meshing.rectangle((1.0, 1.0), (4, 5)),
+                                  lambda: snede.meshing.gaussian_bell(divisions=6)])
+@pytest.mark.parametrize("seed", range(4))
+def test_random_flips_splits_and_refinements_keep_the_mesh_valid(make, seed):
+    rng = np.random.default_rng(seed)
+    mesh = make()
+    area = total_volume(mesh)
+    for step in range(40):
+        kind = rng.choice(["flip", "flip", "split", "refine"], p=[0.4, 0.2, 0.3, 0.1])
+        if kind == "refine" and mesh.n_cells < 2000:
+            mesh.refine_uniform(1)
+        elif kind == "split":
+            a, b = interior_edges(mesh)[rng.integers(len(interior_edges(mesh)))]
+            mesh.split_edge(a, b, float(rng.choice([1e-12, 1e-6, 0.5, rng.uniform(0.01, 0.99)])))
+        else:
+            edges = interior_edges(mesh)
+            mesh.flip_edge(*edges[rng.integers(len(edges))])
+        mesh.validate()
+        assert smallest_relative_area(mesh) > FLAT_TO_ROUNDING, f"step {step}: {kind}"
+        if not mesh.is_surface:
+            assert total_volume(mesh) == pytest.approx(area, rel=1e-12)
