@@ -1,9 +1,12 @@
 #include "bindings.hpp"
+#include "core/rank_agreement.hpp"
 #include "mesh/distributed_mesh.hpp"
 #include "solve/distributed_relaxation.hpp"
 #include "solve/distributed_static.hpp"
 
 #include <pybind11/stl.h>
+
+#include <string_view>
 
 namespace snede::bindings {
 
@@ -23,6 +26,19 @@ void bind_distributed(py::module_& m) {
         return distribute_mesh(MPI_Comm_f2c(static_cast<MPI_Fint>(comm)), serial);
       },
       py::arg("comm"), py::arg("serial").none(true));
+  // RankAgreement for Python's collective calls: `inputs` are (name, the input's bytes) pairs,
+  // the same names in the same order on every rank.
+  m.def(
+      "require_same_on_every_rank",
+      [](std::int64_t comm, const std::string& caller, const std::vector<std::pair<std::string, py::bytes>>& inputs) {
+        RankAgreement agreement(caller);
+        for (const auto& [name, bytes] : inputs) {
+          const std::string_view view(bytes);
+          agreement.input(name, std::span<const char>(view.data(), view.size()));
+        }
+        agreement.require(MPI_Comm_f2c(static_cast<MPI_Fint>(comm)));
+      },
+      py::arg("comm"), py::arg("caller"), py::arg("inputs"));
 
   py::class_<DistributedStatic>(m, "DistributedStatic")
       .def(py::init([](DistributedMesh& part, const py::handle& material, double density, double thickness,

@@ -1,7 +1,8 @@
 // Collective calls must be entered by every rank with the same arguments: a rank that throws
 // alone, or solves to another tolerance, leaves the others waiting in a reduction for ever.
-// A digest of the arguments is compared across the ranks before anything can differ, and a
-// mismatch is the same std::invalid_argument on every rank (issue 18).
+// A digest of each argument is compared across the ranks before anything can differ, and a
+// mismatch is the same std::invalid_argument on every rank, naming the arguments that differ
+// (issue 18; named since issue 38).
 #pragma once
 
 #include <mpi.h>
@@ -10,6 +11,8 @@
 #include <span>
 #include <stdexcept>
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace snede {
 
@@ -24,6 +27,8 @@ class InputDigest {
     for (int shift = 0; shift < 64; shift += 8) mix(static_cast<unsigned char>(size >> shift));
     return *this;
   }
+  template <class T>
+  InputDigest& add(const std::vector<T>& values) { return add(std::span<const T>(values)); }
   InputDigest& add(double value) { return add(std::span<const double>(&value, 1)); }
   InputDigest& add(const std::string& text) { return add(std::span<const char>(text.data(), text.size())); }
   std::uint64_t value() const { return hash_; }
@@ -33,16 +38,50 @@ class InputDigest {
   std::uint64_t hash_ = 14695981039346656037ULL;
 };
 
-// Collective: throws std::invalid_argument "<what>: the ranks were given different
-// <inputs>; every rank must pass the same" on every rank unless the digests agree.
-inline void require_same_on_every_rank(MPI_Comm comm, const InputDigest& digest, const std::string& what,
-                                       const std::string& inputs) {
-  std::uint64_t low = digest.value(), high = digest.value();
-  MPI_Allreduce(MPI_IN_PLACE, &low, 1, MPI_UINT64_T, MPI_MIN, comm);
-  MPI_Allreduce(MPI_IN_PLACE, &high, 1, MPI_UINT64_T, MPI_MAX, comm);
-  if (low != high)
-    throw std::invalid_argument(what + ": the ranks were given different inputs (" + inputs +
-                                "); every rank must pass the same");
-}
+// The named inputs of one collective call, which every rank must give alike:
+//   RankAgreement("DistributedStatic.solve").input("method", method).input("rtol", rtol).require(comm);
+class RankAgreement {
+ public:
+  explicit RankAgreement(std::string caller) : caller_(std::move(caller)) {}
+
+  RankAgreement& input(std::string name, const InputDigest& digest) {
+    names_.push_back(std::move(name));
+    digests_.push_back(digest.value());
+    return *this;
+  }
+  template <class T>
+  RankAgreement& input(std::string name, const T& value) {
+    return input(std::move(name), InputDigest().add(value));
+  }
+
+  // Collective (every rank names the same inputs, in the same order): throws
+  // std::invalid_argument "<caller>: the ranks were given different inputs (<name>: rank r
+  // differs from rank 0; ...); every rank must pass the same" on every rank unless every
+  // rank's digests are rank 0's. r is the lowest rank whose input differs.
+  void require(MPI_Comm comm) const {
+    int n_ranks = 1;
+    MPI_Comm_size(comm, &n_ranks);
+    const std::size_t n = digests_.size();
+    std::vector<std::uint64_t> every_rank(n * static_cast<std::size_t>(n_ranks));
+    MPI_Allgather(digests_.data(), static_cast<int>(n), MPI_UINT64_T, every_rank.data(), static_cast<int>(n),
+                  MPI_UINT64_T, comm);
+    std::string differences;
+    for (std::size_t k = 0; k < n; ++k)
+      for (int rank = 1; rank < n_ranks; ++rank)
+        if (every_rank[static_cast<std::size_t>(rank) * n + k] != every_rank[k]) {
+          differences += (differences.empty() ? "" : "; ") + names_[k] + ": rank " + std::to_string(rank) +
+                         " differs from rank 0";
+          break;
+        }
+    if (!differences.empty())
+      throw std::invalid_argument(caller_ + ": the ranks were given different inputs (" + differences +
+                                  "); every rank must pass the same");
+  }
+
+ private:
+  std::string caller_;
+  std::vector<std::string> names_;
+  std::vector<std::uint64_t> digests_;
+};
 
 }  // namespace snede

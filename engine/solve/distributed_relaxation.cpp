@@ -13,8 +13,11 @@ namespace snede {
 DistributedRelaxation::DistributedRelaxation(DistributedStatic& problem, double damping, double dt,
                                              const std::string& options_prefix)
     : problem_(problem) {
-  require_same_on_every_rank(problem.comm(), InputDigest().add(damping).add(dt).add(options_prefix),
-                             "DistributedRelaxation", "damping, dt or prefix");
+  RankAgreement("DistributedRelaxation")
+      .input("damping", damping)
+      .input("dt", dt)
+      .input("options_prefix", options_prefix)
+      .require(problem.comm());
   require_valid_damping(damping);
   require(dt == 0 || positive_finite(dt), "dt", "positive and finite (or 0 for the CFL estimate)", dt);
   Vec u = problem.state();
@@ -42,8 +45,7 @@ double DistributedRelaxation::time_step() const {
 }
 
 SolveResult DistributedRelaxation::run(double rtol, int max_steps) {
-  require_same_on_every_rank(problem_.comm(), InputDigest().add(rtol).add(max_steps), "DistributedRelaxation.run",
-                             "rtol or max_steps");
+  RankAgreement("DistributedRelaxation.run").input("rtol", rtol).input("max_steps", max_steps).require(problem_.comm());
   require(positive_finite(rtol), "rtol", "positive and finite", rtol);
   require(max_steps >= 0, "max_steps", "≥ 0", max_steps);
   const double start = wall_seconds();

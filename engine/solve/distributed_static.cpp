@@ -43,20 +43,20 @@ void check_conditions(const DistributedConditions& c, int dim, std::int64_t n_ve
 }
 
 // The same material, density, thickness and conditions on every rank, or the same error on
-// every rank: a rank with other loads would silently solve another problem.
+// every rank naming what differs: a rank with other loads would silently solve another problem.
+// Named as the Python arguments (DistributedStatic(part, material, fixed=, fixed_values=, ...)).
 bool require_same_inputs_everywhere(MPI_Comm comm, const Material& material, double density, double thickness,
                                     const DistributedConditions& c) {
   const Lame lame = std::visit([](const auto& m) { return m.lame; }, material);
-  const double scalars[] = {lame.lambda, lame.mu, density, thickness, static_cast<double>(material.index())};
-  InputDigest digest;
-  digest.add(std::span<const double>(scalars))
-      .add(std::span<const std::int64_t>(c.fixed))
-      .add(std::span<const double>(c.fixed_values))
-      .add(std::span<const std::int64_t>(c.loaded))
-      .add(std::span<const double>(c.forces))
-      .add(std::span<const double>(c.gravity));
-  require_same_on_every_rank(comm, digest, "DistributedStatic",
-                             "material, density, thickness, fixed vertices and values, forces or gravity");
+  RankAgreement("DistributedStatic")
+      .input("material", InputDigest().add(static_cast<double>(material.index())).add(lame.lambda).add(lame.mu))
+      .input("density", density)
+      .input("thickness", thickness)
+      .input("fixed", c.fixed)
+      .input("fixed_values", c.fixed_values)
+      .input("forces", InputDigest().add(c.loaded).add(c.forces))
+      .input("gravity", c.gravity)
+      .require(comm);
   return true;
 }
 
@@ -193,8 +193,7 @@ DistributedStatic::DistributedStatic(DistributedMesh& part, Material material, d
 }
 
 void DistributedStatic::set_displacement(std::span<const double> serial) {
-  require_same_on_every_rank(part_.comm, InputDigest().add(serial), "DistributedStatic.set_displacement",
-                             "displacements");
+  RankAgreement("DistributedStatic.set_displacement").input("displacement", serial).require(part_.comm);
   const auto expected = static_cast<std::size_t>(part_.n_global_vertices * dim_);
   if (!serial.empty() && serial.size() != expected)
     throw std::invalid_argument("DistributedStatic.set_displacement: needs " + std::to_string(expected) +
@@ -381,17 +380,15 @@ void DistributedStatic::tangent_diagonal(Vec diagonal) {
 SolveResult DistributedStatic::solve(const std::string& method, const std::string& preconditioner, double rtol,
                                      int max_iterations, const std::string& prefix, const std::string& criterion,
                                      double round_tolerance) {
-  require_same_on_every_rank(part_.comm,
-                             InputDigest()
-                                 .add(method)
-                                 .add(preconditioner)
-                                 .add(rtol)
-                                 .add(max_iterations)
-                                 .add(prefix)
-                                 .add(criterion)
-                                 .add(round_tolerance),
-                             "DistributedStatic.solve",
-                             "method, preconditioner, rtol, max_iterations, prefix, criterion or round_tolerance");
+  RankAgreement("DistributedStatic.solve")
+      .input("method", method)
+      .input("preconditioner", preconditioner)
+      .input("rtol", rtol)
+      .input("max_iterations", max_iterations)
+      .input("options_prefix", prefix)
+      .input("criterion", criterion)
+      .input("round_tolerance", round_tolerance)
+      .require(part_.comm);
   if (method != "cg" && method != "newton" && method != "ncg")
     throw std::invalid_argument("DistributedStatic.solve: method must be \"cg\", \"newton\" or \"ncg\", got \"" +
                                 method + "\"");

@@ -89,8 +89,9 @@ class DistributedStatic:
     fixed_values=None, forces=None, gravity=None)``: ``fixed`` are serial vertex ids held at
     ``fixed_values`` ((len(fixed), dim), default zero); ``forces`` maps serial vertex ids to
     nodal force vectors; ``gravity`` (m/s², dim components) loads the element masses as
-    ``Body.add_gravity`` does. Every rank passes the same conditions. The density also sets the
-    masses of :class:`DistributedRelaxation`.
+    ``Body.add_gravity`` does. Every rank passes the same arguments (else every rank raises
+    ValueError naming those that differ). The density also sets the masses of
+    :class:`DistributedRelaxation`.
 
     ``solve(method="cg" | "newton" | "ncg", rtol=1e-8, preconditioner="none" | "jacobi" |
     "gamg" | "bjacobi" | "sor" | "lu")`` returns a :class:`snede.SolveResult` with PETSc's reason; ``-<prefix>snes_*``/

@@ -1,20 +1,23 @@
 """A serial Body solved over MPI ranks (issue 18): what ``StaticSolver(body, ..., comm=...)``
 and ``DynamicRelaxation(body, ..., comm=...)`` do, on any number of ranks.
 
-Every rank runs the same script and holds the same serial Body; rank 0's is the one used. Its
-mesh is distributed (``snede.distribute``), its fixed vertices and external forces (gravity and
-the nodal-force channels, which do not depend on the state) become a
-:class:`snede.DistributedStatic` that starts from the body's displacement, the solve runs on all
-ranks to the serial solver's criterion, and the displacement is gathered back into the Body on
-every rank, so the script goes on as serially. The distribution is kept while the mesh is
-unchanged (a cut or a refinement of the serial body, done on every rank, makes the next solve
-distribute anew). What cannot be taken over raises
-NotImplementedError on every rank: sliding constraints and membranes.
+Every rank runs the same script and holds the same serial Body: a body that differs on some
+rank (its mesh, constraints, loads or displacement) raises ValueError on every rank, naming
+what differs, instead of being ignored for rank 0's (issue 38). Rank 0's mesh is distributed
+(``snede.distribute``), its fixed vertices and external forces (gravity and the nodal-force
+channels, which do not depend on the state) become a :class:`snede.DistributedStatic` that
+starts from the body's displacement, the solve runs on all ranks to the serial solver's
+criterion, and the displacement is gathered back into the Body on every rank, so the script
+goes on as serially. The distribution is kept while the mesh is unchanged (a cut or a
+refinement of the serial body, done on every rank, makes the next solve distribute anew). What
+cannot be taken over raises NotImplementedError on every rank: sliding constraints and
+membranes.
 """
 from __future__ import annotations
 
 import numpy as np
 
+from snede import _snede
 from snede.distributed import DistributedStatic, agreed, distribute
 
 
@@ -27,56 +30,69 @@ class DistributedBody:
         self.part, self._revision, self._last = None, None, None
 
     def problem(self) -> DistributedStatic:
-        """A DistributedStatic with the body's current conditions, on the mesh as it is now."""
+        """A DistributedStatic with the body's current conditions, on the mesh as it is now.
+        Every rank's body must be rank 0's: one that differs (a load, a fixed vertex, an edit
+        made on some ranks only) makes every rank raise ValueError naming what differs."""
         body, comm = self.body, self.comm
-        why = None
-        if comm.rank == 0:
-            fixed, anchors, sliding = body._model.constraint_table()
-            loads = body.external_forces()
-            loaded = np.flatnonzero(np.any(loads != 0, axis=1))
-            if body.mesh.is_surface:
-                why = "membranes (surface meshes) are not distributed yet"
-            elif len(sliding):
-                why = f"sliding constraints ({len(sliding)} vertices) are not distributed yet; fix them instead"
-            conditions = (why, fixed, anchors, loaded, loads[loaded], body.mesh._impl.revision, body.displacement)
-            self._last = _fingerprint(body.mesh._impl.revision, fixed, anchors, loads, body.displacement)
-        why, fixed, anchors, loaded, loads, revision, start = comm.bcast(conditions if comm.rank == 0 else None, root=0)
-        if why is not None:
-            raise NotImplementedError(f"a solve on {comm.size} MPI ranks: {why}")
+        inputs = _inputs(body)
+        self._require_same_on_every_rank({name: value for name, value in inputs.items() if name != "gravity"})
+        # The gravity is the loads less the nodal forces, comparable once those agree.
+        self._require_same_on_every_rank({"gravity": inputs["gravity"]})
+        fixed, anchors, sliding = body._model.constraint_table()
+        if body.mesh.is_surface:
+            raise NotImplementedError(f"a solve on {comm.size} MPI ranks: membranes (surface meshes) are not "
+                                      "distributed yet")
+        if len(sliding):
+            raise NotImplementedError(f"a solve on {comm.size} MPI ranks: sliding constraints ({len(sliding)} "
+                                      "vertices) are not distributed yet; fix them instead")
+        # The meshes are equal; rank 0 decides whether its mesh changed since the last
+        # distribution, so that every rank distributes or none does.
+        revision = comm.bcast(body.mesh._impl.revision if comm.rank == 0 else None, root=0)
         if self.part is None or revision != self._revision:
             self.part = distribute(body.mesh if comm.rank == 0 else None, comm)
             self._revision = revision
+        loads = body.external_forces()
+        loaded = np.flatnonzero(np.any(loads != 0, axis=1))
         problem = DistributedStatic(self.part, body.material, density=body.density, thickness=body.thickness,
-                                    fixed=fixed, fixed_values=anchors, forces={int(v): f for v, f in zip(loaded, loads)})
-        problem.set_displacement(start)  # where the serial solve would start
+                                    fixed=fixed, fixed_values=anchors,
+                                    forces={int(v): f for v, f in zip(loaded, loads[loaded])})
+        problem.set_displacement(body.displacement)  # where the serial solve would start
+        self._last = inputs
         return problem
 
     def gather_into_body(self, problem: DistributedStatic) -> None:
-        """The answer into the body on every rank; a rank whose body is not rank 0's (edited on
-        one rank only) makes every rank raise."""
+        """The answer into the body on every rank; should it not fit one rank's body, every
+        rank raises."""
         u = problem.gathered_displacement()
 
         def assign():
             self.body.displacement = u
 
         agreed(self.comm, assign)
-        self._last = self._state() if self.comm.rank == 0 else None
+        self._last = _inputs(self.body)
 
     def changed(self) -> bool:
-        """Collective: whether the body's mesh, conditions or displacement changed since the
-        latest problem() or gather_into_body() (rank 0's body decides)."""
-        now = self._state() if self.comm.rank == 0 else None
-        return bool(self.comm.bcast(now != self._last if self.comm.rank == 0 else None, root=0))
+        """Collective: whether the body's mesh, conditions or displacement changed on any rank
+        since the latest problem() or gather_into_body()."""
+        return self.comm.allreduce(int(_inputs(self.body) != self._last)) > 0
 
-    def _state(self):
-        body = self.body
-        fixed, anchors, _ = body._model.constraint_table()
-        return _fingerprint(body.mesh._impl.revision, fixed, anchors, body.external_forces(), body.displacement)
+    def _require_same_on_every_rank(self, inputs: dict) -> None:
+        _snede.require_same_on_every_rank(self.comm.py2f(), f"a Body solved on {self.comm.size} MPI ranks",
+                                          list(inputs.items()))
 
 
-def _fingerprint(revision, fixed, anchors, loads, displacement):
-    """What a problem is made of, to tell whether the body changed since."""
-    return revision, fixed.tobytes(), anchors.tobytes(), loads.tobytes(), displacement.tobytes()
+def _inputs(body) -> dict:
+    """What a distributed solve of ``body`` is made of, as bytes, by the names an error gives
+    when the ranks' bodies differ."""
+    mesh = body.mesh
+    fixed, anchors, sliding = body._model.constraint_table()
+    channels = {name: body.external_forces(name) for name in body.load_channels}
+    loads = body.external_forces()
+    return {"mesh": mesh.points.tobytes() + mesh.cells.tobytes(), "fixed vertices": fixed.tobytes(),
+            "prescribed displacements": anchors.tobytes(), "sliding vertices": sliding.tobytes(),
+            "nodal forces": b"".join(name.encode() + b"\0" + f.tobytes() for name, f in sorted(channels.items())),
+            "displacement": body.displacement.tobytes(),
+            "gravity": (loads - sum(channels.values(), np.zeros_like(loads))).tobytes()}
 
 
 class RunsOnRanks:

@@ -178,13 +178,44 @@ def test_dynamic_relaxation_takes_up_a_body_changed_between_runs():
     assert relative_difference(body.displacement, reference.displacement) <= 1e-4
 
 
+ONE_RANK_EDITS = {
+    "mesh": lambda body: body.mesh.refine_uniform(),
+    "fixed vertices": lambda body: body.fix([int(np.argmax(body.mesh.points[:, 0]))]),
+    "prescribed displacements": lambda body: body.fix(np.flatnonzero(body.mesh.points[:, 0] == 0.0), (0.0, 0.0, 1e-3)),
+    "sliding vertices": lambda body: body.slide([int(np.argmax(body.mesh.points[:, 0]))], (1.0, 0.0, 0.0)),
+    "nodal forces": lambda body: body.add_nodal_force([int(np.argmax(body.mesh.points[:, 0]))], (0.0, 1.0, 0.0)),
+    "gravity": lambda body: body.add_gravity((0.0, 0.0, -2.0)),
+    "displacement": lambda body: setattr(body, "displacement", np.full_like(body.displacement, 1e-4)),
+}
+
+
 @pytest.mark.skipif(COMM.size == 1, reason="needs a rank whose body differs")
-def test_a_body_edited_on_one_rank_only_raises_on_every_rank():
-    """The last rank refines its body alone: the answer (rank 0's mesh) does not fit its body,
-    and every rank raises, naming it, instead of that rank alone."""
+@pytest.mark.parametrize("edited", ONE_RANK_EDITS)
+def test_a_body_edited_on_one_rank_only_raises_on_every_rank(edited):
+    """The last rank alone refines its body, loads it, holds or moves it otherwise: every rank
+    raises the same ValueError naming what differs, before solving (rank 0's body was solved
+    and the other ranks' conditions silently ignored)."""
     body = loaded_body(snede.LinearElastic(1e5, 0.3))
     if COMM.rank == COMM.size - 1:
-        body.mesh.refine_uniform()
-    with pytest.raises(ValueError, match=f"rank {COMM.size - 1}: "):
+        ONE_RANK_EDITS[edited](body)
+    differs = rf"the ranks were given different inputs \({edited}[^)]*: rank {COMM.size - 1} differs from rank 0\)"
+    with pytest.raises(ValueError, match=differs):
         snede.StaticSolver(body, "cg", rtol=1e-8, comm=COMM).solve()
+    with pytest.raises(ValueError, match=differs):
+        snede.DynamicRelaxation(body, damping=1.5, comm=COMM)
+    assert COMM.allreduce(1) == COMM.size
+
+
+@pytest.mark.skipif(COMM.size == 1, reason="needs a rank whose body differs")
+def test_a_body_loaded_on_one_rank_between_relaxations_raises_on_every_rank():
+    """A load added on the last rank alone after a relaxation: the next run raises on every
+    rank, naming the nodal forces (rank 0 alone decided whether the body had changed, and the
+    load was dropped)."""
+    body = loaded_body(snede.LinearElastic(1e5, 0.3))
+    relaxation = snede.DynamicRelaxation(body, damping=1.5, comm=COMM)
+    assert relaxation.run(rtol=1e-3, max_steps=20000).converged
+    if COMM.rank == COMM.size - 1:
+        ONE_RANK_EDITS["nodal forces"](body)
+    with pytest.raises(ValueError, match=rf"\(nodal forces: rank {COMM.size - 1} differs from rank 0\)"):
+        relaxation.run(rtol=1e-3, max_steps=20000)
     assert COMM.allreduce(1) == COMM.size
