@@ -1,7 +1,10 @@
 """snede: soft deformable objects whose meshes change (cuts, bisection, needle insertion).
 
 Importing snede initialises PETSc once, through petsc4py (see ``snede._petsc``).
+``snede.output`` (series files, h5py) and ``snede.plotting`` (matplotlib) load on first use.
 """
+import importlib
+
 from snede._petsc import PETSc  # noqa: F401  (initialises PETSc before the engine loads)
 from snede._snede import (  # noqa: F401
     DomainError,
@@ -35,3 +38,12 @@ __all__ = [
     "EditResult", "FileError", "InvalidMesh", "PetscError", "DomainError", "LockingWarning", "PETSc",
 ]
 __version__ = "0.1.0"
+
+# Submodules that load slow libraries; importing snede does not load them until used.
+_ON_FIRST_USE = ("output", "plotting")
+
+
+def __getattr__(name):
+    if name in _ON_FIRST_USE:
+        return importlib.import_module(f"snede.{name}")
+    raise AttributeError(f"module 'snede' has no attribute {name!r}")

@@ -1,9 +1,12 @@
 """The README's code, run as written (issue 38, item 9): its statements are what a reader
 copies, so they must work as they stand, with what the README says is needed around them."""
 import re
+import subprocess
+import sys
 from pathlib import Path
 
 import snede
+from snede.output import SeriesWriter
 
 README = Path(__file__).resolve().parents[2] / "README.md"
 
@@ -24,3 +27,20 @@ def test_the_membrane_of_the_readme_is_built_from_boundary_surface_as_written():
         (body_statement,) = inline_code("snede.Body(surface, material")
         body = eval(body_statement, namespace)
         assert body.mesh.is_surface and body.mesh.n_cells == 48
+
+
+def run_python(code: str, cwd: Path) -> subprocess.CompletedProcess:
+    """``code`` in a fresh interpreter (what a reader's script starts from), in ``cwd``."""
+    return subprocess.run([sys.executable, "-c", code], cwd=cwd, capture_output=True, text=True, timeout=300)
+
+
+def test_read_series_of_the_readme_needs_only_import_snede(tmp_path):
+    """``snede.output.read_series(...)`` raised AttributeError unless snede.output had been
+    imported; importing snede still does not load h5py (the output module loads on first use)."""
+    mesh = snede.meshing.rectangle((1.0, 1.0), (2, 2))
+    SeriesWriter(tmp_path / "out" / "sheet-cut" / "sheet-cut").write_mesh(mesh, 0.5)
+    (statement,) = [span for span in inline_code("snede.output.read_series(") if span.endswith(")")]
+    done = run_python("import sys\nimport snede\nassert 'h5py' not in sys.modules\n"
+                      f"steps = {statement}\nprint(len(steps), steps[0].time)", tmp_path)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.split() == ["1", "0.5"]
