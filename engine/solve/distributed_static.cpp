@@ -407,20 +407,53 @@ SolveResult DistributedStatic::solve(const std::string& method, const std::strin
   if (criterion != "relative" && criterion != "6.9" && criterion != "6.8")
     throw std::invalid_argument("DistributedStatic.solve: criterion must be \"relative\", \"6.9\" or \"6.8\", got \"" +
                                 criterion + "\"");
+  if (!(round_tolerance >= 0) || !std::isfinite(round_tolerance))
+    throw std::invalid_argument("DistributedStatic.solve: round_tolerance must be ≥ 0 and finite");
+  // The serial StaticSolver's rule: the criterion's, or (6.9) under PETSc's relative tests,
+  // where it only decides whether the start is already in equilibrium (below).
+  const StoppingRule rule{criterion == "relative" ? StoppingCriterion::with_reactions : stopping_criterion(criterion),
+                          rtol, round_tolerance, force_scale(), static_cast<double>(n_global_dofs())};
   stopping_.reset();
-  if (criterion != "relative") {
-    if (!(round_tolerance >= 0) || !std::isfinite(round_tolerance))
-      throw std::invalid_argument("DistributedStatic.solve: round_tolerance must be ≥ 0 and finite");
-    stopping_ = StoppingRule{stopping_criterion(criterion), rtol, round_tolerance, force_scale(),
-                             static_cast<double>(n_global_dofs())};
-    stopping_external_norm_ = external_force_norm();
-  }
+  if (criterion != "relative") stopping_ = rule;
+  stopping_external_norm_ = external_force_norm();
   const double start = wall_seconds();
   SolveResult result;
-  residual(u_, work_);
+  const bool admissible_start = residual(u_, work_);
   result.initial_residual_norm = vec_norm(work_);
   stopping_reaction_norm_.reset();
   if (method == "cg") stopping_reaction_norm_ = last_reaction_norm_;
+  // A start already in equilibrium by that rule is converged without an iteration, as
+  // serially: the relative tests' ‖F‖ ≤ rtol ‖F(u₀)‖ is out of reach of a residual already at
+  // round-off (Newton ended DIVERGED_LINE_SEARCH there, issue 38).
+  const double equilibrium_tolerance = rule.tolerance(stopping_external_norm_, last_reaction_norm_);
+  const bool at_equilibrium = admissible_start && result.initial_residual_norm <= equilibrium_tolerance;
+  if (at_equilibrium) {
+    result.converged = true;
+    result.reason = method == "cg" ? "CONVERGED_ATOL" : "CONVERGED_FNORM_ABS";  // PETSc's, for a met absolute test
+  } else {
+    run_petsc(method, preconditioner, rtol, max_iterations, prefix, result);
+  }
+  // An inverted element or a non-finite state is never converged, and a rule is checked on
+  // the final state (the factor allows CG's recursive residual to differ by round-off). The
+  // relative tests stay PETSc's verdict: preconditioned CG measures another norm.
+  const bool admissible = residual(u_, work_);
+  result.residual_norm = vec_norm(work_);
+  result.tolerance = at_equilibrium ? equilibrium_tolerance
+                     : stopping_    ? stopping_tolerance()
+                                    : rtol * result.initial_residual_norm;
+  if (!admissible || !std::isfinite(result.residual_norm)) result.converged = false;
+  if (result.converged && stopping_ && result.residual_norm > 2 * result.tolerance) {
+    result.converged = false;
+    result.reason = "DIVERGED_RESIDUAL_ABOVE_TOLERANCE (PETSc: " + result.reason + ")";
+  }
+  stopping_.reset();
+  result.energy = energy();
+  result.seconds = wall_seconds() - start;
+  return result;
+}
+
+void DistributedStatic::run_petsc(const std::string& method, const std::string& preconditioner, double rtol,
+                                  int max_iterations, const std::string& prefix, SolveResult& result) {
   SnesHandle snes;
   SNEDE_PETSC(SNESCreate(part_.comm, snes.out()));
   SNEDE_PETSC(SNESSetOptionsPrefix(snes, prefix.c_str()));
@@ -483,21 +516,6 @@ SolveResult DistributedStatic::solve(const std::string& method, const std::strin
     result.iterations = static_cast<int>(iterations);
     result.linear_iterations = static_cast<int>(linear);
   }
-  // An inverted element or a non-finite state is never converged, and a rule is checked on
-  // the final state (the factor allows CG's recursive residual to differ by round-off). The
-  // relative tests stay PETSc's verdict: preconditioned CG measures another norm.
-  const bool admissible = residual(u_, work_);
-  result.residual_norm = vec_norm(work_);
-  result.tolerance = stopping_ ? stopping_tolerance() : rtol * result.initial_residual_norm;
-  if (!admissible || !std::isfinite(result.residual_norm)) result.converged = false;
-  if (result.converged && stopping_ && result.residual_norm > 2 * result.tolerance) {
-    result.converged = false;
-    result.reason = "DIVERGED_RESIDUAL_ABOVE_TOLERANCE (PETSc: " + result.reason + ")";
-  }
-  stopping_.reset();
-  result.energy = energy();
-  result.seconds = wall_seconds() - start;
-  return result;
 }
 
 double DistributedStatic::energy() {

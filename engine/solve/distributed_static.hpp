@@ -104,6 +104,9 @@ class DistributedStatic {
   std::int64_t n_global_dofs() const { return part_.n_global_vertices * dim_; }
 
  private:
+  // SNES (or its KSP, for "cg") from the current state; its reason and iteration counts.
+  void run_petsc(const std::string& method, const std::string& preconditioner, double rtol, int max_iterations,
+                 const std::string& prefix, SolveResult& result);
   void to_local(Vec global, std::vector<double>& local);
   void add_to_global(const std::vector<double>& local, Vec global);
   // The fixed owned rows of `out` set to `source`'s entries, or to `value` without a source.

@@ -142,11 +142,12 @@ class DistributedStatic:
 
         ``criterion`` "relative" (default): PETSc's relative tests and verdict, ‖F‖ ≤
         rtol·‖F(u₀)‖ (CG: ‖r‖ ≤ rtol·‖b‖ in its preconditioned norm, on its recursive
-        residual; ``tolerance`` in the result is rtol·‖F(u₀)‖, which a solve started at
-        equilibrium cannot reach below round-off). "6.9" or "6.8": the serial
+        residual; ``tolerance`` in the result is rtol·‖F(u₀)‖). "6.9" or "6.8": the serial
         :class:`snede.StaticSolver`'s criteria (§6.6) on the true residual, ‖F‖ ≤
         rtol·√(‖f_ext‖² + ‖f_react‖²) plus ``round_tolerance``'s floor, or ‖F‖ ≤ rtol·‖f_ext‖;
-        ``tolerance`` in the result is the threshold."""
+        ``tolerance`` in the result is the threshold. A start that already meets the serial
+        solver's criterion ((6.9) under "relative", which a residual at round-off cannot meet)
+        is converged with no iteration, as serially, ``tolerance`` that threshold."""
         arguments = agreed(self.part.comm, lambda: (str(method), str(preconditioner), float(rtol),
                                                     _checks.count(max_iterations, "max_iterations"), str(options_prefix),
                                                     str(criterion), float(round_tolerance)))

@@ -70,6 +70,31 @@ def test_an_inverted_element_is_never_converged():
     assert set(COMM.allgather(result.reason)) == {"DIVERGED_FUNCTION_DOMAIN"}
 
 
+@pytest.mark.parametrize("method", ["cg", "newton", "ncg"])
+def test_a_solve_from_the_converged_state_stops_at_once_as_serially(method):
+    """Solved once (PETSc's relative test, the default), the cantilever is in equilibrium:
+    solved again it stops at once, converged and unmoved, as the serial StaticSolver does
+    (Newton and nonlinear CG ended DIVERGED_LINE_SEARCH: ‖F‖ ≤ rtol·‖F(u₀)‖ asked a residual
+    already at round-off for rtol of itself)."""
+    serial, _ = cantilever(3)
+    fixed, tip, force = conditions(serial)
+    material = snede.LinearElastic(1e5, 0.3) if method == "cg" else snede.NeoHookean(1e5, 0.3)
+    part = snede.distribute(serial if COMM.rank == 0 else None)
+    problem = snede.DistributedStatic(part, material, fixed=fixed, forces={int(v): force for v in tip})
+    assert problem.solve(method, rtol=1e-8, max_iterations=20000).converged
+    answer = problem.gathered_displacement()
+    again = problem.solve(method, rtol=1e-8, max_iterations=20000)
+    assert again.converged and again.iterations == 0, again
+    np.testing.assert_array_equal(problem.gathered_displacement(), answer)
+    body = snede.Body(cantilever(3)[0], material)
+    body.fix(fixed)
+    body.add_nodal_force(tip, force)
+    solver = snede.StaticSolver(body, method, preconditioner="none", rtol=1e-8, max_iterations=20000)
+    assert solver.solve().converged
+    serial_again = solver.solve()
+    assert serial_again.converged and serial_again.iterations == 0, serial_again
+
+
 def test_bad_conditions_raise_the_same_error_everywhere():
     serial, _ = cantilever(3)
     part = snede.distribute(serial if COMM.rank == 0 else None)
