@@ -16,8 +16,8 @@ def _quality_line(name: str, mesh: snede.Mesh) -> str:
     q = mesh.quality()
     edges = _edge_lengths(mesh)
     return (f"{name:<22} {mesh.n_cells:>8} {mesh.n_points:>7} {q.volume.sum():>10.6f} "
-            f"{edges.min():>8.4f} {edges.max():>8.4f} {np.degrees(q.min_dihedral.min()):>7.1f} "
-            f"{np.degrees(q.max_dihedral.max()):>7.1f} {q.aspect_ratio.min():>7.3f}")
+            f"{edges.min():>8.4f} {edges.max():>8.4f} {np.degrees(q.min_dihedral.min()):>8.1f} "
+            f"{np.degrees(q.max_dihedral.max()):>8.1f} {q.aspect_ratio.min():>7.3f}")
 
 
 def _edge_lengths(mesh: snede.Mesh) -> np.ndarray:
@@ -59,7 +59,7 @@ def run(out: Path = Path("out"), progress: bool = True) -> int:
 
 def cut_box(divisions: int, out: Path) -> None:
     print(f"{'mesh':<22} {'cells':>8} {'points':>7} {'volume':>10} {'min edge':>8} {'max edge':>8} "
-          f"{'min dih':>7} {'max dih':>7} {'min AR':>7}")
+          f"{'min dih°':>8} {'max dih°':>8} {'min AR':>7}")
     start = time.perf_counter()
     box = snede.meshing.box((1.0, 1.0, 1.0), (divisions,) * 3)
     build_seconds = time.perf_counter() - start

@@ -13,7 +13,8 @@ from snede.mesh_edits import MeshEdits, serial_only
 
 
 class MeshQuality(NamedTuple):
-    """Per-cell measures, each an array of shape (n_cells,), in the row order of ``Mesh.cells``."""
+    """Per-cell measures, each an array of shape (n_cells,), in the row order of ``Mesh.cells``.
+    Angles are in radians (``np.degrees`` gives degrees, as the demo prints them)."""
 
     volume: np.ndarray  #: volume (area in 2D), positive
     aspect_ratio: np.ndarray  #: minimum height / maximum edge (§3.2.3); 0.816 regular tet, 0.866 regular triangle
@@ -147,7 +148,7 @@ class Mesh(MeshEdits):
         return self._impl.boundary_faces()
 
     def quality(self) -> MeshQuality:
-        """Per-cell volume, aspect ratio and extreme dihedral angles, see MeshQuality."""
+        """Per-cell volume, aspect ratio and extreme dihedral angles (radians), see MeshQuality."""
         return MeshQuality(**self._impl.quality())
 
     def validate(self) -> None:
