@@ -10,7 +10,10 @@ class SolveResult:
     divergence, the iteration limit was hit, or the state holds NaN/Inf or an inverted
     element of a material that forbids inversion. ``reason`` is PETSc's converged reason
     (e.g. ``CONVERGED_FNORM_RELATIVE``, ``DIVERGED_LINE_SEARCH``) or snede's own
-    (``DIVERGED_INVERTED_ELEMENTS``, ``DIVERGED_NONFINITE_STATE``, ``DIVERGED_BLOW_UP``)."""
+    (``DIVERGED_INVERTED_ELEMENTS``, ``DIVERGED_NONFINITE_STATE``, ``DIVERGED_BLOW_UP``).
+
+    ``seconds`` is the solve's wall time; ``flops`` counts the floating-point operations PETSc
+    logged during the solve on this rank, in FLOP (``str(result)`` shows them in MFLOP, 10⁶ FLOP)."""
 
     converged: bool
     reason: str
