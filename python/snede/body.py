@@ -193,6 +193,11 @@ class Body:
     def clear_gravity(self) -> None:
         self._model.clear_gravity()
 
+    @property
+    def has_gravity(self) -> bool:
+        """Whether gravity acts (``add_gravity`` until ``clear_gravity`` or ``clear_loads()``)."""
+        return self._model.has_gravity
+
     def add_nodal_force(self, vertices, force, channel: str = "nodal") -> None:
         """Add a force (newtons) to load channel ``channel``: one (dim,) vector on every listed
         vertex, or (n_vertices, dim)."""
@@ -211,7 +216,10 @@ class Body:
 
     @property
     def load_channels(self) -> list[str]:
-        """Names of the nodal-force channels in use."""
+        """Names of the nodal-force channels in use, those ``external_forces(channel)`` and
+        ``clear_loads(channel)`` take. Gravity is not among them: it is a body force on the
+        element masses, not forces on named vertices, set by ``add_gravity`` and cleared by
+        ``clear_gravity``; ``has_gravity`` says whether it acts."""
         return list(self._model.load_channels)
 
     def external_forces(self, channel: str | None = None) -> np.ndarray:

@@ -112,6 +112,23 @@ def test_load_channels_are_changed_and_cleared_alone():
     assert body.load_channels == [] and not body.external_forces().any()
 
 
+def test_gravity_is_not_a_load_channel_and_has_gravity_says_whether_it_acts():
+    """load_channels names the nodal-force channels, those external_forces(channel) and
+    clear_loads(channel) take; gravity is a body force of its own (issue 38, item 9)."""
+    mesh, body = sheet()
+    assert not body.has_gravity
+    body.add_gravity((0.0, -9.81))
+    assert body.has_gravity and body.load_channels == []
+    body.add_nodal_force([5], (1.0, 0.0))
+    body.clear_loads("nodal")
+    assert body.has_gravity and body.load_channels == []
+    body.clear_gravity()
+    assert not body.has_gravity
+    body.add_gravity((0.0, -9.81))
+    body.clear_loads()  # every channel and gravity
+    assert not body.has_gravity
+
+
 def test_switching_constraints_between_fixed_and_sliding_does_not_rebuild_the_solver():
     mesh, body = sheet()
     body.displacement = np.zeros((mesh.n_points, 2))
