@@ -3,7 +3,9 @@
 Each step stores the displacement and per-cell fields: ``aspect_ratio`` (reference shape,
 §3.2.3) and ``inverted`` (1 where det F ≤ 0), and any extra point fields. When the mesh changes
 between steps (a cut, a refinement) the new mesh is written and the step points to it.
-``read_series`` reads such a series back, each step with its own mesh.
+``read_series`` reads such a series back, each step with its own mesh. meshio cannot:
+``meshio.read`` stops at "Unknown section 'Grid'", and ``meshio.xdmf.TimeSeriesReader`` gives
+every step the first step's mesh, wrong once the mesh has changed.
 
 ``SeriesWriter(base, comm)`` writes one series from the parts of a distributed mesh
 (``snede.distribute``): every rank of ``comm`` writes its part into the shared HDF5 file
@@ -370,7 +372,7 @@ def _read(path, last_only: bool = False) -> list[SeriesStep]:
 
 def read_series(path) -> list[SeriesStep]:
     """Read back a series that ``SeriesWriter`` wrote: ``path`` is the ``.xdmf`` file (its
-    ``.h5`` is found next to it). Returns one ``SeriesStep`` per step, in order, each with its
+    ``.h5`` is found next to it); this, not meshio, reads such series (see the module). Returns one ``SeriesStep`` per step, in order, each with its
     ``time``, its own ``mesh`` (the topology and reference coordinates of that step; steps
     that share a mesh share one Mesh object, so do not edit it in place), ``point_fields``
     (``displacement`` as (n_points, dim) and the scalar point fields) and ``cell_fields``.
