@@ -44,3 +44,25 @@ def test_read_series_of_the_readme_needs_only_import_snede(tmp_path):
                       f"steps = {statement}\nprint(len(steps), steps[0].time)", tmp_path)
     assert done.returncode == 0, done.stderr
     assert done.stdout.split() == ["1", "0.5"]
+
+
+def python_blocks(containing: str = "") -> list[str]:
+    """The README's ```python blocks that contain ``containing``."""
+    return [block for block in re.findall(r"```python\n(.*?)```", README.read_text(), re.S) if containing in block]
+
+
+def test_every_python_block_of_the_readme_is_python():
+    """A command line inside a python block (``python myscript.py -static_pc_type gamg``) is a
+    syntax error where a reader pastes it; placeholders (``u``, ``vertices``) are not checked."""
+    for block in python_blocks():
+        compile(block, "README.md", "exec")
+
+
+def test_the_scene_of_your_own_of_the_readme_runs_as_written(tmp_path):
+    """The README's copy of examples/sagging_beam.py lacked its imports (SeriesWriter, plot_body)."""
+    (block,) = python_blocks("sagging_beam")
+    done = run_python(block, tmp_path)
+    assert done.returncode == 0, done.stderr
+    assert re.match(r"converged \(CONVERGED_FNORM_ABS\) after \d+ iterations.* MFLOP$", done.stdout.strip())
+    assert (tmp_path / "out" / "sagging_beam" / "sagging_beam.xdmf").is_file()
+    assert (tmp_path / "out" / "sagging_beam" / "sagging_beam.png").is_file()
