@@ -15,10 +15,10 @@ MPI_ROOT = {"OMPI_ALLOW_RUN_AS_ROOT": "1", "OMPI_ALLOW_RUN_AS_ROOT_CONFIRM": "1"
             "OMPI_MCA_rmaps_base_oversubscribe": "1"}
 
 
-def run_on_two_ranks(tmp_path, body: str) -> subprocess.CompletedProcess:
+def run_on_two_ranks(tmp_path, body: str, mpirun_options=()) -> subprocess.CompletedProcess:
     script = tmp_path / "scene.py"
     script.write_text(textwrap.dedent(body))
-    return subprocess.run(["mpirun", "-n", "2", sys.executable, "-m", "snede", "run", str(script)],
+    return subprocess.run(["mpirun", *mpirun_options, "-n", "2", sys.executable, "-m", "snede", "run", str(script)],
                           capture_output=True, text=True, timeout=120, env={**os.environ, **MPI_ROOT})
 
 
@@ -82,3 +82,17 @@ def test_petsc_objects_freed_at_different_times_on_the_ranks(tmp_path):
         """)
     assert run.returncode == 0, (run.stdout, run.stderr)
     assert "converged on ranks: [True, True]" in run.stdout, run.stdout
+
+
+def test_a_rank_that_skips_a_collective_call_is_ended_only_by_a_time_limit(tmp_path):
+    """The limit the README states (issue 38): rank 1 skips the reduction rank 0 waits in and
+    ends the script without an error, so nothing aborts the job; mpirun's --timeout, as the
+    README advises, ends it with a non-zero status."""
+    run = run_on_two_ranks(tmp_path, """
+        from mpi4py import MPI
+        if MPI.COMM_WORLD.rank == 0:
+            MPI.COMM_WORLD.allreduce(1)
+        print(f"rank {MPI.COMM_WORLD.rank} finished", flush=True)
+        """, mpirun_options=("--timeout", "3"))
+    assert run.returncode != 0, (run.stdout, run.stderr)
+    assert "rank 1 finished" in run.stdout and "rank 0 finished" not in run.stdout, run.stdout
