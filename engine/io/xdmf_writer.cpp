@@ -81,7 +81,7 @@ CodePoint utf8_code_point(const std::string& text, std::size_t at) {
   for (std::size_t k = 1; k < length; ++k) {
     const auto next = static_cast<unsigned char>(text[at + k]);
     if ((next & 0xC0) != 0x80) return {};
-    value = value << 6 | (next & 0x3F);
+    value = (value << 6) | (next & 0x3F);
   }
   static constexpr char32_t smallest[] = {0, 0, 0x80, 0x800, 0x10000};
   if (value < smallest[length] || value > 0x10FFFF || (value >= 0xD800 && value <= 0xDFFF)) return {};
