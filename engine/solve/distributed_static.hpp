@@ -40,7 +40,8 @@ struct DistributedConditions {
 class DistributedStatic {
  public:
   // Collective. Throws std::invalid_argument (the same on every rank) for conditions of the
-  // wrong size or ids outside the serial mesh. The density sets gravity's load (ρ|τ|g shared
+  // wrong size, ids outside the serial mesh, or arguments that differ between the ranks
+  // (naming them, core/rank_agreement.hpp). The density sets gravity's load (ρ|τ|g shared
   // by each cell's corners, as serially) and the lumped masses of dynamic relaxation.
   DistributedStatic(DistributedMesh& part, Material material, double density, double thickness,
                     const DistributedConditions& conditions);
@@ -55,7 +56,8 @@ class DistributedStatic {
   // symmetric sweeps) or "lu" (MUMPS); options under `prefix`. Stopping:
   // criterion "relative" is PETSc's relative test (‖F‖ ≤ rtol ‖F(u₀)‖; CG ‖r‖ ≤ rtol ‖b‖ in
   // its preconditioned norm); "6.9" and "6.8" are the serial StaticSolver's (§6.6,
-  // stopping.hpp), on the true residual, with the same round-off floor.
+  // stopping.hpp), on the true residual, with the same round-off floor. A start that already
+  // meets the serial rule ((6.9) at rtol under "relative") is converged with no iteration.
   SolveResult solve(const std::string& method, const std::string& preconditioner, double rtol, int max_iterations,
                     const std::string& prefix, const std::string& criterion = "relative",
                     double round_tolerance = 1e-12);
