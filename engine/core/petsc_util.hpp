@@ -4,6 +4,7 @@
 #include <petsctime.h>
 #include <petscvec.h>
 
+#include <cmath>
 #include <span>
 #include <string>
 #include <vector>
@@ -12,10 +13,33 @@
 
 namespace snede {
 
+// ‖v‖₂ over all of v's ranks, scaled by the largest entry as BLAS's dnrm2 is: PETSc's VecNorm
+// sums the squares, which underflow below about 1e-154 (the forces on a body with E = 1e-160 Pa)
+// and overflow above 1e154, and it caches that wrong norm, which VecCopy and VecScale then carry
+// on (a right-hand side of norm 1e-6 looked like 0 to CG). Not cached: PETSc never sees it.
 inline double vec_norm(Vec v) {
-  PetscReal norm = 0;
-  SNEDE_PETSC(VecNorm(v, NORM_2, &norm));
-  return norm;
+  const PetscScalar* x = nullptr;
+  PetscInt n = 0;
+  MPI_Comm comm = MPI_COMM_NULL;
+  SNEDE_PETSC(PetscObjectGetComm(reinterpret_cast<PetscObject>(v), &comm));
+  SNEDE_PETSC(VecGetLocalSize(v, &n));
+  SNEDE_PETSC(VecGetArrayRead(v, &x));
+  double largest = 0;
+  bool has_nan = false;
+  for (PetscInt i = 0; i < n; ++i) {
+    has_nan = has_nan || std::isnan(x[i]);
+    largest = std::fmax(largest, std::fabs(x[i]));
+  }
+  double sum = 0;
+  MPI_Allreduce(MPI_IN_PLACE, &largest, 1, MPI_DOUBLE, MPI_MAX, comm);
+  MPI_Allreduce(MPI_IN_PLACE, &has_nan, 1, MPI_CXX_BOOL, MPI_LOR, comm);
+  if (!has_nan && largest > 0 && std::isfinite(largest)) {
+    for (PetscInt i = 0; i < n; ++i) sum += (x[i] / largest) * (x[i] / largest);
+    MPI_Allreduce(MPI_IN_PLACE, &sum, 1, MPI_DOUBLE, MPI_SUM, comm);
+  }
+  SNEDE_PETSC(VecRestoreArrayRead(v, &x));
+  if (has_nan) return std::nan("");
+  return largest > 0 && std::isfinite(largest) ? largest * std::sqrt(sum) : largest;
 }
 
 inline double wall_seconds() {

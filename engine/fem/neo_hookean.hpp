@@ -42,14 +42,16 @@ struct NeoHookean {
            T(0.5 * lame.lambda) * (T(2) * J - T(1)) * J * double_dot<T, 3>(C_inv, H) * C_inv;
   }
   // Plane stress: with C = diag(C₂, c), d = det C₂ and s = √c, S₃₃ = 0 reads
-  // (μ + λ d) s² − λ √d s − μ = 0, whose positive root is taken (closed form).
+  // (μ + λ d) s² − λ √d s − μ = 0, whose positive root is taken (closed form), divided by μ
+  // (r = λ/μ): λ² overflows from E = 1e155 Pa and underflows below E = 1e-160 Pa.
   template <class T>
   T plane_stress_c33(const Tensor<T, 2>& C2) const {
     using std::sqrt;
     const T d = C2.determinant();
-    const T a = T(lame.mu) + T(lame.lambda) * d;
+    const double r = lame.lambda / lame.mu;
+    const T a = T(1) + T(r) * d;
     const T root_d = sqrt(d);
-    const T s = (T(lame.lambda) * root_d + sqrt(T(lame.lambda * lame.lambda) * d + T(4 * lame.mu) * a)) / (T(2) * a);
+    const T s = (T(r) * root_d + sqrt(T(r * r) * d + T(4) * a)) / (T(2) * a);
     return s * s;
   }
 };

@@ -41,7 +41,8 @@ class MaxStepsGuard {
 double dilatational_modulus(const Material& material, int dim) {
   Lame lame = std::visit([](const auto& m) { return m.lame; }, material);
   if (const auto* vw = std::get_if<VerondaWestmann>(&material)) lame.lambda += 2 * lame.mu * (2 * vw->gamma - 1);
-  return dim == 3 ? lame.lambda + 2 * lame.mu : 4 * lame.mu * (lame.lambda + lame.mu) / (lame.lambda + 2 * lame.mu);
+  // The ratio first: μ(λ + μ) underflows for E = 1e-200 Pa and overflows for E = 1e160 Pa.
+  return dim == 3 ? lame.lambda + 2 * lame.mu : 4 * lame.mu * ((lame.lambda + lame.mu) / (lame.lambda + 2 * lame.mu));
 }
 
 }  // namespace
