@@ -134,7 +134,8 @@ class Body:
         """J at ``u`` (default the current displacement) assembled from the same element kernels
         into a new petsc4py ``Mat``: ``format`` "baij" (blocks of dim × dim) or "aij". For
         preconditioners and comparison; it does not follow later mesh changes. Not for
-        membranes yet: the assembly takes every cell to have dim + 1 corners."""
+        membranes yet: the assembly takes every cell to have dim + 1 corners. A dropped one is
+        freed when snede next hands out a PETSc handle (petsc4py defers the destroy)."""
         if self.mesh.is_surface:
             raise ValueError("assemble_tangent is not available for membranes (surface meshes) yet: the assembly "
                              "expects dim + 1 corners per cell; use the matrix-free tangent_operator")
