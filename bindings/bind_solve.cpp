@@ -119,6 +119,17 @@ void bind_solve(py::module_& m) {
              }
              return py::make_tuple(to_array(fixed, 1), to_array(anchors, s.dim()), to_array(sliding, 1));
            })
+      // The corners of one cell of each piece the constraints do not hold, (n_pieces, cell_dim + 1).
+      .def("loose_piece_cells", [](Model& s) {
+             const Mesh& mesh = s.body().mesh();
+             std::vector<std::int64_t> corners;
+             for (const LoosePiece& piece : PieceHolding(mesh).loose_pieces(s.constraints())) {
+               const auto cell = mesh.connectivity().element(piece.first_cell).simplex.vertices();
+               corners.insert(corners.end(), cell.begin(), cell.end());
+             }
+             return to_array(corners, mesh.cell_dim() + 1);
+           })
+      .def("require_held", [](Model& s) { PieceHolding(s.body().mesh()).require_held(s.constraints()); })
       .def_property_readonly("generation", &Model::generation)
       .def_property("displacement", [](const Model& s) { return vec_to_array(s.displacement(), s.dim()); },
                     [](Model& s, const DoubleArray& u) { array_to_vec(u, s.displacement()); })

@@ -6,7 +6,10 @@
 #include <array>
 #include <cmath>
 #include <stdexcept>
+#include <string>
 #include <unordered_map>
+
+#include "mesh/traversal.hpp"
 
 namespace snede {
 
@@ -95,10 +98,14 @@ std::size_t Constraints::n_constrained() const {
   return n;
 }
 
+std::size_t Constraints::constrained_components(VertexId v) const {
+  const ConstraintKind kind = vertices_[v].kind;
+  return kind == ConstraintKind::fixed ? dim_ : kind == ConstraintKind::slide ? dim_ - 1 : 0;
+}
+
 std::size_t Constraints::n_constrained_components() const {
   std::size_t n = 0;
-  for (const auto& c : vertices_)
-    n += c.kind == ConstraintKind::fixed ? dim_ : c.kind == ConstraintKind::slide ? dim_ - 1 : 0;
+  for (VertexId v = 0; v < n_points(); ++v) n += constrained_components(v);
   return n;
 }
 
@@ -191,6 +198,68 @@ void Constraints::inherit(VertexId v, const VertexParents& parents) {
 void Constraints::remove(VertexId v) {
   if (v >= n_points()) resize(v + 1);
   vertices_[v] = VertexConstraint{ConstraintKind::absent, {0, 0, 0}, {0, 0, 0}};
+}
+
+void PieceHolding::label_pieces() {
+  const Connectivity& c = mesh_.connectivity();
+  const auto [label, pieces] = connected_components(c);
+  vertex_piece_.assign(mesh_.n_points(), -1);
+  hinge_pieces_.clear();
+  piece_cells_.assign(pieces, 0);
+  piece_first_cell_.assign(pieces, no_id);
+  for (ElementId e = 0; e < c.element_capacity(); ++e) {
+    if (!c.is_element(e)) continue;
+    const int piece = label[e];
+    if (piece_cells_[piece]++ == 0) piece_first_cell_[piece] = e;
+    for (VertexId v : c.element(e).simplex.vertices()) {
+      if (vertex_piece_[v] < 0) vertex_piece_[v] = piece;
+      else if (vertex_piece_[v] != piece) hinge_pieces_.emplace_back(v, piece);
+    }
+  }
+  std::sort(hinge_pieces_.begin(), hinge_pieces_.end());
+  hinge_pieces_.erase(std::unique(hinge_pieces_.begin(), hinge_pieces_.end()), hinge_pieces_.end());
+  labelled_revision_ = c.revision();
+  labelled_ = true;
+}
+
+std::vector<LoosePiece> PieceHolding::loose_pieces(const Constraints& constraints) {
+  if (!labelled_ || labelled_revision_ != mesh_.connectivity().revision()) label_pieces();
+  const int pieces = static_cast<int>(piece_cells_.size());
+  std::vector<std::size_t> held(pieces, 0);
+  const VertexId n = std::min(constraints.n_points(), static_cast<VertexId>(vertex_piece_.size()));
+  for (VertexId v = 0; v < n; ++v)
+    if (vertex_piece_[v] >= 0) held[vertex_piece_[v]] += constraints.constrained_components(v);
+  for (const auto& [v, piece] : hinge_pieces_)
+    if (v < n) held[piece] += constraints.constrained_components(v);
+  const std::size_t rigid_motions = constraints.dim() == 3 ? 6 : 3;
+  std::vector<LoosePiece> loose;
+  for (int piece = 0; piece < pieces; ++piece)
+    if (held[piece] < rigid_motions)
+      loose.push_back({piece, pieces, piece_cells_[piece], piece_first_cell_[piece], held[piece], rigid_motions});
+  return loose;
+}
+
+void PieceHolding::require_held(const Constraints& constraints) {
+  const std::vector<LoosePiece> loose = loose_pieces(constraints);
+  if (loose.empty()) return;
+  const LoosePiece& first = loose.front();
+  const std::string which =
+      first.pieces == 1 ? "it is one piece of " + std::to_string(first.cells) + " cells with "
+                        : "piece " + std::to_string(first.piece + 1) + " of " + std::to_string(first.pieces) + " (" +
+                              std::to_string(first.cells) + " cells, vertex " +
+                              std::to_string(mesh_.connectivity().element(first.first_cell).simplex.vertices()[0]) +
+                              " among them) has ";
+  std::string message = "the body is not held: " + which + std::to_string(first.constrained_components) +
+                        " constrained displacement components where at least " +
+                        std::to_string(first.rigid_motions) +
+                        " are needed to stop its rigid motions (3 in 2D, 6 in 3D and on membranes)";
+  if (first.pieces == 1)
+    throw std::invalid_argument(message + "; fix some of its vertices with body.fix");
+  message += "; " + std::to_string(loose.size()) + " of the " + std::to_string(first.pieces) + " pieces " +
+             (loose.size() == 1 ? "is" : "are") + " not held. A static solve needs every piece held (a cut can " +
+             "free one): fix some vertices of each with body.fix, or call body.fix_free_pieces() to fix each on " +
+             "one of its cells where it is now (TetrahedralCutter(fix_free_pieces=True) does this while cutting)";
+  throw std::invalid_argument(message);
 }
 
 }  // namespace snede

@@ -5,7 +5,9 @@
 #pragma once
 
 #include <array>
+#include <cstdint>
 #include <span>
+#include <utility>
 #include <vector>
 
 #include "mesh/mesh.hpp"
@@ -41,7 +43,9 @@ class Constraints {
   // Gives v the constraint `c` as it is (a copy of another mesh's vertex: a multigrid level).
   void assign(VertexId v, const VertexConstraint& c);
   std::size_t n_constrained() const;
-  // Number of independent constrained displacement components.
+  // Number of independent constrained displacement components: of vertex v (dim when fixed,
+  // dim − 1 when sliding), and of all vertices.
+  std::size_t constrained_components(VertexId v) const;
   std::size_t n_constrained_components() const;
 
   // v ← P v
@@ -64,6 +68,47 @@ class Constraints {
   void check_vertex(VertexId v) const;
   int dim_;
   std::vector<VertexConstraint> vertices_;
+};
+
+// A piece of a mesh (cells joined through faces, §3.3) with fewer constrained displacement
+// components than it has rigid motions.
+struct LoosePiece {
+  int piece = 0;   // label in [0, pieces)
+  int pieces = 0;  // in the mesh
+  std::size_t cells = 0;
+  ElementId first_cell = no_id;  // its lowest cell id
+  std::size_t constrained_components = 0;
+  std::size_t rigid_motions = 0;  // 3 in 2D, 6 in 3D and on membranes
+};
+
+// Whether constraints hold every piece of a mesh. A piece cut free of every support keeps its
+// rigid motions, so the static problem has no unique solution, however many components the
+// rest of the body has constrained: Newton spins to its iteration limit, CG meets an indefinite
+// matrix. So each piece needs at least as many constrained components as it has rigid motions
+// (necessary, not sufficient: three fixed vertices on a line pass, as for the whole body). A
+// constrained vertex where pieces meet without a face (a hinge) counts for each of them; a free
+// hinge for none, though it may help hold a piece: the check errs towards refusing, as a piece
+// hinged there still turns about it unless held by constraints of its own.
+class PieceHolding {
+ public:
+  explicit PieceHolding(const Mesh& mesh) : mesh_(mesh) {}
+  // The pieces `constraints` do not hold, by label. The pieces are labelled once per mesh
+  // revision (O(n)); each call then counts the constrained vertices (one pass, no search).
+  std::vector<LoosePiece> loose_pieces(const Constraints& constraints);
+  // Throws std::invalid_argument naming the first loose piece (its size, a vertex, its
+  // constrained components against its rigid motions) and the remedies.
+  void require_held(const Constraints& constraints);
+
+ private:
+  void label_pieces();
+
+  const Mesh& mesh_;
+  bool labelled_ = false;
+  std::uint64_t labelled_revision_ = 0;
+  std::vector<int> vertex_piece_;                       // per vertex id: a piece of its cells; -1 in none
+  std::vector<std::pair<VertexId, int>> hinge_pieces_;  // a vertex in several pieces, with each further one
+  std::vector<std::size_t> piece_cells_;
+  std::vector<ElementId> piece_first_cell_;
 };
 
 }  // namespace snede

@@ -58,7 +58,8 @@ StaticSolver::StaticSolver(Model& model, StaticOptions options, const Refinement
     : model_(model),
       options_(std::move(options)),
       option_database_(options_.options_prefix, options_.petsc_options),
-      hierarchy_(hierarchy) {
+      hierarchy_(hierarchy),
+      piece_holding_(model.body().mesh()) {
   if (options_.stopping.rtol <= 0 || !std::isfinite(options_.stopping.rtol))
     throw std::invalid_argument("rtol must be positive, got " + std::to_string(options_.stopping.rtol));
   if (!(options_.stopping.round_tolerance >= 0) || !std::isfinite(options_.stopping.round_tolerance))
@@ -382,6 +383,9 @@ double StaticSolver::current_tolerance() const {
 }
 
 SolveResult StaticSolver::solve() {
+  // A piece with rigid motions has no unique static solution: refused before any set-up, as no
+  // method or preconditioner would converge (Newton spun to its iteration limit).
+  piece_holding_.require_held(model_.constraints());
   const double follow_start = wall_seconds();
   follow_mesh_changes();
   follow_seconds_ = wall_seconds() - follow_start;
@@ -397,13 +401,6 @@ SolveResult StaticSolver::solve() {
   // tangent. The iterate keeps its units and the stopping tests multiply back.
   system_scale_ = std::isfinite(rule_.force_scale) && rule_.force_scale > 0 ? rule_.force_scale : 1.0;
   model_.enforce_constraints(model_.displacement());
-  // A free body has rigid motions: the static problem has no unique solution.
-  const std::size_t rigid_modes = model_.dim() == 3 ? 6 : 3;
-  if (model_.constraints().n_constrained_components() < rigid_modes)
-    throw std::invalid_argument(
-        "the body is not held: a static solve needs constraints that stop its " + std::to_string(rigid_modes) +
-        " rigid motions (fix some vertices with body.fix); only " +
-        std::to_string(model_.constraints().n_constrained_components()) + " displacement components are constrained");
   SolveResult result = ksp_ ? solve_linear() : solve_nonlinear();
   if (result.converged) remember_smoother_bounds();
   option_database_.mark_read_options_used();  // a solve reads more (-snes_view, -ksp_converged_reason)

@@ -132,6 +132,7 @@ class StaticSolver {
   double reaction_norm_ = 0;  // reactions used by the KSP test (at the start of a linear solve)
   std::vector<double> history_;
   double follow_seconds_ = 0;
+  PieceHolding piece_holding_;  // whether every piece of the body is held (checked before each solve)
 };
 
 // Registers snede's line searches with PETSc (idempotent): snede_newton, snede_secant.

@@ -177,6 +177,19 @@ class Body:
         """Let vertices move only along ``direction`` (a line through where they are now)."""
         self._model.slide(self._vertices(vertices), np.asarray(direction, dtype=np.float64))
 
+    def fix_free_pieces(self) -> int:
+        """Fix every piece of the body (cells joined through faces) that its constraints do not
+        hold: the corners of one of its cells, where they are now, so that the static problem
+        stays well posed (§3.3). Returns how many pieces it fixed. A piece is held when it has at
+        least as many constrained displacement components as rigid motions (3 in 2D, 6 in 3D and
+        on membranes); a static solve refuses a body with a piece that is not. For pieces cut
+        free by ``mesh.dissect`` or a ``DelaunayCutter``; a ``TetrahedralCutter`` fixes them as it
+        cuts (``fix_free_pieces=True``)."""
+        corners = self._model.loose_piece_cells().ravel()
+        if len(corners):
+            self.fix(corners, self.displacement[corners])
+        return len(corners) // (self.mesh.cell_dim + 1)
+
     def release(self, vertices) -> None:
         """Remove the constraints of these vertices."""
         self._model.release(self._vertices(vertices))

@@ -73,6 +73,11 @@ class StaticSolver(RunsOnRanks):
       ``part`` is this rank's part. None (default): the body's ``comm``, and without one the
       serial solver.
 
+    ``solve()`` first checks that every piece of the body (cells joined through faces) is held:
+    a piece with fewer constrained displacement components than rigid motions (3 in 2D, 6 in 3D
+    and on membranes), e.g. one a cut freed of its supports, has no static solution, and raises
+    ValueError at once naming it (``body.fix_free_pieces()`` or ``body.fix`` holds it).
+
     Every method solves the system divided by the force scale E·t·H (E·H² in 3D), so that the
     answer does not depend on the units (E from 1e-3 to 1e155 Pa give the same displacement);
     ``-static_ksp_monitor`` prints residual norms divided by it, while ``SolveResult``
@@ -127,6 +132,8 @@ class StaticSolver(RunsOnRanks):
     def _solve_distributed(self) -> SolveResult:
         method, rtol, max_iterations, preconditioner, prefix, criterion, round_tolerance = self._distributed_settings
         problem = self._distributed.problem()
+        # The serial check, on the body every rank now agrees on: all ranks raise, none waits.
+        self.body._model.require_held()
         chosen = "none" if method == "ncg" else (preconditioner or "gamg")
         result = problem.solve(method, rtol=rtol, max_iterations=max_iterations, preconditioner=chosen,
                                options_prefix=prefix, criterion=criterion, round_tolerance=round_tolerance)
