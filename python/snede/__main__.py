@@ -4,8 +4,13 @@ Options starting with ``--`` are snede's: one snede does not know is an error (a
 ``run path/to/scene.py`` gets the ones snede does not know, as its own arguments). Options
 starting with a single ``-`` (and their values) are PETSc's (``-static_snes_monitor``,
 ``-log_view``): PETSc read them, and only them, from sys.argv when snede was imported (see
-``snede._argv``). At the end, options with snede's prefixes (static_, dynamic_, needle_) that
-no solver read are reported, as PETSc's ``-options_left`` does for all options.
+``snede._argv``). Before a built-in scene runs, a value PETSc refuses is an error, whether or
+not the scene's solver reads the option; at the end, the options nothing read are reported,
+as PETSc's ``-options_left`` does.
+
+Bad input gives one line, ``python -m snede: error: ...``, and exit status 2 (under mpirun,
+from rank 0 alone when every rank finds it); Ctrl-C one line and status 130; a solve that did
+not converge status 1 (see ``snede._command_line``).
 
 ``-h``/``--help`` is snede's help; ``-help`` is PETSc's: PETSc prints its options as the
 solvers are set up (with ``run SCENE``, the scene runs); without a command, snede's help
@@ -15,16 +20,14 @@ from __future__ import annotations
 
 import argparse
 import logging
-import os
 import runpy
-import signal
 import sys
-import threading
 import traceback
 from pathlib import Path
 
+from snede import _command_line
+
 METHODS = ("cg", "ncg", "newton", "dynamic")
-PREFIXES = ("static_", "dynamic_", "needle_")  # the options prefixes of snede's solvers
 SCENE_OPTIONS = ("divisions", "mesh_size", "speed")  # apply to the scenes whose OPTIONS name them
 
 
@@ -48,10 +51,17 @@ def _positive_int(text: str) -> int:
     return value
 
 
+class _ArgumentParser(argparse.ArgumentParser):
+    """argparse, with its errors on the command line's one line (no usage: --help has it)."""
+
+    def error(self, message):
+        _command_line.fail(message)
+
+
 def _parser() -> argparse.ArgumentParser:
     from snede.scenes import MATERIAL_NAMES
 
-    parser = argparse.ArgumentParser(
+    parser = _ArgumentParser(
         prog="python -m snede",
         description="snede: soft deformable objects whose meshes change. Options starting with '--' are snede's; "
                     "options starting with a single '-' are passed to PETSc (e.g. -static_snes_monitor, -log_view; "
@@ -100,8 +110,7 @@ def _check_scene_options(parser, args, module) -> None:
 def _warn_unused(logger) -> None:
     from snede._petsc import unused_options
 
-    unused = unused_options(PREFIXES)
-    for name, value in unused:
+    for name, value in unused_options():
         logger.warning("PETSc option -%s%s was not used (misspelled, or not for this scene's solver?)",
                        name, "" if value is None else f" {value}")
 
@@ -130,39 +139,27 @@ def main(argv: list[str] | None = None) -> int:
     logger.setLevel(logging.WARNING if args.quiet else logging.INFO)
     import snede  # (initialised PETSc with the PETSc options of sys.argv)
 
-    if signal.getsignal(signal.SIGINT) is signal.default_int_handler:
-        signal.signal(signal.SIGINT, _interrupt_outside_finalizers)
+    # Until here Ctrl-C ended the process at once (nothing written yet); now solves stop
+    # between iterations (engine/core/interrupt.hpp) and the files written so far are closed.
+    _command_line.on_ctrl_c(_command_line.raise_keyboard_interrupt)
     try:
         code = _command(parser, args, unknown, petsc)
-    except (snede.PetscError, ValueError, OSError) as error:  # a bad PETSc option value, bad input
-        print(f"error: {error}", file=sys.stderr)
-        return 2
-    except KeyboardInterrupt:  # Ctrl-C: solves stop between iterations (engine/core/interrupt.hpp)
+        if args.command != "list":
+            _warn_unused(logger)
+    except (snede.PetscError, ValueError, OSError) as error:  # bad input, maybe on this rank alone
+        print(_command_line.error_line(error), file=sys.stderr)
+        return _command_line.BAD_INPUT
+    except KeyboardInterrupt:
         where = f" (the files written so far in {args.out} are complete up to the last step)" \
             if args.command in ("run", "demo") else ""
         print(f"interrupted{where}", file=sys.stderr)
-        return 130
-    if args.command != "list":
-        _warn_unused(logger)
+        return _command_line.INTERRUPTED
     return code
-
-
-def _interrupt_outside_finalizers(signum, frame) -> None:
-    """Ctrl-C as KeyboardInterrupt, except inside a finalizer (a weakref callback or a
-    __del__, run whenever the garbage collector frees PETSc objects): Python prints and
-    swallows an exception raised there, and the run went on to its end with status 0. There the
-    signal is sent again a moment later, once the finalizer has returned."""
-    while frame is not None:
-        code = frame.f_code
-        if code.co_name == "__del__" or code.co_filename.endswith("weakref.py"):
-            threading.Timer(0.02, os.kill, (os.getpid(), signum)).start()
-            return
-        frame = frame.f_back
-    raise KeyboardInterrupt
 
 
 def _command(parser, args, unknown, petsc) -> int:
     from snede import run_scene
+    from snede._petsc import OptionValueError, check_option_values
     from snede.scenes import builders
 
     if args.command == "list":
@@ -184,8 +181,12 @@ def _command(parser, args, unknown, petsc) -> int:
     if args.scene not in scenes:
         parser.error(f"unknown scene {args.scene!r}: choose one of {', '.join(scenes)}, or give a .py file")
     _check_scene_options(parser, args, scenes[args.scene])
-    scene = scenes[args.scene].build(args)
-    summary = run_scene.run(scene, args.method, args.rtol, args.out, progress=not args.quiet)
+    try:
+        check_option_values()
+        scene = scenes[args.scene].build(args)
+        summary = run_scene.run(scene, args.method, args.rtol, args.out, progress=not args.quiet)
+    except (OptionValueError, run_scene.SerialOnly) as error:  # the same on every rank
+        _command_line.fail(error)
     if summary.get("rank", 0) == 0:  # on several MPI ranks, rank 0 reports
         run_scene.print_table([summary])
     return 0 if summary["converged"] else 1
@@ -204,11 +205,15 @@ def _end_every_rank(code: int) -> None:
 
 
 if __name__ == "__main__":
-    # Not converged (1, from the collective summary) ends every rank alike; an error, an
-    # interrupt or a script's sys.exit may have happened on this rank alone.
+    # Not converged (1, from the collective summary) and bad input every rank finds alike end
+    # every rank alike; an error, an interrupt or a script's sys.exit may have happened on this
+    # rank alone.
     try:
-        exit_code, alone = main(), False
-    except SystemExit as stop:  # sys.exit in a scene script, or a usage error
+        exit_code = main()
+        alone = exit_code in (_command_line.BAD_INPUT, _command_line.INTERRUPTED)  # an error or Ctrl-C
+    except _command_line.AlikeOnEveryRank as stop:
+        exit_code, alone = stop.code, False
+    except SystemExit as stop:  # sys.exit in a scene script, Ctrl-C while modules load
         exit_code = stop.code if isinstance(stop.code, int) else (0 if stop.code is None else 1)
         if not isinstance(stop.code, (int, type(None))):
             print(stop.code, file=sys.stderr)  # as Python prints it
@@ -216,6 +221,6 @@ if __name__ == "__main__":
     except Exception:
         traceback.print_exc()
         exit_code, alone = 1, True
-    if exit_code != 0 and (alone or exit_code in (2, 130)):
+    if exit_code != 0 and alone:
         _end_every_rank(exit_code)
     sys.exit(exit_code)

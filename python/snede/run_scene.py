@@ -90,6 +90,22 @@ def picture_arguments(scene, method: str) -> dict:
             "decorate": scene.decorate, "fixed": fixed, **(scene.picture() if scene.picture else {})}
 
 
+class SerialOnly(NotImplementedError):
+    """The scene cannot run on several MPI ranks; raised on every rank alike."""
+
+
+def draw_picture(scene, method: str, folder: Path, outcome: dict) -> dict:
+    """The picture of the scene after its run, as ``{"png": path}``. A failed run's state is
+    drawn with its reason in the title, never as if it were a solution; a state holding NaN or
+    Inf is not drawn at all (the summary's reason says what went wrong)."""
+    if not np.isfinite(scene.body.displacement).all():
+        return {}
+    arguments = picture_arguments(scene, method)
+    if not outcome["converged"]:
+        arguments["title"] += f"\nNOT converged: {outcome['reason']}"
+    return {"png": str(plot_body(scene.body, folder / f"{scene.name}.png", **arguments))}
+
+
 def _world():
     """MPI.COMM_WORLD when the run has several ranks (mpirun -n N), else None."""
     from mpi4py import MPI
@@ -110,7 +126,8 @@ def run(scene, method: str | None, rtol: float | None, out: Path, progress: bool
         from snede.distributed_scene import solve_distributed, unsupported
 
         if (why := unsupported(scene, method)) is not None:
-            raise NotImplementedError(f"{scene.name} on {comm.size} MPI ranks: {why}")
+            raise SerialOnly(f"{scene.name} on {comm.size} MPI ranks: {why}; it runs on one rank only "
+                             "(without mpirun)")
         if comm.rank == 0:
             folder.mkdir(parents=True, exist_ok=True)
         writer = SeriesWriter(folder / scene.name, comm=comm)
@@ -121,9 +138,8 @@ def run(scene, method: str | None, rtol: float | None, out: Path, progress: bool
         folder.mkdir(parents=True, exist_ok=True)
         writer = SeriesWriter(folder / scene.name)
         outcome = (scene.evolve or partial(solve_once, scene))(method, rtol, writer, folder, progress)
-    picture = plot_body(body, folder / f"{scene.name}.png", **picture_arguments(scene, method))
+    files = {**draw_picture(scene, method, folder, outcome), **outcome.pop("files", {})}
     value = scene.probe(body)
-    files = outcome.pop("files", {})
     summary = {
         "scene": scene.name,
         "description": scene.description,
@@ -138,7 +154,7 @@ def run(scene, method: str | None, rtol: float | None, out: Path, progress: bool
         "analytic": scene.analytic,
         "error_percent": None if scene.analytic is None else 100 * abs(value - scene.analytic) / abs(scene.analytic),
         "max_rss_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024,
-        "files": {"xdmf": str(writer.xdmf_path), "h5": str(writer.h5_path), "png": str(picture), **files},
+        "files": {"xdmf": str(writer.xdmf_path), "h5": str(writer.h5_path), **files},
         **scene.details,
     }
     (folder / "summary.json").write_text(json.dumps(summary, indent=2))

@@ -323,7 +323,7 @@ def test_an_output_folder_deleted_mid_run_stops_the_command_line_with_one_line(t
     assert result.returncode == 2, (result.stdout, result.stderr)
     assert "NOT REACHED" not in result.stdout and "Traceback" not in result.stderr
     lines = result.stderr.strip().splitlines()
-    assert len(lines) == 1 and lines[0].startswith("error: cannot open") and "series.h5" in lines[0], lines
+    assert len(lines) == 1 and lines[0].startswith("python -m snede: error: cannot open") and "series.h5" in lines[0], lines
     assert issubclass(snede.FileError, OSError)
 
 
