@@ -7,13 +7,15 @@ namespace snede::bindings {
 namespace {
 
 std::unique_ptr<TetrahedralCutter> make_cutter(Mesh& mesh, Model* model, bool snap, bool remove_degeneracies,
-                                               double min_aspect_ratio, double large_angle, bool fix_free_pieces) {
+                                               double min_aspect_ratio, double large_angle, bool fix_free_pieces,
+                                               int max_fragment_elements) {
   CutterOptions options;
   options.snap = snap;
   options.remove_degeneracies = remove_degeneracies;
   options.degeneracy.min_aspect_ratio = min_aspect_ratio;
   options.degeneracy.large_angle = large_angle;
   options.fix_free_pieces = fix_free_pieces;
+  options.max_fragment_elements = max_fragment_elements;
   return std::make_unique<TetrahedralCutter>(mesh, model, options);
 }
 
@@ -38,12 +40,15 @@ void bind_cutting(py::module_& m) {
       .def_readwrite("components", &CutReport::components)
       .def_readwrite("free_pieces", &CutReport::free_pieces)
       .def_readwrite("pieces_fixed", &CutReport::pieces_fixed)
+      .def_readwrite("fragments_removed", &CutReport::fragments_removed)
+      .def_readwrite("fragment_elements", &CutReport::fragment_elements)
       .def_readwrite("piece_search", &CutReport::piece_search)
       .def_readwrite("seconds", &CutReport::seconds);
 
   py::class_<TetrahedralCutter>(m, "TetrahedralCutter")
       .def(py::init(&make_cutter), py::arg("mesh"), py::arg("model"), py::arg("snap"), py::arg("remove_degeneracies"),
-           py::arg("min_aspect_ratio"), py::arg("large_angle"), py::arg("fix_free_pieces"), py::keep_alive<1, 2>(),
+           py::arg("min_aspect_ratio"), py::arg("large_angle"), py::arg("fix_free_pieces"), py::arg("max_fragment_elements"),
+           py::keep_alive<1, 2>(),
            py::keep_alive<1, 3>())
       .def("cut_triangle", [](TetrahedralCutter& c, const DoubleArray& corners) { return c.cut_triangle(view(corners)); },
            py::arg("corners"))

@@ -5,6 +5,7 @@
 #include <unordered_set>
 
 #include "mesh/element_quality.hpp"
+#include "mesh/traversal.hpp"
 
 namespace snede {
 
@@ -85,33 +86,94 @@ FaceSelection FaceSelector::select(const Connectivity& c, const DeformedPosition
     return it->second;
   };
 
+  // Every vertex a crossing marks, with the earliest sweep that marked it. Once the marked
+  // vertices are snapped onto the sweep, no edge crosses it any more, so each tetrahedron
+  // near the sweep lies on one side of it, or on it (all four corners marked).
+  std::unordered_map<VertexId, int> marked_by;
+  std::unordered_map<VertexId, ElementId> marked_in;  // a tetrahedron with the vertex, for its star
+  const auto mark_edges_of = [&](std::span<const ElementId> tets) {
+    for (ElementId e : tets) {
+      const Simplex& tet = c.element(e).simplex;
+      for (const auto& [i, j] : tetrahedron_edges) {
+        const Mark m = mark_of(tet.vertex(i), tet.vertex(j));  // a < b: simplex vertices are sorted
+        if (m.node == no_id) continue;
+        auto [it, fresh] = marked_by.try_emplace(m.node, m.sweep);
+        if (!fresh) it->second = std::min(it->second, m.sweep);
+        marked_in.try_emplace(m.node, e);
+      }
+    }
+  };
+  mark_edges_of(candidates);
+  // A face whose last corner this sweep marks may lie in a tetrahedron no recent sweep met:
+  // the stars of the marked vertices are candidates too, or the surface keeps a hole there.
+  {
+    std::unordered_set<ElementId> known(candidates.begin(), candidates.end());
+    std::vector<ElementId> stars;
+    for (const auto& [v, e0] : marked_in)
+      for (ElementId e : vertex_star(c, v, e0))
+        if (known.insert(e).second) stars.push_back(e);
+    mark_edges_of(stars);
+    candidates.insert(candidates.end(), stars.begin(), stars.end());
+  }
+  const auto is_marked = [&](VertexId v) { return marked_by.count(v) > 0; };
+  // The side of `plane` a tetrahedron is on: that of its corners neither marked nor on the
+  // plane (0 if they are on both sides: beyond the sweep's edge, where no crossing marked
+  // them), or of its centroid when there are none.
+  const auto side = [&](const Simplex& tet, const SweepTriangle& plane) {
+    const std::array<Point3, 4> corners = x.corners(tet);
+    std::array<double, 12> flat;
+    for (int i = 0; i < 4; ++i) std::copy(corners[i].begin(), corners[i].end(), flat.begin() + 3 * i);
+    // A corner snapped onto this plane by an earlier sweep is on it (to rounding), marked or not.
+    const double on_plane = 1e-9 * cell_longest_edge(3, 3, flat);
+    int found = 0;
+    bool any_unmarked = false;
+    Point3 centroid{0, 0, 0};
+    for (int i = 0; i < 4; ++i) {
+      for (int k = 0; k < 3; ++k) centroid[k] += corners[i][k] / 4;
+      const double d = plane.signed_distance(corners[i]);
+      if (is_marked(tet.vertex(i)) || std::abs(d) <= on_plane) continue;
+      any_unmarked = true;
+      const int sign = d > 0 ? 1 : -1;
+      if (found != 0 && sign != found) return 0;
+      found = sign;
+    }
+    if (any_unmarked) return found;
+    const double d = plane.signed_distance(centroid);
+    return (d > 0) - (d < 0);
+  };
+
+  // §3.2.1 selects the face a tetrahedron's marked corners span. Here a face is cut when its
+  // three corners are marked and the tetrahedra on its two sides are on opposite sides of
+  // the sweep that marked it last: the faces between the two sides, which close up into one
+  // surface wherever the sweeps cross the body, so a sweep across the whole body separates it.
+  // (Faces chosen tetrahedron by tetrahedron left holes where two or four corners were
+  // marked, and the body stayed joined across them.)
   std::unordered_set<FaceId> chosen;
   for (ElementId e : candidates) {
     const Simplex& tet = c.element(e).simplex;
-    std::array<int, 4> marked_by{-1, -1, -1, -1};
-    for (const auto& [i, j] : tetrahedron_edges) {
-      const Mark m = mark_of(tet.vertex(i), tet.vertex(j));  // a < b: simplex vertices are sorted
-      if (m.node == no_id) continue;
-      int& by = marked_by[tet.index(m.node)];
-      if (by < 0 || m.sweep < by) by = m.sweep;
+    for (int k = 0; k < 4; ++k) {
+      const FaceId f = c.opposite_face(e, tet.vertex(k));
+      const FaceId mate = c.face(f).mate;
+      if (mate == no_id) continue;  // already on the surface: nothing to dissect
+      const Simplex& face = c.face(f).simplex;
+      int last = -1;
+      bool all_marked = true;
+      for (VertexId v : face.vertices()) {
+        const auto it = marked_by.find(v);
+        if (it == marked_by.end()) {
+          all_marked = false;
+          break;
+        }
+        last = std::max(last, it->second);
+      }
+      if (!all_marked || chosen.count(std::min(f, mate))) continue;
+      const SweepTriangle& plane = sweeps_[last];
+      const int here = side(tet, plane), there = side(c.element(c.face(mate).element).simplex, plane);
+      if (here * there >= 0) continue;
+      chosen.insert(std::min(f, mate));
+      selection.faces.push_back(std::min(f, mate));
+      for (VertexId v : face.vertices()) selection.plane.try_emplace(v, sweeps_[marked_by[v]]);
     }
-    const int n_marked = static_cast<int>(std::count_if(marked_by.begin(), marked_by.end(), [](int s) { return s >= 0; }));
-    if (n_marked < 3) continue;
-    int left_out = static_cast<int>(std::find(marked_by.begin(), marked_by.end(), -1) - marked_by.begin());
-    if (n_marked == 4) {
-      // Only when a sweep halves the edges exactly (§3.2.1): keep the three corners closest
-      // to this sweep's plane (the thesis picks a face at random).
-      double farthest = -1;
-      for (int k = 0; k < 4; ++k)
-        if (const double d = std::abs(sweep.signed_distance(x(tet.vertex(k)))); d > farthest) farthest = d, left_out = k;
-    }
-    const FaceId f = c.opposite_face(e, tet.vertex(left_out));
-    const FaceId mate = c.face(f).mate;
-    if (mate == no_id) continue;  // already on the surface: nothing to dissect
-    if (!chosen.insert(std::min(f, mate)).second) continue;
-    selection.faces.push_back(std::min(f, mate));
-    for (int k = 0; k < 4; ++k)
-      if (k != left_out) selection.plane.try_emplace(tet.vertex(k), sweeps_[marked_by[k]]);
   }
   std::sort(selection.faces.begin(), selection.faces.end());
   previous_touched_ = selection.touched;

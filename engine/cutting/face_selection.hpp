@@ -2,17 +2,23 @@
 //
 // Every mesh edge that a sweep triangle crosses marks the end closest to the crossing (the
 // lower id when the edge is halved); only an edge's first crossing counts, so that sweeps
-// turning back cannot mark all four corners of a tetrahedron. A tetrahedron whose edges mark
-// exactly three of its corners selects the face they span (Figure 3.1).
+// turning back cannot mark all four corners of a tetrahedron. Snapped onto the sweep, the
+// marked vertices leave no edge crossing it, so each tetrahedron near the sweep is on one side
+// of it. The thesis selects, per tetrahedron whose edges mark exactly three of its corners, the
+// face they span (Figure 3.1); that left holes where two or four corners were marked, and a
+// sweep across the whole body left it joined. Here a face is selected when its three corners
+// are marked and the tetrahedra on its two sides lie on opposite sides of the sweep: the faces
+// between the two sides, a surface without holes across the swept region. Its tetrahedra with
+// all four corners marked may come out as one-element pieces; the cutter removes those.
 //
 // Intersections of earlier sweep triangles count for the tetrahedra the scalpel is still in
 // (the incomplete ones, Figure 3.2), so successive triangles give one connected cut surface,
 // lagging behind the scalpel (Figure 3.4). The thesis stores those intersections; here the
 // selector keeps the last few sweep triangles instead and re-evaluates the crossings of the
-// tetrahedra met by the current and the previous sweep on the mesh as it is now: node
-// snapping has moved vertices since, and stored marks from before the move leave gaps in the
-// cut surface. Re-evaluated, a vertex snapped onto a sweep is marked by every edge that
-// touches it, and a planar sweep through the body always separates it.
+// tetrahedra met by the current and the previous sweep, and of the stars of the vertices they
+// mark (a face whose last corner is marked now may lie in a tetrahedron no recent sweep met),
+// on the mesh as it is now: node snapping has moved vertices since, and stored marks from
+// before the move leave gaps in the cut surface. A corner snapped onto a sweep counts as on it.
 //
 // The search is local: the tetrahedra a sweep meets are found by a walk across faces from
 // those the previous sweep met; only the first contact (no previous sweep, or nothing met

@@ -50,7 +50,8 @@ constexpr double crease_angle_cosine = 0.866;  // 30°
 
 }  // namespace
 
-EditResult snap_to_sweep(Mesh& mesh, const DeformedPositions& x, VertexId v, const SweepTriangle& plane) {
+EditResult snap_to_sweep(Mesh& mesh, const DeformedPositions& x, VertexId v, const SweepTriangle& plane,
+                         const DeformedPositions* current) {
   const Connectivity& c = mesh.connectivity();
   const std::vector<ElementId> star = local_star(c, v).elements;
   const Eigen::Vector3d from = vec(x(v));
@@ -111,19 +112,23 @@ EditResult snap_to_sweep(Mesh& mesh, const DeformedPositions& x, VertexId v, con
   const std::array<VertexId, 4> parents{tet.vertex(0), tet.vertex(1), tet.vertex(2), tet.vertex(3)};
   const VertexParents snapped = VertexParents::barycentric(parents, std::span<const double>(weights.data(), 4));
 
-  // The deformed star must stay positive with v at its new deformed position.
-  Eigen::Vector3d moved = Eigen::Vector3d::Zero();
-  for (int k = 0; k < 4; ++k) moved += weights[k] * vec(x(parents[k]));
-  const Point3 at{moved[0], moved[1], moved[2]};
-  for (ElementId e : star) {
-    const std::array<VertexId, 4> order = c.element(e).simplex.oriented_vertices();
-    std::array<Point3, 4> p;
-    for (int k = 0; k < 4; ++k) p[k] = x(order[k]);
-    if (orientation_3d(p[0].data(), p[1].data(), p[2].data(), p[3].data()) <= 0) continue;  // already inverted
-    for (int k = 0; k < 4; ++k)
-      if (order[k] == v) p[k] = at;
-    if (orientation_3d(p[0].data(), p[1].data(), p[2].data(), p[3].data()) <= 0)
-      return EditResult::refused(name + ": snapping would invert element " + std::to_string(e) + " in the deformed body");
+  // The deformed star must stay positive with v at its new deformed position, in the
+  // configuration the sweep is made against and in the body's current one.
+  for (const DeformedPositions* config : {&x, current}) {
+    if (!config) continue;
+    Eigen::Vector3d moved = Eigen::Vector3d::Zero();
+    for (int k = 0; k < 4; ++k) moved += weights[k] * vec((*config)(parents[k]));
+    const Point3 at{moved[0], moved[1], moved[2]};
+    for (ElementId e : star) {
+      const std::array<VertexId, 4> order = c.element(e).simplex.oriented_vertices();
+      std::array<Point3, 4> p;
+      for (int k = 0; k < 4; ++k) p[k] = (*config)(order[k]);
+      if (orientation_3d(p[0].data(), p[1].data(), p[2].data(), p[3].data()) <= 0) continue;  // already inverted
+      for (int k = 0; k < 4; ++k)
+        if (order[k] == v) p[k] = at;
+      if (orientation_3d(p[0].data(), p[1].data(), p[2].data(), p[3].data()) <= 0)
+        return EditResult::refused(name + ": snapping would invert element " + std::to_string(e) + " in the deformed body");
+    }
   }
   return snap_vertex(mesh, v, snapped);
 }

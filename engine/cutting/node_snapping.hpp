@@ -25,7 +25,9 @@ namespace snede {
 // Refused, leaving the mesh unchanged, when the plane crosses no boundary face around a
 // boundary vertex, when no tetrahedron around the vertex contains the point (the
 // thesis's failed repositioning), or when the move would make an element of the vertex's
-// star flat or inverted in the reference or the deformed configuration.
-EditResult snap_to_sweep(Mesh& mesh, const DeformedPositions& x, VertexId v, const SweepTriangle& plane);
+// star flat or inverted in the reference or the deformed configuration (and, when given, in
+// `current`: the body as it is now, when the sweep is made against an earlier configuration).
+EditResult snap_to_sweep(Mesh& mesh, const DeformedPositions& x, VertexId v, const SweepTriangle& plane,
+                         const DeformedPositions* current = nullptr);
 
 }  // namespace snede

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <stdexcept>
 #include <string>
 
@@ -29,6 +30,8 @@ void CutReport::add(const CutReport& o) {
   if (o.sweeps > 0 || sweeps == 0) components = o.components;  // the later count, unless it swept nothing
   free_pieces += o.free_pieces;
   pieces_fixed += o.pieces_fixed;
+  fragments_removed += o.fragments_removed;
+  fragment_elements += o.fragment_elements;
   piece_search += o.piece_search;
   seconds += o.seconds;
 }
@@ -50,10 +53,12 @@ TetrahedralCutter::TetrahedralCutter(Mesh& mesh, Model* model, CutterOptions opt
 
 TetrahedralCutter::~TetrahedralCutter() { mesh_.connectivity().remove_watcher(this); }
 
+DeformedPositions TetrahedralCutter::cut_positions() const {
+  return DeformedPositions(mesh_, cut_configuration_.empty() ? nullptr : cut_configuration_.data());
+}
+
 bool TetrahedralCutter::constrained(VertexId v) const {
-  if (!model_) return false;
-  const ConstraintKind kind = model_->constraints()[v].kind;
-  return kind == ConstraintKind::fixed || kind == ConstraintKind::slide;
+  return model_ && model_->constraints().constrained_components(v) > 0;
 }
 
 CutReport TetrahedralCutter::cut_triangle(std::span<const double> corners) {
@@ -63,13 +68,14 @@ CutReport TetrahedralCutter::cut_triangle(std::span<const double> corners) {
   report.sweeps = 1;
   report.components = pieces_.pieces();
 
-  FaceSelection selection;
-  {
-    std::optional<ReadView> u;
-    if (model_) u.emplace(model_->displacement());
-    const DeformedPositions x(mesh_, u ? u->span().data() : nullptr);
-    selection = selector_.select(mesh_.connectivity(), x, sweep);
-  }
+  // A sweep triangle given alone (not by a move of the placed scalpel) meets the body as it is.
+  const bool alone = cut_configuration_.empty() && model_;
+  if (alone) cut_configuration_ = vec_values(model_->displacement());
+  const auto forget_alone = [&](void*) {
+    if (alone) cut_configuration_.clear();
+  };
+  const std::unique_ptr<void, decltype(forget_alone)> forget(this, forget_alone);
+  FaceSelection selection = selector_.select(mesh_.connectivity(), cut_positions(), sweep);
   // Faces selected earlier but left joined by their dissection are cut again with the new ones.
   for (const auto& [f, simplex] : joined_) {
     const Connectivity& c = mesh_.connectivity();
@@ -117,11 +123,10 @@ std::vector<VertexId> TetrahedralCutter::snap(const FaceSelection& selection, Cu
     }
     const auto plane = selection.plane.find(v);
     if (plane == selection.plane.end()) continue;  // a vertex of a face selected by an earlier sweep
-    // Read again for every vertex: each snap moves the vertex before it, with its displacement.
-    std::optional<ReadView> u;
+    std::optional<ReadView> u;  // read again for every vertex: each snap moves the one before
     if (model_) u.emplace(model_->displacement());
-    const DeformedPositions x(mesh_, u ? u->span().data() : nullptr);
-    const EditResult result = snap_to_sweep(mesh_, x, v, plane->second);
+    const DeformedPositions now(mesh_, u ? u->span().data() : nullptr);
+    const EditResult result = snap_to_sweep(mesh_, cut_positions(), v, plane->second, &now);
     if (result.done) {
       ++report.vertices_snapped;
       placed_.insert(v);
@@ -159,26 +164,67 @@ std::vector<VertexId> TetrahedralCutter::dissect_selected(std::vector<FaceId> fa
   return region;
 }
 
+bool TetrahedralCutter::remove_fragments(CutReport& report) {
+  Connectivity& c = mesh_.connectivity();
+  // By volume: degeneracy removal splits elements, so a sliver can be several tiny ones.
+  std::vector<double> volume(pieces_.pieces(), 0.0);
+  double total = 0;
+  for (ElementId e : c.element_ids()) {
+    const double v = mesh_.measure(e);
+    volume[pieces_.label(e)] += v;
+    total += v;
+  }
+  const double limit = options_.max_fragment_elements * total / static_cast<double>(c.n_elements());
+  const int largest = static_cast<int>(std::max_element(volume.begin(), volume.end()) - volume.begin());
+  const auto fragment = [&](int piece) { return piece != largest && volume[piece] <= limit; };
+  std::vector<ElementId> doomed;
+  for (ElementId e : c.element_ids())
+    if (fragment(pieces_.label(e))) doomed.push_back(e);
+  if (doomed.empty()) return false;
+  for (int piece = 0; piece < static_cast<int>(volume.size()); ++piece) report.fragments_removed += fragment(piece);
+  report.fragment_elements = static_cast<int>(doomed.size());
+  std::vector<VertexId> corners;
+  for (ElementId e : doomed)
+    for (VertexId v : c.element(e).simplex.vertices()) corners.push_back(v);
+  ChangeBatch batch(c);
+  c.replace_elements(doomed, {});
+  std::sort(corners.begin(), corners.end());
+  corners.erase(std::unique(corners.begin(), corners.end()), corners.end());
+  for (VertexId v : corners)
+    if (c.n_vertex_uses(v) == 0) mesh_.remove_vertex(v);
+  return true;
+}
+
 void TetrahedralCutter::count_pieces(CutReport& report) {
   const Connectivity& c = mesh_.connectivity();
-  const bool separated = pieces_.update(c);
+  bool separated = pieces_.update(c);
+  if (separated && options_.max_fragment_elements > 0 && remove_fragments(report)) {
+    pieces_ = PieceTracker(c);  // whole pieces went: count again (O(n), only after a fragment)
+    separated = pieces_.pieces() > 1;
+  }
   report.piece_search = pieces_.last_search_size();
   report.components = pieces_.pieces();
   if (!separated || !model_) return;  // a bare mesh has no supports to be free of
   const int n = pieces_.pieces();
   auto label = [this](ElementId e) { return pieces_.label(e); };
-  std::vector<char> supported(n, 0);
+  // Held: as many constrained displacement components as rigid motions (what a static solve
+  // needs); a piece with one fixed vertex left on it still turns about that vertex.
+  constexpr std::size_t rigid_motions = 6;
+  std::vector<std::size_t> held_components(n, 0);
+  std::vector<char> counted(mesh_.n_points(), 0);
   std::vector<ElementId> first(n, no_id);
   for (ElementId e = 0; e < c.element_capacity(); ++e) {
     if (!c.is_element(e)) continue;
     const int piece = label(e);
     if (first[piece] == no_id) first[piece] = e;
-    if (!supported[piece])
-      for (VertexId v : c.element(e).simplex.vertices())
-        if (constrained(v)) supported[piece] = 1;
+    for (VertexId v : c.element(e).simplex.vertices())
+      if (!counted[v]) {
+        counted[v] = 1;
+        held_components[piece] += model_->constraints().constrained_components(v);
+      }
   }
   for (int piece = 0; piece < n; ++piece) {
-    if (supported[piece]) continue;
+    if (held_components[piece] >= rigid_motions) continue;
     ++report.free_pieces;
     if (!options_.fix_free_pieces || !model_) continue;
     // §3.3: fixed on one face, where it is now, so that the static problem stays well posed.
@@ -205,6 +251,7 @@ CutReport TetrahedralCutter::move(std::span<const double> scalpel) {
   if (now[0] == now[3] && now[1] == now[4] && now[2] == now[5])
     throw std::invalid_argument("TetrahedralCutter.move: the scalpel's two ends coincide (a segment of zero length)");
   CutReport report;
+  if (!scalpel_ && model_) cut_configuration_ = vec_values(model_->displacement());
   if (scalpel_) {
     const std::array<double, 6>& was = *scalpel_;
     // The quadrilateral p0 p1 q1 q0 swept from (p0, p1) to (q0, q1), as two triangles.
@@ -225,6 +272,7 @@ CutReport TetrahedralCutter::move(std::span<const double> scalpel) {
 
 void TetrahedralCutter::lift() {
   scalpel_.reset();
+  cut_configuration_.clear();
   selector_.forget();
   joined_.clear();
 }
@@ -242,6 +290,10 @@ std::vector<VertexId> TetrahedralCutter::incision_faces() const {
 
 void TetrahedralCutter::on_change(const Connectivity& c, const ConnectivityChange& change) {
   pieces_.on_change(c, change);
+  if (!cut_configuration_.empty()) {
+    cut_configuration_.resize(3 * static_cast<std::size_t>(mesh_.n_points()), 0.0);
+    replay_vertex_events(cut_configuration_, 3, change.vertex_events);
+  }
   for (const VertexEvent& event : change.vertex_events)
     if (event.kind == VertexEventKind::removed) placed_.erase(event.vertex);
   // A face whose vertices were substituted (a collapse) leaves the boundary under its old

@@ -22,6 +22,7 @@
 #include <unordered_set>
 #include <vector>
 
+#include "cutting/deformed_positions.hpp"
 #include "cutting/face_selection.hpp"
 #include "mesh/piece_tracker.hpp"
 #include "solve/model.hpp"
@@ -34,6 +35,12 @@ struct CutterOptions {
   bool remove_degeneracies = true;
   DegeneracyOptions degeneracy;
   bool fix_free_pieces = true;
+  // A piece a sweep separates whose volume is at most this many mean elements of the mesh is
+  // removed (0: kept). The cut
+  // surface is placed only to within about one element (snapping moves a vertex by up to
+  // half an edge), so a piece of a few elements is an artefact of that approximation: a flat
+  // tetrahedron between two cut faces, not a part of the body the scalpel meant to separate.
+  int max_fragment_elements = 4;
 };
 
 struct CutReport {
@@ -50,8 +57,11 @@ struct CutReport {
   int faces_split = 0;         // cap removals: a vertex inserted in a face
   int elements_cut_free = 0;
   int components = 0;          // pieces of the body after the cut
-  int free_pieces = 0;         // after a sweep that separated a piece: pieces without any constraint
+  int free_pieces = 0;         // after a sweep that separated a piece: pieces not held (fewer constrained
+                               // displacement components than their 6 rigid motions)
   int pieces_fixed = 0;        // of those, fixed on one face (fix_free_pieces)
+  int fragments_removed = 0;   // separated pieces of at most max_fragment_elements (by volume), removed
+  int fragment_elements = 0;   // the elements they had
   std::size_t piece_search = 0;  // elements the local search for separated pieces visited
   double seconds = 0;
 
@@ -96,7 +106,13 @@ class TetrahedralCutter : public ConnectivityWatcher {
   std::vector<VertexId> snap(const FaceSelection& selection, CutReport& report);
   std::vector<VertexId> dissect_selected(std::vector<FaceId> faces, CutReport& report);
   void count_pieces(CutReport& report);
+  // Removes the pieces of at most max_fragment_elements mean elements' volume (never the
+  // largest piece); true if any.
+  bool remove_fragments(CutReport& report);
   bool constrained(VertexId v) const;
+  // Where the scalpel meets the body: X + u with u the displacement the incision was begun in
+  // (see cut_configuration_), or X without a model.
+  DeformedPositions cut_positions() const;
 
   Mesh& mesh_;
   Model* model_;
@@ -106,6 +122,12 @@ class TetrahedralCutter : public ConnectivityWatcher {
   std::vector<std::pair<FaceId, Simplex>> joined_;  // selected faces the dissection left joined
   std::unordered_map<FaceId, Simplex> incision_;
   std::optional<std::array<double, 6>> scalpel_;
+  // The displacement of the body when the scalpel was placed (3 per mesh row, carried to new
+  // and moved vertices like the body's own): every sweep of one incision is made against it.
+  // Against the displacement of each move instead, a body relaxed between moves (the lips
+  // opening under gravity, Figure 3.17) has moved its incision's front away from where the
+  // next sweep starts, and a sweep across the whole body left a bridge of material.
+  std::vector<double> cut_configuration_;
   PieceTracker pieces_;
 };
 

@@ -38,4 +38,10 @@ struct VertexEvent {
   VertexParents parents;
 };
 
+// Replays `events` on a field of `components` numbers per vertex (values has a row for every
+// vertex id the events name): an added or moved vertex takes its parents' values as they were
+// just before its event; an added vertex without parents, or a removed one, gets zeros; a
+// vertex moved to explicit coordinates keeps its values (§7.4: watchers carry fields over).
+void replay_vertex_events(std::span<double> values, int components, std::span<const VertexEvent> events);
+
 }  // namespace snede

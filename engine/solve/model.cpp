@@ -250,23 +250,6 @@ PetscErrorCode Model::tangent_diagonal_callback(Mat A, Vec diagonal) {
   });
 }
 
-void Model::replay(std::span<double> values, const ConnectivityChange& change) const {
-  const int d = dim();
-  std::vector<double> x(d);
-  for (const VertexEvent& event : change.vertex_events) {
-    double* at = values.data() + static_cast<std::size_t>(event.vertex) * d;
-    if (event.kind == VertexEventKind::removed || event.parents.count() == 0) {
-      if (event.kind != VertexEventKind::moved) std::fill(at, at + d, 0.0);  // moved to coordinates: kept
-      continue;
-    }
-    std::fill(x.begin(), x.end(), 0.0);  // parents' values as they were before this event
-    for (std::size_t i = 0; i < event.parents.count(); ++i)
-      for (int k = 0; k < d; ++k)
-        x[k] += event.parents.weight[i] * values[static_cast<std::size_t>(event.parents.vertex[i]) * d + k];
-    std::copy(x.begin(), x.end(), at);
-  }
-}
-
 void Model::on_change(const Connectivity&, const ConnectivityChange& change) {
   external_valid_ = false;  // gravity follows the element masses
   if (change.vertex_events.empty()) return;
@@ -285,14 +268,14 @@ void Model::on_change(const Connectivity&, const ConnectivityChange& change) {
   std::vector<Vec*> fields{u_.slot()};
   fields.insert(fields.end(), carried_fields_.begin(), carried_fields_.end());
   if (n_new == n_points_) {  // same rows (moves, removals, reused ids): in place, O(events)
-    for (Vec* field : fields) replay(WriteView(*field).span(), change);
+    for (Vec* field : fields) replay_vertex_events(WriteView(*field).span(), dim(), change.vertex_events);
     return;
   }
   std::vector<std::vector<double>> values;
   for (Vec* field : fields) {
     std::vector<double>& v = values.emplace_back(vec_values(*field));
     v.resize(body_.n_dofs(), 0.0);
-    replay(v, change);
+    replay_vertex_events(v, dim(), change.vertex_events);
   }
   for (Vec* field : fields) SNEDE_PETSC(VecDestroy(field));
   u_linearization_.reset();

@@ -106,9 +106,6 @@ class Model : public ConnectivityWatcher {
   // The shell's MatGetDiagonal (for PCJACOBI): the diagonal of J without forming J.
   static PetscErrorCode tangent_diagonal_callback(Mat A, Vec diagonal);
 
-  // The vertex events of `change` applied, in order, to one nodal field already sized for the
-  // mesh's rows.
-  void replay(std::span<double> values, const ConnectivityChange& change) const;
   std::vector<double>& channel(const std::string& name);
 
   ElasticBody& body_;

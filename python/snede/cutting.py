@@ -14,7 +14,7 @@ from dataclasses import dataclass, fields
 
 import numpy as np
 
-from snede import _snede
+from snede import _checks, _snede
 from snede.mesh import Mesh
 
 
@@ -29,7 +29,9 @@ class CutReport:
     ``elements_cut_free`` the incollapsible ones that were cut free and removed. ``components``
     is the number of pieces of the body afterwards. On a sweep that separates a piece,
     ``free_pieces`` counts the pieces with no constraint and ``pieces_fixed`` those of them
-    fixed on one face (``fix_free_pieces``). ``piece_search`` is the number of elements the
+    fixed on one face (``fix_free_pieces``). ``fragments_removed`` counts the separated pieces
+    no bigger than ``max_fragment_elements`` mean elements that were removed,
+    ``fragment_elements`` the elements they had. ``piece_search`` is the number of elements the
     local search for separated pieces visited (it stays near the cut unless a piece separates)."""
 
     sweeps: int = 0
@@ -47,6 +49,8 @@ class CutReport:
     components: int = 0
     free_pieces: int = 0
     pieces_fixed: int = 0
+    fragments_removed: int = 0
+    fragment_elements: int = 0
     piece_search: int = 0
     seconds: float = 0.0
 
@@ -64,7 +68,8 @@ class CutReport:
     def __str__(self) -> str:
         return (f"{self.faces_dissected} faces dissected ({self.vertices_snapped} vertices snapped, "
                 f"{self.snaps_refused} refused), {self.degenerate_found} degenerate: {self.edges_collapsed} collapses, "
-                f"{self.edges_split} splits, {self.elements_cut_free} cut free; {self.components} pieces "
+                f"{self.edges_split} splits, {self.elements_cut_free} cut free, {self.fragments_removed} fragments removed; "
+                f"{self.components} pieces "
                 f"in {self.seconds * 1e3:.2f} ms")
 
 
@@ -112,7 +117,7 @@ def _points(value, shape: tuple, what: str) -> np.ndarray:
 
 class TetrahedralCutter:
     """``TetrahedralCutter(body_or_mesh, *, snap=True, remove_degeneracies=True,
-    min_aspect_ratio=0.01, large_angle=0.99*pi, fix_free_pieces=True)``.
+    min_aspect_ratio=0.01, large_angle=0.99*pi, fix_free_pieces=True, max_fragment_elements=4)``.
 
     * ``body_or_mesh``: a 3D ``snede.Body`` (the scalpel then acts on the deformed body,
       ``X + u``, as the user sees it) or a tetrahedral ``snede.Mesh`` (cut as it is).
@@ -123,6 +128,14 @@ class TetrahedralCutter:
       shape, the rest cut free.
     * ``fix_free_pieces``: a piece the cut separates from every constraint is fixed on one
       face where it is (§3.3), so that the next static solve is well posed.
+    * ``max_fragment_elements``: a piece a sweep separates whose volume is at most this many
+      mean elements of the mesh is removed (0 keeps them). The cut surface is only placed to
+      within about one element, so such a piece (typically one flat tetrahedron between two cut
+      faces) is an artefact of the approximation, not a part the scalpel meant to separate.
+    * Every sweep of one incision (from placing the scalpel to ``lift``) meets the body as it
+      was when the scalpel was placed: a body relaxed between moves (its lips opening under
+      gravity) would otherwise have moved the incision's front away from where the next sweep
+      starts, leaving a bridge of material. ``cut_triangle`` alone meets the body as it is.
 
     ``cut_triangle(corners)`` processes one sweep triangle ((3, 3), deformed coordinates);
     ``move(scalpel)`` moves the scalpel ((2, 3): its two ends) and cuts along the sweep from
@@ -131,7 +144,8 @@ class TetrahedralCutter:
     """
 
     def __init__(self, body_or_mesh, *, snap: bool = True, remove_degeneracies: bool = True,
-                 min_aspect_ratio: float = 0.01, large_angle: float = 0.99 * math.pi, fix_free_pieces: bool = True):
+                 min_aspect_ratio: float = 0.01, large_angle: float = 0.99 * math.pi, fix_free_pieces: bool = True,
+                 max_fragment_elements: int = 4):
         self.body, self.mesh, model = body_and_mesh(body_or_mesh, type(self).__name__)
         if self.mesh.cell_dim != 3:
             raise ValueError(f"TetrahedralCutter needs a tetrahedral mesh; this mesh has {self.mesh.cell_dim}-D cells")
@@ -140,7 +154,8 @@ class TetrahedralCutter:
         if not (0 < large_angle < math.pi):
             raise ValueError(f"large_angle must be in (0, pi) radians, got {large_angle}")
         self._impl = _snede.TetrahedralCutter(self.mesh._impl, model, bool(snap), bool(remove_degeneracies),
-                                              float(min_aspect_ratio), float(large_angle), bool(fix_free_pieces))
+                                              float(min_aspect_ratio), float(large_angle), bool(fix_free_pieces),
+                                              _checks.count(max_fragment_elements, "max_fragment_elements", 0))
 
     def cut_triangle(self, corners) -> CutReport:
         return CutReport._from_engine(self._impl.cut_triangle(_points(corners, (3, 3), "corners")))

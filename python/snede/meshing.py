@@ -1,4 +1,5 @@
-"""Mesh generators: structured boxes and rectangles, unstructured cylinders (gmsh), and
+"""Mesh generators: structured boxes and rectangles, unstructured solids (gmsh: a cylinder, an
+ellipsoid, a torus, a lumpy organ-like solid), and
 surfaces in 3D for cutting (height fields, the Gaussian bell of Figure 5.19, a folded sheet)."""
 from __future__ import annotations
 
@@ -71,15 +72,18 @@ def rectangle(size=(1.0, 1.0), divisions=(10, 10)) -> Mesh:
     return Mesh(points, np.concatenate([lower, upper]))
 
 
-def cylinder(length=0.1, radius=0.03, h=0.01, seed: int | None = None) -> Mesh:
-    """Unstructured tetrahedra of the cylinder 0 ≤ x ≤ length, y² + z² ≤ radius², meshed by
-    gmsh (Delaunay, then optimised) with target edge length ``h``. Deterministic for given
-    arguments (gmsh's random factor is fixed by ``seed`` when given)."""
-    import gmsh
-
-    for name, value in (("length", length), ("radius", radius), ("h", h)):
+def _positive(**values) -> None:
+    for name, value in values.items():
         if not (np.isfinite(value) and value > 0):
             raise ValueError(f"{name} must be positive and finite, got {value}")
+
+
+def _gmsh_tetrahedra(name: str, add_solid, h: float, seed: int | None) -> Mesh:
+    """Tetrahedra of the OpenCASCADE solid that ``add_solid(occ)`` adds, meshed by gmsh
+    (Delaunay, then optimised) at target edge length ``h``; deterministic for given arguments
+    (gmsh's random factor fixed by ``seed`` when given)."""
+    import gmsh
+
     if seed is not None:
         seed = _checks.count(seed, "seed", 0)  # gmsh's Mesh.RandomSeed is a C int
     initialized_here = not gmsh.isInitialized()
@@ -89,11 +93,13 @@ def cylinder(length=0.1, radius=0.03, h=0.01, seed: int | None = None) -> Mesh:
         gmsh.initialize(readConfigFiles=False, interruptible=False)
     try:
         gmsh.option.setNumber("General.Terminal", 0)
-        gmsh.model.add("snede-cylinder")
-        gmsh.model.occ.addCylinder(0, 0, 0, length, 0, 0, radius)
+        gmsh.option.setNumber("General.NumThreads", 1)  # deterministic
+        gmsh.model.add(f"snede-{name}")
+        add_solid(gmsh.model.occ)
         gmsh.model.occ.synchronize()
         gmsh.option.setNumber("Mesh.MeshSizeMin", h)
         gmsh.option.setNumber("Mesh.MeshSizeMax", h)
+        gmsh.option.setNumber("Mesh.MeshSizeFromCurvature", 0)
         gmsh.option.setNumber("Mesh.Algorithm3D", 1)  # Delaunay
         gmsh.option.setNumber("Mesh.Optimize", 1)
         if seed is not None:
@@ -110,11 +116,64 @@ def cylinder(length=0.1, radius=0.03, h=0.01, seed: int | None = None) -> Mesh:
     index_of_tag[node_tags.astype(np.int64)] = np.arange(len(node_tags))
     tetra = [nodes for kind, nodes in zip(element_types, element_nodes) if kind == 4]
     if not tetra:
-        raise RuntimeError("gmsh produced no tetrahedra")
+        raise RuntimeError(f"gmsh produced no tetrahedra for the {name}")
     cells = index_of_tag[np.concatenate(tetra).astype(np.int64)].reshape(-1, 4)
     # gmsh lists nodes that are not in any tetrahedron (geometry points); keep only used ones.
     used, cells = np.unique(cells, return_inverse=True)
     return Mesh(points[used], cells.reshape(-1, 4))
+
+
+def cylinder(length=0.1, radius=0.03, h=0.01, seed: int | None = None) -> Mesh:
+    """Unstructured tetrahedra of the cylinder 0 ≤ x ≤ length, y² + z² ≤ radius², meshed by
+    gmsh (Delaunay, then optimised) with target edge length ``h``. Deterministic for given
+    arguments (gmsh's random factor is fixed by ``seed`` when given)."""
+    _positive(length=length, radius=radius, h=h)
+    return _gmsh_tetrahedra("cylinder", lambda occ: occ.addCylinder(0, 0, 0, length, 0, 0, radius), h, seed)
+
+
+def ellipsoid(radii=(0.06, 0.04, 0.03), h=0.01, seed: int | None = None) -> Mesh:
+    """Unstructured tetrahedra (gmsh, edge length ``h``) of the ellipsoid centred at the origin
+    with semi-axes ``radii`` along x, y, z."""
+    radii = np.asarray(radii, dtype=np.float64)
+    if radii.shape != (3,):
+        raise ValueError(f"radii must be 3 numbers, got shape {radii.shape}")
+    _positive(h=h, **{f"radii[{k}]": r for k, r in enumerate(radii)})
+
+    def add(occ):
+        sphere = occ.addSphere(0, 0, 0, 1.0)
+        occ.dilate([(3, sphere)], 0, 0, 0, *radii)
+    return _gmsh_tetrahedra("ellipsoid", add, h, seed)
+
+
+def torus(radius=0.05, tube=0.02, h=0.01, seed: int | None = None) -> Mesh:
+    """Unstructured tetrahedra (gmsh, edge length ``h``) of the torus around the z axis with
+    centre-line ``radius`` and tube radius ``tube`` < ``radius``: a body with a hole, which one
+    cut through its ring leaves in one piece."""
+    _positive(radius=radius, tube=tube, h=h)
+    if not tube < radius:
+        raise ValueError(f"tube ({tube}) must be smaller than radius ({radius})")
+    return _gmsh_tetrahedra("torus", lambda occ: occ.addTorus(0, 0, 0, radius, tube), h, seed)
+
+
+def lumpy(radius=0.04, lumps: int = 6, h=0.01, seed: int = 0) -> Mesh:
+    """Unstructured tetrahedra (gmsh, edge length ``h``) of an organ-like lumpy solid: a sphere
+    of ``radius`` fused with ``lumps`` smaller spheres (radius 0.45–0.7 × ``radius``) centred
+    0.6–0.9 × ``radius`` from its centre in directions drawn from ``seed``: lobes, necks and
+    concave folds a cut can run into."""
+    _positive(radius=radius, h=h)
+    lumps = _checks.count(lumps, "lumps", 0)
+    rng = np.random.default_rng(_checks.count(seed, "seed", 0))
+    directions = rng.normal(size=(lumps, 3))
+    directions /= np.linalg.norm(directions, axis=1, keepdims=True)
+    centres = directions * rng.uniform(0.6, 0.9, size=(lumps, 1)) * radius
+    radii = rng.uniform(0.45, 0.7, size=lumps) * radius
+
+    def add(occ):
+        body = [(3, occ.addSphere(0, 0, 0, radius))]
+        others = [(3, occ.addSphere(*c, r)) for c, r in zip(centres, radii)]
+        if others:
+            occ.fuse(body, others)
+    return _gmsh_tetrahedra("lumpy", add, h, seed)
 
 
 def lifted(sheet: Mesh, to_space) -> Mesh:
