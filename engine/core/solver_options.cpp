@@ -66,6 +66,10 @@ std::optional<std::string> SolverOptions::string_option(const std::string& name)
   return std::string(value);
 }
 
+void SolverOptions::set_string_option(const std::string& name, const std::string& value) {
+  SNEDE_PETSC(PetscOptionsSetValue(database_, ("-" + name).c_str(), value.c_str()));
+}
+
 void SolverOptions::mark_read_options_used() const {
   for (const std::string& name : global_names_) {
     PetscBool read = PETSC_FALSE, set = PETSC_FALSE;

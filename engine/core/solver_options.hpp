@@ -46,6 +46,8 @@ class SolverOptions {
 
   // The value of option `name` (with its prefix, without '-') in this database, if set.
   std::optional<std::string> string_option(const std::string& name) const;
+  // Sets option `name` (with its prefix, without '-') in this database only.
+  void set_string_option(const std::string& name, const std::string& value);
 
   // Marks the global options this solver has read as used in the global database, so that
   // -options_left lists only the options that no solver read.

@@ -74,7 +74,12 @@ StaticSolver::StaticSolver(Model& model, StaticOptions options, const Refinement
   // The command line (copied into the solver's database) wins over the argument.
   pc_type_ = option_database_.string_option(options_.options_prefix + "pc_type")
                  .value_or(options_.preconditioner.empty() ? std::string("auto") : options_.preconditioner);
-  if (pc_type_ == "auto") pc_type_ = automatic_preconditioner(model, options_.method);
+  if (pc_type_ == "auto") {
+    pc_type_ = automatic_preconditioner(model, options_.method);
+    // -<prefix>pc_type auto is snede's: PETSc, which reads the option again, must see the choice.
+    if (option_database_.string_option(options_.options_prefix + "pc_type"))
+      option_database_.set_string_option(options_.options_prefix + "pc_type", pc_type_);
+  }
   if (options_.method == StaticMethod::nonlinear_cg && pc_type_ != PCNONE)
     throw std::invalid_argument("a preconditioner ('" + pc_type_ + "') applies to the CG of methods 'cg' and 'newton'; "
                                 "nonlinear CG ('ncg') takes none");
@@ -190,6 +195,12 @@ void StaticSolver::create_objects() {
                                           PETSC_DEFAULT));
   SNEDE_PETSC(SNESSetFromOptions(snes_));
   option_database_.mark_read_options_used();
+  // PETSc takes any damping; a NaN one made its backtracking line search loop for ever.
+  PetscReal damping = 0;
+  SNEDE_PETSC(SNESLineSearchGetDamping(line_search, &damping));
+  if (!(std::isfinite(damping) && damping > 0))
+    throw std::invalid_argument("-" + options_.options_prefix + "snes_linesearch_damping must be positive and finite, got " +
+                                std::to_string(damping));
 }
 
 void StaticSolver::follow_mesh_changes() {

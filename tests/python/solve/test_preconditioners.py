@@ -137,6 +137,29 @@ def test_the_preconditioner_comes_from_the_options_and_the_command_line_wins():
         PETSc.Options().delValue("-pcwins_pc_type")
 
 
+@pytest.mark.parametrize("cells_per_side, chosen", [(2, "none"), (6, "mg")])
+def test_pc_type_auto_on_the_command_line_is_resolved_as_the_argument_is(cells_per_side, chosen):
+    """-static_pc_type auto reached PETSc, which knows no such PC: 'Unable to find requested PC
+    type auto' (issue 38 item 5)."""
+    body = snede.Body(snede.meshing.box((1.0, 1.0, 1.0), (cells_per_side,) * 3), snede.NeoHookean(1e6, 0.3), density=1000.0)
+    body.fix(np.isclose(body.mesh.points[:, 0], 0.0))
+    body.add_gravity((0.0, 0.0, -9.81))
+    PETSc.Options().setValue("-autowins_pc_type", "auto")
+    try:
+        solver = snede.StaticSolver(body, "newton", preconditioner="jacobi", options_prefix="autowins_")
+        assert solver.preconditioner == chosen and solver.ksp.getPC().getType() == chosen
+        assert solver.solve().converged
+    finally:
+        PETSc.Options().delValue("-autowins_pc_type")
+
+
+@pytest.mark.parametrize("damping", ["nan", "inf", "0", "-1"])
+def test_a_line_search_damping_that_is_not_positive_and_finite_is_refused(damping):
+    """A NaN damping made PETSc's backtracking line search loop for ever (issue 38 item 5)."""
+    with pytest.raises(ValueError, match="snes_linesearch_damping must be positive and finite"):
+        snede.StaticSolver(cantilever(2), "newton", petsc_options={"snes_linesearch_damping": damping})
+
+
 def test_bad_preconditioners_are_refused():
     body = cantilever(2)
     with pytest.raises(ValueError, match="nonlinear CG"):
