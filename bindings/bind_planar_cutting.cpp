@@ -4,6 +4,7 @@
 namespace snede::bindings {
 
 void bind_planar_cutting(py::module_& m) {
+  py::register_exception<IncisionLost>(m, "IncisionLost", PyExc_RuntimeError);
   py::class_<PlanarCutReport>(m, "PlanarCutReport")
       .def(py::init<>())
       .def("add", &PlanarCutReport::add, py::arg("later"))

@@ -87,7 +87,12 @@ void PlanarCutReport::add(const PlanarCutReport& later) {
 }
 
 DelaunayCutter::DelaunayCutter(Mesh& mesh, Model* model, DelaunayCutterOptions options)
-    : mesh_(mesh), model_(model), options_(options) {
+    : mesh_(mesh),
+      model_(model),
+      options_(options),
+      watch_(mesh.connectivity(), incision_vertices_,
+             [this](const Connectivity& c, const IncisionWatch::Fates& fates) { settle(c, fates); }) {
+  watch_.forget_removed_from(forbidden_);
   if (mesh.cell_dim() != 2 || mesh.space_dim() != 2)
     throw std::invalid_argument("DelaunayCutter: the mesh must be a 2D triangle mesh, got cell_dim " +
                                 std::to_string(mesh.cell_dim()) + " in " + std::to_string(mesh.space_dim()) + "D");
@@ -200,13 +205,13 @@ PlanarCutReport DelaunayCutter::move(std::span<const double> point) {
   if (point.size() != 2)
     throw std::invalid_argument("DelaunayCutter.move: the scalpel is a point, 2 coordinates; got " + std::to_string(point.size()));
   require_finite_points(point.data(), point.size(), 2, "DelaunayCutter.move", "point");
+  watch_.settle_before_move();
+  const IncisionWatch::OwnEdits own(watch_);
   const double start = wall_seconds();
   PlanarCutReport report;
   report.moves = 1;
   report.triangles_before = mesh_.n_cells();
   const Point now{point[0], point[1]};
-  if (phase_ != Phase::outside && !(mesh_.is_vertex(active_) && mesh_.connectivity().n_vertex_uses(active_) > 0))
-    phase_ = Phase::outside;  // the active node was removed by another edit
   if (exit_point_ && distance(now, *exit_point_) > 2 * options_.eps_exit) {
     exit_point_.reset();
     forbidden_.clear();
@@ -257,6 +262,7 @@ PlanarCutReport DelaunayCutter::move(std::span<const double> point) {
   if (phase_ == Phase::cutting) touched_.push_back(active_);
   legalize(report);
   batch.reset();
+  watch_.follow(phase_ == Phase::outside ? std::span<const VertexId>{} : std::span<const VertexId>(&active_, 1));
   report.triangles_after = mesh_.n_cells();
   report.seconds = wall_seconds() - start;
   return report;
@@ -303,6 +309,28 @@ void DelaunayCutter::lift() {
   scalpel_.reset();
   last_target_.reset();
   trail_.clear();
+  watch_.follow({});
+}
+
+void DelaunayCutter::settle(const Connectivity& c, const IncisionWatch::Fates& fates) {
+  if (phase_ == Phase::outside) return;
+  const auto fate = fates.find(active_);
+  const std::vector<VertexId> heirs = fate == fates.end() ? std::vector<VertexId>{active_} : fate->second.heirs;
+  for (VertexId v : heirs) {
+    // An entry node waits on the boundary; a cut's tip has the two cut edges (§5.2.2).
+    const bool carries = phase_ == Phase::entering ? c.n_vertex_uses(v) > 0 && on_boundary(v)
+                                                   : is_incision_tip(mesh_, v, incision_vertices_, fate != fates.end());
+    if (!carries) continue;
+    if (phase_ == Phase::entering) entry_ = reference(v);
+    active_ = v;
+    watch_.follow(std::span<const VertexId>(&active_, 1));
+    return;
+  }
+  watch_.lose("DelaunayCutter.move: edits made to the mesh since the last move took the incision's active node " +
+              std::to_string(active_) + " away (" +
+              (fate == fates.end() ? "it is no longer the incision's tip" : fate->second.change) +
+              ") and left no vertex that is the incision's tip; the scalpel is lifted: the next move only places it");
+  lift();
 }
 
 void DelaunayCutter::enter(const Crossing& crossing, PlanarCutReport& report) {
@@ -316,6 +344,7 @@ void DelaunayCutter::enter(const Crossing& crossing, PlanarCutReport& report) {
   else if (const EditResult split = split_edge(mesh_, crossing.y, crossing.z, crossing.lambda); split.done) {
     a = split.vertex;
     ++report.nodes_inserted;
+    if (incision_vertices_.count(crossing.y) && incision_vertices_.count(crossing.z)) incision_vertices_.insert(a);  // on a lip
   } else {
     a = distance(at, y) < distance(at, z) ? crossing.y : crossing.z;
   }

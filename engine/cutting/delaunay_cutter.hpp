@@ -22,6 +22,10 @@
 // is dissected and the short edges it leaves are contracted; entries within ε_exit of an exit
 // are ignored until the scalpel has moved 2 ε_exit away from it (the forbidden edges).
 //
+// Edits that others make to the mesh between moves (§7.4: the cutter watches the mesh) keep
+// the incision right: its vertices follow splits, bisections, collapses and removals, and the
+// active node follows a collapse into its neighbour or a dissection to the vertex that is then
+// the incision's tip; when no vertex is, the next move raises IncisionLost (incision_star.hpp).
 // Departures from the thesis: the dent of a postponed entry is not drawn (the entry node stays
 // on the boundary until the fix-up); a new incision node goes on the path (the active node's
 // trail) where the line through the opposite nodes crosses it, and on the cut edges' chord
@@ -80,7 +84,9 @@ class DelaunayCutter {
   DelaunayCutter(Mesh& mesh, Model* model, DelaunayCutterOptions options);
 
   // Moves the scalpel to `point` (2 numbers, deformed coordinates). Throws
-  // std::invalid_argument, before changing anything, for a non-finite point.
+  // std::invalid_argument, before changing anything, for a non-finite point, and IncisionLost
+  // when edits by others took the incision's tip away since the last move (the scalpel is
+  // lifted then: the next move only places it).
   PlanarCutReport move(std::span<const double> point);
   // Lifts the scalpel: an incision in progress stays as it is, the next move only places it.
   void lift();
@@ -142,6 +148,9 @@ class DelaunayCutter {
   void predict_exit(const Point& direction, PlanarCutReport& report);
   void exit_through(VertexId y, VertexId z, double lambda, PlanarCutReport& report);
   std::vector<VertexId> dissect_edge(VertexId a, VertexId b);
+  // After edits by others: the active node is the heir that is still the tip, or the
+  // incision is given up.
+  void settle(const Connectivity& c, const IncisionWatch::Fates& fates);
 
   Mesh& mesh_;
   Model* model_;
@@ -157,6 +166,7 @@ class DelaunayCutter {
   std::vector<VertexId> touched_;  // vertices whose stars this move changed
   // Reference positions of the active node since the newest incision node behind it (first).
   std::vector<Point> trail_;
+  IncisionWatch watch_;  // last: it refers to the sets above
 };
 
 }  // namespace snede

@@ -40,7 +40,13 @@ const double facing_cosine = std::cos(75.0 * std::acos(-1.0) / 180);
 }  // namespace
 
 SurfaceCutter::SurfaceCutter(Mesh& mesh, Model* model, SurfaceCutterOptions options)
-    : mesh_(mesh), model_(model), options_(options) {
+    : mesh_(mesh),
+      model_(model),
+      options_(options),
+      watch_(
+          mesh.connectivity(), incision_vertices_,
+          [this](const Connectivity& c, const IncisionWatch::Fates& fates) { settle(c, fates); },
+          [this](const VertexEvent& event) { carry_normal(event); }) {
   if (mesh.cell_dim() != 2 || mesh.space_dim() != 3)
     throw std::invalid_argument("SurfaceCutter: the mesh must be a surface (triangles in 3D), got cell_dim " +
                                 std::to_string(mesh.cell_dim()) + " in " + std::to_string(mesh.space_dim()) + "D");
@@ -67,6 +73,43 @@ Point3 SurfaceCutter::deformed(VertexId v) const {
   if (at + 2 < displacement_.size())
     for (int d = 0; d < 3; ++d) x[d] += displacement_[at + d];
   return x;
+}
+
+void SurfaceCutter::carry_normal(const VertexEvent& event) {
+  if (event.kind == VertexEventKind::removed) {
+    surface_normals_.erase(event.vertex);  // its id may come back as another vertex
+    return;
+  }
+  if (event.parents.count() == 0) return;  // moved to given coordinates: its normal stays
+  Point3 n{0, 0, 0};
+  for (std::size_t k = 0; k < event.parents.count(); ++k)
+    n = plus_scaled(n, event.parents.weight[k], surface_normal(event.parents.vertex[k]));
+  surface_normals_[event.vertex] = n;
+}
+
+void SurfaceCutter::settle(const Connectivity& c, const IncisionWatch::Fates& fates) {
+  std::vector<VertexId> carried;
+  for (auto incision = incisions_.begin(); incision != incisions_.end();) {
+    const auto fate = fates.find(incision->active);
+    const std::vector<VertexId> heirs = fate == fates.end() ? std::vector<VertexId>{incision->active} : fate->second.heirs;
+    // An entry node may be anywhere on the surface; a cut's tip has the two cut edges.
+    const auto carries = [&](VertexId v) {
+      return std::find(carried.begin(), carried.end(), v) == carried.end() &&
+             (incision->entering ? c.n_vertex_uses(v) > 0 : is_incision_tip(mesh_, v, incision_vertices_, fate != fates.end()));
+    };
+    if (const auto heir = std::find_if(heirs.begin(), heirs.end(), carries); heir != heirs.end()) {
+      incision->active = *heir;
+      carried.push_back(*heir);
+      ++incision;
+      continue;
+    }
+    watch_.lose("SurfaceCutter.move: edits made to the mesh since the last move took an incision's active node " +
+                std::to_string(incision->active) + " away (" +
+                (fate == fates.end() ? "it is no longer the incision's tip" : fate->second.change) +
+                ") and left no vertex that is its tip: that incision ends there, the others go on with the next move");
+    incision = incisions_.erase(incision);
+  }
+  watch_.follow(carried);
 }
 
 void SurfaceCutter::follow(VertexId v, const VertexParents& parents) {
@@ -246,14 +289,12 @@ PlanarCutReport SurfaceCutter::move(std::span<const double> segment) {
   require_finite_points(segment.data(), segment.size(), 3, "SurfaceCutter.move", "segment");
   const Segment now{{segment[0], segment[1], segment[2]}, {segment[3], segment[4], segment[5]}};
   if (now.head == now.tail) throw std::invalid_argument("SurfaceCutter.move: the scalpel's two ends coincide (segment)");
+  watch_.settle_before_move();
+  const IncisionWatch::OwnEdits own(watch_);
   const double start = wall_seconds();
   PlanarCutReport report;
   report.moves = 1;
   report.triangles_before = mesh_.n_cells();
-  // An active node removed by another edit ends its incision.
-  std::erase_if(incisions_, [this](const Incision& i) {
-    return !(mesh_.is_vertex(i.active) && mesh_.connectivity().n_vertex_uses(i.active) > 0);
-  });
   displacement_.clear();
   moved_.clear();
   if (model_) {
@@ -277,6 +318,7 @@ PlanarCutReport SurfaceCutter::move(std::span<const double> segment) {
     for (const Incision& i : incisions_) touched_.push_back(i.active);
     legalize(report);
   }
+  watch_.follow(active_nodes());
   report.triangles_after = mesh_.n_cells();
   report.seconds = wall_seconds() - start;
   return report;
@@ -285,6 +327,7 @@ PlanarCutReport SurfaceCutter::move(std::span<const double> segment) {
 void SurfaceCutter::lift() {
   incisions_.clear();
   scalpel_.reset();
+  watch_.follow({});
 }
 
 void SurfaceCutter::sweep(const Segment& from, const Segment& to, PlanarCutReport& report) {
@@ -379,7 +422,10 @@ bool SurfaceCutter::enter(const Contact& contact, PlanarCutReport& report) {
     const std::array<VertexId, 2> ends{y, z};
     entry = free_vertex_near(at, ends, options_.eps_entry);
     const double mu = contact.weights[(opposite + 2) % 3];
-    if (entry < 0 && (entry = split(y, z, mu)) >= 0) ++report.nodes_inserted;
+    if (entry < 0 && (entry = split(y, z, mu)) >= 0) {
+      ++report.nodes_inserted;
+      if (incision_vertices_.count(y) && incision_vertices_.count(z)) incision_vertices_.insert(entry);  // on a lip
+    }
   }
   if (entry < 0) return false;
   incisions_.push_back({entry, true, contact.way == Contact::Way::crest});

@@ -30,6 +30,9 @@
 //    (the first move after construction or lift()) enters where it pierces it.
 // Every triangle touches at most one active node (§5.3.2): flips that would join two, removals
 // of nodes between two, and entries into triangles of an active node are refused.
+// Edits that others make to the mesh between moves keep the incisions right, as for the 2D
+// cutter (IncisionWatch): an incision whose tip they took away ends, and the next move raises
+// IncisionLost naming it.
 // Departures from the thesis: the new incision nodes go on the cut edges (a chord of the
 // path), not onto the path itself; a node separating two incisions annihilates them only when
 // it is within ε_edge, and the edge case inserts the node where the scalpel crosses the edge
@@ -68,7 +71,9 @@ class SurfaceCutter {
   // Moves the scalpel to `segment` (6 numbers: its two ends, deformed coordinates); the first
   // move after construction or lift() places it, entering where it pierces the surface.
   // Throws std::invalid_argument, before changing anything, for non-finite coordinates or
-  // coinciding ends. The report's fields mean what they mean for the 2D cutter.
+  // coinciding ends, and IncisionLost when edits by others took an incision's tip away since
+  // the last move (that incision has ended; the next move goes on with the others). The
+  // report's fields mean what they mean for the 2D cutter.
   PlanarCutReport move(std::span<const double> segment);
   // Lifts the scalpel: the incisions in progress stay as they are and stop being active.
   void lift();
@@ -189,6 +194,11 @@ class SurfaceCutter {
   std::vector<VertexId> join_at(VertexId w, const std::vector<VertexId>& actives);
   std::vector<VertexId> dissect_edges(const std::vector<std::array<VertexId, 2>>& edges);
   void legalize(PlanarCutReport& report);
+  // After edits by others: each active node is the heir that still carries its incision, or
+  // the incision ends.
+  void settle(const Connectivity& c, const IncisionWatch::Fates& fates);
+  // The uncut surface's normal at a vertex another edit added or moved, as follow() does.
+  void carry_normal(const VertexEvent& event);
 
   Mesh& mesh_;
   Model* model_;
@@ -204,6 +214,7 @@ class SurfaceCutter {
   std::unordered_map<VertexId, Point3> surface_normals_;
   std::vector<VertexId> touched_;
   std::unordered_set<ElementId> refused_;  // contacts this move could not enter
+  IncisionWatch watch_;                    // last: it refers to the sets above
 };
 
 }  // namespace snede

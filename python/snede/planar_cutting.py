@@ -16,6 +16,13 @@ import numpy as np
 from snede import _snede
 from snede.cutting import body_and_mesh, engine_sum, move_along
 
+#: Raised by a Delaunay cutter's ``move`` (a RuntimeError) when edits others made to the mesh
+#: since its last move — a collapse, a dissection, a removal — took an incision's active node
+#: away and left no vertex that is that incision's tip; the message names the node and what
+#: happened to it. Edits that leave a tip (a collapse into a neighbour, splits, bisection,
+#: flips) are followed instead, and the cut goes on.
+IncisionLost = _snede.IncisionLost
+
 
 @dataclass(frozen=True)
 class PlanarCutReport:
@@ -138,6 +145,11 @@ class DelaunayCutter(IncisionCutter):
     the body finishes the cut. ``cut(path)`` samples the polyline ``path`` ((n, 2)) and moves
     along it. Both return a :class:`PlanarCutReport`. Invalid input raises ``ValueError``
     before anything changes.
+
+    The cutter watches the mesh (§7.4): edits made by others between moves (collapses, splits,
+    flips, refinement, removals, dissections) keep ``active_node`` and ``incision_edges()``
+    right, or the next move raises :data:`IncisionLost` and lifts the scalpel (the move after
+    it only places it).
     """
 
     def __init__(self, body_or_mesh, *, eps_edge=None, eps_entry=None, eps_exit=None, short_edge_angle=None):

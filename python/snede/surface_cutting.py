@@ -38,6 +38,10 @@ class SurfaceCutter(IncisionCutter):
     scalpel positions, the first places it). Both return a :class:`snede.PlanarCutReport`
     (the 2D cutter's fields plus ``branches`` and ``annihilations``). Invalid input raises
     ``ValueError`` before anything changes.
+
+    Edits made by others between moves are followed as by the 2D cutter; an incision whose
+    tip they took away ends, and the next move raises :data:`snede.planar_cutting.IncisionLost`
+    naming it (the other incisions go on with the move after it).
     """
 
     def __init__(self, body_or_mesh, *, eps_edge=None, eps_entry=None, eps_exit=None):
