@@ -294,14 +294,52 @@ void TetrahedralCutter::on_change(const Connectivity& c, const ConnectivityChang
     cut_configuration_.resize(3 * static_cast<std::size_t>(mesh_.n_points()), 0.0);
     replay_vertex_events(cut_configuration_, 3, change.vertex_events);
   }
-  for (const VertexEvent& event : change.vertex_events)
-    if (event.kind == VertexEventKind::removed) placed_.erase(event.vertex);
+  // The older vertices each vertex this change added lies between (its parents, or theirs if
+  // they were added too); ids removed in the change may come back as other vertices.
+  std::unordered_map<VertexId, std::vector<VertexId>> made_from;
+  for (const VertexEvent& event : change.vertex_events) {
+    if (event.kind == VertexEventKind::removed) {
+      placed_.erase(event.vertex);
+      made_from.erase(event.vertex);
+    }
+    if (event.kind != VertexEventKind::added) continue;
+    std::vector<VertexId> from;
+    for (std::size_t k = 0; k < event.parents.count(); ++k) {
+      if (event.parents.weight[k] == 0) continue;
+      const VertexId p = event.parents.vertex[k];
+      const auto earlier = made_from.find(p);
+      if (earlier == made_from.end()) from.push_back(p);
+      else from.insert(from.end(), earlier->second.begin(), earlier->second.end());
+    }
+    std::sort(from.begin(), from.end());
+    from.erase(std::unique(from.begin(), from.end()), from.end());
+    made_from[event.vertex] = std::move(from);
+  }
   // A face whose vertices were substituted (a collapse) leaves the boundary under its old
   // simplex and returns under its new one: the incision follows it.
   std::unordered_set<Simplex, SimplexHash> left(change.boundary_removed.begin(), change.boundary_removed.end());
+  std::vector<Simplex> left_incision;
+  for (const auto& [f, simplex] : incision_)
+    if (left.count(simplex)) left_incision.push_back(simplex);
   for (FaceId f : change.boundary_added)
     if (const auto it = incision_.find(f); it != incision_.end() && left.count(it->second)) it->second = c.face(f).simplex;
   std::erase_if(incision_, [&](const auto& entry) { return !c.is_face(entry.first) || c.face(entry.first).simplex != entry.second; });
+  // A boundary face made inside an incision face that left the boundary (a bisection or split
+  // of it, §6.5): all its vertices lie between that face's vertices, and it is on the incision.
+  if (left_incision.empty()) return;
+  for (FaceId f : change.boundary_added) {
+    if (!c.is_face(f) || c.face(f).mate != no_id || incision_.count(f)) continue;
+    std::vector<VertexId> from;
+    for (VertexId v : c.face(f).simplex.vertices()) {
+      const auto made = made_from.find(v);
+      if (made == made_from.end()) from.push_back(v);
+      else from.insert(from.end(), made->second.begin(), made->second.end());
+    }
+    const bool inside = std::any_of(left_incision.begin(), left_incision.end(), [&](const Simplex& sigma) {
+      return std::all_of(from.begin(), from.end(), [&](VertexId v) { return sigma.contains(v); });
+    });
+    if (inside) incision_[f] = c.face(f).simplex;
+  }
 }
 
 }  // namespace snede

@@ -94,7 +94,9 @@ class TetrahedralCutter : public ConnectivityWatcher {
   // incomplete, and faces left joined are not cut again).
   void lift();
 
-  // The incision: the boundary faces the cuts opened, (n, 3) vertex ids oriented outward.
+  // The incision: the boundary faces the cuts opened, (n, 3) vertex ids oriented outward. It
+  // follows later edits (§7.4): a face whose vertices a collapse substituted, and the faces a
+  // split or bisection of an incision face made inside it.
   std::vector<VertexId> incision_faces() const;
   const CutterOptions& options() const { return options_; }
 

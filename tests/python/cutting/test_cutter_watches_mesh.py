@@ -200,3 +200,28 @@ def test_random_outside_edits_between_moves_on_a_surface(seed):
             random_outside_edit(mesh, rng, scalpel[0, :2])
             check_cutter(mesh, cutter)
         move_checked(mesh, cutter, scalpel)
+
+
+def cut_faces(mesh) -> set:
+    """The boundary faces of a unit box's tetrahedral mesh that are not on its sides, from the
+    cells alone: the incision's faces (both lips)."""
+    faces = mesh.boundary_faces()
+    x = mesh.points[faces]
+    on_a_side = np.any(np.all(np.isclose(x, 0) | np.isclose(x, 1), axis=1) & np.all(np.isclose(x, x[:, :1]), axis=1), axis=1)
+    return pairs(faces[~on_a_side])
+
+
+def test_refinement_mid_cut_keeps_every_face_of_a_tetrahedral_incision():
+    mesh = snede.meshing.box((1, 1, 1), (6, 6, 6))
+    cutter = snede.TetrahedralCutter(mesh)
+    for y in (-0.5, 0.2, 0.6):  # into the face y = 0, stopping inside on the plane x = 0.43
+        cutter.move([[0.43, y, -1.0], [0.43, y, 2.0]])
+    assert pairs(cutter.incision_faces()) == cut_faces(mesh)
+    before = len(cut_faces(mesh))
+    mesh.refine_around([0.43, 0.3, 0.5], 0.08)
+    mesh.validate()
+    assert len(cut_faces(mesh)) > before
+    assert pairs(cutter.incision_faces()) == cut_faces(mesh)
+    cutter.move([[0.43, 0.8, -1.0], [0.43, 0.8, 2.0]])
+    mesh.validate()
+    assert pairs(cutter.incision_faces()) == cut_faces(mesh)
