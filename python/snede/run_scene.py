@@ -97,8 +97,15 @@ class SerialOnly(NotImplementedError):
 def draw_picture(scene, method: str, folder: Path, outcome: dict) -> dict:
     """The picture of the scene after its run, as ``{"png": path}``. A failed run's state is
     drawn with its reason in the title, never as if it were a solution; a state holding NaN or
-    Inf is not drawn at all (the summary's reason says what went wrong)."""
-    if not np.isfinite(scene.body.displacement).all():
+    Inf is not drawn at all, nor a failed one displaced by more than a thousand times the body's
+    size, which no picture shows (matplotlib's projection fails on it: 'Singular matrix'); the
+    summary's reason says what went wrong."""
+    u = scene.body.displacement
+    if not np.isfinite(u).all():
+        return {}
+    points = scene.body.mesh.points
+    size = float(np.linalg.norm(points.max(axis=0) - points.min(axis=0)))
+    if not outcome["converged"] and np.abs(u).max() > 1e3 * size:
         return {}
     arguments = picture_arguments(scene, method)
     if not outcome["converged"]:
@@ -168,11 +175,11 @@ def print_table(summaries) -> None:
           f"{'probe':<30} {'value':>11} {'analytic':>10} {'error %':>8}")
     for s in summaries:
         analytic = "" if s["analytic"] is None else f"{s['analytic']:.4g}"
-        error = "" if s["error_percent"] is None else f"{s['error_percent']:.2f}"
+        error = "" if s["error_percent"] is None else f"{s['error_percent']:.4g}"
         print(f"{s['scene']:<11} {s['cells']:>7} {s['material']:<18} {s['method']:<8} {s['iterations']:>6} "
               f"{s['reason']:<24} {s['seconds']:>7.2f} {s['probe']:<30} {s['value']:>11.4g} {analytic:>10} {error:>8}")
     for s in summaries:
         others = [path for kind, path in s["files"].items() if kind not in ("xdmf", "h5")]
-        print(f"  {s['scene']}: {s['files']['xdmf']} (ParaView), {', '.join(others)}")
+        print(f"  {s['scene']}: " + ", ".join([f"{s['files']['xdmf']} (ParaView)", *others]))
         if s.get("notes"):
             print(f"  {s['scene']}: {s['notes']}")

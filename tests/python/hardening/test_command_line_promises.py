@@ -68,14 +68,21 @@ def test_ctrl_c_while_modules_load_is_the_one_interrupted_line(tmp_path, module)
 
 
 def test_a_non_finite_state_is_reported_by_the_solvers_reason_and_not_drawn(tmp_path):
-    # A NaN initial step of the line search makes the state NaN: the picture failed with
-    # "Axis limits cannot be NaN or Inf" (status 2) and hid the solver's reason.
+    # A line search's first step of 1e300 makes the state overflow: the picture failed with
+    # "Singular matrix" (status 2) and hid the solver's reason (a NaN damping, the probe's way
+    # to get there, is now refused as bad input: see the next test).
     run = run_cli("--quiet", "run", "cantilever", "--divisions", "4", "--method", "ncg", "--out", str(tmp_path),
-                  "-static_snes_linesearch_type", "cp", "-static_snes_linesearch_damping", "nan")
+                  "-static_snes_linesearch_type", "cp", "-static_snes_linesearch_damping", "1e300")
     line = the_one_line(run, status=1)  # not converged, as for any solve that fails
     assert "did not converge: DIVERGED_NONFINITE_STATE" in line, line
     assert "DIVERGED_NONFINITE_STATE" in run.stdout  # the table's reason column
     assert not (tmp_path / "cantilever" / "cantilever.png").exists()
+
+
+def test_a_nan_line_search_damping_is_bad_input(tmp_path):
+    run = run_cli("--quiet", "run", "cantilever", "--divisions", "4", "--method", "ncg", "--out", str(tmp_path),
+                  "-static_snes_linesearch_type", "cp", "-static_snes_linesearch_damping", "nan")
+    assert "snes_linesearch_damping must be positive and finite, got nan" in the_one_line(run, status=2)
 
 
 def test_a_failed_but_finite_state_is_drawn_with_its_reason(tmp_path, monkeypatch):
