@@ -14,8 +14,9 @@ std::vector<ElementId> FaceSelector::seeds(const Connectivity& c, const Deformed
   std::vector<ElementId> found;
   for (ElementId e : previous_touched_)
     if (c.is_element(e) && sweep.meets_tetrahedron(x.corners(c.element(e).simplex))) found.push_back(e);
-  if (!found.empty()) return found;
-  // First contact: the boundary faces the sweep meets.
+  // And the boundary faces the sweep meets: the first contact, and every later one where the
+  // blade enters the body again apart from where it already is (the other side of a torus's
+  // ring, a second lobe), which no walk from the tetrahedra met so far reaches.
   for (const auto& [simplex, f] : c.boundary()) {
     const Point3 a = x(simplex.vertex(0)), b = x(simplex.vertex(1)), d = x(simplex.vertex(2));
     Point3 lo = a, hi = a;

@@ -20,10 +20,11 @@
 // on the mesh as it is now: node snapping has moved vertices since, and stored marks from
 // before the move leave gaps in the cut surface. A corner snapped onto a sweep counts as on it.
 //
-// The search is local: the tetrahedra a sweep meets are found by a walk across faces from
-// those the previous sweep met; only the first contact (no previous sweep, or nothing met
-// near it) scans the boundary of the body, and a sweep entirely inside the body with no
-// previous contact scans the elements.
+// The tetrahedra a sweep meets are found by a walk across faces from those the previous sweep
+// met and from the boundary faces it meets: a scan of the boundary with every sweep (a box
+// test per face), so that a blade entering the body again elsewhere (the far side of a torus's
+// ring, another lobe) is seen at once; a sweep entirely inside the body with no previous
+// contact scans the elements.
 #pragma once
 
 #include <deque>

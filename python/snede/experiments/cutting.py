@@ -33,6 +33,7 @@ from pathlib import Path
 import numpy as np
 
 import snede
+from snede.experiments import organ_cuts
 from snede.experiments.common import Column, markdown_table, options_prefix, parse_arguments, pyplot, write_csv
 
 DIVISIONS = 8  # 8 × 8 × 8 cubes of 6 tetrahedra: 3072 tetrahedra, 729 nodes (§3.3)
@@ -931,7 +932,8 @@ def main(argv=None) -> dict:
     plot_incisions(pictures, out / "cutting_incision.png")
 
     write_csv(out / "cutting.csv", cube + scan + steps + cylinder)
-    (out / "cutting.md").write_text(describe(cube, scan, steps, cylinder, fresh, quick, (time.perf_counter() - start) / 60))
+    text = describe(cube, scan, steps, cylinder, fresh, quick, (time.perf_counter() - start) / 60)
+    (out / "cutting.md").write_text(text + "\n" + organ_cuts.section_for_cutting(out))
     print(f"wrote {out / 'cutting.md'}, cutting.csv, cutting_quality.png, cutting_scan.png, cutting_incision.png "
           f"in {time.perf_counter() - start:.0f} s")
     return {"cube": cube, "scan": scan, "steps": steps, "cylinder": cylinder}
