@@ -36,11 +36,11 @@ struct CutterOptions {
   DegeneracyOptions degeneracy;
   bool fix_free_pieces = true;
   // A piece a sweep separates whose volume is at most this many mean elements of the mesh is
-  // removed (0: kept). The cut
-  // surface is placed only to within about one element (snapping moves a vertex by up to
-  // half an edge), so a piece of a few elements is an artefact of that approximation: a flat
-  // tetrahedron between two cut faces, not a part of the body the scalpel meant to separate.
-  int max_fragment_elements = 4;
+  // removed (0: kept). The cut surface is placed only to within about one element (snapping
+  // moves a vertex by up to half an edge), so a piece about two elements across or less is an
+  // artefact of that approximation (flat tetrahedra between two cut faces), not a part of the
+  // body the scalpel meant to separate.
+  int max_fragment_elements = 10;
 };
 
 struct CutReport {

@@ -117,7 +117,7 @@ def _points(value, shape: tuple, what: str) -> np.ndarray:
 
 class TetrahedralCutter:
     """``TetrahedralCutter(body_or_mesh, *, snap=True, remove_degeneracies=True,
-    min_aspect_ratio=0.01, large_angle=0.99*pi, fix_free_pieces=True, max_fragment_elements=4)``.
+    min_aspect_ratio=0.01, large_angle=0.99*pi, fix_free_pieces=True, max_fragment_elements=10)``.
 
     * ``body_or_mesh``: a 3D ``snede.Body`` (the scalpel then acts on the deformed body,
       ``X + u``, as the user sees it) or a tetrahedral ``snede.Mesh`` (cut as it is).
@@ -131,7 +131,8 @@ class TetrahedralCutter:
     * ``max_fragment_elements``: a piece a sweep separates whose volume is at most this many
       mean elements of the mesh is removed (0 keeps them). The cut surface is only placed to
       within about one element, so such a piece (typically one flat tetrahedron between two cut
-      faces) is an artefact of the approximation, not a part the scalpel meant to separate.
+      faces; anything about two elements across or less) is an artefact of the approximation,
+      not a part the scalpel meant to separate.
     * Every sweep of one incision (from placing the scalpel to ``lift``) meets the body as it
       was when the scalpel was placed: a body relaxed between moves (its lips opening under
       gravity) would otherwise have moved the incision's front away from where the next sweep
@@ -145,7 +146,7 @@ class TetrahedralCutter:
 
     def __init__(self, body_or_mesh, *, snap: bool = True, remove_degeneracies: bool = True,
                  min_aspect_ratio: float = 0.01, large_angle: float = 0.99 * math.pi, fix_free_pieces: bool = True,
-                 max_fragment_elements: int = 4):
+                 max_fragment_elements: int = 10):
         self.body, self.mesh, model = body_and_mesh(body_or_mesh, type(self).__name__)
         if self.mesh.cell_dim != 3:
             raise ValueError(f"TetrahedralCutter needs a tetrahedral mesh; this mesh has {self.mesh.cell_dim}-D cells")

@@ -17,7 +17,7 @@ pieces the cut should leave. Blades whose expected pieces include one smaller th
 cells (the plane grazing a lobe, which the mesh cannot resolve), or whose count changes when
 the sweep ends two edge lengths earlier or later (a partial cut ending just across a section: the
 tetrahedra the scalpel is still in are cut with its next move), are drawn again. A fragment is
-a piece of the cut body smaller than 4 mean cells. ``validate()`` runs after every move.
+a piece of the cut body smaller than 50 mean cells: every piece the cut should leave is bigger. ``validate()`` runs after every move.
 
 Writes organ_cuts.md and organ_cuts.csv (one row per cut).
 """
@@ -38,8 +38,8 @@ from snede.experiments.common import Column, markdown_table, parse_arguments, wr
 
 E, NU, DENSITY, GRAVITY = 5e3, 0.45, 1000.0, 9.81
 MOVES = 12
-FRAGMENT_CELLS = 4        # a piece below this many mean cell volumes is a fragment
-RESOLVED_CELLS = 50       # blades whose expected pieces are all at least this big
+RESOLVED_CELLS = 50       # blades whose expected pieces are all at least this big; a smaller
+                          # piece of the cut body is a fragment (the cutter removes up to 10)
 RELAXATION_RTOL = 1e-4
 
 
@@ -167,7 +167,7 @@ def piece_volumes(mesh: snede.Mesh) -> np.ndarray:
 
 
 def one_cut(name: str, mesh: snede.Mesh, blade: Blade, relaxed: bool, expected: np.ndarray,
-            mean_cell: float, max_fragment_elements: int = 4) -> dict:
+            mean_cell: float, max_fragment_elements: int = 10) -> dict:
     volume_before = float(mesh.quality().volume.sum())
     body = held_body(mesh)
     solver = snede.StaticSolver(body, "newton", rtol=RELAXATION_RTOL)
@@ -185,7 +185,7 @@ def one_cut(name: str, mesh: snede.Mesh, blade: Blade, relaxed: bool, expected: 
         if relaxed and k > 0:
             solves_failed += not solver.solve().converged
     volumes = piece_volumes(mesh)
-    big = int(np.sum(volumes >= FRAGMENT_CELLS * mean_cell))
+    big = int(np.sum(volumes >= RESOLVED_CELLS * mean_cell))
     return {"shape": name, "cells": expected.size, "relaxed": relaxed,
             "full": blade.travel_to > 0.5 * blade.half_length, "expected": int(expected.max() + 1),
             "pieces": int(volumes.size), "big pieces": big, "fragments": int(volumes.size - big),
@@ -195,7 +195,7 @@ def one_cut(name: str, mesh: snede.Mesh, blade: Blade, relaxed: bool, expected: 
             "cut ms median": float(np.median(cut_ms[1:])), "cut ms max": float(np.max(cut_ms[1:]))}
 
 
-def run(quick: bool, cuts_per_shape: int, seed: int = 0, progress=print, max_fragment_elements: int = 4) -> list[dict]:
+def run(quick: bool, cuts_per_shape: int, seed: int = 0, progress=print, max_fragment_elements: int = 10) -> list[dict]:
     rng = np.random.default_rng(seed)
     rows = []
     for name, make in shapes(quick).items():

@@ -61,11 +61,11 @@ def test_fragments_appear_without_their_removal_and_are_reported_when_removed():
     assert sum(r["fragments"] for r in kept) > 0
     assert sum(r["fragments"] for r in removed) == 0
     assert sum(r["fragments removed"] for r in removed) == sum(r["fragments"] for r in kept)
-    # Removing them loses at most their volume: each at most max_fragment_elements (4) mean cells
+    # Removing them loses at most their volume: each at most max_fragment_elements (10) mean cells
     # (the same blades, drawn from the same seed, cut with and without the removal).
     for k, r in zip(kept, removed):
         lost = k["volume change %"] - r["volume change %"]
-        assert lost <= 100 * r["fragments removed"] * 4 / r["cells"] + 0.01, (k, r)
+        assert lost <= 100 * r["fragments removed"] * 10 / r["cells"] + 0.01, (k, r)
 
 
 def test_the_independent_count_sees_a_torus_cut_through_its_ring_once_as_one_piece():
