@@ -4,11 +4,13 @@
 #include <cmath>
 #include <limits>
 #include <sstream>
+#include <vector>
 
 #include "core/error.hpp"
 #include "core/interrupt.hpp"
 #include "core/norms.hpp"
 #include "core/petsc_util.hpp"
+#include "mesh/element_quality.hpp"
 
 namespace snede {
 namespace {
@@ -57,10 +59,17 @@ std::string blow_up_failure(Vec u) {
 // stability limit 2/√λ_max(M⁻¹K) by 1.4–1.8× on structured boxes and gmsh cylinders, so the
 // default step would blow up. The inscribed diameter is the element length in 1D and gave
 // 0.3–0.98 of the limit on the same meshes (2D and 3D, ν from 0 to 0.49).
+// A membrane (§5.3) carries in-plane waves only: each triangle is measured in its own plane,
+// and its waves travel at the plane-stress speed.
 double cfl_time_step(const Mesh& mesh, const Material& material, double density) {
   double size = std::numeric_limits<double>::infinity();
-  for (ElementId e : mesh.cell_ids()) size = std::min(size, element_quality(mesh.dim(), mesh.corners(e)).inscribed_diameter);
-  const double wave_speed = std::sqrt(dilatational_modulus(material, mesh.dim()) / density);
+  for (ElementId e : mesh.cell_ids()) {
+    const std::vector<double> corners = mesh.corners(e);
+    const ElementQuality quality = mesh.is_surface() ? element_quality(2, flattened_triangle(corners))
+                                                     : element_quality(mesh.dim(), corners);
+    size = std::min(size, quality.inscribed_diameter);
+  }
+  const double wave_speed = std::sqrt(dilatational_modulus(material, mesh.cell_dim()) / density);
   return 2 / std::sqrt(3.0) * size / wave_speed;  // (2.61)
 }
 
@@ -70,9 +79,6 @@ DynamicRelaxation::DynamicRelaxation(Model& model, double damping_eta, double dt
                                      const OptionList& petsc_options)
     : model_(model), option_database_(options_prefix, petsc_options) {
   require_valid_damping(damping_eta);
-  if (model.body().mesh().is_surface())
-    throw std::invalid_argument("dynamic relaxation of membranes (surface meshes) is not implemented yet: its CFL "
-                                "time step assumes volume elements; use StaticSolver with method 'newton'");
   require(dt == 0 || positive_finite(dt), "dt", "positive and finite (or 0 for the CFL estimate)", dt);
   try {
     generation_ = model_.generation();

@@ -33,6 +33,7 @@ std::string blow_up_failure(Vec u);
 
 // (2.61): Δt = (2/√3) h/c, c = √((λ+2μ)/ρ) (plane stress: √(E/((1−ν²)ρ))), h the smallest
 // element size, taken as the diameter of the smallest inscribed sphere (circle); ∞ without cells.
+// A membrane's triangles are measured in their own planes, with the plane-stress speed.
 double cfl_time_step(const Mesh& mesh, const Material& material, double density);
 
 class DynamicRelaxation {

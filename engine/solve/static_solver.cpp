@@ -34,6 +34,14 @@ class ScaledOperator {
 
 bool is_linear(const Material& material) { return std::holds_alternative<LinearElastic>(material); }
 
+// Newton with a line search (snede's default), not a trust region (-snes_type newtontr), which
+// has no line search to finish with and rejects steps without a stall.
+bool is_line_search_newton(SNES snes) {
+  PetscBool same = PETSC_FALSE;
+  SNEDE_PETSC(PetscObjectTypeCompare(reinterpret_cast<PetscObject>(snes), SNESNEWTONLS, &same));
+  return same;
+}
+
 // After a line-search failure Newton tries at most this many full steps, and keeps them only
 // if they meet the stopping criterion (quadratic convergence needs a handful).
 constexpr PetscInt newton_finish_steps = 10;
@@ -105,6 +113,10 @@ StaticSolver::~StaticSolver() {
       SNESSetJacobian(snes_, nullptr, nullptr, [](SNES, Vec, Mat, Mat, void*) { return orphaned_callback_error(owner); },
                       nullptr);
     SNESSetConvergenceTest(snes_, snes_converged_callback, nullptr, nullptr);
+    SNESLineSearch line_search = nullptr;
+    SNESGetLineSearch(snes_, &line_search);
+    SNESLineSearchSetPreCheck(
+        line_search, [](SNESLineSearch, Vec, Vec, PetscBool*, void*) { return orphaned_callback_error(owner); }, nullptr);
   }
   if (ksp_) KSPSetConvergenceTest(ksp_, ksp_converged_callback, nullptr, nullptr);
 }
@@ -187,6 +199,7 @@ void StaticSolver::create_objects() {
       SNEDE_PETSC(SNESKSPSetUseEW(snes_, PETSC_TRUE));
     }
     SNEDE_PETSC(SNESSetMaxLinearSolveFailures(snes_, options_.max_iterations));
+    SNEDE_PETSC(SNESLineSearchSetPreCheck(line_search, descent_direction_callback, this));
   }
   // A line search's absolute tolerance depends on the units (cp declares CONVERGED_FNORM_ABS
   // once the slope F·y falls below it, and F is in scaled units here): convergence is decided
@@ -491,8 +504,7 @@ SolveResult StaticSolver::solve_nonlinear() {
   // where the line search stopped, so the attempt never makes a result worse.
   // (PETSc reports some of these failures as DIVERGED_LOCAL_MIN when ‖Jᵀ F‖ is small.)
   const SNESConvergedReason stopped_by = reason;
-  if (options_.method == StaticMethod::newton &&
-      (reason == SNES_DIVERGED_LINE_SEARCH || reason == SNES_DIVERGED_LOCAL_MIN)) {
+  if (is_line_search_newton(snes_) && (reason == SNES_DIVERGED_LINE_SEARCH || reason == SNES_DIVERGED_LOCAL_MIN)) {
     VecHandle stopped;
     SNEDE_PETSC(VecDuplicate(u, stopped.out()));
     SNEDE_PETSC(VecCopy(u, stopped));
@@ -588,6 +600,48 @@ PetscErrorCode StaticSolver::jacobian_callback(SNES snes, Vec x, Mat J, Mat P, v
   });
 }
 
+PetscErrorCode StaticSolver::descent_direction_callback(SNESLineSearch line_search, Vec /*u*/, Vec step,
+                                                        PetscBool* changed, void* context) {
+  return petsc_callback("snede Newton direction", [&] {
+    callback_owner<StaticSolver>(context, "StaticSolver");
+    *changed = PETSC_FALSE;
+    SNES snes = nullptr;
+    Vec residual = nullptr;
+    SNEDE_PETSC(SNESLineSearchGetSNES(line_search, &snes));
+    SNEDE_PETSC(SNESGetFunction(snes, &residual, nullptr, nullptr));
+    // Newton moves to u − λ·step: downhill iff F·step > 0 (F = ∇Π, §2.4.3).
+    PetscScalar slope = 0;
+    SNEDE_PETSC(VecDot(residual, step, &slope));
+    if (slope > 0) return;
+    // Truncated Newton (§2.4.3) stops CG at the first direction of non-positive curvature and
+    // keeps its iterate so far, or at the first iteration takes the steepest descent. PETSc's CG
+    // tests only for a change of the curvature's sign: when the very first direction has negative
+    // curvature (a closed membrane hanging under gravity, whose compressed part wrinkles), it
+    // steps along it backwards and returns an uphill direction, along which the energy line
+    // search can only fail (DIVERGED_LINE_SEARCH after 25 iterations on the liver's skin). Then
+    // the (preconditioned) steepest descent, scaled by the magnitude of its curvature.
+    KSP ksp = nullptr;
+    PC pc = nullptr;
+    Mat tangent = nullptr;
+    SNEDE_PETSC(SNESGetKSP(snes, &ksp));
+    SNEDE_PETSC(KSPGetPC(ksp, &pc));
+    SNEDE_PETSC(KSPGetOperators(ksp, &tangent, nullptr));
+    SNEDE_PETSC(PCApply(pc, residual, step));
+    SNEDE_PETSC(VecDot(residual, step, &slope));
+    if (!(slope > 0)) {  // an indefinite preconditioner
+      SNEDE_PETSC(VecCopy(residual, step));
+      SNEDE_PETSC(VecDot(residual, step, &slope));
+    }
+    VecHandle tangent_times_step;
+    SNEDE_PETSC(VecDuplicate(step, tangent_times_step.out()));
+    SNEDE_PETSC(MatMult(tangent, step, tangent_times_step));
+    PetscScalar curvature = 0;
+    SNEDE_PETSC(VecDot(step, tangent_times_step, &curvature));
+    if (curvature != 0 && std::isfinite(curvature)) SNEDE_PETSC(VecScale(step, slope / std::abs(curvature)));
+    *changed = PETSC_TRUE;
+  });
+}
+
 PetscErrorCode StaticSolver::snes_converged_callback(SNES snes, PetscInt it, PetscReal xnorm, PetscReal snorm,
                                                      PetscReal fnorm, SNESConvergedReason* reason, void* context) {
   return petsc_callback("snede stopping criterion", [&] {
@@ -606,9 +660,10 @@ PetscErrorCode StaticSolver::snes_converged_callback(SNES snes, PetscInt it, Pet
     // A Newton iteration that leaves ‖F‖ as it was made no progress: the line search took a
     // vanishing step, which near the solution means the energy cannot show the decrease any
     // more (its round-off). Stop as a line-search failure, so that the full-step finish in
-    // solve_nonlinear takes over now rather than after more stalled iterations.
+    // solve_nonlinear takes over now rather than after more stalled iterations. (A trust region
+    // leaves ‖F‖ as it was at every step it rejects: that is no stall.)
     const std::size_t n = self->history_.size();
-    if (*reason == SNES_CONVERGED_ITERATING && self->options_.method == StaticMethod::newton && it > 0 && n >= 2 &&
+    if (*reason == SNES_CONVERGED_ITERATING && is_line_search_newton(snes) && it > 0 && n >= 2 &&
         std::abs(fnorm - self->history_[n - 2]) <= newton_stall * self->history_[n - 2])
       *reason = SNES_DIVERGED_LINE_SEARCH;
   });

@@ -103,6 +103,9 @@ class StaticSolver {
   static PetscErrorCode residual_callback(SNES, Vec x, Vec F, void* context);
   static PetscErrorCode objective_callback(SNES, Vec x, PetscReal* value, void* context);
   static PetscErrorCode jacobian_callback(SNES, Vec x, Mat J, Mat P, void* context);
+  // Newton's inner solve must give a descent direction; if it did not, the steepest descent.
+  static PetscErrorCode descent_direction_callback(SNESLineSearch, Vec u, Vec step, PetscBool* changed,
+                                                   void* context);
   static PetscErrorCode snes_converged_callback(SNES, PetscInt it, PetscReal xnorm, PetscReal snorm,
                                                 PetscReal fnorm, SNESConvergedReason* reason, void* context);
   static PetscErrorCode ksp_converged_callback(KSP, PetscInt it, PetscReal rnorm, KSPConvergedReason* reason,

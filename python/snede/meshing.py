@@ -218,11 +218,113 @@ def folded_sheet(flat: float = 0.4, radius: float = 0.15, divisions=(10, 8)) -> 
     return lifted(rectangle((1.0, 1.0), divisions), to_space)
 
 
+def _edge_keys(a: np.ndarray, b: np.ndarray, n: int) -> np.ndarray:
+    """One integer per undirected edge {a, b} of vertex ids below n."""
+    return np.minimum(a, b) * n + np.maximum(a, b)
+
+
+def _wedge_partners(faces: np.ndarray, tetrahedra: np.ndarray, edges: np.ndarray, n: int) -> np.ndarray:
+    """For each edge (a, b) met by more than two boundary faces, pairs (f, g) of the faces that
+    bound the same wedge of solid around it: going round the edge from f through the
+    tetrahedra that share a face with it, the next boundary face is g."""
+    edge_keys = _edge_keys(edges[:, 0], edges[:, 1], n)
+    local_edges = np.array(list(itertools.combinations(range(4), 2)))
+    keys = _edge_keys(tetrahedra[:, local_edges[:, 0]], tetrahedra[:, local_edges[:, 1]], n)
+    tets, slots = np.nonzero(np.isin(keys, edge_keys))
+    around: dict[int, list[int]] = {}
+    for tet, key in zip(tets.tolist(), keys[tets, slots].tolist()):
+        around.setdefault(key, []).append(tet)
+    near = np.nonzero(np.isin(faces, edges).sum(axis=1) >= 2)[0]
+    face_of = {tuple(sorted(faces[f])): f for f in near.tolist()}
+    pairs = []
+    for (a, b), key in zip(edges.tolist(), edge_keys.tolist()):
+        # Around edge ab each tetrahedron abcd joins its faces abc and abd: chains of them run
+        # from one boundary face to another (the wedges), the boundary faces being those of a
+        # single tetrahedron.
+        neighbours: dict[int, list[int]] = {}
+        for tet in tetrahedra[around[key]].tolist():
+            c, d = (v for v in tet if v != a and v != b)
+            neighbours.setdefault(c, []).append(d)
+            neighbours.setdefault(d, []).append(c)
+        seen = set()
+        for start in neighbours:
+            if len(neighbours[start]) != 1 or start in seen:
+                continue
+            previous, current = start, neighbours[start][0]
+            while len(neighbours[current]) == 2:
+                previous, current = current, next(v for v in neighbours[current] if v != previous)
+            seen.update((start, current))
+            pairs.append((face_of[tuple(sorted((a, b, start)))], face_of[tuple(sorted((a, b, current)))]))
+    return np.array(pairs, dtype=np.int64).reshape(-1, 2)
+
+
+def _fans(faces: np.ndarray, mesh: Mesh) -> np.ndarray:
+    """A label per corner of each boundary face of `mesh`, (n_faces, 3): corners of one vertex
+    get one label per fan of faces around it, faces that follow each other round the vertex
+    across a shared edge."""
+    n = mesh.n_points
+    n_faces = len(faces)
+    # Half-edge k of face f runs from corner k to corner k + 1; an edge's faces are its owners.
+    tail, head = faces, np.roll(faces, -1, axis=1)
+    keys = _edge_keys(tail, head, n).ravel()
+    order = np.argsort(keys, kind="stable")
+    _, first, uses = np.unique(keys[order], return_index=True, return_counts=True)
+    # Two faces at an edge follow each other; at an edge where the boundary touches itself
+    # (4, 6, ... faces), those that close the same wedge of solid do.
+    two = first[uses == 2]
+    half_edge_pairs = [np.c_[order[two], order[two + 1]]]
+    touching = first[uses > 2]
+    if len(touching):
+        half_edges = order[touching]
+        edges = np.c_[tail.ravel()[half_edges], head.ravel()[half_edges]]
+        wedges = _wedge_partners(faces, mesh.cells, edges, n)
+        for f, g in wedges.tolist():
+            shared = set(faces[f]) & set(faces[g])
+            k = next(k for k in range(3) if {faces[f][k], faces[f][(k + 1) % 3]} == shared)
+            m = next(m for m in range(3) if {faces[g][m], faces[g][(m + 1) % 3]} == shared)
+            half_edge_pairs.append(np.array([[3 * f + k, 3 * g + m]]))
+    half_edge_pairs = np.concatenate(half_edge_pairs)
+    # Across paired half-edges (a → b in one face, b → a in the other) the corners at a and
+    # those at b belong to the same fans.
+    f, k = np.divmod(half_edge_pairs[:, 0], 3)
+    g, m = np.divmod(half_edge_pairs[:, 1], 3)
+    joined = np.concatenate([np.c_[3 * f + k, 3 * g + (m + 1) % 3], np.c_[3 * f + (k + 1) % 3, 3 * g + m]])
+    labels = np.arange(3 * n_faces)
+    while True:  # the smallest corner of each fan spreads through it
+        lowest = np.minimum(labels[joined[:, 0]], labels[joined[:, 1]])
+        updated = labels.copy()
+        np.minimum.at(updated, joined[:, 0], lowest)
+        np.minimum.at(updated, joined[:, 1], lowest)
+        updated = updated[updated]
+        if np.array_equal(updated, labels):
+            return labels.reshape(n_faces, 3)
+        labels = updated
+
+
 def boundary_surface(mesh: Mesh) -> tuple[Mesh, np.ndarray]:
     """The boundary of a tetrahedral mesh as a surface mesh (triangles in 3D, outward
-    normals), with the volume mesh's id of each surface vertex: ``(surface, vertex_ids)``."""
+    normals), with the volume mesh's id of each surface vertex: ``(surface, vertex_ids)``.
+
+    Where the boundary touches itself — two bones that meet along an edge or at a vertex — the
+    surface is split into manifold surfaces: such a vertex becomes one surface vertex per fan of
+    boundary triangles around it (along an edge, the two triangles that close the same wedge of
+    solid follow each other), so that every edge is shared by exactly two triangles and a
+    membrane can be built on it. Each copy sits where its vertex is, and ``vertex_ids`` maps
+    every copy to that same volume vertex. Surface vertices are numbered in ascending order of
+    their volume vertex; the extra copies come after them."""
     if mesh.cell_dim != 3:
         raise ValueError(f"boundary_surface needs a tetrahedral mesh, got cell_dim {mesh.cell_dim}")
     faces = mesh.boundary_faces()
-    vertex_ids, local = np.unique(faces, return_inverse=True)
-    return Mesh(mesh.points[vertex_ids], local.reshape(faces.shape)), vertex_ids
+    fans = _fans(faces, mesh)
+    fan_ids, fan_of_corner = np.unique(fans, return_inverse=True)
+    fan_vertex = faces.ravel()[fan_ids]
+    # The first fan of each vertex (by lowest corner) keeps the vertex's place in ascending
+    # order; further fans of a vertex are appended.
+    vertex_ids, first_fan = np.unique(fan_vertex, return_index=True)
+    extra = np.setdiff1d(np.arange(len(fan_ids)), first_fan)
+    numbering = np.empty(len(fan_ids), dtype=np.int64)
+    numbering[first_fan] = np.arange(len(first_fan))
+    numbering[extra] = len(first_fan) + np.arange(len(extra))
+    vertex_ids = np.concatenate([vertex_ids, fan_vertex[extra]])
+    triangles = numbering[fan_of_corner].reshape(faces.shape)
+    return Mesh(mesh.points[vertex_ids], triangles), vertex_ids

@@ -347,14 +347,13 @@ def test_assembled_tangent_is_refused_on_membranes():
 
 
 def test_what_is_not_implemented_for_membranes_says_so():
-    # The assembled tangent, its diagonal and the CFL step take volume elements: refused on a
-    # membrane rather than computed from the wrong corners.
+    # The assembled tangent and its diagonal take volume elements: refused on a membrane rather
+    # than computed from the wrong corners. (DynamicRelaxation handles membranes:
+    # test_membranes_on_organs.py.)
     surface, _ = snede.meshing.boundary_surface(snede.meshing.box((1.0, 1.0, 1.0), (2, 2, 2)))
     body = snede.Body(surface, snede.NeoHookean(1e4, 0.3), thickness=0.01)
     for preconditioner in ("jacobi", "gamg"):
         with pytest.raises(ValueError, match="membranes"):
             snede.StaticSolver(body, "newton", preconditioner=preconditioner)
-    with pytest.raises(ValueError, match="membranes"):
-        snede.DynamicRelaxation(body, damping=20.0)
     with pytest.raises(Exception, match="error code"):
         body.tangent_operator(np.zeros((surface.n_points, 3))).getDiagonal()
