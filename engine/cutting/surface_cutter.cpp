@@ -229,6 +229,12 @@ std::vector<SurfaceCutter::StarHit> SurfaceCutter::hits_in_star(VertexId b, cons
   return hits;
 }
 
+SurfaceCutter::Segment SurfaceCutter::through(const Segment& scalpel, const Point3& x) {
+  const Point3 along = minus(scalpel.tail, scalpel.head);
+  const Point3 shift = minus(x, plus_scaled(scalpel.head, dot(minus(x, scalpel.head), along) / dot(along, along), along));
+  return {plus_scaled(scalpel.head, 1.0, shift), plus_scaled(scalpel.tail, 1.0, shift)};
+}
+
 std::optional<SurfaceCutter::LinkCrossing> SurfaceCutter::first_link_crossing(VertexId b, const Segment& from,
                                                                              const Segment& to) const {
   std::optional<LinkCrossing> first;
@@ -242,7 +248,11 @@ std::optional<SurfaceCutter::LinkCrossing> SurfaceCutter::first_link_crossing(Ve
 double SurfaceCutter::step_limit(VertexId b, const Segment& scalpel) const {
   double limit = std::numeric_limits<double>::infinity();
   for (const Wedge& w : wedges(b)) limit = std::min(limit, line_distance(scalpel.head, scalpel.tail, deformed(w.y), deformed(w.z)));
-  return std::max(limit, options_.eps_edge / 4);
+  // §5.3.1: a scalpel nearly parallel to the surface moves its hit far for a small move of its
+  // ends; d_max keeps the hit within the star. The floor only bounds the number of steps; at
+  // ε_edge/4 it let the hit jump across the star in one step on a coarse surface, and the node
+  // was left behind (below ε_edge/8 the bell's cap, cut by a tangent scalpel, gets slivers).
+  return std::max(limit, options_.eps_edge / 8);
 }
 
 std::vector<ElementId> SurfaceCutter::triangles_near(const Segment& from, const Segment& to) {
@@ -570,16 +580,24 @@ void SurfaceCutter::advance(VertexId b, const Segment& from, const Segment& to, 
       std::optional<Wedge> blocking;
       if (!move_active_to(b, hits.front().wedge, hits.front().weights, &blocking)) {
         // A star triangle would fold over on the whole way (the 2D cutter's triangle that
-        // the way inverts): its link edge is cleared away and the hit looked for again.
-        if (blocking && clear_link_edge(b, blocking->y, blocking->z, report)) continue;
+        // the way inverts): its link edge is cleared away and the hit looked for again. One
+        // the node leaves behind (dragged along from a crease it crossed) is taken out of the
+        // star by flipping a spoke instead: "the active triangles are subjected to flipping"
+        // (§5.3.1).
+        if (blocking && (clear_link_edge(b, blocking->y, blocking->z, report) || flip(b, blocking->y, report) ||
+                         flip(b, blocking->z, report)))
+          continue;
         ++report.stuck;
       }
       remesh_around(b, report);
       split_incision(b, report);
       return;
     }
-    // §5.3.1: the scalpel has left the active triangles across the edge it swept first.
-    const std::optional<LinkCrossing> crossing = first_link_crossing(b, from, to);
+    // §5.3.1: the scalpel has left the active triangles across the edge it swept first. The
+    // thesis's node is at the scalpel when a step begins; one a refused move left behind is
+    // swept to from where it is (the scalpel moved over to it), or it would stay there for good.
+    std::optional<LinkCrossing> crossing = first_link_crossing(b, from, to);
+    if (!crossing) crossing = first_link_crossing(b, through(from, deformed(b)), to);
     if (!crossing) {
       if (meets_ring(b, to)) ++report.stuck;
       return;
@@ -831,6 +849,13 @@ std::vector<VertexId> SurfaceCutter::join_at(VertexId w, const std::vector<Verte
   for (VertexId v : actives) incision_vertices_.insert(v), touched_.push_back(v);
   incision_vertices_.insert(w);
   touched_.push_back(w);
+  // As at an exit in 2D (§5.2.2, forbidden edges): where incisions ended, the scalpel that is
+  // still there enters nothing new in this move.
+  std::vector<VertexId> ended = copies;
+  ended.insert(ended.end(), actives.begin(), actives.end());
+  ended.push_back(w);
+  for (VertexId v : ended)
+    for (ElementId e : local_star(mesh_.connectivity(), v).elements) refused_.insert(e);
   return copies;
 }
 

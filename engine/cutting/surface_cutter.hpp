@@ -4,7 +4,7 @@
 //
 // The scalpel is a segment whose ends move with constant velocity between samples. A move is
 // taken in steps no longer than d_max of every active node (Figure 5.11: the distance between
-// the scalpel's line and the lines of the edges opposite the active node, at least ε_edge/4),
+// the scalpel's line and the lines of the edges opposite the active node, at least ε_edge/8),
 // and cut short where the scalpel first touches the surface somewhere new. Each step:
 //  * every incision follows the scalpel (§5.3.1). An entry node waits until the scalpel has
 //    moved ε_entry from it, then the edge to a new active node is dissected (for an entry
@@ -12,16 +12,19 @@
 //    opens). A cutting incision's active node moves to where the scalpel meets its triangles;
 //    when the scalpel misses them, the edge opposite the active node that the swept scalpel
 //    crosses first is flipped away (refused flips, Figure 5.9, remove its nearer interior end
-//    instead, Figure 5.10) after the node has moved 0.6 of the way towards it. Then the active
-//    triangles are flipped to the unfolded Delaunay criterion, interior nodes within ε_edge of
-//    the active node removed, and the incision split (Figure 5.5) where its cut edges, unfolded
-//    about the active node, fail the empty-circle test;
+//    instead, Figure 5.10) after the node has moved 0.6 of the way towards it (a node a
+//    refused move left behind is swept to from where it is). A star triangle that would fold
+//    on the way is cleared the same way, or, left behind, taken from the star by a flip of a
+//    spoke. Then the active triangles are flipped to the unfolded Delaunay criterion, interior
+//    nodes within ε_edge of the active node removed, and the incision split (Figure 5.5) where
+//    its cut edges, unfolded about the active node, fail the empty-circle test;
 //  * the scalpel meeting an active node's triangles in several places far apart branches the
 //    incision (Figure 5.14): a new active node at each place, the edges to them dissected;
 //  * an incision ends where its active node reaches an edge it may not flip (Figure 5.13,
 //    annihilation): a boundary edge (the exit, Figure 5.7) or an edge whose other triangle has
 //    another active node, whose incision then ends there too. A node that separates two active
-//    nodes and is closer than ε_edge to one of them is where both end;
+//    nodes and is closer than ε_edge to one of them is where both end. Where incisions ended,
+//    nothing new is entered for the rest of the move (2D's forbidden edges, Figure 5.7);
 //  * new incisions begin in one of the three ways of Figure 5.12, on triangles that touch no
 //    active node: the swept scalpel crossing a boundary edge into its triangle, an end of the
 //    scalpel passing through a triangle, or the swept scalpel meeting an interior edge from
@@ -137,6 +140,8 @@ class SurfaceCutter {
 
   std::vector<StarHit> hits_in_star(VertexId b, const Segment& scalpel) const;  // nearest b first
   std::optional<LinkCrossing> first_link_crossing(VertexId b, const Segment& from, const Segment& to) const;
+  // The scalpel moved across, parallel to itself, so that its line passes through x.
+  static Segment through(const Segment& scalpel, const Point3& x);
   double step_limit(VertexId b, const Segment& scalpel) const;  // d_max, Figure 5.11
   std::vector<ElementId> triangles_near(const Segment& from, const Segment& to);
   // Whether the scalpel meets a triangle with a vertex in a's star.
@@ -213,7 +218,7 @@ class SurfaceCutter {
   std::unordered_set<VertexId> incision_vertices_;
   std::unordered_map<VertexId, Point3> surface_normals_;
   std::vector<VertexId> touched_;
-  std::unordered_set<ElementId> refused_;  // contacts this move could not enter
+  std::unordered_set<ElementId> refused_;  // this move enters none of these (refused, or where an incision ended)
   IncisionWatch watch_;                    // last: it refers to the sets above
 };
 
