@@ -39,6 +39,11 @@ class DynamicRelaxation(RunsOnRanks):
 
     The state is ``body.displacement`` and ``velocity`` (both (n_points, dim)); it starts at
     rest. After a cut or refinement the velocity is carried over like the displacement.
+
+    A membrane (a body on a surface mesh, §5.3) relaxes like a volume: its lumped masses are
+    area × thickness × density, and ``cfl_time_step`` measures each triangle in its own plane
+    with the plane-stress wave speed. An organ's closed skin hanging under gravity settles at
+    ``damping=10`` (docs/results/membranes_on_organs.md).
     """
 
     _on_ranks = "run(), dt and part"

@@ -21,7 +21,10 @@ class StaticSolver(RunsOnRanks):
 
     * ``method``: ``"cg"`` (linear CG, LinearElastic only), ``"ncg"`` (nonlinear CG,
       Polak-Ribière by default; ``ncg_type="fr"`` for Fletcher-Reeves) or ``"newton"``
-      (truncated Newton: inner CG with Eisenstat-Walker tolerances).
+      (truncated Newton: inner CG with Eisenstat-Walker tolerances, stopped at negative
+      curvature; a direction that does not go downhill, which PETSc's CG returns when its first
+      direction has negative curvature, is replaced by the steepest descent, so that a
+      wrinkling membrane does not end in DIVERGED_LINE_SEARCH).
     * ``line_search`` (ncg): ``"snede_secant"`` (default: the secant method of §4.4.2, whose
       first slope comes from a tangent action, so it needs no scale), ``"snede_newton"``
       (Newton on the directional derivative), or ``"cp"`` (PETSc's secant on the directional
