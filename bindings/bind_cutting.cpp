@@ -42,6 +42,7 @@ void bind_cutting(py::module_& m) {
       .def_readwrite("pieces_fixed", &CutReport::pieces_fixed)
       .def_readwrite("fragments_removed", &CutReport::fragments_removed)
       .def_readwrite("fragment_elements", &CutReport::fragment_elements)
+      .def_readwrite("piece_elements", &CutReport::piece_elements)
       .def_readwrite("piece_search", &CutReport::piece_search)
       .def_readwrite("seconds", &CutReport::seconds);
 

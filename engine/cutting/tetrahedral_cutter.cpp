@@ -28,6 +28,7 @@ void CutReport::add(const CutReport& o) {
   faces_split += o.faces_split;
   elements_cut_free += o.elements_cut_free;
   if (o.sweeps > 0 || sweeps == 0) components = o.components;  // the later count, unless it swept nothing
+  if (!o.piece_elements.empty()) piece_elements = o.piece_elements;
   free_pieces += o.free_pieces;
   pieces_fixed += o.pieces_fixed;
   fragments_removed += o.fragments_removed;
@@ -204,6 +205,11 @@ void TetrahedralCutter::count_pieces(CutReport& report) {
   }
   report.piece_search = pieces_.last_search_size();
   report.components = pieces_.pieces();
+  if (separated) {
+    report.piece_elements.assign(pieces_.pieces(), 0);
+    for (ElementId e : c.element_ids()) ++report.piece_elements[pieces_.label(e)];
+    std::sort(report.piece_elements.rbegin(), report.piece_elements.rend());
+  }
   if (!separated || !model_) return;  // a bare mesh has no supports to be free of
   const int n = pieces_.pieces();
   auto label = [this](ElementId e) { return pieces_.label(e); };

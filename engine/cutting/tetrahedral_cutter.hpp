@@ -62,6 +62,9 @@ struct CutReport {
   int pieces_fixed = 0;        // of those, fixed on one face (fix_free_pieces)
   int fragments_removed = 0;   // separated pieces of at most max_fragment_elements (by volume), removed
   int fragment_elements = 0;   // the elements they had
+  // After a sweep that separated a piece: the elements of each piece, largest first (the
+  // latest such sweep's when reports are added).
+  std::vector<std::size_t> piece_elements;
   std::size_t piece_search = 0;  // elements the local search for separated pieces visited
   double seconds = 0;
 

@@ -31,7 +31,8 @@ class CutReport:
     ``free_pieces`` counts the pieces with no constraint and ``pieces_fixed`` those of them
     fixed on one face (``fix_free_pieces``). ``fragments_removed`` counts the separated pieces
     no bigger than ``max_fragment_elements`` mean elements that were removed,
-    ``fragment_elements`` the elements they had. ``piece_search`` is the number of elements the
+    ``fragment_elements`` the elements they had; ``piece_elements`` the elements of each piece,
+    largest first, after a sweep that separated one (empty otherwise). ``piece_search`` is the number of elements the
     local search for separated pieces visited (it stays near the cut unless a piece separates)."""
 
     sweeps: int = 0
@@ -51,6 +52,7 @@ class CutReport:
     pieces_fixed: int = 0
     fragments_removed: int = 0
     fragment_elements: int = 0
+    piece_elements: tuple = ()
     piece_search: int = 0
     seconds: float = 0.0
 
@@ -58,6 +60,7 @@ class CutReport:
     def _from_engine(cls, r) -> "CutReport":
         values = {f.name: getattr(r, f.name) for f in fields(cls)}
         values["degenerate_shapes"] = tuple(values["degenerate_shapes"])
+        values["piece_elements"] = tuple(values["piece_elements"])
         return cls(**values)
 
     def __add__(self, other: "CutReport") -> "CutReport":

@@ -33,14 +33,17 @@ def test_a_blade_swept_through_the_whole_liver_leaves_two_pieces(liver, end, rel
     size = hi - lo
     x = lo[0] + 0.6 * size[0]
     cutter = snede.TetrahedralCutter(body)
+    total = snede.CutReport()
     for y in np.linspace(lo[1] - 0.1 * size[1], lo[1] + end * size[1], 21):
-        cutter.move([[x, y, lo[2] - 0.1 * size[2]], [x, y, hi[2] + 0.1 * size[2]]])
+        total = total + cutter.move([[x, y, lo[2] - 0.1 * size[2]], [x, y, hi[2] + 0.1 * size[2]]])
         if relaxed:
             solver.solve()
         mesh.validate()
     n, labels = mesh.connected_components()
     volumes = np.bincount(labels, weights=mesh.quality().volume)
     assert n == 2, volumes
+    # The report of the separating sweep gives the pieces' sizes (largest first).
+    assert total.piece_elements == tuple(sorted(np.bincount(labels).tolist(), reverse=True))
     # Both sides of x are whole pieces, not slivers: each holds at least a tenth of the liver.
     assert volumes.min() > 0.1 * volumes.sum()
 
