@@ -218,35 +218,24 @@ void TetrahedralCutter::count_pieces(CutReport& report) {
   constexpr std::size_t rigid_motions = 6;
   std::vector<std::size_t> held_components(n, 0);
   std::vector<char> counted(mesh_.n_points(), 0);
+  std::vector<ElementId> first(n, no_id);
   for (ElementId e = 0; e < c.element_capacity(); ++e) {
     if (!c.is_element(e)) continue;
     const int piece = label(e);
+    if (first[piece] == no_id) first[piece] = e;
     for (VertexId v : c.element(e).simplex.vertices())
       if (!counted[v]) {
         counted[v] = 1;
         held_components[piece] += model_->constraints().constrained_components(v);
       }
   }
-  std::vector<std::vector<VertexId>> loose(n);
   for (int piece = 0; piece < n; ++piece) {
     if (held_components[piece] >= rigid_motions) continue;
     ++report.free_pieces;
-    if (options_.fix_free_pieces) loose[piece].push_back(no_id);  // marks it: to be fixed
-  }
-  if (!options_.fix_free_pieces) return;
-  // §3.3 fixes a free piece on one face so that the static problem stays well posed; under
-  // gravity that face's few elements then carry the whole piece's weight, turn inside out, and
-  // every later Newton solve failed. The piece is held where it is, at all its vertices.
-  std::fill(counted.begin(), counted.end(), 0);
-  for (ElementId e : c.element_ids()) {
-    std::vector<VertexId>& vertices = loose[label(e)];
-    if (vertices.empty()) continue;
-    for (VertexId v : c.element(e).simplex.vertices())
-      if (!counted[v]) counted[v] = 1, vertices.push_back(v);
-  }
-  for (std::vector<VertexId>& vertices : loose) {
-    if (vertices.empty()) continue;
-    vertices.erase(vertices.begin());  // the mark
+    if (!options_.fix_free_pieces || !model_) continue;
+    // §3.3: fixed on one face, where it is now, so that the static problem stays well posed.
+    const Simplex face = c.element(first[piece]).simplex.subn(0);
+    std::vector<VertexId> vertices(face.vertices().begin(), face.vertices().end());
     std::vector<double> values;
     {
       const ReadView u(model_->displacement());

@@ -8,7 +8,7 @@
 //  3. dissection along the selected faces (§7.3, dissect.hpp),
 //  4. degeneracy removal around the cut (§3.2.3, degeneracy_removal.hpp),
 //  5. the pieces (§3.3, piece_tracker.hpp, a search local to the cut): a piece that the cut
-//     separates from its supports is reported and, by option, held where it is so that
+//     separates from every constraint is reported and, by option, fixed on one face so that
 //     the next static solve is well posed.
 // Steps 3–5 are one change for the mesh's watchers, so a body (its displacement, velocity and
 // constraints carried to new and moved vertices by their parents) reissues its sizes once per
@@ -59,7 +59,7 @@ struct CutReport {
   int components = 0;          // pieces of the body after the cut
   int free_pieces = 0;         // after a sweep that separated a piece: pieces not held (fewer constrained
                                // displacement components than their 6 rigid motions)
-  int pieces_fixed = 0;        // of those, held where they are (fix_free_pieces)
+  int pieces_fixed = 0;        // of those, fixed on one face (fix_free_pieces)
   int fragments_removed = 0;   // separated pieces of at most max_fragment_elements (by volume), removed
   int fragment_elements = 0;   // the elements they had
   // After a sweep that separated a piece: the elements of each piece, largest first (the

@@ -29,7 +29,7 @@ class CutReport:
     ``elements_cut_free`` the incollapsible ones that were cut free and removed. ``components``
     is the number of pieces of the body afterwards. On a sweep that separates a piece,
     ``free_pieces`` counts the pieces with no constraint and ``pieces_fixed`` those of them
-    held where it is at all its vertices (``fix_free_pieces``). ``fragments_removed`` counts the separated pieces
+    fixed on one face (``fix_free_pieces``). ``fragments_removed`` counts the separated pieces
     no bigger than ``max_fragment_elements`` mean elements that were removed,
     ``fragment_elements`` the elements they had; ``piece_elements`` the elements of each piece,
     largest first, after a sweep that separated one (empty otherwise). ``piece_search`` is the number of elements the
@@ -129,10 +129,8 @@ class TetrahedralCutter:
     * ``remove_degeneracies``, ``min_aspect_ratio``, ``large_angle``: §3.2.3; elements around
       the cut with aspect ratio (min height / max edge) below the threshold are collapsed by
       shape, the rest cut free.
-    * ``fix_free_pieces``: a piece the cut separates from its supports (fewer than 6 constrained
-      displacement components) is held where it is at all its vertices, so that the next static
-      solve is well posed. The thesis (§3.3) fixes one face; under gravity that face's elements
-      carried the whole piece, turned inside out, and later Newton solves failed.
+    * ``fix_free_pieces``: a piece the cut separates from every constraint is fixed on one
+      face where it is (§3.3), so that the next static solve is well posed.
     * ``max_fragment_elements``: a piece a sweep separates whose volume is at most this many
       mean elements of the mesh is removed (0 keeps them). The cut surface is only placed to
       within about one element, so such a piece (typically one flat tetrahedron between two cut

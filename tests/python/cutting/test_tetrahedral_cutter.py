@@ -156,12 +156,6 @@ def test_a_piece_cut_free_of_its_supports_is_fixed_and_the_solve_converges():
     cutter.move([[0.11, -1, 1], [0.11, 1, 1]])
     report = cutter.move([[0.11, -1, -1], [0.11, 1, -1]])
     assert report.components == 2 and report.free_pieces == 1 and report.pieces_fixed == 1
-    # Held where it is at all its vertices: on one face (§3.3) the piece hung from that face's
-    # few elements under gravity, which turned inside out, and later Newton solves failed.
-    _, labels = mesh.connected_components()
-    free_piece = labels[np.argmax(mesh.points[mesh.cells].mean(axis=1)[:, 0])]
-    fixed, _, _ = body._model.constraint_table()
-    assert set(np.unique(mesh.cells[labels == free_piece]).tolist()) <= set(np.ravel(fixed).tolist())
     result = solver.solve()
     assert result.converged, result
     assert not len(body.inverted_elements(body.displacement))
