@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <memory>
 #include <stdexcept>
 #include <string>
 
@@ -64,18 +63,25 @@ bool TetrahedralCutter::constrained(VertexId v) const {
 
 CutReport TetrahedralCutter::cut_triangle(std::span<const double> corners) {
   const SweepTriangle sweep(corners);  // validates before anything changes
+  if (!cut_configuration_.empty() || !model_) return cut(sweep);
+  // A sweep triangle given alone (not by a move of the placed scalpel) meets the body as it is.
+  cut_configuration_ = vec_values(model_->displacement());
+  try {
+    CutReport report = cut(sweep);
+    cut_configuration_.clear();
+    return report;
+  } catch (...) {
+    cut_configuration_.clear();
+    throw;
+  }
+}
+
+CutReport TetrahedralCutter::cut(const SweepTriangle& sweep) {
   const double start = wall_seconds();
   CutReport report;
   report.sweeps = 1;
   report.components = pieces_.pieces();
 
-  // A sweep triangle given alone (not by a move of the placed scalpel) meets the body as it is.
-  const bool alone = cut_configuration_.empty() && model_;
-  if (alone) cut_configuration_ = vec_values(model_->displacement());
-  const auto forget_alone = [&](void*) {
-    if (alone) cut_configuration_.clear();
-  };
-  const std::unique_ptr<void, decltype(forget_alone)> forget(this, forget_alone);
   FaceSelection selection = selector_.select(mesh_.connectivity(), cut_positions(), sweep);
   // Faces selected earlier but left joined by their dissection are cut again with the new ones.
   for (const auto& [f, simplex] : joined_) {
@@ -211,30 +217,13 @@ void TetrahedralCutter::count_pieces(CutReport& report) {
     std::sort(report.piece_elements.rbegin(), report.piece_elements.rend());
   }
   if (!separated || !model_) return;  // a bare mesh has no supports to be free of
-  const int n = pieces_.pieces();
-  auto label = [this](ElementId e) { return pieces_.label(e); };
-  // Held: as many constrained displacement components as rigid motions (what a static solve
-  // needs); a piece with one fixed vertex left on it still turns about that vertex.
-  constexpr std::size_t rigid_motions = 6;
-  std::vector<std::size_t> held_components(n, 0);
-  std::vector<char> counted(mesh_.n_points(), 0);
-  std::vector<ElementId> first(n, no_id);
-  for (ElementId e = 0; e < c.element_capacity(); ++e) {
-    if (!c.is_element(e)) continue;
-    const int piece = label(e);
-    if (first[piece] == no_id) first[piece] = e;
-    for (VertexId v : c.element(e).simplex.vertices())
-      if (!counted[v]) {
-        counted[v] = 1;
-        held_components[piece] += model_->constraints().constrained_components(v);
-      }
-  }
-  for (int piece = 0; piece < n; ++piece) {
-    if (held_components[piece] >= rigid_motions) continue;
+  // Held as a static solve requires it (PieceHolding, the solver's own check): a piece with
+  // one fixed vertex left on it still turns about that vertex.
+  for (const LoosePiece& piece : PieceHolding(mesh_).loose_pieces(model_->constraints())) {
     ++report.free_pieces;
-    if (!options_.fix_free_pieces || !model_) continue;
+    if (!options_.fix_free_pieces) continue;
     // §3.3: fixed on one face, where it is now, so that the static problem stays well posed.
-    const Simplex face = c.element(first[piece]).simplex.subn(0);
+    const Simplex face = c.element(piece.first_cell).simplex.subn(0);
     std::vector<VertexId> vertices(face.vertices().begin(), face.vertices().end());
     std::vector<double> values;
     {
@@ -268,7 +257,7 @@ CutReport TetrahedralCutter::move(std::span<const double> scalpel) {
     for (const auto& triangle : halves) {
       const std::array<const double*, 3> p{triangle.data(), triangle.data() + 3, triangle.data() + 6};
       if (collinear_3d(p[0], p[1], p[2])) continue;  // this half swept no area
-      report.add(cut_triangle(triangle));
+      report.add(cut(SweepTriangle(triangle)));
     }
   }
   scalpel_ = now;

@@ -107,6 +107,8 @@ class TetrahedralCutter : public ConnectivityWatcher {
   void on_change(const Connectivity& connectivity, const ConnectivityChange& change) override;
 
  private:
+  // One sweep triangle against cut_positions(): what cut_triangle and move do.
+  CutReport cut(const SweepTriangle& sweep);
   // Snaps the selected faces' vertices; returns those moved.
   std::vector<VertexId> snap(const FaceSelection& selection, CutReport& report);
   std::vector<VertexId> dissect_selected(std::vector<FaceId> faces, CutReport& report);
