@@ -153,18 +153,24 @@ def test_fix_free_pieces_fixes_the_free_half_where_it_is_and_the_solve_converges
         assert result.converged, result
 
 
-def test_a_box_cut_in_two_with_one_side_fixed_names_the_free_side():
+def box_cut_in_two_held_on_the_left(material):
+    """A 120-cell box dissected at x = 0.6 and fixed at x = 0, under gravity: its right 48 cells are free."""
     mesh = snede.meshing.box((1.0, 0.4, 0.4), (5, 2, 2))
     mesh.dissect(mesh.faces_where(lambda x: np.isclose(x[:, 0], 0.6)))
-    body = snede.Body(mesh, snede.NeoHookean(1e4, 0.3))
+    body = snede.Body(mesh, material)
     body.fix(np.isclose(mesh.points[:, 0], 0.0))
     body.add_gravity((0.0, 0.0, -9.81))
+    return body
+
+
+def test_a_box_cut_in_two_with_one_side_fixed_names_the_free_side():
+    body = box_cut_in_two_held_on_the_left(snede.NeoHookean(1e4, 0.3))
     named = refusal(body, "newton")
     check_named_piece(body, named)
     assert (named["cells"], named["components"], named["needed"]) == (2 * 2 * 2 * 6, 0, 6)
     assert body.mesh.points[named["vertex"], 0] >= 0.6
     # Holding the free side properly (its far end) instead: the solve converges.
-    body.fix(np.isclose(mesh.points[:, 0], 1.0))
+    body.fix(np.isclose(body.mesh.points[:, 0], 1.0))
     result = snede.StaticSolver(body, "newton", rtol=1e-8, options_prefix="free_box_held_").solve()
     assert result.converged, result
 
@@ -239,11 +245,7 @@ def test_a_tetrahedral_cut_that_frees_a_piece_without_fixing_it_is_refused():
 
 def test_a_solve_on_mpi_ranks_refuses_a_free_piece_as_the_serial_one():
     from mpi4py import MPI
-    mesh = snede.meshing.box((1.0, 0.4, 0.4), (5, 2, 2))
-    mesh.dissect(mesh.faces_where(lambda x: np.isclose(x[:, 0], 0.6)))
-    body = snede.Body(mesh, snede.LinearElastic(1e4, 0.3))
-    body.fix(np.isclose(mesh.points[:, 0], 0.0))
-    body.add_gravity()
+    body = box_cut_in_two_held_on_the_left(snede.LinearElastic(1e4, 0.3))
     with pytest.raises(ValueError, match=r"piece 2 of 2 \(48 cells.*fix_free_pieces"):
         snede.StaticSolver(body, "cg", comm=MPI.COMM_WORLD).solve()
     body.fix_free_pieces()
