@@ -1,5 +1,5 @@
 """Mesh generators: structured boxes and rectangles, unstructured solids (gmsh: a cylinder, an
-ellipsoid, a torus, a lumpy organ-like solid), and
+ellipsoid, a torus, a lumpy organ-like solid, the inside of any closed surface), and
 surfaces in 3D for cutting (height fields, the Gaussian bell of Figure 5.19, a folded sheet)."""
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ import math
 
 import numpy as np
 
-from snede import _checks
+from snede import _checks, _geometry, _gmsh
 from snede.mesh import Mesh
 
 
@@ -82,44 +82,31 @@ def _gmsh_tetrahedra(name: str, add_solid, h: float, seed: int | None) -> Mesh:
     """Tetrahedra of the OpenCASCADE solid that ``add_solid(occ)`` adds, meshed by gmsh
     (Delaunay, then optimised) at target edge length ``h``; deterministic for given arguments
     (gmsh's random factor fixed by ``seed`` when given)."""
-    import gmsh
-
-    if seed is not None:
-        seed = _checks.count(seed, "seed", 0)  # gmsh's Mesh.RandomSeed is a C int
-    initialized_here = not gmsh.isInitialized()
-    if initialized_here:
-        # interruptible=False: gmsh would otherwise take over SIGINT for good, and Ctrl-C
-        # would kill the process without a word instead of raising KeyboardInterrupt.
-        gmsh.initialize(readConfigFiles=False, interruptible=False)
-    try:
-        gmsh.option.setNumber("General.Terminal", 0)
-        gmsh.option.setNumber("General.NumThreads", 1)  # deterministic
-        gmsh.model.add(f"snede-{name}")
+    def add(gmsh):
         add_solid(gmsh.model.occ)
         gmsh.model.occ.synchronize()
-        gmsh.option.setNumber("Mesh.MeshSizeMin", h)
-        gmsh.option.setNumber("Mesh.MeshSizeMax", h)
-        gmsh.option.setNumber("Mesh.MeshSizeFromCurvature", 0)
-        gmsh.option.setNumber("Mesh.Algorithm3D", 1)  # Delaunay
-        gmsh.option.setNumber("Mesh.Optimize", 1)
+    return _gmsh_fill(name, add, h, seed)
+
+
+def _gmsh_fill(name: str, add_volume, h: float, seed: int | None) -> Mesh:
+    """Tetrahedra of the volume that ``add_volume(gmsh)`` adds to a new gmsh model (leaving it
+    synchronised), at target edge length ``h``: gmsh's Delaunay mesher, then its optimiser."""
+    if seed is not None:
+        seed = _checks.count(seed, "seed", 0)  # gmsh's Mesh.RandomSeed is a C int
+    with _gmsh.model(f"snede-{name}") as gmsh:
+        add_volume(gmsh)
+        for option, value in (("Mesh.MeshSizeMin", h), ("Mesh.MeshSizeMax", h), ("Mesh.MeshSizeFromCurvature", 0),
+                              ("Mesh.Algorithm3D", 1), ("Mesh.Optimize", 1)):
+            gmsh.option.setNumber(option, value)
         if seed is not None:
             gmsh.option.setNumber("Mesh.RandomSeed", seed)
         gmsh.model.mesh.generate(3)
-        node_tags, coords, _ = gmsh.model.mesh.getNodes()
-        element_types, _, element_nodes = gmsh.model.mesh.getElements(3)
-        gmsh.model.remove()
-    finally:
-        if initialized_here:
-            gmsh.finalize()
-    points = coords.reshape(-1, 3)
-    index_of_tag = np.zeros(int(node_tags.max()) + 1, dtype=np.int64)
-    index_of_tag[node_tags.astype(np.int64)] = np.arange(len(node_tags))
-    tetra = [nodes for kind, nodes in zip(element_types, element_nodes) if kind == 4]
-    if not tetra:
+        points, blocks = _gmsh.elements(gmsh, 3)
+    tetrahedra = [cells for kind, cells in blocks if kind == "tetra"]
+    if not tetrahedra:
         raise RuntimeError(f"gmsh produced no tetrahedra for the {name}")
-    cells = index_of_tag[np.concatenate(tetra).astype(np.int64)].reshape(-1, 4)
     # gmsh lists nodes that are not in any tetrahedron (geometry points); keep only used ones.
-    used, cells = np.unique(cells, return_inverse=True)
+    used, cells = np.unique(np.concatenate(tetrahedra), return_inverse=True)
     return Mesh(points[used], cells.reshape(-1, 4))
 
 
@@ -174,6 +161,62 @@ def lumpy(radius=0.04, lumps: int = 6, h=0.01, seed: int = 0) -> Mesh:
         if others:
             occ.fuse(body, others)
     return _gmsh_tetrahedra("lumpy", add, h, seed)
+
+
+def _where(point) -> str:
+    return "(" + ", ".join(f"{float(x):.4g}" for x in point) + ")"
+
+
+def tetrahedralize(surface, size: float, *, remesh: bool = True, seed: int | None = None) -> Mesh:
+    """Tetrahedra filling a closed triangle surface: ``surface`` is a surface ``Mesh`` (triangles
+    in 3D) or a file ``Mesh.read`` reads as one (STL, OBJ, OFF, PLY, VTK, ...). gmsh fills it
+    (Delaunay, then optimised) with edges of about ``size``. With ``remesh`` (default) gmsh first
+    remeshes the surface at ``size`` on its own triangles (in patches split at creases sharper
+    than 40°, which stay sharp); ``remesh=False`` keeps the surface's triangles as the boundary
+    of the result. ``seed`` fixes gmsh's random factor.
+
+    A ValueError names what stops it: a mesh that is no surface, a surface that is open (with
+    one of its boundary edges), in several pieces, or that crosses itself (with a pair of
+    crossing triangles and where they are), or else gmsh's own error."""
+    if not isinstance(surface, Mesh):
+        surface = Mesh.read(surface)
+    _positive(size=size)
+    if not surface.is_surface:
+        raise ValueError(f"tetrahedralize fills a closed surface (triangles in 3D), got {surface!r}"
+                         + (": its boundary is meshing.boundary_surface(mesh)[0]" if surface.cell_dim == 3 else ""))
+    points, triangles = surface.points, surface.cells
+    edges = surface.boundary_faces()
+    if len(edges):
+        a, b = edges[0]
+        raise ValueError(f"the surface is open: {len(edges)} edges belong to one triangle only, e.g. the edge from "
+                         f"vertex {a} at {_where(points[a])} to vertex {b} at {_where(points[b])}; tetrahedralize "
+                         "needs a closed surface")
+    pieces = surface.connected_components()[0]
+    if pieces > 1:
+        raise ValueError(f"the surface is in {pieces} separate pieces; tetrahedralize fills one closed surface: "
+                         "pass each piece alone")
+
+    def add(gmsh):
+        entity = gmsh.model.addDiscreteEntity(2)
+        gmsh.model.mesh.addNodes(2, entity, np.arange(1, len(points) + 1), points.ravel())
+        gmsh.model.mesh.addElementsByType(entity, 2, [], (triangles + 1).ravel())
+        if remesh:
+            gmsh.model.mesh.classifySurfaces(math.radians(40), True, True, math.pi)
+            gmsh.model.mesh.createGeometry()
+        gmsh.model.geo.addVolume([gmsh.model.geo.addSurfaceLoop([tag for _, tag in gmsh.model.getEntities(2)])])
+        gmsh.model.geo.synchronize()
+
+    try:
+        return _gmsh_fill("surface", add, size, seed)
+    except Exception as error:  # gmsh raises plain Exceptions
+        crossing = _geometry.crossing_triangles(points, triangles)
+        if len(crossing):
+            i, j = crossing[0]
+            raise ValueError(f"the surface crosses itself: {len(crossing)} pairs of triangles cross, e.g. triangles "
+                             f"{i} {triangles[i].tolist()} and {j} {triangles[j].tolist()} near "
+                             f"{_where(points[triangles[i]].mean(axis=0))} (gmsh: {error})") from None
+        hint = "; the surface itself does not cross itself: with remesh=True try another size or remesh=False"
+        raise ValueError(f"gmsh could not fill the surface: {error}" + (hint if remesh else "")) from None
 
 
 def lifted(sheet: Mesh, to_space) -> Mesh:

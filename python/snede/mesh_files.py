@@ -1,0 +1,204 @@
+"""Reading mesh files for ``Mesh.read``: meshio's reader for the file's suffix first, then gmsh's
+own reader for what meshio cannot read (gmsh format 1, binary VTK, ...), and a reader of VTK
+legacy POLYDATA surfaces, which neither reads. Every reader gives ``(points, blocks)``: (n, 2|3)
+points and {meshio cell type: (m, corners) vertex indices}, quads and polygons split into
+triangles."""
+from __future__ import annotations
+
+import contextlib
+import io
+from pathlib import Path
+
+import numpy as np
+
+from snede import _gmsh
+
+#: meshio's format for each suffix Mesh.read knows by name
+MESHIO_FORMATS = {".msh": "gmsh", ".vtk": "vtk", ".vtu": "vtu", ".mesh": "medit", ".meshb": "medit", ".stl": "stl",
+                  ".obj": "obj", ".off": "off", ".ply": "ply", ".xdmf": "xdmf", ".xmf": "xdmf"}
+#: suffixes gmsh's own reader is tried on when meshio fails
+GMSH_SUFFIXES = (".msh", ".vtk", ".stl", ".mesh", ".off")
+
+
+def read_blocks(path: Path) -> tuple[np.ndarray, dict[str, np.ndarray]]:
+    """The points and cell blocks of the first reader that reads ``path``; a ValueError naming
+    the file and why each reader failed if none does. OSError (permissions, a folder) passes."""
+    reasons = []
+    for name, reader in _readers(path):
+        try:
+            points, blocks = reader(path)
+        except OSError:
+            raise
+        except Exception as error:  # meshio's parsers fail in many ways
+            reasons.append(f"{name}: {_reason(error)}")
+            continue
+        if len(points):
+            return points, blocks
+        reasons.append(f"{name}: no points in it")
+    raise ValueError(f"{path}: could not read this file as a mesh ({'; '.join(reasons)})")
+
+
+def _reason(error: BaseException) -> str:
+    return f"{type(error).__name__}: {error}" if type(error).__name__ not in ("ValueError", "ReadError") else str(error)
+
+
+def _readers(path: Path) -> list:
+    suffix = path.suffix.lower()
+    head = path.read_bytes()[:256] if path.is_file() else b""
+    readers = [("meshio", _meshio_reader(MESHIO_FORMATS.get(suffix)))]
+    if suffix == ".vtk" and head.lstrip().startswith(b"<"):  # an XML (VTU) file named .vtk
+        readers.append(("meshio as VTU", _meshio_reader("vtu")))
+    if suffix == ".vtk" and b"POLYDATA" in head.upper():
+        readers.append(("VTK POLYDATA", read_vtk_polydata))
+    if suffix in GMSH_SUFFIXES:
+        readers.append(("gmsh", read_with_gmsh))
+    return readers
+
+
+def _meshio_reader(file_format: str | None):
+    def read(path: Path):
+        import meshio
+
+        # meshio prints why its readers failed (and rich warnings), then calls sys.exit: keep
+        # the noise out, and give what it printed last as the reason.
+        printed = io.StringIO()
+        try:
+            with contextlib.redirect_stdout(printed), contextlib.redirect_stderr(io.StringIO()):
+                data = meshio.read(str(path), file_format=file_format)
+        except SystemExit:
+            lines = printed.getvalue().strip().splitlines()
+            raise ValueError(lines[-1] if lines else "could not parse it") from None
+        return np.asarray(data.points), collect((block.type, block.data) for block in data.cells)
+    return read
+
+
+def read_with_gmsh(path: Path):
+    """gmsh's own reader (``gmsh.merge``): every format gmsh reads, gmsh's .msh 1, 2 and 4 among them."""
+    with _gmsh.model("snede-read") as gmsh:
+        try:
+            gmsh.merge(str(path))
+        except Exception as error:
+            raise ValueError("; ".join(_gmsh.errors(gmsh)) or str(error)) from None
+        points, blocks = _gmsh.elements(gmsh)
+    return points, collect(blocks)
+
+
+# -- VTK legacy POLYDATA ------------------------------------------------------------------------
+_VTK_TYPES = {"float": "f4", "double": "f8", "int": "i4", "unsigned_int": "u4", "long": "i8", "unsigned_long": "u8",
+              "vtktypeint32": "i4", "vtktypeint64": "i8", "short": "i2", "unsigned_short": "u2"}
+
+
+class _Words:
+    """The words of a VTK legacy file after its header, and its arrays (text, or big-endian binary
+    data starting on the line after the word before them)."""
+
+    def __init__(self, data: bytes, start: int, binary: bool):
+        self.data, self.position, self.binary = data, start, binary
+
+    def next(self) -> str | None:
+        data, n = self.data, len(self.data)
+        while self.position < n and data[self.position:self.position + 1].isspace():
+            self.position += 1
+        if self.position == n:
+            return None
+        end = self.position
+        while end < n and not data[end:end + 1].isspace():
+            end += 1
+        word, self.position = data[self.position:end].decode("ascii", "replace"), end
+        return word
+
+    def peek(self) -> str | None:
+        position = self.position
+        word = self.next()
+        self.position = position
+        return word
+
+    def array(self, count: int, vtk_type: str) -> np.ndarray:
+        code = _VTK_TYPES.get(vtk_type.lower())
+        if code is None:
+            raise ValueError(f"unknown VTK data type {vtk_type!r}")
+        if self.binary:
+            self.position = self.data.index(b"\n", self.position) + 1
+            values = np.frombuffer(self.data, dtype=">" + code, count=count, offset=self.position)
+            self.position += count * values.itemsize
+            return values.astype(code)
+        values = [self.next() for _ in range(count)]
+        if None in values:
+            raise ValueError(f"the file ends inside an array of {count} values")
+        return np.array(values, dtype=code)
+
+
+def read_vtk_polydata(path: Path):
+    """A VTK legacy file of ``DATASET POLYDATA`` (ASCII or binary, VTK 2 to 5.1 layouts): its
+    points and the triangles of its polygons (split into fans) and triangle strips."""
+    data = path.read_bytes()
+    lines = data.split(b"\n", 4)
+    if len(lines) < 5 or not lines[0].startswith(b"# vtk DataFile"):
+        raise ValueError("no '# vtk DataFile' header")
+    encoding, dataset = lines[2].strip().upper(), lines[3].split()
+    if encoding not in (b"ASCII", b"BINARY") or dataset[1:2] != [b"POLYDATA"]:
+        raise ValueError(f"not an ASCII or BINARY POLYDATA file ({lines[2].strip()!r}, {lines[3].strip()!r})")
+    words = _Words(data, len(data) - len(lines[4]), encoding == b"BINARY")
+    points, polygons = None, []
+    while (key := words.next()) is not None and key.upper() not in ("POINT_DATA", "CELL_DATA"):
+        key = key.upper()
+        if key == "POINTS":
+            n = int(words.next())
+            points = words.array(3 * n, words.next()).reshape(n, 3)
+        elif key in ("VERTICES", "LINES", "POLYGONS", "TRIANGLE_STRIPS"):
+            cells = _vtk_cells(words, int(words.next()), int(words.next()))
+            if key == "POLYGONS":
+                polygons += [("polygon", cell[None]) for cell in cells if len(cell) >= 3]
+            elif key == "TRIANGLE_STRIPS":
+                polygons += [("triangle", _strip(cell)) for cell in cells if len(cell) >= 3]
+        # other words (a METADATA section's entries) are passed over up to the next section
+    if points is None:
+        raise ValueError("no POINTS section")
+    return points, collect(polygons)
+
+
+def _vtk_cells(words: _Words, first: int, second: int) -> list[np.ndarray]:
+    """The cells of a VERTICES/LINES/POLYGONS/TRIANGLE_STRIPS section, whose header gave ``first``
+    and ``second``: (cells, total size) with each cell's vertex count first (VTK < 5.1), or
+    (offsets, connectivity) followed by OFFSETS and CONNECTIVITY arrays (VTK 5.1)."""
+    if words.peek() == "OFFSETS":
+        words.next()
+        offsets = words.array(first, words.next()).astype(np.int64)
+        if words.next() != "CONNECTIVITY":
+            raise ValueError("OFFSETS without CONNECTIVITY")
+        connectivity = words.array(second, words.next()).astype(np.int64)
+        return np.split(connectivity, offsets[1:-1])
+    flat = words.array(second, "int").astype(np.int64)
+    cells, position = [], 0
+    for _ in range(first):
+        count = int(flat[position]) if position < second else -1
+        if not 0 <= count < second - position:
+            raise ValueError(f"the cells' sizes run past the section's {second} values: the file is damaged")
+        cells.append(flat[position + 1:position + 1 + count])
+        position += count + 1
+    if position != second:
+        raise ValueError(f"cell sizes add up to {position}, the section says {second}")
+    return cells
+
+
+def _strip(strip: np.ndarray) -> np.ndarray:
+    """A triangle strip's triangles, every second one turned so that all share one orientation."""
+    k = np.arange(len(strip) - 2)
+    triangles = np.c_[strip[k], strip[k + 1], strip[k + 2]]
+    triangles[1::2] = triangles[1::2][:, [1, 0, 2]]
+    return triangles
+
+
+def collect(blocks) -> dict[str, np.ndarray]:
+    """{cell type: (m, corners) vertex indices} from (cell type, cells) pairs, blocks of one type
+    joined; quads and polygons (``"polygon"``, rows of k ≥ 3 vertices) become triangles, each a
+    fan (0, j, j + 1) from its first vertex."""
+    joined: dict[str, list[np.ndarray]] = {}
+    for kind, cells in blocks:
+        cells = np.asarray(cells, dtype=np.int64)
+        if kind in ("quad", "polygon"):
+            j = np.arange(1, cells.shape[1] - 1)
+            kind, cells = "triangle", np.stack([np.repeat(cells[:, :1], len(j), 1), cells[:, j], cells[:, j + 1]],
+                                               axis=-1).reshape(-1, 3)
+        joined.setdefault(kind, []).append(cells)
+    return {kind: np.concatenate(parts) for kind, parts in joined.items()}
