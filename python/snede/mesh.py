@@ -204,7 +204,10 @@ class Mesh(MeshEdits):
 
     # -- aiming (where a needle or a blade meets the body) -------------------------------
     def _vector(self, value, name: str) -> np.ndarray:
-        vector = np.asarray(value, dtype=np.float64)
+        try:
+            vector = np.asarray(value, dtype=np.float64)
+        except (TypeError, ValueError):
+            vector = np.full(0, np.nan)
         if vector.shape != (self.dim,) or not np.all(np.isfinite(vector)):
             raise ValueError(f"{name} must be {self.dim} finite numbers for this {self.dim}-D mesh, got {value!r}")
         return vector
@@ -348,8 +351,9 @@ class Mesh(MeshEdits):
                                  f"target_cells={target_cells!r})")
             target_cells = _checks.count(target_cells, "target_cells", 1)
             split = 0
-            while self.n_cells < target_cells:
-                split += self.refine_uniform(1)
+            with self.batch():  # watchers (a Body) hear of all the levels at once
+                while self.n_cells < target_cells:
+                    split += self.refine_uniform(1)
             return split
         levels = 1 if levels is None else levels
         cells = max(self.n_cells, 1)
