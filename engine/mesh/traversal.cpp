@@ -1,6 +1,7 @@
 #include "mesh/traversal.hpp"
 
 #include <algorithm>
+#include <numeric>
 #include <stdexcept>
 #include <unordered_set>
 
@@ -86,6 +87,25 @@ std::vector<FaceId> boundary_faces(const Connectivity& c) {
   faces.reserve(entries.size());
   for (const auto& entry : entries) faces.push_back(entry.second);
   return faces;
+}
+
+VertexStars all_vertex_stars(const Connectivity& c, VertexId n_points) {
+  VertexStars stars;
+  stars.elements = c.element_ids();
+  stars.vertices.resize(stars.elements.size());
+  stars.start.assign(static_cast<std::size_t>(n_points) + 1, 0);
+  const int corners = c.dim() + 1;
+  for (std::size_t k = 0; k < stars.elements.size(); ++k) {
+    stars.vertices[k] = c.element(stars.elements[k]).simplex.oriented_vertices();
+    for (int a = 0; a < corners; ++a) ++stars.start[stars.vertices[k][a] + 1];
+  }
+  std::partial_sum(stars.start.begin(), stars.start.end(), stars.start.begin());
+  stars.entries.resize(stars.start.back());
+  std::vector<std::size_t> fill(stars.start.begin(), stars.start.end() - 1);
+  for (std::size_t k = 0; k < stars.elements.size(); ++k)
+    for (int a = 0; a < corners; ++a)
+      stars.entries[fill[stars.vertices[k][a]]++] = static_cast<std::uint32_t>(k << 2) | static_cast<std::uint32_t>(a);
+  return stars;
 }
 
 std::pair<std::vector<int>, int> connected_components(const Connectivity& c) {

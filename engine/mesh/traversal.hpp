@@ -2,6 +2,8 @@
 // and of any simplex, boundary faces, connected components.
 #pragma once
 
+#include <array>
+#include <cstdint>
 #include <vector>
 
 #include "mesh/connectivity.hpp"
@@ -22,6 +24,18 @@ std::vector<ElementId> elements_around(const Connectivity& c, const Simplex& s, 
 // faces that contain v (the (v, ∅)-connected part); without one, every element containing v,
 // found by a scan (O(n)). Empty if no element contains v.
 std::vector<ElementId> vertex_star(const Connectivity& c, VertexId v, ElementId start = no_id);
+
+// Every vertex's star at once, as one flat array (CSR) — what whole-mesh loops over vertex
+// neighbourhoods (assembled matrices' sparsity, coarse spaces) rebuild after every edit.
+struct VertexStars {
+  std::vector<ElementId> elements;                               // live elements, by id
+  std::vector<std::array<VertexId, max_dimension + 1>> vertices;  // per element: oriented vertices
+  std::vector<std::size_t> start;                                // per vertex id: its first entry
+  std::vector<std::uint32_t> entries;                            // (element index << 2) | corner
+  std::size_t element_of(std::uint32_t entry) const { return entry >> 2; }
+  int corner_of(std::uint32_t entry) const { return static_cast<int>(entry & 3u); }
+};
+VertexStars all_vertex_stars(const Connectivity& c, VertexId n_points);
 
 // Face ids of the boundary faces, sorted by their simplex (deterministic order).
 std::vector<FaceId> boundary_faces(const Connectivity& c);

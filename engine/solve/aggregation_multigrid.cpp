@@ -7,6 +7,7 @@
 #include <numeric>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 #include "core/error.hpp"
 #include "solve/coarse_basis.hpp"
@@ -367,7 +368,7 @@ std::vector<std::size_t> AggregationMultigrid::level_unknowns() const {
 void AggregationMultigrid::configure(PC pc, const SolverOptions& options, const std::vector<double>&) {
   std::vector<Mat> interpolations;
   for (const Level& level : coarse_) interpolations.push_back(level.interpolation);
-  configure_galerkin_levels(pc, interpolations, options);
+  configure_levels(pc, std::move(interpolations), options);
 }
 
 }  // namespace snede

@@ -311,7 +311,7 @@ void BisectionMultigrid::configure(PC pc, const SolverOptions& options, const st
   SNEDE_PETSC(KSPSetOperators(coarse, coarse_[0]->model->tangent(), coarsest_matrix_->mat()));
 }
 
-void BisectionMultigrid::update(Vec u) {
+void BisectionMultigrid::update(Vec u, Mat) {
   const int d = fine_.dim();
   ReadView fine_state(u);
   for (const auto& level : coarse_) {

@@ -57,7 +57,7 @@ class BisectionMultigrid final : public Multigrid {
   void configure(PC pc, const SolverOptions& options, const std::vector<double>& smoother_bounds = {}) override;
   // Linearises every coarse level at u (the fine state, injected) with the fine model's
   // operator scale, and refills the coarsest level's matrix.
-  void update(Vec u) override;
+  void update(Vec u, Mat assembled_tangent) override;
 
  private:
   struct Level;

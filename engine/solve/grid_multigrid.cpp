@@ -4,10 +4,12 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <span>
 #include <stdexcept>
 #include <string>
 
 #include "core/error.hpp"
+#include "mesh/traversal.hpp"
 #include "solve/coarse_basis.hpp"
 
 namespace snede {
@@ -96,20 +98,26 @@ GridMultigrid::GridMultigrid(Model& fine, double grid_width)
   // Virtual nodes: (vertex, slot) pairs on the same grid node are one copy of it when a fine
   // edge joins them, so that each copy spans one connected piece of the node's fine vertices.
   DisjointSets copies(n * slots);
-  const std::vector<VertexId> cells = mesh.cells();
-  const int nv = mesh.cell_dim() + 1;
   auto uses = [&](VertexId v, int s) { return weights[v].node[s] >= 0 && weights[v].weight[s] > negligible_weight; };
-  for (std::size_t c = 0; c < cells.size(); c += nv)
-    for (int a = 0; a < nv; ++a)
-      for (int b = a + 1; b < nv; ++b) {
-        const VertexId i = cells[c + a], j = cells[c + b];
-        for (int s = 0; s < slots; ++s) {
-          if (!uses(i, s)) continue;
-          for (int t = 0; t < slots; ++t)
-            if (uses(j, t) && weights[i].node[s] == weights[j].node[t])
-              copies.unite(static_cast<std::int32_t>(i * slots + s), static_cast<std::int32_t>(j * slots + t));
+  auto join = [&](VertexId i, VertexId j) {
+    for (int s = 0; s < slots; ++s) {
+      if (!uses(i, s)) continue;
+      for (int t = 0; t < slots; ++t)
+        if (uses(j, t) && weights[i].node[s] == weights[j].node[t])
+          copies.unite(static_cast<std::int32_t>(i * slots + s), static_cast<std::int32_t>(j * slots + t));
+    }
+  };
+  // Each edge once (from its lower end), found in the vertex stars: an edge lies in about five
+  // tetrahedra, and this runs after every edit.
+  const VertexStars stars = all_vertex_stars(mesh.connectivity(), mesh.n_points());
+  std::vector<VertexId> last_seen_from(n, no_id);
+  for (VertexId i = 0; i < mesh.n_points(); ++i)
+    for (std::size_t e = stars.start[i]; e < stars.start[i + 1]; ++e)
+      for (VertexId j : std::span(stars.vertices[stars.element_of(stars.entries[e])]).first(slots))
+        if (j > i && last_seen_from[j] != i) {
+          last_seen_from[j] = i;
+          join(i, j);
         }
-      }
   // Members of each copy, in vertex order.
   std::vector<std::int32_t> copy_of(n * slots, -1);
   std::vector<std::size_t> count;
@@ -190,7 +198,7 @@ std::vector<std::size_t> GridMultigrid::level_unknowns() const {
 }
 
 void GridMultigrid::configure(PC pc, const SolverOptions& options, const std::vector<double>&) {
-  configure_galerkin_levels(pc, {interpolation_.get()}, options);
+  configure_levels(pc, {interpolation_.get()}, options);
 }
 
 }  // namespace snede

@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "core/petsc_handle.hpp"
 #include "core/solver_options.hpp"
 #include "solve/model.hpp"
 
@@ -41,9 +42,10 @@ class Multigrid {
   // Makes `pc` a PCMG over these levels. `smoother_bounds`: Chebyshev's largest eigenvalue per
   // smoothed level (finest last) from an earlier set-up with as many levels; empty: estimate.
   virtual void configure(PC pc, const SolverOptions& options, const std::vector<double>& smoother_bounds) = 0;
-  // Relinearises matrix-free levels at the fine state u (a no-op for Galerkin levels, which
-  // PCMG recomputes from the refilled fine matrix).
-  virtual void update(Vec u) = 0;
+  // Relinearises the levels at the fine state u, after `assembled_tangent` (null for levels
+  // that do not need it) was filled at u: matrix-free levels take the state, Galerkin levels
+  // recompute their products with the matrix.
+  virtual void update(Vec u, Mat assembled_tangent) = 0;
 };
 
 // Levels of any mesh (grid_multigrid.hpp, aggregation_multigrid.hpp) whose coarse operators are
@@ -55,15 +57,26 @@ class GalerkinMultigrid : public Multigrid {
   bool matches_mesh(const Model& fine) const override;
   bool follow_constraints() override { return false; }
   bool needs_assembled_tangent() const override { return true; }
-  void update(Vec) override {}
+  // Recomputes R A P level by level from the refilled fine matrix (numeric only while the
+  // matrices are those of the first call: the mesh has not changed).
+  void update(Vec u, Mat assembled_tangent) override;
 
  protected:
   explicit GalerkinMultigrid(Model& fine);
+  // Makes `pc` a PCMG over `interpolations` (each level to the next finer one, coarsest first,
+  // owned by the subclass): Chebyshev/Jacobi smoothers that estimate their bounds (the levels of
+  // a changing mesh are rebuilt after every edit, and a cut's slivers change the spectrum), LU
+  // on the coarsest level, and coarse operators from update().
+  void configure_levels(PC pc, std::vector<Mat> interpolations, const SolverOptions& options);
   Model& fine_;
 
  private:
   std::uint64_t revision_;
   std::uint64_t constraints_;
+  PC pc_ = nullptr;                      // the PCMG of the last configure_levels (owned by its KSP)
+  std::vector<Mat> interpolations_;      // coarsest first
+  Mat fine_matrix_ = nullptr;            // the fine matrix the products were made with
+  std::vector<MatHandle> coarse_;        // R A P per coarse level, finest coarse level first
 };
 
 // Chebyshev/Jacobi on one smoothed level: with `largest_bound` > 0 the bounds are fixed from
@@ -74,11 +87,5 @@ void set_chebyshev_jacobi_smoother(KSP smoother, const SolverOptions& options, d
 std::vector<double> chebyshev_estimates(PC pc);
 // The coarsest level's solve: a direct factorisation of its assembled matrix.
 void set_direct_coarse_solve(PC pc, const SolverOptions& options);
-// Makes `pc` a PCMG with Galerkin coarse operators R A P from the PC's assembled matrix
-// (recomputed whenever it is refilled): `interpolations` from each level to the next finer one,
-// coarsest first; Chebyshev/Jacobi smoothers that estimate their bounds (the levels of a
-// changing mesh are rebuilt after every edit, and a cut's slivers change the spectrum); LU on
-// the coarsest level.
-void configure_galerkin_levels(PC pc, const std::vector<Mat>& interpolations, const SolverOptions& options);
 
 }  // namespace snede

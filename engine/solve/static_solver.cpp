@@ -398,7 +398,7 @@ void StaticSolver::refill_preconditioner(SNES snes, Vec x) {
   const bool lagged = (lag == -1 || (lag > 1 && iteration % lag != 0)) && preconditioner_filled_;
   if (lagged) return;
   if (assembled_) assembled_->assemble(model_, x);
-  if (multigrid_) multigrid_->update(x);
+  if (multigrid_) multigrid_->update(x, assembled_ ? assembled_->mat() : nullptr);
   preconditioner_filled_ = true;
 }
 
@@ -451,7 +451,7 @@ SolveResult StaticSolver::solve_linear() {
   SNEDE_PETSC(VecSet(step, 0.0));
   const ScaledOperator scaled(model_, system_scale_);
   if (needs_matrix_) assembled_->assemble(model_, u);
-  if (multigrid_) multigrid_->update(u);
+  if (multigrid_) multigrid_->update(u, assembled_ ? assembled_->mat() : nullptr);
   SNEDE_PETSC(KSPSolve(ksp_, rhs, step));
   SNEDE_PETSC(VecAXPY(u, 1.0, step));
   KSPConvergedReason reason;

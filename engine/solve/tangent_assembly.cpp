@@ -8,6 +8,7 @@
 
 #include "core/error.hpp"
 #include "core/petsc_util.hpp"
+#include "mesh/traversal.hpp"
 
 namespace snede {
 namespace {
@@ -83,51 +84,43 @@ AssembledTangent::AssembledTangent(const Model& model, MatrixFormat format)
   const Connectivity& c = mesh.connectivity();
   const int d = model.dim();
   const VertexId n = mesh.n_points();
-  // Each vertex's neighbours (itself included), sorted, in one flat array (CSR): a cut or a
-  // refinement rebuilds this for every solve that follows, so no per-vertex allocations.
-  const std::vector<ElementId> elements = mesh.cell_ids();
-  std::vector<std::size_t> start(static_cast<std::size_t>(n) + 1, 0);
-  for (VertexId v = 0; v < n; ++v) start[v + 1] = 1;
-  for (ElementId e : elements) {
-    const auto vertices = c.element(e).simplex.oriented_vertices();
-    for (int a = 0; a <= d; ++a) start[vertices[a] + 1] += d;
-  }
-  std::partial_sum(start.begin(), start.end(), start.begin());
-  std::vector<VertexId> listed(start.back());
-  std::vector<std::size_t> fill(start.begin(), start.end() - 1);
-  for (VertexId v = 0; v < n; ++v) listed[fill[v]++] = v;
-  for (ElementId e : elements) {
-    const auto vertices = c.element(e).simplex.oriented_vertices();
-    for (int a = 0; a <= d; ++a)
-      for (int b = 0; b <= d; ++b)
-        if (a != b) listed[fill[vertices[a]]++] = vertices[b];
-  }
-  std::vector<std::size_t> row(static_cast<std::size_t>(n) + 1, 0);  // compacted offsets
+  // Each vertex's neighbours (itself included), sorted, in one flat array (CSR), and every
+  // element block's place among them: a cut or a refinement rebuilds this for every solve that
+  // follows, so it is made vertex by vertex from the elements around each (one small sort per
+  // vertex, a scratch array for the places) rather than by searching sorted lists.
+  const VertexStars stars = all_vertex_stars(c, n);
+  const int corners = d + 1;
+  std::vector<std::size_t> row(static_cast<std::size_t>(n) + 1, 0);
   std::vector<VertexId> neighbour_list;
-  neighbour_list.reserve(listed.size());
+  neighbour_list.reserve(stars.entries.size() * 2 + n);
+  std::vector<std::int32_t> place(n, -1);
+  block_rank_.assign(static_cast<std::size_t>(c.element_capacity()) * corners * corners, 0);
+  self_rank_.resize(n);
   for (VertexId v = 0; v < n; ++v) {
-    const auto first = listed.begin() + static_cast<std::ptrdiff_t>(start[v]);
-    const auto last = listed.begin() + static_cast<std::ptrdiff_t>(start[v + 1]);
-    std::sort(first, last);
-    neighbour_list.insert(neighbour_list.end(), first, std::unique(first, last));
+    const std::size_t first = neighbour_list.size();
+    neighbour_list.push_back(v);
+    place[v] = 0;
+    for (std::size_t s = stars.start[v]; s < stars.start[v + 1]; ++s)
+      for (VertexId w : std::span(stars.vertices[stars.element_of(stars.entries[s])]).first(corners))
+        if (place[w] < 0) {
+          place[w] = 0;
+          neighbour_list.push_back(w);
+        }
+    std::sort(neighbour_list.begin() + static_cast<std::ptrdiff_t>(first), neighbour_list.end());
+    for (std::size_t k = first; k < neighbour_list.size(); ++k) place[neighbour_list[k]] = static_cast<std::int32_t>(k - first);
+    self_rank_[v] = place[v];
+    for (std::size_t s = stars.start[v]; s < stars.start[v + 1]; ++s) {
+      const std::size_t k = stars.element_of(stars.entries[s]);
+      const int a = stars.corner_of(stars.entries[s]);
+      std::int32_t* ranks = block_rank_.data() + (static_cast<std::size_t>(stars.elements[k]) * corners + a) * corners;
+      for (int b = 0; b < corners; ++b) ranks[b] = place[stars.vertices[k][b]];
+    }
+    for (std::size_t k = first; k < neighbour_list.size(); ++k) place[neighbour_list[k]] = -1;
     row[v + 1] = neighbour_list.size();
   }
   auto neighbours = [&](VertexId v) {
     return std::span<const VertexId>(neighbour_list.data() + row[v], row[v + 1] - row[v]);
   };
-  auto rank = [&](VertexId a, VertexId b) {
-    const std::span<const VertexId> list = neighbours(a);
-    return static_cast<std::int32_t>(std::lower_bound(list.begin(), list.end(), b) - list.begin());
-  };
-  block_rank_.assign(static_cast<std::size_t>(c.element_capacity()) * (d + 1) * (d + 1), 0);
-  for (ElementId e : elements) {
-    const auto vertices = c.element(e).simplex.oriented_vertices();
-    for (int a = 0; a <= d; ++a)
-      for (int b = 0; b <= d; ++b)
-        block_rank_[(static_cast<std::size_t>(e) * (d + 1) + a) * (d + 1) + b] = rank(vertices[a], vertices[b]);
-  }
-  self_rank_.resize(n);
-  for (VertexId v = 0; v < n; ++v) self_rank_[v] = rank(v, v);
 
   const PetscInt rows = static_cast<PetscInt>(n) * d;
   SNEDE_PETSC(MatCreate(PETSC_COMM_SELF, A_.out()));
