@@ -1,0 +1,75 @@
+"""pyproject.toml declares every package snede imports at run time (issue 34 item 7) — an import
+guarded by ``except ImportError`` in an optional extra — and tools/requirements.txt, which `make
+setup` installs (snede itself with --no-deps), pins every required one."""
+import ast
+import importlib.metadata
+import re
+import sys
+import tomllib
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[2]
+#: declared without an import of their own: why
+INDIRECT = {"pillow": "matplotlib's PillowWriter writes the GIFs (snede.plotting.save_animation)"}
+
+
+def name(requirement: str) -> str:
+    return re.split(r"[\s<>=!~;\[]", requirement, maxsplit=1)[0].lower().replace("_", "-")
+
+
+def project():
+    return tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]
+
+
+def declared() -> set[str]:
+    return {name(r) for r in project()["dependencies"]}
+
+
+def optional() -> set[str]:
+    return {name(r) for extra in project().get("optional-dependencies", {}).values() for r in extra}
+
+
+def imports(node) -> set[str]:
+    if isinstance(node, ast.Import):
+        return {alias.name.split(".")[0] for alias in node.names}
+    if isinstance(node, ast.ImportFrom) and node.level == 0:
+        return {node.module.split(".")[0]}
+    return set()
+
+
+def imported_modules() -> tuple[set[str], set[str]]:
+    """Top-level modules imported anywhere in python/snede (inside functions too), not the
+    standard library's nor snede's own: (required, guarded by ``except ImportError``)."""
+    required, guarded = set(), set()
+    for path in (ROOT / "python" / "snede").rglob("*.py"):
+        for node in ast.walk(ast.parse(path.read_text())):
+            required |= imports(node)
+            if isinstance(node, ast.Try) and any("ImportError" in ast.dump(h.type) for h in node.handlers if h.type):
+                guarded |= set().union(*(imports(n) for statement in node.body for n in ast.walk(statement)))
+    own = set(sys.stdlib_module_names) | {"snede", "_snede", "__future__"}
+    return required - guarded - own, guarded - own
+
+
+def owners(module: str) -> set[str]:
+    return {d.lower().replace("_", "-") for d in importlib.metadata.packages_distributions().get(module, [module])}
+
+
+def test_every_imported_package_is_declared():
+    required, guarded = imported_modules()
+    missing = {m: sorted(owners(m)) for m in required if not owners(m) & declared()}
+    assert not missing, f"imported but not in pyproject.toml's dependencies: {missing}"
+    missing = {m: sorted(owners(m)) for m in guarded if not owners(m) & (declared() | optional())}
+    assert not missing, f"imported where present but in no optional extra: {missing}"
+    assert {"matplotlib", "pillow", "gmsh", "meshio", "h5py"} <= declared() and "triangle" in optional()
+
+
+def test_every_declared_package_is_used():
+    required, guarded = imported_modules()
+    used = set().union(*map(owners, required | guarded))
+    assert (declared() | optional()) - used - set(INDIRECT) == set()
+
+
+def test_make_setup_installs_every_declared_package():
+    pinned = {name(line) for line in (ROOT / "tools" / "requirements.txt").read_text().splitlines()
+              if line.strip() and not line.startswith("#")}
+    assert declared() <= pinned
