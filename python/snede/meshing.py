@@ -217,8 +217,9 @@ def tetrahedralize(surface, size: float, *, remesh: bool = True, seed: int | Non
             raise ValueError(f"the surface crosses itself: {len(crossing)} pairs of triangles cross, e.g. triangles "
                              f"{i} {triangles[i].tolist()} and {j} {triangles[j].tolist()} near "
                              f"{_where(points[triangles[i]].mean(axis=0))} (gmsh: {error})") from None
-        hint = "; the surface itself does not cross itself: with remesh=True try another size or remesh=False"
-        raise ValueError(f"gmsh could not fill the surface: {error}" + (hint if remesh else "")) from None
+        hint = "; the remeshed one may: try another size, or remesh=False" if remesh else ""
+        raise ValueError(f"gmsh could not fill the surface: {error}; no two of its triangles cross (touching ones "
+                         f"are not looked for){hint}") from None
 
 
 def lifted(sheet: Mesh, to_space) -> Mesh:

@@ -9,6 +9,7 @@ import meshio
 import numpy as np
 import pytest
 from closed_surfaces import box_surface, corner_sets, enclosed_volume, icosphere, torus_surface
+from expected_errors import refused
 
 import snede
 from snede import _geometry
@@ -93,19 +94,14 @@ def test_the_same_seed_gives_the_same_mesh():
 
 
 # -- what stops it ------------------------------------------------------------------------------
-def refused(surface, size, *fragments):
-    with pytest.raises(ValueError) as info:
-        tetrahedralize(surface, size)
-    message = str(info.value)
-    for fragment in fragments:
-        assert fragment in message, (fragment, message)
-    return message
+def fill_refused(surface, size, *fragments):
+    return refused(lambda: tetrahedralize(surface, size), *fragments)
 
 
 def test_an_open_surface_names_one_of_its_boundary_edges():
     points, triangles = icosphere(2)
     surface = snede.Mesh(points, triangles[1:])  # one triangle taken out: a hole of three edges
-    message = refused(surface, 0.2, "the surface is open: 3 edges belong to one triangle only",
+    message = fill_refused(surface, 0.2, "the surface is open: 3 edges belong to one triangle only",
                       "tetrahedralize needs a closed surface")
     a, b = map(int, re.search(r"from vertex (\d+) at .* to vertex (\d+) at", message).groups())
     assert {a, b} < set(triangles[0].tolist())
@@ -116,7 +112,7 @@ def test_an_open_surface_names_one_of_its_boundary_edges():
 def test_a_surface_in_two_pieces():
     points, triangles = box_surface((1.0, 1.0, 1.0))
     two = snede.Mesh(np.r_[points, points + 2.0], np.r_[triangles, triangles + 8])
-    refused(two, 0.3, "the surface is in 2 separate pieces; tetrahedralize fills one closed surface: pass each "
+    fill_refused(two, 0.3, "the surface is in 2 separate pieces; tetrahedralize fills one closed surface: pass each "
                       "piece alone")
 
 
@@ -131,7 +127,7 @@ def dented_box():
 
 def test_a_surface_that_crosses_itself_names_two_crossing_triangles_and_where():
     points, triangles = dented_box()
-    message = refused(snede.Mesh(points, triangles), 0.2, "the surface crosses itself:", "pairs of triangles cross",
+    message = fill_refused(snede.Mesh(points, triangles), 0.2, "the surface crosses itself:", "pairs of triangles cross",
                       "(gmsh: ")
     i, j = map(int, re.search(r"e\.g\. triangles (\d+) \[[^]]*\] and (\d+) \[", message).groups())
     assert len(_geometry.crossing_triangles(points, triangles[[i, j]])) == 1
@@ -142,27 +138,38 @@ def test_a_surface_that_crosses_itself_names_two_crossing_triangles_and_where():
 def test_sofas_first_liver_crosses_itself_in_its_fold():
     """meshes/README.md: liver_surface.obj crosses itself in a fold near file coordinates
     (−2.1, 3.9, −1.05), which gmsh refuses."""
-    message = refused(MESHES / "liver_surface.obj", 0.2, "the surface crosses itself")
+    message = fill_refused(MESHES / "liver_surface.obj", 0.2, "the surface crosses itself")
     near = [float(x) for x in re.search(r"near \(([^)]*)\)", message).group(1).split(",")]
     np.testing.assert_allclose(near, (-2.1, 3.9, -1.05), atol=0.3)
 
 
+@pytest.mark.parametrize("remesh", [True, False])
+def test_what_gmsh_refuses_otherwise_is_its_own_error(remesh):
+    """The dented box's vertex pushed down just onto the bottom: it touches it, crossing nothing."""
+    points, triangles = dented_box()
+    points[-1, 2] = 0.0
+    message = refused(lambda: tetrahedralize(snede.Mesh(points, triangles), 0.3, remesh=remesh),
+                      "gmsh could not fill the surface: PLC Error", "no two of its triangles cross (touching ones are "
+                      "not looked for)")
+    assert ("the remeshed one may: try another size, or remesh=False" in message) == remesh
+
+
 def test_a_tetrahedral_mesh_or_a_2d_mesh_is_not_a_surface():
-    refused(snede.meshing.box((1, 1, 1), (1, 1, 1)), 0.2, "tetrahedralize fills a closed surface (triangles in 3D), "
+    fill_refused(snede.meshing.box((1, 1, 1), (1, 1, 1)), 0.2, "tetrahedralize fills a closed surface (triangles in 3D), "
                                                           "got <snede.Mesh 6 tetrahedra", "boundary_surface(mesh)[0]")
-    message = refused(snede.meshing.rectangle((1, 1), (1, 1)), 0.2, "got <snede.Mesh 2 triangles")
+    message = fill_refused(snede.meshing.rectangle((1, 1), (1, 1)), 0.2, "got <snede.Mesh 2 triangles")
     assert "boundary_surface" not in message
 
 
 @pytest.mark.parametrize("size", [0, -1.0, math.nan, math.inf])
 def test_a_size_that_is_no_length(size):
     points, triangles = icosphere(1)
-    refused(snede.Mesh(points, triangles), size, f"size must be positive and finite, got {size}")
+    fill_refused(snede.Mesh(points, triangles), size, f"size must be positive and finite, got {size}")
 
 
 def test_a_file_that_is_no_mesh_says_so(tmp_path):
     (tmp_path / "nothing.stl").write_text("solid nothing\nendsolid nothing\n")
-    refused(tmp_path / "nothing.stl", 0.2, str(tmp_path / "nothing.stl"))
+    fill_refused(tmp_path / "nothing.stl", 0.2, str(tmp_path / "nothing.stl"))
 
 
 # -- the crossing search against a plain one -------------------------------------------------------
