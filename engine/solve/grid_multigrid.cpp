@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <numeric>
 #include <span>
 #include <stdexcept>
 #include <string>
@@ -161,34 +162,33 @@ GridMultigrid::GridMultigrid(Model& fine, double grid_width)
   n_nodes_ = n_copies;
   n_unknowns_ = first_column.back();
 
+  // P in CSR, filled copy by copy: the columns grow with the copy, so each row comes out sorted.
   const auto n_rows = static_cast<PetscInt>(n * d);
-  std::vector<PetscInt> nonzeros(static_cast<std::size_t>(n_rows), 0);
+  std::vector<PetscInt> row_start(static_cast<std::size_t>(n_rows) + 1, 0);
   for (std::size_t i = 0; i < n * slots; ++i)
     if (copy_of[i] >= 0)
       for (int r = 0; r < d; ++r)
-        nonzeros[(i / slots) * d + r] += first_column[copy_of[i] + 1] - first_column[copy_of[i]];
-  SNEDE_PETSC(MatCreateSeqAIJ(PETSC_COMM_SELF, n_rows, n_unknowns_, 0, nonzeros.data(), interpolation_.out()));
-  std::vector<PetscInt> columns;
-  std::vector<double> values;
+        row_start[(i / slots) * d + r + 1] += first_column[copy_of[i] + 1] - first_column[copy_of[i]];
+  std::partial_sum(row_start.begin(), row_start.end(), row_start.begin());
+  std::vector<PetscInt> columns(static_cast<std::size_t>(row_start.back()));
+  std::vector<double> values(columns.size());
+  std::vector<PetscInt> next(row_start.begin(), row_start.end() - 1);
   for (std::size_t k = 0; k < n_copies; ++k) {
     const std::size_t rows = (start[k + 1] - start[k]) * d;
-    const auto width_k = static_cast<int>(first_column[k + 1] - first_column[k]);
-    if (width_k == 0) continue;
-    columns.resize(width_k);
-    values.resize(width_k);
-    for (int p = 0; p < width_k; ++p) columns[p] = first_column[k] + p;
-    for (std::size_t m = start[k]; m < start[k + 1]; ++m) {
-      const std::size_t v = members[m] / slots;
+    for (std::size_t m = start[k]; m < start[k + 1]; ++m)
       for (int i = 0; i < d; ++i) {
         const std::size_t row = (m - start[k]) * d + i;
-        const auto global_row = static_cast<PetscInt>(v * d + i);
-        for (int p = 0; p < width_k; ++p) values[p] = Q[k][static_cast<std::size_t>(p) * rows + row];
-        SNEDE_PETSC(MatSetValues(interpolation_, 1, &global_row, width_k, columns.data(), values.data(), ADD_VALUES));
+        PetscInt& at = next[(members[m] / slots) * d + i];
+        for (PetscInt p = 0; p < first_column[k + 1] - first_column[k]; ++p, ++at) {
+          columns[at] = first_column[k] + p;
+          values[at] = Q[k][static_cast<std::size_t>(p) * rows + row];
+        }
       }
-    }
   }
-  SNEDE_PETSC(MatAssemblyBegin(interpolation_, MAT_FINAL_ASSEMBLY));
-  SNEDE_PETSC(MatAssemblyEnd(interpolation_, MAT_FINAL_ASSEMBLY));
+  SNEDE_PETSC(MatCreate(PETSC_COMM_SELF, interpolation_.out()));
+  SNEDE_PETSC(MatSetSizes(interpolation_, n_rows, n_unknowns_, n_rows, n_unknowns_));
+  SNEDE_PETSC(MatSetType(interpolation_, MATSEQAIJ));
+  SNEDE_PETSC(MatSeqAIJSetPreallocationCSR(interpolation_, row_start.data(), columns.data(), values.data()));
 }
 
 std::vector<std::size_t> GridMultigrid::level_sizes() const { return {n_nodes_, fine_.body().mesh().n_cells()}; }
