@@ -38,7 +38,7 @@ def model(name: str):
 
 
 def errors(gmsh) -> list[str]:
-    """gmsh's error and warning lines logged in this session, without their "Error: " prefix."""
+    """gmsh's error and warning lines logged in this session, without their "Error: " or "Warning: "."""
     return [line.split(": ", 1)[1] for line in gmsh.logger.get() if line.startswith(("Error: ", "Warning: "))]
 
 

@@ -27,7 +27,8 @@ class RayHit(NamedTuple):
     """Where a ray first meets a mesh's boundary (``Mesh.ray_hit``)."""
 
     point: np.ndarray  #: (dim,) the point hit (on the deformed boundary when a displacement was given)
-    face: np.ndarray  #: (cell_dim,) vertex indices of the face hit: a boundary triangle, or edge in 2D
+    face: np.ndarray  #: (cell_dim,) vertex indices of the face hit: a boundary triangle (a triangle of a
+    #: surface mesh), or a boundary edge in 2D
     weights: np.ndarray  #: (cell_dim,) barycentric weights of the point on the face's vertices
     distance: float  #: from the ray's origin to the point
 
@@ -212,14 +213,15 @@ class Mesh(MeshEdits):
             raise ValueError(f"{name} must be {self.dim} finite numbers for this {self.dim}-D mesh, got {value!r}")
         return vector
 
-    def _outside(self, displacement) -> tuple[np.ndarray, np.ndarray]:
+    def _aiming_faces(self, displacement) -> tuple[np.ndarray, np.ndarray]:
         """The faces a ray can meet — the boundary faces, or every triangle of a surface mesh —
         and the points, displaced by ``displacement`` ((n_points, dim)) when it is given."""
         points = self.points
         if displacement is not None:
             displacement = np.asarray(displacement, dtype=np.float64)
             if displacement.shape != points.shape:
-                raise ValueError(f"displacement must have shape {points.shape} (n_points, dim), got {displacement.shape}")
+                raise ValueError(f"displacement must have shape {points.shape} (n_points, dim), "
+                                 f"got {displacement.shape}")
             points = points + displacement
         return (self.cells if self.is_surface else self.boundary_faces()).astype(np.int64), points
 
@@ -234,7 +236,7 @@ class Mesh(MeshEdits):
         if length == 0:
             raise ValueError("direction must not be zero")
         direction = direction / length
-        faces, points = self._outside(displacement)
+        faces, points = self._aiming_faces(displacement)
         corners = [points[faces[:, k]] for k in range(faces.shape[1])]
         tolerance = 1e-12  # on barycentric coordinates: a ray through an edge hits a face beside it
         if self.dim == 3:
@@ -258,7 +260,7 @@ class Mesh(MeshEdits):
         radius = float(radius)
         if not (np.isfinite(radius) and radius >= 0):
             raise ValueError(f"radius must be non-negative and finite, got {radius}")
-        faces, points = self._outside(displacement)
+        faces, points = self._aiming_faces(displacement)
         vertices = np.unique(faces)
         return vertices[np.linalg.norm(points[vertices] - point, axis=1) <= radius]
 

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import contextlib
 import io
+import re
 from pathlib import Path
 
 import numpy as np
@@ -38,13 +39,16 @@ def read_blocks(path: Path) -> tuple[np.ndarray, dict[str, np.ndarray]]:
     raise ValueError(f"{path}: could not read this file as a mesh ({'; '.join(reasons)})")
 
 
-def _reason(error: BaseException) -> str:
-    return f"{type(error).__name__}: {error}" if type(error).__name__ not in ("ValueError", "ReadError") else str(error)
+def _reason(error: Exception) -> str:
+    """The error's message, after its type unless it is a ValueError or meshio's ReadError."""
+    kind = type(error).__name__
+    return str(error) if kind in ("ValueError", "ReadError") else f"{kind}: {error}"
 
 
 def _readers(path: Path) -> list:
     suffix = path.suffix.lower()
-    head = path.read_bytes()[:256] if path.is_file() else b""
+    with open(path, "rb") as file:  # a folder or an unreadable file: the OSError says why
+        head = file.read(256)
     readers = [("meshio", _meshio_reader(MESHIO_FORMATS.get(suffix)))]
     if suffix == ".vtk" and head.lstrip().startswith(b"<"):  # an XML (VTU) file named .vtk
         readers.append(("meshio as VTU", _meshio_reader("vtu")))
@@ -92,26 +96,21 @@ class _Words:
     """The words of a VTK legacy file after its header, and its arrays (text, or big-endian binary
     data starting on the line after the word before them)."""
 
+    _WORD = re.compile(rb"\S+")
+
     def __init__(self, data: bytes, start: int, binary: bool):
         self.data, self.position, self.binary = data, start, binary
 
     def next(self) -> str | None:
-        data, n = self.data, len(self.data)
-        while self.position < n and data[self.position:self.position + 1].isspace():
-            self.position += 1
-        if self.position == n:
+        match = self._WORD.search(self.data, self.position)
+        if match is None:
             return None
-        end = self.position
-        while end < n and not data[end:end + 1].isspace():
-            end += 1
-        word, self.position = data[self.position:end].decode("ascii", "replace"), end
-        return word
+        self.position = match.end()
+        return match.group().decode("ascii", "replace")
 
     def peek(self) -> str | None:
-        position = self.position
-        word = self.next()
-        self.position = position
-        return word
+        match = self._WORD.search(self.data, self.position)
+        return None if match is None else match.group().decode("ascii", "replace")
 
     def array(self, count: int, vtk_type: str) -> np.ndarray:
         code = _VTK_TYPES.get(vtk_type.lower())
@@ -122,10 +121,11 @@ class _Words:
             values = np.frombuffer(self.data, dtype=">" + code, count=count, offset=self.position)
             self.position += count * values.itemsize
             return values.astype(code)
-        values = [self.next() for _ in range(count)]
-        if None in values:
+        words = self.data[self.position:].split(None, count)
+        if len(words) < count:
             raise ValueError(f"the file ends inside an array of {count} values")
-        return np.array(values, dtype=code)
+        self.position = len(self.data) - (len(words[count]) if len(words) > count else 0)
+        return np.array(words[:count]).astype("f8" if code[0] == "f" else code)  # text: keep its digits
 
 
 def read_vtk_polydata(path: Path):
@@ -139,7 +139,7 @@ def read_vtk_polydata(path: Path):
     if encoding not in (b"ASCII", b"BINARY") or dataset[1:2] != [b"POLYDATA"]:
         raise ValueError(f"not an ASCII or BINARY POLYDATA file ({lines[2].strip()!r}, {lines[3].strip()!r})")
     words = _Words(data, len(data) - len(lines[4]), encoding == b"BINARY")
-    points, polygons = None, []
+    points, blocks = None, []
     while (key := words.next()) is not None and key.upper() not in ("POINT_DATA", "CELL_DATA"):
         key = key.upper()
         if key == "POINTS":
@@ -148,45 +148,53 @@ def read_vtk_polydata(path: Path):
         elif key in ("VERTICES", "LINES", "POLYGONS", "TRIANGLE_STRIPS"):
             cells = _vtk_cells(words, int(words.next()), int(words.next()))
             if key == "POLYGONS":
-                polygons += [("polygon", cell[None]) for cell in cells if len(cell) >= 3]
+                blocks += [("polygon", rows) for rows in cells if rows.shape[1] >= 3]
             elif key == "TRIANGLE_STRIPS":
-                polygons += [("triangle", _strip(cell)) for cell in cells if len(cell) >= 3]
+                blocks += [("triangle", _strips(rows)) for rows in cells if rows.shape[1] >= 3]
         # other words (a METADATA section's entries) are passed over up to the next section
     if points is None:
         raise ValueError("no POINTS section")
-    return points, collect(polygons)
+    return points, collect(blocks)
 
 
 def _vtk_cells(words: _Words, first: int, second: int) -> list[np.ndarray]:
     """The cells of a VERTICES/LINES/POLYGONS/TRIANGLE_STRIPS section, whose header gave ``first``
     and ``second``: (cells, total size) with each cell's vertex count first (VTK < 5.1), or
-    (offsets, connectivity) followed by OFFSETS and CONNECTIVITY arrays (VTK 5.1)."""
+    (offsets, connectivity) followed by OFFSETS and CONNECTIVITY arrays (VTK 5.1). One (m, k)
+    array of vertex indices per cell size k."""
     if words.peek() == "OFFSETS":
         words.next()
         offsets = words.array(first, words.next()).astype(np.int64)
         if words.next() != "CONNECTIVITY":
             raise ValueError("OFFSETS without CONNECTIVITY")
         connectivity = words.array(second, words.next()).astype(np.int64)
-        return np.split(connectivity, offsets[1:-1])
-    flat = words.array(second, "int").astype(np.int64)
-    cells, position = [], 0
-    for _ in range(first):
-        count = int(flat[position]) if position < second else -1
-        if not 0 <= count < second - position:
-            raise ValueError(f"the cells' sizes run past the section's {second} values: the file is damaged")
-        cells.append(flat[position + 1:position + 1 + count])
-        position += count + 1
-    if position != second:
-        raise ValueError(f"cell sizes add up to {position}, the section says {second}")
-    return cells
+        starts, sizes = offsets[:-1], np.diff(offsets)
+    else:
+        connectivity = words.array(second, "int").astype(np.int64)
+        k = int(connectivity[0]) if second else 0
+        if second == first * (k + 1) and np.all(connectivity[::k + 1] == k):  # all of one size
+            return [connectivity.reshape(first, k + 1)[:, 1:]]
+        starts = np.empty(first, dtype=np.int64)
+        position = 0
+        for cell in range(first):  # each count says where the next cell starts
+            count = int(connectivity[position]) if position < second else -1
+            if not 0 <= count < second - position:
+                raise ValueError(f"the cells' sizes run past the section's {second} values: the file is damaged")
+            starts[cell] = position + 1
+            position += count + 1
+        if position != second:
+            raise ValueError(f"cell sizes add up to {position}, the section says {second}")
+        sizes = connectivity[starts - 1]
+    return [connectivity[starts[sizes == k, None] + np.arange(k)] for k in np.unique(sizes)]
 
 
-def _strip(strip: np.ndarray) -> np.ndarray:
-    """A triangle strip's triangles, every second one turned so that all share one orientation."""
-    k = np.arange(len(strip) - 2)
-    triangles = np.c_[strip[k], strip[k + 1], strip[k + 2]]
-    triangles[1::2] = triangles[1::2][:, [1, 0, 2]]
-    return triangles
+def _strips(strips: np.ndarray) -> np.ndarray:
+    """The triangles of triangle strips of k vertices (m, k): (j, j + 1, j + 2), every second
+    one turned so that all share one orientation."""
+    j = np.arange(strips.shape[1] - 2)
+    corners = np.c_[j, j + 1, j + 2]
+    corners[1::2] = corners[1::2][:, [1, 0, 2]]
+    return strips[:, corners].reshape(-1, 3)
 
 
 def collect(blocks) -> dict[str, np.ndarray]:

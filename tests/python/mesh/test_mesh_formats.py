@@ -158,10 +158,9 @@ def test_triangles_with_a_repeated_vertex_are_left_out_with_a_warning(tmp_path):
     """STL files hold triangles whose corners coincide (meshio merges them into one point)."""
     points, triangles = icosphere(1)
     path = tmp_path / "with-slivers.stl"
-    corners = np.concatenate([points[triangles], points[[[0, 0, 1]]]])
+    corners = np.concatenate([points[triangles], points[[[0, 0, 1]]]]).reshape(-1, 3)  # the last: corners 0, 0, 1
     with np.errstate(invalid="ignore"):  # meshio's normal of the triangle without area
-        meshio.write_points_cells(path, corners.reshape(-1, 3), [("triangle", np.arange(len(corners) * 3).reshape(-1, 3))],
-                                  binary=False)
+        meshio.write_points_cells(path, corners, [("triangle", np.arange(len(corners)).reshape(-1, 3))], binary=False)
     with pytest.warns(UserWarning, match=re.escape(f"{path}: 1 triangles with a repeated vertex (no area) left out")):
         mesh = snede.Mesh.read(path)
     assert_same_cells(mesh.points, mesh.cells, points, triangles)
@@ -205,6 +204,25 @@ def test_polydata_binary(tmp_path):
     mesh = read(path)
     np.testing.assert_array_equal(mesh.points, SQUARE)
     assert_same_cells(mesh.points, mesh.cells, SQUARE, SQUARE_TRIANGLES)
+
+
+@pytest.mark.parametrize("binary", [False, True], ids=["text", "binary"])
+def test_polydata_of_triangles_only(tmp_path, binary):
+    points, triangles = icosphere(2)
+    cells = np.c_[np.full(len(triangles), 3), triangles]
+    if binary:
+        arrays = (points.astype(">f4").tobytes(), cells.astype(">i4").tobytes())
+        points = points.astype(np.float32).astype(np.float64)
+    else:
+        arrays = ("\n".join(" ".join(map(repr, p)) for p in points.tolist()).encode(),
+                  "\n".join(" ".join(map(str, c)) for c in cells.tolist()).encode())
+    path = tmp_path / "sphere.vtk"
+    path.write_bytes(b"# vtk DataFile Version 2.0\nsphere\n" + (b"BINARY" if binary else b"ASCII")
+                     + f"\nDATASET POLYDATA\nPOINTS {len(points)} float\n".encode() + arrays[0]
+                     + f"\nPOLYGONS {len(cells)} {cells.size}\n".encode() + arrays[1] + b"\n")
+    mesh = read(path)
+    np.testing.assert_array_equal(mesh.points, points)
+    assert_same_cells(mesh.points, mesh.cells, points, triangles)
 
 
 def test_an_xml_file_named_vtk_reads_as_vtu(tmp_path):

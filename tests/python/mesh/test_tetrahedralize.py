@@ -127,8 +127,8 @@ def dented_box():
 
 def test_a_surface_that_crosses_itself_names_two_crossing_triangles_and_where():
     points, triangles = dented_box()
-    message = fill_refused(snede.Mesh(points, triangles), 0.2, "the surface crosses itself:", "pairs of triangles cross",
-                      "(gmsh: ")
+    message = fill_refused(snede.Mesh(points, triangles), 0.2, "the surface crosses itself:",
+                           "pairs of triangles cross", "(gmsh: ")
     i, j = map(int, re.search(r"e\.g\. triangles (\d+) \[[^]]*\] and (\d+) \[", message).groups())
     assert len(_geometry.crossing_triangles(points, triangles[[i, j]])) == 1
     near = [float(x) for x in re.search(r"near \(([^)]*)\)", message).group(1).split(",")]
@@ -155,8 +155,9 @@ def test_what_gmsh_refuses_otherwise_is_its_own_error(remesh):
 
 
 def test_a_tetrahedral_mesh_or_a_2d_mesh_is_not_a_surface():
-    fill_refused(snede.meshing.box((1, 1, 1), (1, 1, 1)), 0.2, "tetrahedralize fills a closed surface (triangles in 3D), "
-                                                          "got <snede.Mesh 6 tetrahedra", "boundary_surface(mesh)[0]")
+    fill_refused(snede.meshing.box((1, 1, 1), (1, 1, 1)), 0.2,
+                 "tetrahedralize fills a closed surface (triangles in 3D), got <snede.Mesh 6 tetrahedra",
+                 "boundary_surface(mesh)[0]")
     message = fill_refused(snede.meshing.rectangle((1, 1), (1, 1)), 0.2, "got <snede.Mesh 2 triangles")
     assert "boundary_surface" not in message
 
