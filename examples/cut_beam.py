@@ -15,7 +15,8 @@ body = snede.Body(mesh, snede.NeoHookean(E=3e4, nu=0.3), density=1000.0)
 body.fix(np.isclose(mesh.points[:, 0], 0.0))
 body.add_gravity((0.0, 0.0, -9.81))
 solver = snede.StaticSolver(body, "newton", rtol=1e-8)
-series = SeriesWriter("out/cut_beam/cut_beam")
+folder = snede.output_folder("cut_beam")  # out/cut_beam, or --out DIR/cut_beam
+series = SeriesWriter(folder / "cut_beam")
 series.write(body, time=0.0)
 print("before the cut:", solver.solve())
 series.write(body, time=1.0)
@@ -26,5 +27,5 @@ print(f"cut: {len(copies)} vertices duplicated; the body now has {mesh.n_points}
 
 print("after the cut: ", solver.solve())  # same solver: sizes were reissued by the watcher
 series.write(body, time=2.0)
-plot_body(body, "out/cut_beam/cut_beam.png", title="beam cut from below at x = 5 cm")
+plot_body(body, folder / "cut_beam.png", title="beam cut from below at x = 5 cm")
 print(f"wrote {series.xdmf_path} ({series.n_steps} steps, {series.n_meshes} meshes)")

@@ -1,7 +1,8 @@
 """A user scene: a soft neo-Hookean beam fixed at one end sags under gravity.
 
 Run it with `python -m snede run examples/sagging_beam.py` (add PETSc options such as
--static_snes_monitor); it writes out/sagging_beam/ (XDMF for ParaView and a PNG).
+-static_snes_monitor); it writes out/sagging_beam/ (XDMF for ParaView and a PNG), or with
+--out DIR, DIR/sagging_beam/.
 """
 import numpy as np
 
@@ -24,8 +25,9 @@ result = snede.StaticSolver(body, "newton", rtol=1e-8).solve()
 print(result)
 
 # 5. Output: a ParaView series (reference and deformed) and a picture.
-series = SeriesWriter("out/sagging_beam/sagging_beam")
+folder = snede.output_folder("sagging_beam")  # out/sagging_beam, or --out DIR/sagging_beam
+series = SeriesWriter(folder / "sagging_beam")
 series.write(body, time=0.0, displacement=np.zeros_like(body.displacement))
 series.write(body, time=1.0)
-plot_body(body, "out/sagging_beam/sagging_beam.png", title="sagging beam")
+plot_body(body, folder / "sagging_beam.png", title="sagging beam")
 print(f"tip sag {-body.displacement[:, 2].min() * 1000:.2f} mm; wrote {series.xdmf_path}")

@@ -3,9 +3,9 @@ on the other, is cut from its side by a vertical blade moved in steps; the block
 static solve) after each step, and the cut opens like a mouth, wider the deeper it goes.
 
 Run it with `python -m snede run examples/scalpel_cut.py`; it prints what each move of the
-scalpel did (a CutReport) and how each solve ended, and writes out/scalpel_cut/: the XDMF
-series (a new mesh after each move that cut; the point field `incision` is 1 on the lips) and
-a picture with the incision in red.
+scalpel did (a CutReport) and how each solve ended, and writes out/scalpel_cut/ (with --out DIR,
+DIR/scalpel_cut/): the XDMF series (a new mesh after each move that cut; the point field
+`incision` is 1 on the lips) and a picture with the incision in red.
 """
 import numpy as np
 
@@ -22,7 +22,8 @@ end = np.flatnonzero(np.isclose(mesh.points[:, 0], 0.10))
 body.add_nodal_force(end, (3.0 / len(end), 0.0, 0.0))
 
 solver = snede.StaticSolver(body, "newton", rtol=1e-8)
-series = SeriesWriter("out/scalpel_cut/scalpel_cut")
+folder = snede.output_folder("scalpel_cut")  # out/scalpel_cut, or --out DIR/scalpel_cut
+series = SeriesWriter(folder / "scalpel_cut")
 series.write(body, time=0.0)
 print("stretched:", solver.solve())
 series.write(body, time=1.0)
@@ -58,6 +59,6 @@ deformed = mesh.points + body.displacement
 mouth = np.unique(faces)[np.isclose(mesh.points[np.unique(faces), 1], 0.0)]
 print(f"all moves: {total}")
 print(f"incision: {len(faces)} boundary faces; the mouth is {np.ptp(deformed[mouth, 0]) * 1e3:.1f} mm wide")
-plot_body(body, "out/scalpel_cut/scalpel_cut.png", title="stretched block cut from the side",
+plot_body(body, folder / "scalpel_cut.png", title="stretched block cut from the side",
           highlight=faces, reference=False, view=(50, -75))
 print(f"wrote {series.xdmf_path} ({series.n_steps} steps, {series.n_meshes} meshes)")

@@ -29,6 +29,7 @@ from snede.surface_cutting import SurfaceCutter  # noqa: F401
 from snede.distributed import DistributedMesh, DistributedRelaxation, DistributedStatic, distribute  # noqa: F401
 from snede.subdivision_cutting import SubdivisionCutter  # noqa: F401
 from snede import meshing  # noqa: F401
+from snede._output_folder import output_folder  # noqa: F401
 
 __all__ = [
     "Mesh", "MeshQuality", "Body", "meshing", "StaticSolver", "DynamicRelaxation", "SolveResult",
@@ -36,6 +37,7 @@ __all__ = [
     "SubdivisionCutter", "DistributedMesh", "DistributedRelaxation", "DistributedStatic", "distribute",
     "LinearElastic", "StVenantKirchhoff", "NeoHookean", "VerondaWestmann",
     "EditResult", "FileError", "InvalidMesh", "PetscError", "DomainError", "LockingWarning", "PETSc",
+    "output_folder",
 ]
 __version__ = "0.1.0"
 

@@ -20,12 +20,14 @@ from __future__ import annotations
 
 import argparse
 import logging
+import os
 import runpy
 import sys
 import traceback
 from pathlib import Path
 
 from snede import _command_line
+from snede import _output_folder as output_folder
 
 METHODS = ("cg", "ncg", "newton", "dynamic")
 SCENE_OPTIONS = ("divisions", "mesh_size", "speed")  # apply to the scenes whose OPTIONS name them
@@ -91,7 +93,8 @@ def _parser() -> argparse.ArgumentParser:
     run.add_argument("--speed", type=_positive_float,
                      help="needle: insertion speed, in h_ref per update (default 0.1)")
     run.add_argument("--mesh-size", type=_positive_float, help="target edge length (m) for gmsh meshes (cylinder)")
-    run.add_argument("--out", type=Path, default=Path("out"), help="output folder (default out/)")
+    run.add_argument("--out", type=Path, default=Path("out"),
+                     help="output folder (default out/); a scene script finds it as snede.output_folder(name)")
     demo = commands.add_parser("demo", help="run the default scenes and the cutting demo")
     demo.add_argument("--quiet", action="store_true", default=argparse.SUPPRESS, help=quiet)
     demo.add_argument("--out", type=Path, default=Path("out"), help="output folder (default out/)")
@@ -175,6 +178,7 @@ def _command(parser, args, unknown, petsc) -> int:
         if not script.exists():
             parser.error(f"scene script {script} does not exist")
         sys.argv = [str(script), *unknown, *petsc]
+        os.environ[output_folder.VARIABLE] = str(args.out)  # snede.output_folder(name) is args.out / name
         runpy.run_path(str(script), run_name="__main__")
         return 0
     scenes = builders()
