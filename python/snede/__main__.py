@@ -6,7 +6,8 @@ starting with a single ``-`` (and their values) are PETSc's (``-static_snes_moni
 ``-log_view``): PETSc read them, and only them, from sys.argv when snede was imported (see
 ``snede._argv``). Before a built-in scene runs, a value PETSc refuses is an error, whether or
 not the scene's solver reads the option; at the end, the options nothing read are reported,
-as PETSc's ``-options_left`` does.
+as PETSc's ``-options_left`` does. A scene file (``run path/to/scene.toml``, ``snede.scene_file``)
+runs as a built-in scene does; a script gets ``--out`` through ``snede.output_folder``.
 
 Bad input gives one line, ``python -m snede: error: ...``, and exit status 2 (under mpirun,
 from rank 0 alone when every rank finds it); Ctrl-C one line and status 130; a solve that did
@@ -24,6 +25,7 @@ import os
 import runpy
 import sys
 import traceback
+from functools import partial
 from pathlib import Path
 
 from snede import _command_line
@@ -72,15 +74,16 @@ def _parser() -> argparse.ArgumentParser:
     parser.add_argument("--quiet", action="store_true", help=quiet)
     commands = parser.add_subparsers(dest="command", required=True)
     commands.add_parser("list", help="list the built-in scenes")
-    run = commands.add_parser("run", help="run a built-in scene, or a scene script (a .py file)",
-                              description="Run a built-in scene, or a scene script (a .py file: it gets the "
+    run = commands.add_parser("run", help="run a built-in scene, a scene file (.toml) or a scene script (.py)",
+                              description="Run a built-in scene, a scene file (.toml: docs/guide/meshes_and_scenes.md) "
+                                          "or a scene script (a .py file: it gets the "
                                           "arguments snede does not know). Options starting with a single '-' "
                                           "are PETSc's (e.g. -static_snes_monitor; -help lists the solvers' "
                                           "options as they are set up).")
     # SUPPRESS: `--quiet run ...` is not undone by the subcommand's default
     run.add_argument("--quiet", action="store_true", default=argparse.SUPPRESS, help=quiet)
     run.add_argument("scene", help="cantilever, cylinder, slab, needle, needle3d, cut, sheet-cut, membrane-cut, "
-                                      "or path/to/scene.py")
+                                      "path/to/scene.toml or path/to/scene.py")
     run.add_argument("--material", choices=MATERIAL_NAMES, help="material model (default: the scene's)")
     run.add_argument("--method", choices=METHODS,
                      help="cg: linear CG (linear material); ncg: nonlinear CG; newton: truncated Newton; "
@@ -161,7 +164,7 @@ def main(argv: list[str] | None = None) -> int:
 
 
 def _command(parser, args, unknown, petsc) -> int:
-    from snede import run_scene
+    from snede import run_scene, scene_file
     from snede._petsc import OptionValueError, check_option_values
     from snede.scenes import builders
 
@@ -182,14 +185,20 @@ def _command(parser, args, unknown, petsc) -> int:
         runpy.run_path(str(script), run_name="__main__")
         return 0
     scenes = builders()
-    if args.scene not in scenes:
-        parser.error(f"unknown scene {args.scene!r}: choose one of {', '.join(scenes)}, or give a .py file")
-    _check_scene_options(parser, args, scenes[args.scene])
+    if args.scene.endswith(scene_file.SUFFIX):
+        module, build = scene_file, lambda: scene_file.load(args.scene, args.material)
+    elif args.scene in scenes:
+        module = scenes[args.scene]
+        build = partial(module.build, args)
+    else:
+        parser.error(f"unknown scene {args.scene!r}: choose one of {', '.join(scenes)}, or give a .py or "
+                     f"{scene_file.SUFFIX} file")
+    _check_scene_options(parser, args, module)
     try:
         check_option_values()
-        scene = scenes[args.scene].build(args)
+        scene = build()
         summary = run_scene.run(scene, args.method, args.rtol, args.out, progress=not args.quiet)
-    except (OptionValueError, run_scene.SerialOnly) as error:  # the same on every rank
+    except (OptionValueError, run_scene.SerialOnly, scene_file.SceneFileError) as error:  # the same on every rank
         _command_line.fail(error)
     if summary.get("rank", 0) == 0:  # on several MPI ranks, rank 0 reports
         run_scene.print_table([summary])

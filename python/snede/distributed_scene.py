@@ -23,6 +23,9 @@ def unsupported(scene, method: str) -> str | None:
     body = scene.body
     if scene.evolve is not None:
         return "it changes its mesh or evolves in time (cuts, bisection and needle insertion stay serial)"
+    if scene.solver_options:
+        return "its solver options (a scene file's [solver] preconditioner, max_iterations, petsc) are not passed " \
+               "to distributed solves yet"
     if method not in DISTRIBUTED_METHODS:
         return f"method {method!r} (distributed solves are {', '.join(DISTRIBUTED_METHODS)})"
     if body.mesh.is_surface:

@@ -268,8 +268,6 @@ def draw_body(body, title: str = "", displacement=None, scale: float = 1.0, deco
         tails = draw_loads(ax, deformed, forces, length)
         if gravity is not None:
             draw_gravity(ax, gravity, None)
-        if decorate is not None:
-            decorate(ax)
     else:
         import matplotlib.cm as cm
         import matplotlib.colors as colors
@@ -302,6 +300,8 @@ def draw_body(body, title: str = "", displacement=None, scale: float = 1.0, deco
         ax.set_ylabel("y [m]")
         ax.set_zlabel("z [m]")
         shaded = cm.ScalarMappable(norm=norm, cmap="viridis")
+    if decorate is not None:
+        decorate(ax)
     if reference:
         handles.append(Line2D([], [], color="0.45", linewidth=0.8, linestyle=(0, (3, 2)), label="reference outline")
                        if mesh.dim == 2 else Line2D([], [], color="0.7", linewidth=0.8, label="reference"))
@@ -332,7 +332,7 @@ def plot_body(body, path, title: str = "", displacement=None, scale: float = 1.0
     scale ("displacement ×20", or "to scale"); the axes are to scale. The loads are drawn as
     orange arrows (``loads``: True for every load channel and gravity, False for none, or the
     names of the channels to draw, "gravity" among them for gravity), ``fixed`` (vertex ids or
-    a boolean mask) as black triangles. ``decorate(ax)`` draws on top of a 2D picture.
+    a boolean mask) as black triangles. ``decorate(ax)`` draws on top (in 3D within the box of the body).
     ``highlight``, boundary faces ((m, 3) vertex ids, e.g. ``TetrahedralCutter.incision_faces()``)
     or in 2D and on a membrane (a surface mesh in 3D, whose triangles are drawn) boundary edges
     ((m, 2), e.g. ``DelaunayCutter.incision_edges()``), is drawn in red;

@@ -39,6 +39,12 @@ class Progress:
             self.bar.close()
 
 
+def static_solver(scene, method: str, rtol: float, max_iterations: int = 100000):
+    """The scene's static solver: ``method``, ``rtol`` and the scene's ``solver_options``."""
+    return snede.StaticSolver(scene.body, method, rtol=rtol, **{"max_iterations": max_iterations,
+                                                                 **scene.solver_options})
+
+
 def solve_scene(scene, method: str, rtol: float, progress: bool, max_iterations: int = 100000):
     body = scene.body
     bar = Progress(f"{scene.name} ({method})", progress)
@@ -46,11 +52,12 @@ def solve_scene(scene, method: str, rtol: float, progress: bool, max_iterations:
         if method == "dynamic":
             if not hasattr(snede, "DynamicRelaxation"):
                 raise ValueError("dynamic relaxation is not available in this build")
-            solver = snede.DynamicRelaxation(body, damping=scene.damping)
+            options = scene.solver_options
+            solver = snede.DynamicRelaxation(body, damping=scene.damping, petsc_options=options.get("petsc_options"))
             solver.ts.setMonitor(lambda ts, step, t, u: bar(step))
-            result = solver.run(rtol=rtol, max_steps=max_iterations)
+            result = solver.run(rtol=rtol, max_steps=options.get("max_iterations", max_iterations))
         else:
-            solver = snede.StaticSolver(body, method, rtol=rtol, max_iterations=max_iterations)
+            solver = static_solver(scene, method, rtol, max_iterations)
             if method == "cg":
                 solver.ksp.setMonitor(lambda ksp, it, norm: bar(it, f"|r| = {norm:.2e}"))
             else:

@@ -30,6 +30,9 @@ class Scene:
     # fixed(points) -> (n_points,) bool: the vertices the scene holds (of the mesh after the
     # run), marked on the picture; the scene's loads are drawn from the body.
     fixed: Callable | None = None
+    # Keyword arguments of the scene's static solver (snede.StaticSolver: preconditioner,
+    # petsc_options, max_iterations); petsc_options and max_iterations also reach dynamic relaxation.
+    solver_options: dict = field(default_factory=dict)
 
 
 def material(name: str, young: float, poisson: float, gamma: float = 8.0):
