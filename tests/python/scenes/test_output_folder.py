@@ -25,7 +25,7 @@ def test_every_example_script_asks_for_its_folder():
 
 @pytest.mark.parametrize("script", SCRIPTS, ids=lambda path: path.name)
 def test_a_script_scene_writes_into_the_out_folder_given(script, tmp_path):
-    out = subprocess.run([sys.executable, "-m", "snede", "--quiet", "run", str(script), "--out", str(tmp_path / "mine")],
+    out = subprocess.run([sys.executable, "-m", "snede", "--quiet", "run", str(script), "--out", tmp_path / "mine"],
                          cwd=tmp_path, capture_output=True, text=True, timeout=300)
     assert out.returncode == 0, out.stderr
     folder = tmp_path / "mine" / script.stem

@@ -9,24 +9,16 @@ import sys
 import pytest
 
 from snede import scene_file
+from test_scene_files import BOX
 
-GOOD = """\
-[mesh]
-shape = "box"
-size = [0.1, 0.02, 0.02]
-divisions = [10, 2, 2]
-
-[material]
-name = "neohookean"
-E = 3e4
-nu = 0.3
-
+GOOD = BOX + """
 [[hold]]
 side = "x = min"
 
 [loads]
 gravity = [0.0, 0.0, -9.81]
 """
+BOX_SHAPE = 'shape = "box"\nsize = [0.1, 0.04, 0.04]\ndivisions = [10, 4, 4]'
 SCALPEL = '\n[[tool]]\nkind = "scalpel"\nstart = [[0.05, -0.01, 0.03], [0.05, 0.03, 0.03]]\n' \
           'end = [[0.05, -0.01, 0.01], [0.05, 0.03, 0.01]]\nmoves = 3\n'
 NEEDLE = '\n[[tool]]\nkind = "needle"\nentry = [0.05, -0.1, 0.01]\ndirection = [0, 1, 0]\ndepth = 0.01\nsteps = 3\n'
@@ -46,9 +38,9 @@ def edited(*changes) -> str:
 
 MISTAKES = {
     # missing sections
-    "no mesh": (edited(('[mesh]\nshape = "box"\nsize = [0.1, 0.02, 0.02]\ndivisions = [10, 2, 2]\n', "")),
+    "no mesh": (edited((f"[mesh]\n{BOX_SHAPE}\n", "")),
                 "[mesh] is missing: a scene file needs [mesh], [material] and at least one [[hold]]"),
-    "no material": (edited(('[material]\nname = "neohookean"\nE = 3e4\nnu = 0.3\n', "")), "[material] is missing"),
+    "no material": (edited(('[material]\nname = "linear"\nE = 3e4\nnu = 0.3\n', "")), "[material] is missing"),
     "no hold": (edited(('[[hold]]\nside = "x = min"\n', "")), "[[hold]] is missing: a scene needs at least one"),
     "a required key": (edited(("nu = 0.3\n", "")), "material.nu is missing: Poisson's ratio, a number in (-1, 0.5)"),
     "a tool's required key": (edited(SCALPEL.replace("moves = 3\n", "")),
@@ -68,12 +60,12 @@ MISTAKES = {
                           "hold[1].withn is not a key of [hold[1]]; did you mean hold[1].within?"),
     "a key of a tool": (edited(SCALPEL.replace("moves = 3", "moves = 3\nstrat = 2")),
                         "tool[1].strat is not a key of [tool[1]]; did you mean tool[1].start?"),
-    "a key of the other source": (edited(("divisions = [10, 2, 2]", "divisions = [10, 2, 2]\nradii = [1, 1, 1]")),
+    "a key of the other source": (edited(("divisions = [10, 4, 4]", "divisions = [10, 4, 4]\nradii = [1, 1, 1]")),
                                   "mesh.radii is not a key of [mesh]"),
     # wrong types
     "a string for a number": (edited(("E = 3e4", 'E = "soft"')), 'material.E must be a positive number, got "soft"'),
-    "a float for an integer": (edited(("[10, 2, 2]", "[10, 2.5, 2]")),
-                               "mesh.divisions must be 3 positive integers, got [10, 2.5, 2]"),
+    "a float for an integer": (edited(("[10, 4, 4]", "[10, 4.5, 4]")),
+                               "mesh.divisions must be 3 positive integers, got [10, 4.5, 4]"),
     "a number for a vector": (edited(("gravity = [0.0, 0.0, -9.81]", "gravity = -9.81")),
                               "loads.gravity must be 3 numbers [x, y, z], got -9.81"),
     "a boolean for a number": (edited(("nu = 0.3", "nu = true")),
@@ -83,19 +75,20 @@ MISTAKES = {
                                        '{side = "x = min"}'),
     "a value for a table": (edited(("[mesh]", 'solver = "newton"\n\n[mesh]')),
                             'solver must be a table ([solver] or {...}), got "newton"'),
-    "not TOML at all": (edited(("E = 3e4", "E = ")), "not valid TOML: Invalid value (at line 8, column 5)"),
+    "not TOML at all": (edited(("E = 3e4", "E = ")), "not valid TOML: Invalid value (at line 9, column 5)"),
     # bad values
     "a negative modulus": (edited(("E = 3e4", "E = -3")), "material.E must be a positive number, got -3"),
-    "an incompressible material": (edited(("nu = 0.3", "nu = 0.5")), "material.nu must be a number in (-1, 0.5), got 0.5"),
+    "an incompressible material": (edited(("nu = 0.3", "nu = 0.5")),
+                                   "material.nu must be a number in (-1, 0.5), got 0.5"),
     "a side that is none": (edited(('"x = min"', '"left"')),
                             'hold[1].side must be a side such as "x = min" or "z = max", got "left"'),
-    "two regions in one hold": (edited(('side = "x = min"', 'side = "x = min"\npatch = {point = [0, 0, 0], radius = 1}')),
+    "two regions in one hold": (edited(("side", "patch = {point = [0, 0, 0], radius = 1}\nside")),
                                 "hold[1] needs exactly one of side, box, plane, patch, got side, patch"),
     "an empty box": (edited(('side = "x = min"', "box = {min = [0, 0, 0], max = [1, -1, 1]}")),
                      "hold[1].box.max must be at least hold[1].box.min in every coordinate"),
     "a region that picks nothing": (edited(('side = "x = min"', "box = {min = [1, 1, 1], max = [2, 2, 2]}")),
                                     "hold[1].box (box from [1.0, 1.0, 1.0] to [2.0, 2.0, 2.0]) picks no vertex of "
-                                    "the mesh (it spans [0.0, 0.0, 0.0] to [0.1, 0.02, 0.02])"),
+                                    "the mesh (it spans [0.0, 0.0, 0.0] to [0.1, 0.04, 0.04])"),
     "a zero direction": (edited(NEEDLE.replace("[0, 1, 0]", "[0, 0, 0]")),
                          "tool[1].direction must be 3 numbers [x, y, z], not all 0, got [0, 0, 0]"),
     "a blade of no length": (edited(SCALPEL.replace("[[0.05, -0.01, 0.03], [0.05, 0.03, 0.03]]",
@@ -103,7 +96,7 @@ MISTAKES = {
                              "tool[1].start must be two points [[x, y, z], [x, y, z]]"),
     "a friction that is none": (edited(NEEDLE + "friction = [[0.1, 3.0]]\n"),
                                 "tool[1].friction must be a force per unit of shaft surface in N/m²"),
-    "a method the material cannot take": (edited('\n[solver]\nmethod = "cg"\n'),
+    "a method the material cannot take": (edited(('"linear"', '"neohookean"'), '\n[solver]\nmethod = "cg"\n'),
                                           'solver.method "cg" is linear CG, for name = "linear" only; the material '
                                           'is "neohookean"'),
     "a method a tool cannot take": (edited('\n[solver]\nmethod = "ncg"\n' + NEEDLE),
@@ -113,26 +106,24 @@ MISTAKES = {
     "a PETSc option with its dash": (edited('\n[solver]\npetsc = {"-ksp_monitor" = true}\n'),
                                      "solver.petsc.-ksp_monitor is not a PETSc option name"),
     "a gamma of another material": (edited(("nu = 0.3", "nu = 0.3\ngamma = 3")),
-                                    'material.gamma is the nonlinearity of name = "veronda", not of "neohookean"'),
+                                    'material.gamma is the nonlinearity of name = "veronda", not of "linear"'),
     "a needle before a scalpel": (edited(NEEDLE + SCALPEL),
                                   "tool[2] comes after the needle of tool[1]: a needle stays in the body"),
-    "a shape gmsh cannot make": (edited(('shape = "box"\nsize = [0.1, 0.02, 0.02]\ndivisions = [10, 2, 2]',
-                                         'shape = "torus"\nradius = 0.01\ntube = 0.02')),
-                                 'mesh.shape "torus" could not be made: tube (0.02) must be smaller than radius (0.01)'),
+    "a shape gmsh cannot make": (edited((BOX_SHAPE, 'shape = "torus"\nradius = 0.01\ntube = 0.02')),
+                                 'mesh.shape "torus" could not be made: tube (0.02) must be smaller than radius '
+                                 '(0.01)'),
     "a name that is no folder": (edited(("[mesh]", 'name = "../up"\n\n[mesh]')),
                                  "name must be a name of letters, digits, '-', '_' or '.' (the output folder's), "
                                  'got "../up"'),
     # missing files, unknown materials and shapes
-    "a missing mesh file": (edited(('shape = "box"\nsize = [0.1, 0.02, 0.02]\ndivisions = [10, 2, 2]',
-                                    'file = "no_such.msh"')), "mesh.file names no file: "),
-    "a missing surface": (edited(('shape = "box"\nsize = [0.1, 0.02, 0.02]\ndivisions = [10, 2, 2]',
-                                  'surface = "liver.stl"\nsize = 0.01')), "mesh.surface names no file: "),
-    "an unknown material": (edited(('"neohookean"', '"rubber"')),
+    "a missing mesh file": (edited((BOX_SHAPE, 'file = "no_such.msh"')), "mesh.file names no file: "),
+    "a missing surface": (edited((BOX_SHAPE, 'surface = "liver.stl"\nsize = 0.01')), "mesh.surface names no file: "),
+    "an unknown material": (edited(('"linear"', '"rubber"')),
                             'material.name must be one of "linear", "stvk", "neohookean", "veronda", got "rubber"'),
     "an unknown shape": (edited(('"box"', '"sphere"')),
                          'mesh.shape must be one of "box", "ellipsoid", "cylinder", "torus", "lumpy", got "sphere"'),
     # tool paths that miss the body or leave it
-    "a sweep that misses the body": (edited(SCALPEL.replace("0.05, -0.01", "0.5, -0.01")),
+    "a sweep that misses the body": (edited(SCALPEL.replace("[0.05, ", "[0.5, ")),
                                      "tool[1] never meets the body: the blade's sweep from start"),
     "a needle whose line misses the body": (edited(NEEDLE.replace("0.01]", "0.5]", 1)),
                                             "tool[1].entry [0.05, -0.1, 0.5] with direction [0.0, 1.0, 0.0]: the "
@@ -141,7 +132,7 @@ MISTAKES = {
                                     "tool[1].entry [0.05, 0.01, 0.01] is inside the body"),
     "a needle that comes out the other side": (edited(NEEDLE.replace("depth = 0.01", "depth = 0.05")),
                                                "tool[1].depth 0.05 m takes the tip out of the body: the needle's line "
-                                               "leaves it 0.02 m past the entry point [0.05, 0.0, 0.01]"),
+                                               "leaves it 0.04 m past the entry point [0.05, 0.0, 0.01]"),
 }
 
 
