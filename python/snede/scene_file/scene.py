@@ -88,12 +88,11 @@ class ToolRun:
             notes.append(str(self.cut_report))
         if self.insertion is not None:
             report = self.insertion
-            entries.update(converged=entries["converged"] and report.converged,
-                           reason=entries["reason"] if not entries["converged"] or report.converged else report.reason,
-                           iterations=entries["iterations"] + sum(s.solver_iterations for s in report.steps),
+            if entries["converged"] and not report.converged:
+                entries.update(converged=False, reason=report.reason)
+            entries.update(iterations=entries["iterations"] + sum(s.solver_iterations for s in report.steps),
                            seconds=entries["seconds"] + report.seconds, updates=report.updates,
-                           rearrangements=report.rearrangements, needle_nodes=len(self.needle.needle_nodes),
-                           tetrahedra=self.body.mesh.n_cells)
+                           rearrangements=report.rearrangements, needle_nodes=len(self.needle.needle_nodes))
             notes.append(str(report))
         return {**entries, "notes": "; ".join(notes)}
 
@@ -108,12 +107,16 @@ class ToolRun:
             name = "needle" if isinstance(self.tools[-1], Needle) else "blade"
             ax.plot(tool[:, 0], tool[:, 1], tool[:, 2], color="k", linewidth=2.0, zorder=5, label=name)
 
-    def probe(self):
-        """(what it measures, its value): the last tool's needle force or opening."""
+    @property
+    def probe_name(self) -> str:
+        return "needle force along shaft [N]" if isinstance(self.tools[-1], Needle) else "widest gap between the lips [m]"
+
+    def probe(self, body) -> float:
+        """What the last tool measures: the needle's force along its shaft, or how wide the cut opened."""
         last = self.tools[-1]
         if isinstance(last, Needle):
-            return "needle force along shaft [N]", 0.0 if self.needle is None else last.shaft_force(self.needle)
-        return "widest gap between the lips [m]", lips_gap(self.body, self.incision())
+            return 0.0 if self.needle is None else last.shaft_force(self.needle)
+        return lips_gap(body, self.incision())
 
 
 def largest_displacement(body) -> float:
@@ -152,8 +155,7 @@ def build(recipe: Recipe, material_name: str | None = None) -> Scene:
     if recipe.tools:
         run = ToolRun(scene, recipe.tools)
         scene.evolve = run.evolve
-        scene.probe_name = run.probe()[0]
-        scene.probe = lambda body: run.probe()[1]
+        scene.probe_name, scene.probe = run.probe_name, run.probe
         scene.decorate = run.decorate
         scene.picture = lambda: {"view": VIEW, "loads": ("nodal", "gravity"), "reference": run._cutter is None,
                                  **({"highlight": run.incision()} if run._cutter is not None else {})}

@@ -3,6 +3,7 @@ same output files (``python -m snede run my_scene.toml --out DIR``); the example
 cut and pierce a liver made from a surface. The mistakes a file can hold are in
 test_scene_file_errors.py."""
 import json
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -172,3 +173,11 @@ friction = 50.0
     assert summary["converged"] and summary["incision_faces"] > 0 and summary["updates"] == 4
     assert summary["frames"] == 2 + 4 + 4 and summary["probe"] == "needle force along shaft [N]"
     assert summary["value"] > 0  # the friction drags the body along the shaft
+
+
+def test_the_guides_scene_file_loads(tmp_path):
+    """docs/guide/meshes_and_scenes.md shows examples/liver_cut.toml abridged: it is a scene file."""
+    guide = (ROOT / "docs" / "guide" / "meshes_and_scenes.md").read_text()
+    (text,) = re.findall(r"```toml\n(.*?)```", guide, re.S)
+    scene = scene_file.load(write(tmp_path, text.replace('"../meshes/', f'"{ROOT / "meshes"}/')))
+    assert scene.name == "liver-cut" and scene.probe_name == "widest gap between the lips [m]"
