@@ -17,6 +17,7 @@ from snede.scene_file.tools import read_tools
 from snede.scenes import MATERIAL_NAMES
 
 SECTIONS = ("name", "description", "mesh", "material", "hold", "loads", "solver", "tool")
+NEEDED = "a scene file needs [mesh], [material] and at least one [[hold]]"
 METHODS = ("cg", "ncg", "newton", "dynamic")
 POISSON = number_kind("a number in (-1, 0.5)", lambda v: -1 < v < 0.5)
 NAME = Kind("a name of letters, digits, '-', '_' or '.' (the output folder's)",
@@ -80,9 +81,8 @@ def read(path) -> Recipe:
     top.close()
     name = top.get("name", NAME, path.stem)
     description = top.get("description", TEXT, f"scene file {path.name}")
-    mesh = read_mesh(top.table("mesh", "a scene file needs [mesh], [material] and at least one [[hold]]"),
-                     path.parent)
-    material = _material(top.table("material", "a scene file needs [mesh], [material] and at least one [[hold]]"))
+    mesh = read_mesh(top.table("mesh", NEEDED), path.parent)
+    material = _material(top.table("material", NEEDED))
     holds = [_region_and(t, "displacement", [0.0, 0.0, 0.0]) for t in top.tables("hold")]
     if not holds:
         raise SceneFileError(f"{source}: [[hold]] is missing: a scene needs at least one [[hold]] table (a static "
