@@ -109,7 +109,9 @@ class ToolRun:
 
     @property
     def probe_name(self) -> str:
-        return "needle force along shaft [N]" if isinstance(self.tools[-1], Needle) else "widest gap between the lips [m]"
+        if isinstance(self.tools[-1], Needle):
+            return "needle force along shaft [N]"
+        return "widest gap between the lips [m]"
 
     def probe(self, body) -> float:
         """What the last tool measures: the needle's force along its shaft, or how wide the cut opened."""

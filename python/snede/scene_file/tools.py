@@ -40,14 +40,17 @@ FRICTION = Kind('a force per unit of shaft surface in N/m² (a number ≥ 0), [d
 STATIC_FACTOR = number_kind("a number ≥ 1", lambda v: v >= 1)
 
 
-def _inside(mesh, point) -> bool:
-    """Whether ``point`` is inside the body: the first boundary face a ray from it meets faces
-    away from it (boundary faces are oriented outward)."""
-    hit = mesh.ray_hit(point, AIM)
-    if hit is None:
-        return False
+def _leaves(mesh, hit, direction) -> bool:
+    """Whether a ray along ``direction`` leaves the body where it ``hit`` its boundary (boundary
+    faces are oriented outward), rather than enters it."""
     a, b, c = mesh.points[hit.face]
-    return float(np.cross(b - a, c - a) @ AIM) > 0
+    return float(np.cross(b - a, c - a) @ direction) > 0
+
+
+def _inside(mesh, point) -> bool:
+    """Whether ``point`` is inside the body: a ray from it first meets the boundary leaving."""
+    hit = mesh.ray_hit(point, AIM)
+    return hit is not None and _leaves(mesh, hit, AIM)
 
 
 def _crosses(mesh, a, b) -> bool:
@@ -121,10 +124,13 @@ class Needle:
             self.table.fail("entry", f"{self.entry.tolist()} with direction {self.direction.round(6).tolist()}: "
                                      f"the needle's line never meets the body (its reference shape spans "
                                      f"{_span(mesh)})")
-        if _inside(mesh, self.entry):
+        size = float(np.ptp(mesh.points, axis=0).max())
+        if _leaves(mesh, hit, self.direction):  # (an entry on the surface, going in, is outside)
+            if hit.distance <= 1e-9 * size:
+                self.table.fail("direction", f"{self.direction.round(6).tolist()} points out of the body at the entry "
+                                             f"{self.entry.tolist()}, which is on its surface")
             self.table.fail("entry", f"{self.entry.tolist()} is inside the body: give a point outside it on the "
                                      "needle's line (the needle starts where the line meets the surface)")
-        size = float(np.ptp(mesh.points, axis=0).max())
         leaves = mesh.ray_hit(hit.point + 1e-9 * size * self.direction, self.direction)
         if leaves is not None and self.depth >= leaves.distance:
             self.table.fail("depth", f"{self.depth:g} m takes the tip out of the body: the needle's line leaves "

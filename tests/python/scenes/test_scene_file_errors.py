@@ -130,6 +130,10 @@ MISTAKES = {
                                             "needle's line never meets the body"),
     "a needle that starts inside": (edited(NEEDLE.replace("[0.05, -0.1, 0.01]", "[0.05, 0.01, 0.01]")),
                                     "tool[1].entry [0.05, 0.01, 0.01] is inside the body"),
+    "a needle that points out of the body": (edited(NEEDLE.replace("[0.05, -0.1, 0.01]", "[0.05, 0.0, 0.01]")
+                                                    .replace("[0, 1, 0]", "[0, -1, 0]")),
+                                             "tool[1].direction [0.0, -1.0, 0.0] points out of the body at the entry "
+                                             "[0.05, 0.0, 0.01], which is on its surface"),
     "a needle that comes out the other side": (edited(NEEDLE.replace("depth = 0.01", "depth = 0.05")),
                                                "tool[1].depth 0.05 m takes the tip out of the body: the needle's line "
                                                "leaves it 0.04 m past the entry point [0.05, 0.0, 0.01]"),

@@ -148,6 +148,13 @@ def test_the_command_lines_material_and_method_replace_the_files(tmp_path):
     assert (summary["material"], summary["method"]) == ("NeoHookean", "ncg")
 
 
+def test_a_needle_may_start_on_the_surface(tmp_path):
+    """An entry on the surface (from Mesh.ray_hit, say), the needle going in, is outside the body."""
+    tool = '[[tool]]\nkind = "needle"\nentry = [0.05, 0.0, 0.013]\ndirection = [0, 1, 0]\ndepth = 0.02\nsteps = 2\n'
+    scene = scene_file.load(write(tmp_path, BOX + '\n[[hold]]\nside = "z = min"\n\n' + tool))
+    assert run_scene.run(scene, None, None, tmp_path / "out", progress=False)["converged"]
+
+
 def test_a_scalpel_then_a_needle_in_one_scene(tmp_path):
     """Tools run in order on the same body: the needle goes in beside the cut the blade made."""
     text = BOX + """
