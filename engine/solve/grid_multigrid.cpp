@@ -73,12 +73,11 @@ class KuhnGrid {
 GridMultigrid::GridMultigrid(Model& fine, double grid_width)
     : GalerkinMultigrid(fine) {
   const Mesh& mesh = fine.body().mesh();
-  if (mesh.is_surface())
-    throw std::invalid_argument("preconditioner 'mg' works on volume meshes (triangles in 2D, tetrahedra in 3D), "
-                                "not on a surface mesh");
   if (!(grid_width > 0) || !std::isfinite(grid_width))
     throw std::invalid_argument("mg_grid_width must be positive (mean edge lengths), got " + std::to_string(grid_width));
-  const int d = mesh.dim(), slots = d + 1;
+  // A fine vertex uses the d + 1 nodes of its grid simplex (its slots); a cell has cell_dim + 1
+  // corners (3 on a membrane in 3D).
+  const int d = mesh.dim(), slots = d + 1, corners = mesh.cell_dim() + 1;
   const auto n = static_cast<std::size_t>(mesh.n_points());
   std::array<double, 3> low{}, high{};
   low.fill(std::numeric_limits<double>::infinity());
@@ -114,7 +113,7 @@ GridMultigrid::GridMultigrid(Model& fine, double grid_width)
   std::vector<VertexId> last_seen_from(n, no_id);
   for (VertexId i = 0; i < mesh.n_points(); ++i)
     for (std::size_t e = stars.start[i]; e < stars.start[i + 1]; ++e)
-      for (VertexId j : std::span(stars.vertices[stars.element_of(stars.entries[e])]).first(slots))
+      for (VertexId j : std::span(stars.vertices[stars.element_of(stars.entries[e])]).first(corners))
         if (j > i && last_seen_from[j] != i) {
           last_seen_from[j] = i;
           join(i, j);

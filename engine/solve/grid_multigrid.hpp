@@ -20,8 +20,8 @@ namespace snede {
 
 class GridMultigrid final : public GalerkinMultigrid {
  public:
-  // Two levels: `fine`'s volume mesh and a grid `grid_width` mean edge lengths wide.
-  // Throws std::invalid_argument for a surface mesh or a non-positive width.
+  // Two levels: `fine`'s mesh (volume or membrane) and a grid `grid_width` mean edge lengths wide.
+  // Throws std::invalid_argument for a non-positive width.
   explicit GridMultigrid(Model& fine, double grid_width = default_grid_width);
   // Measured 2, 3 and 4 in benchmarks/interactive_cut.py; 3 was fastest on the block and the liver.
   static constexpr double default_grid_width = 3.0;

@@ -50,14 +50,17 @@ constexpr double newton_stall = 1e-6;
 
 // "auto": multigrid where it pays. On the cantilever block (benchmarks/static_solve_scaling.py
 // and docs/results/interactive.md) mg and no preconditioner cost the same at about 650 cells,
-// mg is 1.3× faster at 1 500, 2–3× at 5 000–40 000; nonlinear CG takes no preconditioner and
-// membranes have none yet.
+// mg is 1.3× faster at 1 500, 2–3× at 5 000–40 000. On membranes mg wins at every size measured
+// (benchmarks/membrane_preconditioners.py: 1.3–5× from 128 triangles, the slack sheet there
+// excepted), because it also cuts the
+// Newton iterations of a sheet that is slack or wrinkled. Nonlinear CG takes none.
 constexpr std::size_t multigrid_from_cells = 1000;
 
 std::string automatic_preconditioner(const Model& model, StaticMethod method) {
   const Mesh& mesh = model.body().mesh();
-  if (method == StaticMethod::nonlinear_cg || mesh.is_surface() || mesh.n_cells() < multigrid_from_cells) return PCNONE;
-  return PCMG;
+  if (method == StaticMethod::nonlinear_cg) return PCNONE;
+  if (mesh.is_surface() || mesh.n_cells() >= multigrid_from_cells) return PCMG;
+  return PCNONE;
 }
 
 }  // namespace
@@ -91,9 +94,6 @@ StaticSolver::StaticSolver(Model& model, StaticOptions options, const Refinement
   if (options_.method == StaticMethod::nonlinear_cg && pc_type_ != PCNONE)
     throw std::invalid_argument("a preconditioner ('" + pc_type_ + "') applies to the CG of methods 'cg' and 'newton'; "
                                 "nonlinear CG ('ncg') takes none");
-  if (model.body().mesh().is_surface() && pc_type_ != PCNONE)
-    throw std::invalid_argument("preconditioner '" + pc_type_ + "' is not implemented for membranes (surface meshes): "
-                                "the tangent's diagonal and assembly assume volume elements; use 'none'");
   // Jacobi reads the shell's diagonal (MatGetDiagonal), mg builds its own levels (and needs
   // entries only for Galerkin levels); every other PC needs entries.
   pc_needs_matrix_ = pc_type_ != PCNONE && pc_type_ != PCJACOBI && pc_type_ != PCMG;
@@ -270,7 +270,8 @@ void StaticSolver::follow_mesh_changes() {
 Mat StaticSolver::preconditioning_matrix() {
   if (!needs_matrix_) return model_.tangent();
   if (!assembled_) {
-    assembled_ = std::make_unique<AssembledTangent>(model_, MatrixFormat::aij);  // GAMG works on AIJ
+    // GAMG works on AIJ; a membrane's compressed elements must not make the PC indefinite.
+    assembled_ = std::make_unique<AssembledTangent>(model_, MatrixFormat::aij, MembraneTangent::positive_part);
     set_rigid_body_near_null_space(model_, assembled_->mat());
     preconditioner_filled_ = false;
   }

@@ -1,6 +1,9 @@
 #include "solve/tangent_assembly.hpp"
 
+#include <Eigen/Eigenvalues>
+
 #include <algorithm>
+#include <array>
 #include <numeric>
 #include <span>
 #include <string>
@@ -13,11 +16,40 @@
 namespace snede {
 namespace {
 
-// The element-matrix loops below take dim + 1 corners per element: volume meshes only.
-void require_volume_mesh(const Model& model, const char* what) {
-  if (model.body().mesh().is_surface())
-    throw std::invalid_argument(std::string(what) + " is not implemented for membranes (surface meshes) yet");
-}
+// Vertices per cell: dim + 1 for volume meshes, 3 for membranes (triangles in 3D), each with
+// dim displacement components.
+int corners_per_cell(const Model& model) { return model.body().mesh().cell_dim() + 1; }
+
+// A membrane's element tangent is indefinite wherever the sheet is compressed (it has no
+// bending stiffness to resist wrinkling), and multigrid built from it made CG's directions
+// useless (DIVERGED_LINE_SEARCH at once on a hanging box skin). A preconditioner takes each
+// membrane element matrix's positive part instead (its negative eigenvalues raised to a small
+// floor: projected Newton, Teran et al. 2005); the operator of every solve stays the exact
+// tangent.
+class MembranePositivePart {
+ public:
+  static constexpr int n = 9;  // 3 corners × 3 components
+  // Eigenvalues are raised to at least this fraction of the element's largest: a slack element
+  // has none across the sheet, and a singular coarse operator made mg fail on a sheet loaded
+  // across its plane before it was stretched (benchmarks/membrane_preconditioners.py: with 1e-4
+  // it converged at 128 and 512 triangles, with 0 at 512 only). Measured 0, 1e-4, 1e-3, 1e-2,
+  // 1e-1: 1e-4 took the fewest iterations on the taut and the sagging sheets and the
+  // membrane-cut scene (574 Newton iterations against 615 with 0 and 851 with 1e-3).
+  static constexpr double slack_floor = 1e-4;
+  std::span<const double> operator()(std::span<const double> K) {
+    const Eigen::Map<const Eigen::Matrix<double, n, n, Eigen::RowMajor>> matrix(K.data());
+    solver_.compute(matrix);
+    const Eigen::Matrix<double, n, 1> positive =
+        solver_.eigenvalues().cwiseMax(slack_floor * std::max(solver_.eigenvalues().maxCoeff(), 0.0));
+    Eigen::Map<Eigen::Matrix<double, n, n, Eigen::RowMajor>>(part_.data()) =
+        solver_.eigenvectors() * positive.asDiagonal() * solver_.eigenvectors().transpose();
+    return part_;
+  }
+
+ private:
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, n, n>> solver_;
+  std::array<double, n * n> part_{};
+};
 
 // Every vertex's block of P (dim × dim, row-major), one after another.
 std::vector<double> projection_blocks(const Model& model) {
@@ -36,7 +68,7 @@ std::vector<double> projection_blocks(const Model& model) {
 template <class Visit>
 void for_each_projected_element_matrix(const Model& model, std::span<const double> u, const std::vector<double>& P,
                                        Visit&& visit) {
-  const int d = model.dim(), n = (d + 1) * d;
+  const int d = model.dim(), corners = corners_per_cell(model), n = corners * d;
   std::vector<bool> free(model.body().mesh().n_points());
   for (VertexId v = 0; v < static_cast<VertexId>(free.size()); ++v)
     free[v] = model.constraints()[v].kind == ConstraintKind::free;
@@ -48,7 +80,7 @@ void for_each_projected_element_matrix(const Model& model, std::span<const doubl
       return;
     }
     // left = diag(P_a) K, then projected = left diag(P_b): block by block, dim × dim each.
-    for (int a = 0; a <= d; ++a)
+    for (int a = 0; a < corners; ++a)
       for (int col = 0; col < n; ++col)
         for (int i = 0; i < d; ++i) {
           double sum = 0;
@@ -57,7 +89,7 @@ void for_each_projected_element_matrix(const Model& model, std::span<const doubl
           left[static_cast<std::size_t>(a * d + i) * n + col] = sum;
         }
     for (int row = 0; row < n; ++row)
-      for (int b = 0; b <= d; ++b)
+      for (int b = 0; b < corners; ++b)
         for (int j = 0; j < d; ++j) {
           double sum = 0;
           for (int m = 0; m < d; ++m)
@@ -77,9 +109,8 @@ std::vector<double> complement_blocks(const std::vector<double>& P, int d) {
 
 }  // namespace
 
-AssembledTangent::AssembledTangent(const Model& model, MatrixFormat format)
-    : format_(format), revision_(model.body().mesh().connectivity().revision()) {
-  require_volume_mesh(model, "the assembled tangent");
+AssembledTangent::AssembledTangent(const Model& model, MatrixFormat format, MembraneTangent membranes)
+    : format_(format), membranes_(membranes), revision_(model.body().mesh().connectivity().revision()) {
   const Mesh& mesh = model.body().mesh();
   const Connectivity& c = mesh.connectivity();
   const int d = model.dim();
@@ -89,7 +120,7 @@ AssembledTangent::AssembledTangent(const Model& model, MatrixFormat format)
   // follows, so it is made vertex by vertex from the elements around each (one small sort per
   // vertex, a scratch array for the places) rather than by searching sorted lists.
   const VertexStars stars = all_vertex_stars(c, n);
-  const int corners = d + 1;
+  const int corners = corners_per_cell(model);
   std::vector<std::size_t> row(static_cast<std::size_t>(n) + 1, 0);
   std::vector<VertexId> neighbour_list;
   neighbour_list.reserve(stars.entries.size() * 2 + n);
@@ -157,23 +188,26 @@ bool AssembledTangent::matches(const Model& model) const {
 void AssembledTangent::assemble(const Model& model, Vec u) {
   if (!matches(model))
     throw std::logic_error("the assembled tangent was made for another mesh: the mesh changed since");
-  const int d = model.dim(), n = (d + 1) * d;
+  const int d = model.dim(), corners = corners_per_cell(model), n = corners * d;
   const std::vector<double> P = projection_blocks(model);
   const std::vector<double> complement = complement_blocks(P, d);
+  const bool membrane = model.body().mesh().is_surface() && membranes_ == MembraneTangent::positive_part;
+  MembranePositivePart positive_part;
   ReadView x(u);
   if (format_ == MatrixFormat::aij) {
     PetscScalar* values = nullptr;
     SNEDE_PETSC(MatSeqAIJGetArray(A_, &values));
     std::fill(values, values + row_start_.back(), 0.0);
     for_each_projected_element_matrix(model, x.span(), P, [&](ElementId e, std::span<const VertexId> vertices,
-                                                              std::span<const double> K) {
-      const std::int32_t* ranks = block_rank_.data() + static_cast<std::size_t>(e) * (d + 1) * (d + 1);
-      for (int a = 0; a <= d; ++a)
+                                                              std::span<const double> element_matrix) {
+      const std::span<const double> K = membrane ? positive_part(element_matrix) : element_matrix;
+      const std::int32_t* ranks = block_rank_.data() + static_cast<std::size_t>(e) * corners * corners;
+      for (int a = 0; a < corners; ++a)
         for (int i = 0; i < d; ++i) {
           PetscScalar* row = values + row_start_[static_cast<std::size_t>(vertices[a]) * d + i];
           const double* K_row = K.data() + static_cast<std::size_t>(a * d + i) * n;
-          for (int b = 0; b <= d; ++b)
-            for (int j = 0; j < d; ++j) row[d * ranks[a * (d + 1) + b] + j] += K_row[b * d + j];
+          for (int b = 0; b < corners; ++b)
+            for (int j = 0; j < d; ++j) row[d * ranks[a * corners + b] + j] += K_row[b * d + j];
         }
     });
     // + (I − P): the constrained directions keep a unit diagonal, as in the shell.
@@ -186,7 +220,8 @@ void AssembledTangent::assemble(const Model& model, Vec u) {
     SNEDE_PETSC(MatZeroEntries(A_));
     std::vector<PetscInt> block_rows;
     for_each_projected_element_matrix(model, x.span(), P, [&](ElementId, std::span<const VertexId> vertices,
-                                                              std::span<const double> K) {
+                                                              std::span<const double> element_matrix) {
+      const std::span<const double> K = membrane ? positive_part(element_matrix) : element_matrix;
       block_rows.assign(vertices.begin(), vertices.end());
       const auto count = static_cast<PetscInt>(block_rows.size());
       SNEDE_PETSC(MatSetValuesBlocked(A_, count, block_rows.data(), count, block_rows.data(), K.data(), ADD_VALUES));
@@ -213,8 +248,7 @@ void set_rigid_body_near_null_space(const Model& model, Mat A) {
 }
 
 void tangent_diagonal(const Model& model, Vec u, Vec diagonal) {
-  require_volume_mesh(model, "the tangent's diagonal");
-  const int d = model.dim(), n = (d + 1) * d;
+  const int d = model.dim(), n = corners_per_cell(model) * d;
   const std::vector<double> P = projection_blocks(model);
   std::vector<double> values(model.body().n_dofs(), 0.0);
   {

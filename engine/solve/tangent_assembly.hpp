@@ -17,11 +17,17 @@ namespace snede {
 
 enum class MatrixFormat { aij, baij };
 
+// What a membrane element contributes: its exact tangent, or its positive part (eigenvalues
+// raised to a small positive floor) for a preconditioner, which must stay positive semidefinite where
+// the sheet is compressed and its tangent indefinite (tangent_assembly.cpp). Volume elements
+// always contribute their exact tangent.
+enum class MembraneTangent { exact, positive_part };
+
 // J with the block sparsity of the mesh it was made for: a dim × dim block for every pair of
 // vertices that share an element, and a diagonal block for every vertex (removed ones too).
 class AssembledTangent {
  public:
-  AssembledTangent(const Model& model, MatrixFormat format);
+  AssembledTangent(const Model& model, MatrixFormat format, MembraneTangent membranes = MembraneTangent::exact);
   // Whether the mesh is still the one this matrix was made for (no edit since).
   bool matches(const Model& model) const;
   // Fills the matrix with J at u, scaled by the model's operator scale s as the shell is.
@@ -31,6 +37,7 @@ class AssembledTangent {
 
  private:
   MatrixFormat format_;
+  MembraneTangent membranes_;
   std::uint64_t revision_;
   MatHandle A_;
   std::vector<PetscInt> row_start_;       // AIJ: offset of each scalar row's first value

@@ -133,12 +133,10 @@ class Body:
     def assemble_tangent(self, u=None, format: str = "baij"):
         """J at ``u`` (default the current displacement) assembled from the same element kernels
         into a new petsc4py ``Mat``: ``format`` "baij" (blocks of dim × dim) or "aij". For
-        preconditioners and comparison; it does not follow later mesh changes. Not for
-        membranes yet: the assembly takes every cell to have dim + 1 corners. A dropped one is
-        freed when snede next hands out a PETSc handle (petsc4py defers the destroy)."""
-        if self.mesh.is_surface:
-            raise ValueError("assemble_tangent is not available for membranes (surface meshes) yet: the assembly "
-                             "expects dim + 1 corners per cell; use the matrix-free tangent_operator")
+        preconditioners and comparison; it does not follow later mesh changes. (The solvers'
+        preconditioners take a membrane element's positive part instead, where the sheet is
+        compressed.) A dropped one is freed when snede next hands out a PETSc handle (petsc4py
+        defers the destroy)."""
         return self._model.assemble_tangent(self._field("u", self.displacement if u is None else u), str(format))
 
     def lumped_mass(self) -> np.ndarray:

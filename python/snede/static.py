@@ -43,7 +43,7 @@ class StaticSolver(RunsOnRanks):
       rigid-body modes as near null space; refilled at every Newton iteration unless
       ``-static_snes_lag_preconditioner k`` lags it, rebuilt after a cut or refinement); or any
       PETSc PC that works on an assembled matrix (``"ilu"``, ``"icc"``, ``"sor"``, ``"lu"``);
-      or ``"mg"``: multigrid for any volume mesh. On a mesh refined with ``mesh.refine_uniform``
+      or ``"mg"``: multigrid for any mesh, membranes included. On a mesh refined with ``mesh.refine_uniform``
       or ``refine_around`` whose coarser cuts through the refinement tree are conforming (§6.5),
       the levels are those coarser meshes, each with its own matrix-free tangent shell over the
       same element kernels (linearised at the injected state), Chebyshev/Jacobi smoothing and LU
@@ -61,8 +61,10 @@ class StaticSolver(RunsOnRanks):
       ``-static_mg_aggregate_width`` and ``-static_mg_aggregation_smoothing`` tune the coarse
       spaces. ``-static_mg_levels_ksp_type``, ``-static_pc_mg_levels`` and the other
       ``-static_mg_*`` options of PETSc's PCMG tune it (docs/results/interactive.md).
-      ``"auto"``: ``"mg"`` for cg and newton on volume meshes of 1 000 cells or more (where it
-      measured faster than no preconditioner), else ``"none"``. None (default):
+      ``"auto"``: ``"mg"`` for cg and newton on volume meshes of 1 000 cells or more and on
+      membranes of any size (where it measured faster than no preconditioner), else ``"none"``.
+      On a membrane every preconditioner assembled from element matrices takes each element's
+      positive part (compressed, wrinkling elements are indefinite). None (default):
       ``-static_pc_type`` if given, else ``"auto"``. ``-static_pc_type`` on the command line wins
       over the argument. The shell stays the operator in every case.
 

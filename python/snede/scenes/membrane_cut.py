@@ -150,9 +150,9 @@ class MembraneCut:
                              f"stiffness across itself until it is stretched); got {method!r}")
         say = print if progress else (lambda *args, **kwargs: None)
         body, mesh = self.body, self.body.mesh
-        # No preconditioner: the membrane's tangent is singular across the surface where it is
-        # slack, which jacobi and the multigrids refuse.
-        solver = snede.StaticSolver(body, "newton", rtol=rtol, preconditioner="none", max_iterations=MAX_ITERATIONS)
+        # The default preconditioner (mg on a membrane) took 615 Newton iterations over the bell's
+        # 26 solves where none took 2 789 (5 s of solves against 12).
+        solver = snede.StaticSolver(body, "newton", rtol=rtol, max_iterations=MAX_ITERATIONS)
         result = solver.solve()
         self.results.append(result)
         say(f"membrane-cut: bell's rim pulled {PULL:.0%} outward: {result}", flush=True)
