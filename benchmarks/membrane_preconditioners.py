@@ -1,7 +1,7 @@
 """Benchmark: static Newton solves of membranes (triangles in 3D) with each preconditioner
 (issue 31: mg for every mesh the solver accepts).
 
-    .venv/bin/python benchmarks/membrane_preconditioners.py           # about 1 minute
+    .venv/bin/python benchmarks/membrane_preconditioners.py           # about 40 s
     .venv/bin/python benchmarks/membrane_preconditioners.py --quick   # the smaller sizes only
 
 Scenes, neo-Hookean E = 100 kPa, ν = 0.3, 1 mm thick, Newton rtol 1e-6:
@@ -13,19 +13,26 @@ Scenes, neo-Hookean E = 100 kPa, ν = 0.3, 1 mm thick, Newton rtol 1e-6:
   meets elements with no stiffness across the sheet, along which the load pulls;
 * hanging skin: the boundary of a 0.4 × 0.1 × 0.1 m box (36 n² triangles) held at x = 0 under
   gravity (1000 kg/m³); it sags by about its own length into folds, where compressed elements
-  make the tangent indefinite (several equilibria: the final sag differs between rows).
+  make the tangent indefinite (several equilibria: the final sag differs between rows);
+* organ skin: the closed skins of docs/results/membranes_on_organs.md (E = 5 kPa, ν = 0.45, held
+  along the top tenth): snede.meshing.ellipsoid(h=0.01)'s, and those of SOFA's liver filled by
+  gmsh with 1 500 and 6 000 tetrahedra (benchmarks/organ_meshes.py).
 
 One row per scene, size and preconditioner: whether the solve converged (PETSc's reason),
 Newton and CG iterations, seconds, and the time without a preconditioner over this one.
 Compare rows of one run (the machine is shared).
 """
 import argparse
+import sys
 import time
+from pathlib import Path
 import warnings
 
 import numpy as np
 
 import snede
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 PRECONDITIONERS = ("none", "jacobi", "gamg", "mg")
 
@@ -52,13 +59,28 @@ def hanging_skin(n: int) -> snede.Body:
     return body
 
 
+def organ_skin(source: str) -> snede.Body:
+    """The closed skin of docs/results/membranes_on_organs.md: E = 5 kPa, ν = 0.45, held along
+    the top tenth of its height under gravity."""
+    from organ_meshes import organ_mesh
+
+    volume = snede.meshing.ellipsoid(h=0.01) if source == "ellipsoid" else organ_mesh("liver", int(source))
+    surface, _ = snede.meshing.boundary_surface(volume)
+    body = snede.Body(surface, snede.NeoHookean(5e3, 0.45), thickness=0.001, density=1000.0)
+    z = surface.points[:, 2]
+    body.fix(z >= z.max() - 0.1 * np.ptp(z))
+    body.add_gravity((0.0, 0.0, -9.81))
+    return body
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--quick", action="store_true", help="the smaller sizes only")
     args = parser.parse_args()
     sizes = (8, 16) if args.quick else (8, 16, 32)
     scenes = [("taut sheet", lambda n: sheet(n, taut=True), sizes), ("slack sheet", lambda n: sheet(n, taut=False), sizes),
-              ("hanging skin", hanging_skin, (2, 4) if args.quick else (2, 4, 6))]
+              ("hanging skin", hanging_skin, (2, 4) if args.quick else (2, 4, 6)),
+              ("organ skin", organ_skin, ("ellipsoid", "1500") if args.quick else ("ellipsoid", "1500", "6000"))]
     warnings.simplefilter("ignore", snede.LockingWarning)
     print(f"{'scene':>13} {'triangles':>9} {'pc':>7} | {'reason':>22} {'Newton':>6} {'CG':>6} {'seconds':>8} "
           f"{'none/pc':>7} | {'min u_z [m]':>11}")

@@ -50,17 +50,15 @@ constexpr double newton_stall = 1e-6;
 
 // "auto": multigrid where it pays. On the cantilever block (benchmarks/static_solve_scaling.py
 // and docs/results/interactive.md) mg and no preconditioner cost the same at about 650 cells,
-// mg is 1.3× faster at 1 500, 2–3× at 5 000–40 000. On membranes mg wins at every size measured
-// (benchmarks/membrane_preconditioners.py: 1.3–5× from 128 triangles, the slack sheet there
-// excepted), because it also cuts the
-// Newton iterations of a sheet that is slack or wrinkled. Nonlinear CG takes none.
+// mg is 1.3× faster at 1 500, 2–3× at 5 000–40 000. Membranes (docs/results/interactive.md):
+// 1.3–5× faster from 1 000 triangles on sheets and organ skins (a slack sheet loaded across its
+// plane excepted); below, mixed (2× faster on a box's skin of 144, 2× slower on organ skins of
+// 600–700). Nonlinear CG takes none.
 constexpr std::size_t multigrid_from_cells = 1000;
 
 std::string automatic_preconditioner(const Model& model, StaticMethod method) {
-  const Mesh& mesh = model.body().mesh();
-  if (method == StaticMethod::nonlinear_cg) return PCNONE;
-  if (mesh.is_surface() || mesh.n_cells() >= multigrid_from_cells) return PCMG;
-  return PCNONE;
+  if (method == StaticMethod::nonlinear_cg || model.body().mesh().n_cells() < multigrid_from_cells) return PCNONE;
+  return PCMG;
 }
 
 }  // namespace

@@ -61,8 +61,8 @@ class StaticSolver(RunsOnRanks):
       ``-static_mg_aggregate_width`` and ``-static_mg_aggregation_smoothing`` tune the coarse
       spaces. ``-static_mg_levels_ksp_type``, ``-static_pc_mg_levels`` and the other
       ``-static_mg_*`` options of PETSc's PCMG tune it (docs/results/interactive.md).
-      ``"auto"``: ``"mg"`` for cg and newton on volume meshes of 1 000 cells or more and on
-      membranes of any size (where it measured faster than no preconditioner), else ``"none"``.
+      ``"auto"``: ``"mg"`` for cg and newton on meshes of 1 000 cells or more, membranes
+      included (where it measured faster than no preconditioner), else ``"none"``.
       On a membrane every preconditioner assembled from element matrices takes each element's
       positive part (compressed, wrinkling elements are indefinite). None (default):
       ``-static_pc_type`` if given, else ``"auto"``. ``-static_pc_type`` on the command line wins

@@ -266,7 +266,11 @@ def test_auto_takes_multigrid_where_it_pays():
     surface, _ = snede.meshing.boundary_surface(snede.meshing.box((0.4, 0.1, 0.1), (24, 6, 6)))
     assert surface.n_cells >= 1000
     membrane = snede.Body(surface, snede.NeoHookean(1e5, 0.3), thickness=0.001)
-    assert snede.StaticSolver(membrane, "newton").preconditioner == "mg"  # at any size: test_membrane.py
+    assert snede.StaticSolver(membrane, "newton").preconditioner == "mg"
+    small_membrane = snede.Body(snede.meshing.boundary_surface(snede.meshing.box((0.4, 0.1, 0.1), (8, 2, 2)))[0],
+                                snede.NeoHookean(1e5, 0.3), thickness=0.001)
+    assert small_membrane.mesh.n_cells < 1000
+    assert snede.StaticSolver(small_membrane, "newton").preconditioner == "none"
 
 
 def test_bad_coarsening_options_are_refused_naming_them(gmsh_cylinder):
