@@ -18,6 +18,15 @@ Eigen::Vector3d vec(const Point3& p) { return {p[0], p[1], p[2]}; }
 
 // Barycentric coordinates tolerance: a point on a shared face or edge belongs to both sides.
 constexpr double inside_tolerance = 1e-10;
+// A snap may shrink an element of the body as it is now to no less than this fraction of its
+// volume there.
+constexpr double current_flattening_floor = 1e-3;
+
+double signed_volume(const std::array<Point3, 4>& p) {
+  Eigen::Matrix3d edges;
+  for (int k = 0; k < 3; ++k) edges.col(k) = vec(p[k + 1]) - vec(p[0]);
+  return edges.determinant() / 6.0;
+}
 
 // Candidates for a boundary vertex in boundary face `corner`: where the sweep plane crosses
 // the face, a segment; its point closest to `from`, and its two ends (which lie on the face's
@@ -113,7 +122,11 @@ EditResult snap_to_sweep(Mesh& mesh, const DeformedPositions& x, VertexId v, con
   const VertexParents snapped = VertexParents::barycentric(parents, std::span<const double>(weights.data(), 4));
 
   // The deformed star must stay positive with v at its new deformed position, in the
-  // configuration the sweep is made against and in the body's current one.
+  // configuration the sweep is made against and in the body's current one. In the current one
+  // it must not go nearly flat either: the reference configuration's degenerate elements are
+  // removed after the sweep (§3.2), but one flat only as the body is now was not, and left
+  // J ≈ 1e-13, a non-finite neo-Hookean stress and every later solve failing (organ_cuts: the
+  // torus's failed solves after cuts).
   for (const DeformedPositions* config : {&x, current}) {
     if (!config) continue;
     Eigen::Vector3d moved = Eigen::Vector3d::Zero();
@@ -124,10 +137,14 @@ EditResult snap_to_sweep(Mesh& mesh, const DeformedPositions& x, VertexId v, con
       std::array<Point3, 4> p;
       for (int k = 0; k < 4; ++k) p[k] = (*config)(order[k]);
       if (orientation_3d(p[0].data(), p[1].data(), p[2].data(), p[3].data()) <= 0) continue;  // already inverted
+      const double before = signed_volume(p);
       for (int k = 0; k < 4; ++k)
         if (order[k] == v) p[k] = at;
       if (orientation_3d(p[0].data(), p[1].data(), p[2].data(), p[3].data()) <= 0)
         return EditResult::refused(name + ": snapping would invert element " + std::to_string(e) + " in the deformed body");
+      if (config == current && signed_volume(p) < current_flattening_floor * before)
+        return EditResult::refused(name + ": snapping would flatten element " + std::to_string(e) +
+                                   " in the body as it is now");
     }
   }
   return snap_vertex(mesh, v, snapped);

@@ -26,7 +26,8 @@ namespace snede {
 // boundary vertex, when no tetrahedron around the vertex contains the point (the
 // thesis's failed repositioning), or when the move would make an element of the vertex's
 // star flat or inverted in the reference or the deformed configuration (and, when given, in
-// `current`: the body as it is now, when the sweep is made against an earlier configuration).
+// `current`: the body as it is now, when the sweep is made against an earlier configuration;
+// there also when it would shrink an element to less than a thousandth of its volume).
 EditResult snap_to_sweep(Mesh& mesh, const DeformedPositions& x, VertexId v, const SweepTriangle& plane,
                          const DeformedPositions* current = nullptr);
 
