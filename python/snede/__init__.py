@@ -24,7 +24,7 @@ from snede.static import StaticSolver  # noqa: F401
 from snede.dynamics import DynamicRelaxation  # noqa: F401
 from snede.needle import FrictionProfile, NeedleInsertion  # noqa: F401
 from snede.cutting import TetrahedralCutter, CutReport  # noqa: F401
-from snede.planar_cutting import DelaunayCutter, PlanarCutReport  # noqa: F401
+from snede.planar_cutting import DelaunayCutter, IncisionLost, PlanarCutReport  # noqa: F401
 from snede.surface_cutting import SurfaceCutter  # noqa: F401
 from snede.distributed import DistributedMesh, DistributedRelaxation, DistributedStatic, distribute  # noqa: F401
 from snede.subdivision_cutting import SubdivisionCutter  # noqa: F401
@@ -34,6 +34,7 @@ from snede._output_folder import output_folder  # noqa: F401
 __all__ = [
     "Mesh", "MeshQuality", "Body", "meshing", "StaticSolver", "DynamicRelaxation", "SolveResult",
     "FrictionProfile", "NeedleInsertion", "TetrahedralCutter", "CutReport", "DelaunayCutter", "PlanarCutReport", "SurfaceCutter",
+    "IncisionLost",
     "SubdivisionCutter", "DistributedMesh", "DistributedRelaxation", "DistributedStatic", "distribute",
     "LinearElastic", "StVenantKirchhoff", "NeoHookean", "VerondaWestmann",
     "EditResult", "FileError", "InvalidMesh", "PetscError", "DomainError", "LockingWarning", "PETSc",

@@ -40,7 +40,7 @@ class SurfaceCutter(IncisionCutter):
     ``ValueError`` before anything changes.
 
     Edits made by others between moves are followed as by the 2D cutter; an incision whose
-    tip they took away ends, and the next move raises :data:`snede.planar_cutting.IncisionLost`
+    tip they took away ends, and the next move raises :data:`snede.IncisionLost`
     naming it (the other incisions go on with the move after it).
     """
 

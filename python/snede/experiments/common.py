@@ -17,12 +17,16 @@ _REPOSITORY = Path(__file__).resolve().parents[3]
 RESULTS_DIR = (_REPOSITORY if (_REPOSITORY / "pyproject.toml").exists() else Path.cwd()) / "docs" / "results"
 
 
-def parse_arguments(description: str, argv: Sequence[str] | None = None) -> argparse.Namespace:
-    """``--quick`` (small sizes, seconds) and ``--out DIR`` (default docs/results); anything
-    else is left to PETSc, which reads the command line itself."""
+def parse_arguments(description: str, argv: Sequence[str] | None = None,
+                    add_arguments: Callable[[argparse.ArgumentParser], None] | None = None) -> argparse.Namespace:
+    """``--quick`` (small sizes, seconds), ``--out DIR`` (default docs/results) and what
+    ``add_arguments`` adds to the parser (an experiment's own options); anything else is left to
+    PETSc, which reads the command line itself."""
     parser = argparse.ArgumentParser(description=description, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--quick", action="store_true", help="small sizes that run in seconds (for tests)")
     parser.add_argument("--out", type=Path, default=RESULTS_DIR, help=f"output folder (default {RESULTS_DIR})")
+    if add_arguments:
+        add_arguments(parser)
     arguments, _ = parser.parse_known_args(argv)
     arguments.out.mkdir(parents=True, exist_ok=True)
     return arguments

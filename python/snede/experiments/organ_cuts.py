@@ -333,11 +333,9 @@ def _parsed(value: str):
 
 
 def main(argv=None) -> list[dict]:
-    arguments = parse_arguments(__doc__, argv)
-    cuts = 4 if arguments.quick else 200
-    for i, value in enumerate(argv or sys.argv[1:]):
-        if value == "--cuts":
-            cuts = int((argv or sys.argv[1:])[i + 1])
+    arguments = parse_arguments(__doc__, argv, lambda parser: parser.add_argument(
+        "--cuts", type=int, default=None, help="cuts per shape (default 200; 4 with --quick)"))
+    cuts = arguments.cuts if arguments.cuts is not None else 4 if arguments.quick else 200
     start = time.perf_counter()
     rows = run(arguments.quick, cuts)
     write_csv(arguments.out / "organ_cuts.csv", rows)

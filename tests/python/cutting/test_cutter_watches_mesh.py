@@ -111,6 +111,7 @@ def test_an_active_node_a_dissection_leaves_no_tip_makes_the_next_move_raise_nam
     with pytest.raises(IncisionLost, match=rf"active node {tip}\b.*dissect"):
         cutter.move([0.43, 0.45])
     assert isinstance(IncisionLost("x"), RuntimeError)
+    assert snede.IncisionLost is IncisionLost  # catchable as snede.IncisionLost too
     np.testing.assert_array_equal(mesh.points, points)
     np.testing.assert_array_equal(mesh.cells, cells)
     assert cutter.active_node is None

@@ -105,3 +105,9 @@ def test_relaxing_after_every_move_of_a_cut_through_the_hanging_torus_converges(
         if move > 0:
             result = solver.solve()
             assert result.converged, (move, result)
+
+
+def test_the_experiment_takes_its_cuts_per_shape_from_the_command_line(tmp_path):
+    rows = organ_cuts.main(["--quick", "--cuts", "1", "--out", str(tmp_path)])
+    assert len(rows) == len(organ_cuts.shapes(quick=True))  # one cut per shape
+    assert (tmp_path / "organ_cuts.md").exists() and (tmp_path / "organ_cuts.csv").exists()
