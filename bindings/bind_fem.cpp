@@ -61,8 +61,9 @@ py::array_t<double> stiffness_of(const ElasticBody& body, ElementId e, const Dou
 }
 
 // std::variant's caster needs default-constructible alternatives; materials have none.
-std::unique_ptr<ElasticBody> make_body(Mesh& mesh, const py::handle& material, double density, double thickness) {
-  return std::make_unique<ElasticBody>(mesh, material_from(material), density, thickness);
+std::unique_ptr<ElasticBody> make_body(Mesh& mesh, const py::handle& material, double density, double thickness,
+                                       const std::string& formulation) {
+  return std::make_unique<ElasticBody>(mesh, material_from(material), density, thickness, parse_formulation(formulation));
 }
 
 py::dict flops_of(const ElasticBody& body) {
@@ -123,10 +124,15 @@ void bind_fem(py::module_& m) {
   veronda.def(py::init(&make_veronda_westmann), py::arg("E"), py::arg("nu") = py::none(), py::arg("gamma") = py::none())
       .def_readonly("gamma", &VerondaWestmann::gamma);
 
+  m.def("formulations", [] {
+    std::vector<std::string> names(formulation_names.begin(), formulation_names.end());
+    return names;
+  });
   py::class_<ElasticBody>(m, "ElasticBody")
       .def(py::init(&make_body), py::arg("mesh"), py::arg("material"), py::arg("density"),
-           py::arg("thickness"), py::keep_alive<1, 2>())
+           py::arg("thickness"), py::arg("formulation") = "p1", py::keep_alive<1, 2>())
       .def_property_readonly("dim", &ElasticBody::dim)
+      .def_property_readonly("formulation", [](const ElasticBody& b) { return std::string(name_of(b.formulation())); })
       .def_property_readonly("density", &ElasticBody::density)
       .def_property_readonly("thickness", &ElasticBody::thickness)
       .def("energy", &energy_of, py::arg("u"))

@@ -13,6 +13,7 @@
 #include "fem/linear_elastic_kernel.hpp"
 #include "fem/local_dofs.hpp"
 #include "fem/membrane_loops.hpp"
+#include "fem/smoothed_loops.hpp"
 
 namespace snede {
 namespace {
@@ -217,10 +218,14 @@ void throw_if_domain_error(const EvaluationReport& report) {
   throw DomainError(message.str());
 }
 
-ElasticBody::ElasticBody(Mesh& mesh, Material material, double density, double thickness)
-    : mesh_(mesh), material_(std::move(material)), density_(density), thickness_(thickness) {
+ElasticBody::ElasticBody(Mesh& mesh, Material material, double density, double thickness, Formulation formulation)
+    : mesh_(mesh), material_(std::move(material)), density_(density), thickness_(thickness), formulation_(formulation) {
   require_positive("density", density);
   if (is_membrane()) {
+    if (formulation != Formulation::p1)
+      throw std::invalid_argument("formulation '" + std::string(name_of(formulation)) +
+                                  "' is for tetrahedra and plane triangles; a membrane takes 'p1' (in plane stress it "
+                                  "does not lock)");
     require_positive("thickness (required for a membrane on a surface mesh)", thickness);
     flops_ = membrane_kernel_flops(material_);
   } else {
@@ -244,6 +249,19 @@ const ElementStream<2>& ElasticBody::stream<2>() const {
 template <>
 const ElementStream<3>& ElasticBody::stream<3>() const {
   return stream_3d_;
+}
+
+template <>
+const StrainPatches<2>& ElasticBody::patches<2>() const {
+  if (patches_stale_) patches_2d_.build(stream_2d_, mesh_.n_points());
+  patches_stale_ = false;
+  return patches_2d_;
+}
+template <>
+const StrainPatches<3>& ElasticBody::patches<3>() const {
+  if (patches_stale_) patches_3d_.build(stream_3d_, mesh_.n_points());
+  patches_stale_ = false;
+  return patches_3d_;
 }
 
 void ElasticBody::reserve_ids(ElementId capacity) {
@@ -290,6 +308,7 @@ void ElasticBody::init(const Connectivity& connectivity) {
   membranes_ = {};
   reserve_ids(connectivity.element_capacity());
   for (ElementId e : connectivity.element_ids()) compute_reference(connectivity, e);
+  patches_stale_ = true;
 }
 
 void ElasticBody::on_change(const Connectivity& connectivity, const ConnectivityChange& change) {
@@ -301,6 +320,7 @@ void ElasticBody::on_change(const Connectivity& connectivity, const Connectivity
   for (ElementId e : change.added_elements) compute_reference(connectivity, e);
   for (const auto& entry : change.changed_elements) compute_reference(connectivity, entry.first);
   for (ElementId e : change.reshaped_elements) compute_reference(connectivity, e);  // a corner moved
+  patches_stale_ = true;  // vertices may have been added too: the patches' arrays are per vertex
 }
 
 void ElasticBody::check_size(const char* what, std::span<const double> a) const {
@@ -319,6 +339,9 @@ double ElasticBody::energy(std::span<const double> u, EvaluationReport& report) 
     log_flops(flops_.energy, n_evaluated);
     return total;
   }
+  if (formulation_ == Formulation::smoothed)
+    return dim() == 2 ? smoothed_energy<2>(stream_2d_, patches<2>(), material_, u, report)
+                      : smoothed_energy<3>(stream_3d_, patches<3>(), material_, u, report);
   return with_material_and_dimension(material_, dim(), [&](const auto& m, auto dimension) {
     constexpr int D = decltype(dimension)::value;
     std::size_t n_evaluated = 0;
@@ -335,6 +358,11 @@ void ElasticBody::internal_forces(std::span<const double> u, std::span<double> f
   check_size("force", f);
   if (is_membrane()) {
     log_flops(flops_.force, membrane_internal_forces(membranes_, material_, u, f, report));
+    return;
+  }
+  if (formulation_ == Formulation::smoothed) {
+    dim() == 2 ? smoothed_internal_forces<2>(stream_2d_, patches<2>(), material_, u, f, report)
+               : smoothed_internal_forces<3>(stream_3d_, patches<3>(), material_, u, f, report);
     return;
   }
   with_material_and_dimension(material_, dim(), [&](const auto& m, auto dimension) {
@@ -357,6 +385,11 @@ void ElasticBody::tangent_apply(std::span<const double> u, std::span<const doubl
     log_flops(flops_.tangent, membrane_tangent_apply(membranes_, material_, u, d, out, report));
     return;
   }
+  if (formulation_ == Formulation::smoothed) {
+    dim() == 2 ? smoothed_tangent_apply<2>(stream_2d_, patches<2>(), material_, u, d, out, report)
+               : smoothed_tangent_apply<3>(stream_3d_, patches<3>(), material_, u, d, out, report);
+    return;
+  }
   with_material_and_dimension(material_, dim(), [&](const auto& m, auto dimension) {
     constexpr int D = decltype(dimension)::value;
     constexpr bool reads_state = !is_linear_elastic<std::decay_t<decltype(m)>>;
@@ -376,6 +409,9 @@ std::vector<ElementId> ElasticBody::inverted_elements(std::span<const double> u)
 std::vector<double> ElasticBody::element_stress(std::span<const double> u) const {
   check_size("displacement", u);
   if (is_membrane()) return membrane_element_stress(membranes_, material_, u);
+  if (formulation_ == Formulation::smoothed)
+    return dim() == 2 ? smoothed_element_stress<2>(stream_2d_, patches<2>(), material_, u)
+                      : smoothed_element_stress<3>(stream_3d_, patches<3>(), material_, u);
   std::vector<double> stress;
   with_material_and_dimension(material_, dim(), [&](const auto& m, auto dimension) {
     constexpr int D = decltype(dimension)::value;
@@ -392,6 +428,9 @@ std::vector<double> ElasticBody::element_stiffness(ElementId e, std::span<const 
   check_size("displacement", u);
   if (!mesh_.connectivity().is_element(e)) throw std::invalid_argument("element " + std::to_string(e) + " does not exist");
   if (is_membrane()) return membrane_element_stiffness(membranes_, material_, e, u);
+  if (formulation_ != Formulation::p1)
+    throw std::invalid_argument("element_stiffness is a P1 element's; under formulation '" +
+                                std::string(name_of(formulation_)) + "' stiffness belongs to strain patches (assemble the tangent)");
   const int n = (dim() + 1) * dim();
   std::vector<double> K(static_cast<std::size_t>(n) * n);
   with_material_and_dimension(material_, dim(), [&](const auto& m, auto dimension) {
@@ -407,6 +446,9 @@ std::vector<double> ElasticBody::element_stiffness(ElementId e, std::span<const 
 void ElasticBody::for_each_element_stiffness(std::span<const double> u, const StiffnessVisitor& visit) const {
   check_size("displacement", u);
   if (is_membrane()) return membrane_for_each_element_stiffness(membranes_, material_, u, visit);
+  if (formulation_ == Formulation::smoothed)
+    return dim() == 2 ? smoothed_for_each_patch_stiffness<2>(stream_2d_, patches<2>(), material_, u, visit)
+                      : smoothed_for_each_patch_stiffness<3>(stream_3d_, patches<3>(), material_, u, visit);
   with_material_and_dimension(material_, dim(), [&](const auto& m, auto dimension) {
     constexpr int D = decltype(dimension)::value, n = (D + 1) * D;
     using Material = std::decay_t<decltype(m)>;

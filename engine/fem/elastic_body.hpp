@@ -7,6 +7,10 @@
 // plane stress on a 3 × 2 F, kept one element at a time (fem/membrane_loops.hpp) rather than
 // in the streams; "inverted" then means collapsed to zero area.
 //
+// Under the smoothed formulation (fem/formulation.hpp) the loops are fem/smoothed_loops.hpp's,
+// over strain patches rebuilt after each change (fem/strain_patches.hpp); the per-element
+// data and the conventions are the same.
+//
 // Conventions: displacement and force arrays are (n_points, dim) row-major; internal forces
 // are −∂Π_int/∂u; the tangent action is ∂²Π_int/∂u² · d.
 #pragma once
@@ -19,8 +23,10 @@
 
 #include "fem/element_stream.hpp"
 #include "fem/evaluation.hpp"
+#include "fem/formulation.hpp"
 #include "fem/material.hpp"
 #include "fem/membrane_elements.hpp"
+#include "fem/strain_patches.hpp"
 #include "mesh/mesh.hpp"
 
 namespace snede {
@@ -28,8 +34,9 @@ namespace snede {
 class ElasticBody : public ConnectivityWatcher {
  public:
   // thickness: required (> 0) for 2D meshes (plane stress) and surface meshes (membranes),
-  // must be 0 for tetrahedra.
-  ElasticBody(Mesh& mesh, Material material, double density, double thickness);
+  // must be 0 for tetrahedra. A membrane takes only Formulation::p1 (plane stress: no locking).
+  ElasticBody(Mesh& mesh, Material material, double density, double thickness,
+              Formulation formulation = Formulation::p1);
   ~ElasticBody() override;
   ElasticBody(const ElasticBody&) = delete;
   ElasticBody& operator=(const ElasticBody&) = delete;
@@ -39,6 +46,7 @@ class ElasticBody : public ConnectivityWatcher {
   const Material& material() const { return material_; }
   double density() const { return density_; }
   double thickness() const { return thickness_; }
+  Formulation formulation() const { return formulation_; }
   int dim() const { return mesh_.dim(); }
   bool is_membrane() const { return mesh_.is_surface(); }
   std::size_t n_dofs() const { return static_cast<std::size_t>(mesh_.n_points()) * dim(); }
@@ -60,11 +68,14 @@ class ElasticBody : public ConnectivityWatcher {
   std::vector<double> element_stress(std::span<const double> u) const;
   // Stiffness matrix of element e at u: ((corners)·dim)², rows and columns ordered by the
   // element's oriented vertices, then by component. For comparison and preconditioning only.
+  // P1 only: a smoothed body's stiffness is a sum over patches (for_each_element_stiffness).
   std::vector<double> element_stiffness(ElementId e, std::span<const double> u) const;
   // Calls visit(e, vertices, K) for every live element with its stiffness at u, as
   // element_stiffness gives it, computed for a block of elements per kernel call (for
   // assembling J and its diagonal). Inverted elements of a material that forbids inversion
-  // are left out, as the tangent action leaves them out.
+  // are left out, as the tangent action leaves them out. Under the smoothed formulation the
+  // visits are the strain patches' matrices (any number of vertices, increasing; e is the
+  // patch's first element): J is their sum all the same.
   using StiffnessVisitor = std::function<void(ElementId, std::span<const VertexId>, std::span<const double>)>;
   void for_each_element_stiffness(std::span<const double> u, const StiffnessVisitor& visit) const;
   // Lumped mass per vertex: an equal share of each incident element's mass (§2.5).
@@ -79,6 +90,9 @@ class ElasticBody : public ConnectivityWatcher {
  private:
   template <int D>
   const ElementStream<D>& stream() const;
+  // The strain patches of the current mesh, rebuilt on first use after a change.
+  template <int D>
+  const StrainPatches<D>& patches() const;
   void reserve_ids(ElementId capacity);
   void compute_reference(const Connectivity& connectivity, ElementId e);
   void release(ElementId e);
@@ -88,10 +102,14 @@ class ElasticBody : public ConnectivityWatcher {
   Material material_;
   double density_;
   double thickness_;
+  Formulation formulation_;
   ElementStream<2> stream_2d_;
   ElementStream<3> stream_3d_;
   MembraneElements membranes_;
   KernelFlops flops_;
+  mutable StrainPatches<2> patches_2d_;
+  mutable StrainPatches<3> patches_3d_;
+  mutable bool patches_stale_ = true;
 };
 
 }  // namespace snede

@@ -198,7 +198,8 @@ std::unique_ptr<BisectionMultigrid::Level> BisectionMultigrid::make_level(int k,
       !close(boundary_measure(*level->mesh), boundary_measure(mesh)))
     return nullptr;
   const ElasticBody& body = fine_.body();
-  level->body = std::make_unique<ElasticBody>(*level->mesh, body.material(), body.density(), body.thickness());
+  level->body = std::make_unique<ElasticBody>(*level->mesh, body.material(), body.density(), body.thickness(),
+                                              body.formulation());
   level->model = std::make_unique<Model>(*level->body);
   if (!copy_constraints(*level)) return nullptr;
   SNEDE_PETSC(VecDuplicate(level->model->displacement(), level->state.out()));

@@ -68,17 +68,21 @@ std::vector<double> projection_blocks(const Model& model) {
 template <class Visit>
 void for_each_projected_element_matrix(const Model& model, std::span<const double> u, const std::vector<double>& P,
                                        Visit&& visit) {
-  const int d = model.dim(), corners = corners_per_cell(model), n = corners * d;
+  const int d = model.dim();
   std::vector<bool> free(model.body().mesh().n_points());
   for (VertexId v = 0; v < static_cast<VertexId>(free.size()); ++v)
     free[v] = model.constraints()[v].kind == ConstraintKind::free;
-  std::vector<double> left(static_cast<std::size_t>(n) * n), projected(static_cast<std::size_t>(n) * n);
+  std::vector<double> left, projected;
   model.body().for_each_element_stiffness(u, [&](ElementId e, std::span<const VertexId> vertices,
                                                  std::span<const double> K) {
     if (std::all_of(vertices.begin(), vertices.end(), [&](VertexId v) { return free[v]; })) {
       visit(e, vertices, K);
       return;
     }
+    // A P1 element has corners_per_cell vertices, a smoothed formulation's patch any number.
+    const int corners = static_cast<int>(vertices.size()), n = corners * d;
+    left.resize(static_cast<std::size_t>(n) * n);
+    projected.resize(static_cast<std::size_t>(n) * n);
     // left = diag(P_a) K, then projected = left diag(P_b): block by block, dim × dim each.
     for (int a = 0; a < corners; ++a)
       for (int col = 0; col < n; ++col)
@@ -121,26 +125,36 @@ AssembledTangent::AssembledTangent(const Model& model, MatrixFormat format, Memb
   // vertex, a scratch array for the places) rather than by searching sorted lists.
   const VertexStars stars = all_vertex_stars(c, n);
   const int corners = corners_per_cell(model);
+  // A smoothed formulation's vertex patch joins every pair of its vertex's neighbours: blocks
+  // for every vertex within two edges, set through MatSetValuesBlocked (no per-element ranks).
+  patches_ = model.body().formulation() != Formulation::p1;
+  auto add_star = [&](VertexId v, auto&& add) {
+    for (std::size_t s = stars.start[v]; s < stars.start[v + 1]; ++s)
+      for (VertexId w : std::span(stars.vertices[stars.element_of(stars.entries[s])]).first(corners)) add(w);
+  };
   std::vector<std::size_t> row(static_cast<std::size_t>(n) + 1, 0);
   std::vector<VertexId> neighbour_list;
   neighbour_list.reserve(stars.entries.size() * 2 + n);
   std::vector<std::int32_t> place(n, -1);
-  block_rank_.assign(static_cast<std::size_t>(c.element_capacity()) * corners * corners, 0);
+  if (!patches_) block_rank_.assign(static_cast<std::size_t>(c.element_capacity()) * corners * corners, 0);
   self_rank_.resize(n);
   for (VertexId v = 0; v < n; ++v) {
     const std::size_t first = neighbour_list.size();
     neighbour_list.push_back(v);
     place[v] = 0;
-    for (std::size_t s = stars.start[v]; s < stars.start[v + 1]; ++s)
-      for (VertexId w : std::span(stars.vertices[stars.element_of(stars.entries[s])]).first(corners))
-        if (place[w] < 0) {
-          place[w] = 0;
-          neighbour_list.push_back(w);
-        }
+    auto add = [&](VertexId w) {
+      if (place[w] < 0) {
+        place[w] = 0;
+        neighbour_list.push_back(w);
+      }
+    };
+    add_star(v, add);
+    if (patches_)
+      for (std::size_t k = first + 1, end = neighbour_list.size(); k < end; ++k) add_star(neighbour_list[k], add);
     std::sort(neighbour_list.begin() + static_cast<std::ptrdiff_t>(first), neighbour_list.end());
     for (std::size_t k = first; k < neighbour_list.size(); ++k) place[neighbour_list[k]] = static_cast<std::int32_t>(k - first);
     self_rank_[v] = place[v];
-    for (std::size_t s = stars.start[v]; s < stars.start[v + 1]; ++s) {
+    for (std::size_t s = stars.start[v]; s < stars.start[v + 1] && !patches_; ++s) {
       const std::size_t k = stars.element_of(stars.entries[s]);
       const int a = stars.corner_of(stars.entries[s]);
       std::int32_t* ranks = block_rank_.data() + (static_cast<std::size_t>(stars.elements[k]) * corners + a) * corners;
@@ -194,7 +208,7 @@ void AssembledTangent::assemble(const Model& model, Vec u) {
   const bool membrane = model.body().mesh().is_surface() && membranes_ == MembraneTangent::positive_part;
   MembranePositivePart positive_part;
   ReadView x(u);
-  if (format_ == MatrixFormat::aij) {
+  if (format_ == MatrixFormat::aij && !patches_) {
     PetscScalar* values = nullptr;
     SNEDE_PETSC(MatSeqAIJGetArray(A_, &values));
     std::fill(values, values + row_start_.back(), 0.0);
@@ -248,13 +262,14 @@ void set_rigid_body_near_null_space(const Model& model, Mat A) {
 }
 
 void tangent_diagonal(const Model& model, Vec u, Vec diagonal) {
-  const int d = model.dim(), n = corners_per_cell(model) * d;
+  const int d = model.dim();
   const std::vector<double> P = projection_blocks(model);
   std::vector<double> values(model.body().n_dofs(), 0.0);
   {
     ReadView x(u);
     for_each_projected_element_matrix(model, x.span(), P, [&](ElementId, std::span<const VertexId> vertices,
                                                               std::span<const double> K) {
+      const int n = static_cast<int>(vertices.size()) * d;
       for (int row = 0; row < n; ++row)
         values[static_cast<std::size_t>(vertices[row / d]) * d + row % d] += K[static_cast<std::size_t>(row) * n + row];
     });

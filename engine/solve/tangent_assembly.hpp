@@ -24,7 +24,8 @@ enum class MatrixFormat { aij, baij };
 enum class MembraneTangent { exact, positive_part };
 
 // J with the block sparsity of the mesh it was made for: a dim × dim block for every pair of
-// vertices that share an element, and a diagonal block for every vertex (removed ones too).
+// vertices that share an element (under a smoothed formulation: that are at most two edges
+// apart), and a diagonal block for every vertex (removed ones too).
 class AssembledTangent {
  public:
   AssembledTangent(const Model& model, MatrixFormat format, MembraneTangent membranes = MembraneTangent::exact);
@@ -44,6 +45,7 @@ class AssembledTangent {
   std::vector<std::int32_t> block_rank_;  // per element id and block (a, b): b's place among
                                           // a's sorted neighbours
   std::vector<std::int32_t> self_rank_;   // per vertex: its own place among its neighbours
+  bool patches_ = false;                  // a smoothed formulation's patches: blocks to two edges
 };
 
 // The rigid-body motions of the reference configuration as A's near null space (what GAMG

@@ -18,7 +18,7 @@ from snede._snede import (  # noqa: F401
     VerondaWestmann,
 )
 from snede.mesh import Mesh, MeshQuality  # noqa: F401
-from snede.body import Body, LockingWarning  # noqa: F401
+from snede.body import Body, LockingWarning, formulations  # noqa: F401
 from snede.result import SolveResult  # noqa: F401
 from snede.static import StaticSolver  # noqa: F401
 from snede.dynamics import DynamicRelaxation  # noqa: F401
@@ -37,7 +37,7 @@ __all__ = [
     "IncisionLost",
     "SubdivisionCutter", "DistributedMesh", "DistributedRelaxation", "DistributedStatic", "distribute",
     "LinearElastic", "StVenantKirchhoff", "NeoHookean", "VerondaWestmann",
-    "EditResult", "FileError", "InvalidMesh", "PetscError", "DomainError", "LockingWarning", "PETSc",
+    "EditResult", "FileError", "InvalidMesh", "PetscError", "DomainError", "LockingWarning", "formulations", "PETSc",
     "output_folder",
 ]
 __version__ = "0.1.0"

@@ -16,13 +16,26 @@ from snede.mesh import Mesh
 # ν = 0.45 a 16×4×4 cantilever bends 73 % of beam theory, at ν = 0.499 only 10 %).
 LOCKING_POISSON_RATIO = 0.45
 
+FORMULATIONS = {
+    "p1": "one constant strain per linear simplex (the thesis's element, §2.3); tetrahedra lock as ν → ½",
+    "smoothed": "strains averaged over patches (smoothed FEM): on tetrahedra the shear part over edge patches and "
+                "the bulk part over vertex patches, free of volumetric locking; on plane triangles the whole energy "
+                "over edge patches. Tetrahedra and plane triangles only (docs/results/locking.md)",
+}
+
+
+def formulations() -> dict[str, str]:
+    """The names ``Body(..., formulation=NAME)`` takes, each with what it does."""
+    assert set(FORMULATIONS) == set(_snede.formulations())
+    return dict(FORMULATIONS)
+
 
 class LockingWarning(UserWarning):
     """Linear (P1) simplices lock for nearly incompressible materials: too stiff."""
 
 
 class Body:
-    """``Body(mesh, material, density=1000.0, thickness=None, comm=None)``.
+    """``Body(mesh, material, density=1000.0, thickness=None, comm=None, formulation="p1")``.
 
     ``material`` is one of ``snede.LinearElastic(E, nu)``, ``snede.StVenantKirchhoff(E, nu)``,
     ``snede.NeoHookean(E, nu)``, ``snede.VerondaWestmann(E, nu, gamma)``. A 2D mesh is a
@@ -40,13 +53,21 @@ class Body:
     evaluate them as usual. ``inverted_elements(u)`` lists them either way. An exponential
     overflow (Veronda-Westmann at large strain) raises ``snede.DomainError``.
 
+    ``formulation``: how displacements become strains (``snede.formulations()``): "p1", the
+    thesis's constant-strain simplex, or "smoothed", strains averaged over edge and vertex
+    patches, which does not lock for nearly incompressible tissue (ν up to 0.499) and bends
+    more accurately on coarse meshes, for about twice the cost per operator product
+    (docs/results/locking.md). Both keep one unknown per vertex, so cuts, refinement, needles
+    and preconditioners work unchanged; membranes take "p1" only, and MPI solves too (for now).
+
     ``comm`` (an mpi4py communicator, issue 18): the communicator its solvers run on when they
     are not given one (``StaticSolver``, ``DynamicRelaxation``: rank 0's body is distributed
     and the answer gathered back into every rank's). The body itself stays a serial
     description, the same on every rank; None (default): serial solves.
     """
 
-    def __init__(self, mesh: Mesh, material, density: float = 1000.0, thickness: float | None = None, comm=None):
+    def __init__(self, mesh: Mesh, material, density: float = 1000.0, thickness: float | None = None, comm=None,
+                 formulation: str = "p1"):
         if not isinstance(mesh, Mesh):
             raise TypeError(f"mesh must be a snede.Mesh, got {type(mesh).__name__}")
         if mesh.is_surface and thickness is None:
@@ -56,23 +77,32 @@ class Body:
         if mesh.cell_dim == 3 and thickness is not None:
             raise ValueError(f"thickness is only for 2D (plane-stress) meshes and membranes; this mesh is tetrahedral "
                              f"(got thickness={thickness})")
+        if formulation not in FORMULATIONS:
+            raise ValueError(f"unknown formulation {formulation!r}; snede.formulations() lists {sorted(FORMULATIONS)}")
+        if formulation != "p1" and mesh.is_surface:
+            raise ValueError(f"formulation {formulation!r} is for tetrahedra and plane triangles; a membrane (surface "
+                             "mesh) takes 'p1': in plane stress it does not lock")
         lam, mu = material.lame
         poisson = lam / (2 * (lam + mu))
-        if poisson >= LOCKING_POISSON_RATIO:
-            warnings.warn(f"Poisson's ratio {poisson:.4g} is close to 1/2: linear {'tetrahedra' if mesh.cell_dim == 3 else 'triangles'} "
-                          "lock (volumetric locking) and the body will deform too little; see docs/results/extremes.md",
-                          LockingWarning, stacklevel=2)
+        if poisson >= LOCKING_POISSON_RATIO and formulation == "p1" and mesh.cell_dim == 3:
+            warnings.warn(f"Poisson's ratio {poisson:.4g} is close to 1/2: linear tetrahedra lock (volumetric locking) "
+                          "and the body will deform too little; Body(..., formulation=\"smoothed\") does not lock "
+                          "(docs/results/locking.md)", LockingWarning, stacklevel=2)
         if comm is not None and not (hasattr(comm, "rank") and hasattr(comm, "size") and hasattr(comm, "bcast")):
             raise TypeError(f"comm must be an mpi4py communicator (or None), got {type(comm).__name__}")
         self.mesh = mesh
         self.material = material
         self.comm = comm
-        self._impl = _snede.ElasticBody(mesh._impl, material, float(density), float(thickness or 0.0))
+        self._impl = _snede.ElasticBody(mesh._impl, material, float(density), float(thickness or 0.0), formulation)
         self._model = _snede.Model(self._impl)
 
     @property
     def dim(self) -> int:
         return self.mesh.dim
+
+    @property
+    def formulation(self) -> str:
+        return self._impl.formulation
 
     @property
     def density(self) -> float:

@@ -42,6 +42,9 @@ class DistributedBody:
         if body.mesh.is_surface:
             raise NotImplementedError(f"a solve on {comm.size} MPI ranks: membranes (surface meshes) are not "
                                       "distributed yet")
+        if body.formulation != "p1":
+            raise NotImplementedError(f"a solve on {comm.size} MPI ranks: formulation {body.formulation!r} is not "
+                                      "distributed yet (its vertex patches need two layers of ghost cells); use 'p1'")
         if len(sliding):
             raise NotImplementedError(f"a solve on {comm.size} MPI ranks: sliding constraints ({len(sliding)} "
                                       "vertices) are not distributed yet; fix them instead")
