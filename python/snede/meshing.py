@@ -132,6 +132,19 @@ def ellipsoid(radii=(0.06, 0.04, 0.03), h=0.01, seed: int | None = None) -> Mesh
     return _gmsh_tetrahedra("ellipsoid", add, h, seed)
 
 
+def hollow_sphere(inner=0.5, outer=1.0, h=0.1, seed: int | None = None) -> Mesh:
+    """Unstructured tetrahedra (gmsh, edge length ``h``) of the shell inner ≤ |x| ≤ outer centred
+    at the origin: the pressurised sphere of Lamé's analytic solution (benchmarks/locking.py)."""
+    _positive(inner=inner, outer=outer, h=h)
+    if not inner < outer:
+        raise ValueError(f"inner radius must be below the outer one, got inner={inner}, outer={outer}")
+
+    def add(occ):
+        shell, _ = occ.cut([(3, occ.addSphere(0, 0, 0, outer))], [(3, occ.addSphere(0, 0, 0, inner))])
+        assert len(shell) == 1
+    return _gmsh_tetrahedra("hollow sphere", add, h, seed)
+
+
 def torus(radius=0.05, tube=0.02, h=0.01, seed: int | None = None) -> Mesh:
     """Unstructured tetrahedra (gmsh, edge length ``h``) of the torus around the z axis with
     centre-line ``radius`` and tube radius ``tube`` < ``radius``: a body with a hole, which one
