@@ -106,11 +106,18 @@ template <int D>
   if (vertex_part) divide(sums.vertex, patches.vertex_measure());
 }
 
-// Scratch arrays kept per thread between calls (the loops run once per CG iteration).
+// Scratch arrays kept per thread between calls (the loops run once per CG iteration), and the
+// patch gradients of the last state a tangent was applied at: a Krylov solve applies the
+// tangent at one u many times, and an exact comparison of u (a copy, memcmp) is cheaper than
+// averaging it again.
 template <int D>
 struct Workspace {
   PatchGradients<D> H, dH;
   std::array<std::vector<double>, 2> tensors;
+  PatchGradients<D> tangent_H;
+  std::vector<double> tangent_u;
+  std::vector<ElementId> tangent_inverted;
+  std::uint64_t tangent_generation = 0;
 };
 template <int D>
 Workspace<D>& workspace() {
@@ -300,9 +307,19 @@ void smoothed_tangent_apply(const ElementStream<D>& stream, const StrainPatches<
     const Parts<D, M> parts = split<D>(m);
     Workspace<D>& w = workspace<D>();
     average_gradients<D>(stream, patches, parts.has_vertex_part, d, nullptr, w.dH);
-    if constexpr (!is_linear_elastic<M>) average_gradients<D>(stream, patches, parts.has_vertex_part, u, &report.inverted, w.H);
+    if constexpr (!is_linear_elastic<M>) {
+      const bool same_state = w.tangent_generation == patches.generation() && w.tangent_u.size() == u.size() &&
+                              std::equal(u.begin(), u.end(), w.tangent_u.begin());
+      if (!same_state) {
+        w.tangent_inverted.clear();
+        average_gradients<D>(stream, patches, parts.has_vertex_part, u, &w.tangent_inverted, w.tangent_H);
+        w.tangent_u.assign(u.begin(), u.end());
+        w.tangent_generation = patches.generation();
+      }
+      report.inverted.insert(report.inverted.end(), w.tangent_inverted.begin(), w.tangent_inverted.end());
+    }
     const std::array<const std::vector<double>*, 2> directions{&w.dH.edge, &w.dH.vertex};
-    const PatchGradients<D>& at = is_linear_elastic<M> ? w.dH : w.H;
+    const PatchGradients<D>& at = is_linear_elastic<M> ? w.dH : w.tangent_H;
     const auto& dP = evaluate_both<D>(parts, patches, at, report, w.tensors, [&](const M& part, const Tensor<Batch, D>& Hb, int family, std::size_t k0) {
       const std::vector<double>& direction = *directions[family];
       return patch_stress_derivative<D>(part, Hb, load_patches<D>(direction, k0, direction.size() / (D * D)));

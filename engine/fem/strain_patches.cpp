@@ -6,6 +6,8 @@ namespace snede {
 
 template <int D>
 void StrainPatches<D>::build(const ElementStream<D>& stream, VertexId n_points) {
+  static std::uint64_t builds = 0;  // across all patch sets: a rebuilt body never matches an old key
+  generation_ = ++builds;
   const ElementId capacity = stream.capacity();
   // Vertex stars (CSR over vertex ids), elements in id order.
   vertex_start_.assign(static_cast<std::size_t>(n_points) + 1, 0);

@@ -34,6 +34,8 @@ class StrainPatches {
 
   void build(const ElementStream<D>& stream, VertexId n_points);
 
+  // Changes with every build: what was computed for one build is stale for the next.
+  std::uint64_t generation() const { return generation_; }
   std::size_t n_edges() const { return edge_measure_.size(); }
   std::size_t n_vertices() const { return vertex_measure_.size(); }
   // Edge patch ids of element e's local edges (a free slot: −1).
@@ -54,6 +56,7 @@ class StrainPatches {
   std::vector<double> edge_measure_, vertex_measure_;
   std::vector<std::size_t> edge_start_, vertex_start_;
   std::vector<ElementId> edge_element_list_, vertex_element_list_;
+  std::uint64_t generation_ = 0;
 };
 
 }  // namespace snede

@@ -163,6 +163,10 @@ AssembledTangent::AssembledTangent(const Model& model, MatrixFormat format, Memb
     for (std::size_t k = first; k < neighbour_list.size(); ++k) place[neighbour_list[k]] = -1;
     row[v + 1] = neighbour_list.size();
   }
+  if (patches_) {
+    neighbour_start_ = row;
+    neighbours_ = neighbour_list;
+  }
   auto neighbours = [&](VertexId v) {
     return std::span<const VertexId>(neighbour_list.data() + row[v], row[v + 1] - row[v]);
   };
@@ -195,6 +199,24 @@ AssembledTangent::AssembledTangent(const Model& model, MatrixFormat format, Memb
   SNEDE_PETSC(MatSetOption(A_, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_TRUE));
 }
 
+const std::int32_t* AssembledTangent::patch_block_ranks(std::span<const VertexId> vertices,
+                                                        std::vector<std::int32_t>& ranks) const {
+  // Both lists are sorted: one merge walk per row instead of a search per block.
+  const std::size_t count = vertices.size();
+  ranks.resize(count * count);
+  for (std::size_t a = 0; a < count; ++a) {
+    const std::size_t start = neighbour_start_[vertices[a]], end = neighbour_start_[vertices[a] + 1];
+    std::size_t k = start;
+    for (std::size_t b = 0; b < count; ++b) {
+      while (k < end && neighbours_[k] < vertices[b]) ++k;
+      if (k == end || neighbours_[k] != vertices[b])
+        throw std::logic_error("a strain patch joins vertices more than two edges apart");
+      ranks[a * count + b] = static_cast<std::int32_t>(k - start);
+    }
+  }
+  return ranks.data();
+}
+
 bool AssembledTangent::matches(const Model& model) const {
   return model.body().mesh().connectivity().revision() == revision_;
 }
@@ -202,20 +224,23 @@ bool AssembledTangent::matches(const Model& model) const {
 void AssembledTangent::assemble(const Model& model, Vec u) {
   if (!matches(model))
     throw std::logic_error("the assembled tangent was made for another mesh: the mesh changed since");
-  const int d = model.dim(), corners = corners_per_cell(model), n = corners * d;
+  const int d = model.dim();
   const std::vector<double> P = projection_blocks(model);
   const std::vector<double> complement = complement_blocks(P, d);
   const bool membrane = model.body().mesh().is_surface() && membranes_ == MembraneTangent::positive_part;
   MembranePositivePart positive_part;
   ReadView x(u);
-  if (format_ == MatrixFormat::aij && !patches_) {
+  if (format_ == MatrixFormat::aij) {
     PetscScalar* values = nullptr;
     SNEDE_PETSC(MatSeqAIJGetArray(A_, &values));
     std::fill(values, values + row_start_.back(), 0.0);
+    std::vector<std::int32_t> patch_ranks;
     for_each_projected_element_matrix(model, x.span(), P, [&](ElementId e, std::span<const VertexId> vertices,
                                                               std::span<const double> element_matrix) {
       const std::span<const double> K = membrane ? positive_part(element_matrix) : element_matrix;
-      const std::int32_t* ranks = block_rank_.data() + static_cast<std::size_t>(e) * corners * corners;
+      const int corners = static_cast<int>(vertices.size()), n = corners * d;
+      const std::int32_t* ranks = patches_ ? patch_block_ranks(vertices, patch_ranks)
+                                           : block_rank_.data() + static_cast<std::size_t>(e) * corners * corners;
       for (int a = 0; a < corners; ++a)
         for (int i = 0; i < d; ++i) {
           PetscScalar* row = values + row_start_[static_cast<std::size_t>(vertices[a]) * d + i];

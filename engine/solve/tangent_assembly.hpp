@@ -8,6 +8,7 @@
 #include <petscmat.h>
 
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "core/petsc_handle.hpp"
@@ -46,6 +47,10 @@ class AssembledTangent {
                                           // a's sorted neighbours
   std::vector<std::int32_t> self_rank_;   // per vertex: its own place among its neighbours
   bool patches_ = false;                  // a smoothed formulation's patches: blocks to two edges
+  std::vector<std::size_t> neighbour_start_;  // patches only: each vertex's sorted neighbours (CSR)
+  std::vector<VertexId> neighbours_;
+  // Each block's place among its row's neighbours, for a patch's sorted vertices (count²).
+  const std::int32_t* patch_block_ranks(std::span<const VertexId> vertices, std::vector<std::int32_t>& ranks) const;
 };
 
 // The rigid-body motions of the reference configuration as A's near null space (what GAMG

@@ -9,6 +9,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Callable
 
+import snede
 from snede.scene_file.mesh import read_mesh
 from snede.scene_file.reading import (COUNT, POINT, POSITIVE, REFUSED, REQUIRED, TEXT, Kind, SceneFileError, Table,
                                       choice, is_number, number_kind, shown)
@@ -31,6 +32,7 @@ class Material:
     nu: float
     gamma: float
     density: float
+    formulation: str  # snede.formulations()
 
 
 @dataclass
@@ -116,8 +118,9 @@ def _material(table: Table) -> Material:
         table.fail("gamma", f'is the nonlinearity of name = "veronda", not of "{name}"')
     gamma = table.get("gamma", POSITIVE, 8.0)
     density = table.get("density", POSITIVE, 1000.0)
+    formulation = table.get("formulation", choice(tuple(snede.formulations())), "p1")
     table.close()
-    return Material(name, young, poisson, gamma, density)
+    return Material(name, young, poisson, gamma, density, formulation)
 
 
 def _solver(table: Table, material: str) -> Solver:

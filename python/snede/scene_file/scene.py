@@ -130,7 +130,8 @@ def build(recipe: Recipe, material_name: str | None = None) -> Scene:
     the file's material model, its parameters kept."""
     mesh = recipe.mesh()
     m = recipe.material
-    body = snede.Body(mesh, material(material_name or m.name, m.E, m.nu, m.gamma), density=m.density)
+    body = snede.Body(mesh, material(material_name or m.name, m.E, m.nu, m.gamma), density=m.density,
+                      formulation=m.formulation)
     held = np.zeros(mesh.n_points, dtype=bool)
     for region, displacement in recipe.holds:
         vertices = _picked(recipe, region, mesh)
