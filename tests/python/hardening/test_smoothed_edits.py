@@ -324,6 +324,37 @@ def test_a_fully_dissected_mesh_makes_the_smoothed_body_a_p1_body(dim):
     check_invariants(body, 7, "fully dissected")
 
 
+@pytest.mark.parametrize("dim", [2, 3])
+def test_the_tangent_at_an_unchanged_state_follows_an_edit_that_keeps_the_vertices(dim):
+    """The tangent reuses the patch gradients of the last state it was applied at (compared
+    exactly). An edit that keeps every vertex (a flip in 2D, a moved vertex in 3D) leaves the
+    same u valid but changes the patches: the next product must be the edited mesh's, as a
+    fresh body on it gives, and a second body applied in between must not mix them up."""
+    mesh = distorted_grid(dim)
+    material = snede.NeoHookean(1e4, 0.45)
+    body = smoothed_body(mesh, material)
+    other = smoothed_body(snede.Mesh(mesh.points, mesh.cells), material)  # same numbers, own patches
+    rng = np.random.default_rng(dim)
+    u = 0.01 * vertex_scales(mesh) * rng.standard_normal((mesh.n_points, dim))
+    d = rng.standard_normal(u.shape)
+    before = body.tangent_apply(u, d)
+    np.testing.assert_array_equal(other.tangent_apply(u, d), before)
+    if dim == 2:
+        assert try_edges(mesh, rng, mesh.flip_edge)
+    else:
+        vertex = int(np.flatnonzero(interior_vertices(mesh))[0])
+        mesh.move_vertex(vertex, point=mesh.points[vertex] + 0.02)
+    assert mesh.n_points == len(u)
+    after = body.tangent_apply(u, d)
+    fresh = smoothed_body(mesh, material)
+    expected = fresh.tangent_apply(u, d)
+    assert np.abs(expected - before).max() > 1e-3 * np.abs(before).max()  # the edit matters
+    np.testing.assert_allclose(after, expected, rtol=0, atol=1e-13 * np.abs(expected).max())
+    np.testing.assert_array_equal(other.tangent_apply(u, d), before)  # the unedited twin's
+    np.testing.assert_allclose(body.tangent_apply(u, d), expected, rtol=0, atol=1e-13 * np.abs(expected).max())
+    check_invariants(body, dim, "edit at an unchanged state")
+
+
 def pieces_do_not_pull_on_each_other(body):
     """A random displacement of one piece leaves the vertices of the others without force."""
     mesh = body.mesh
