@@ -235,6 +235,14 @@ std::array<std::vector<double>, 2>& evaluate_both(const Parts<D, M>& parts, cons
   return tensors;
 }
 
+// Each element once in each list: an element heads or belongs to several patches.
+void keep_each_element_once(EvaluationReport& report) {
+  for (std::vector<ElementId>* list : {&report.inverted, &report.domain_errors}) {
+    std::sort(list->begin(), list->end());
+    list->erase(std::unique(list->begin(), list->end()), list->end());
+  }
+}
+
 template <class Function>
 decltype(auto) with_material(const Material& material, Function&& function) {
   return std::visit([&](const auto& m) { return function(m); }, material);
@@ -279,6 +287,7 @@ double smoothed_energy(const ElementStream<D>& stream, const StrainPatches<D>& p
     };
     family(parts.edge, H.edge, patches.edge_measure(), first_of_edge(patches));
     if (parts.has_vertex_part) family(parts.vertex, H.vertex, patches.vertex_measure(), first_of_vertex(patches));
+    keep_each_element_once(report);
     return infinite ? std::numeric_limits<double>::infinity() : total;
   });
 }
@@ -295,6 +304,7 @@ void smoothed_internal_forces(const ElementStream<D>& stream, const StrainPatche
       return patch_stress<D>(part, Hb);
     });
     scatter_to_nodes<D>(stream, patches, P[0], P[1], -1.0, f);
+    keep_each_element_once(report);
   });
 }
 
@@ -325,6 +335,7 @@ void smoothed_tangent_apply(const ElementStream<D>& stream, const StrainPatches<
       return patch_stress_derivative<D>(part, Hb, load_patches<D>(direction, k0, direction.size() / (D * D)));
     });
     scatter_to_nodes<D>(stream, patches, dP[0], dP[1], 1.0, out);
+    keep_each_element_once(report);
   });
 }
 

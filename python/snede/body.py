@@ -77,7 +77,7 @@ class Body:
         if mesh.cell_dim == 3 and thickness is not None:
             raise ValueError(f"thickness is only for 2D (plane-stress) meshes and membranes; this mesh is tetrahedral "
                              f"(got thickness={thickness})")
-        if formulation not in FORMULATIONS:
+        if not isinstance(formulation, str) or formulation not in FORMULATIONS:
             raise ValueError(f"unknown formulation {formulation!r}; snede.formulations() lists {sorted(FORMULATIONS)}")
         if formulation != "p1" and mesh.is_surface:
             raise ValueError(f"formulation {formulation!r} is for tetrahedra and plane triangles; a membrane (surface "
