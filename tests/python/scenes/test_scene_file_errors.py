@@ -51,11 +51,12 @@ MISTAKES = {
                              "description, mesh, material, hold, loads, solver, tool)"),
     "a misspelled key": (edited(("nu = 0.3", "nu = 0.3\ndensty = 900")),
                          "material.densty is not a key of [material]; did you mean material.density? (its keys: "
-                         "name, E, nu, gamma, density)"),
+                         "name, E, nu, gamma, density, formulation)"),
     "a misspelled required key": (edited(("E = 3e4", "e = 3e4")),
                                   "material.e is not a key of [material]; did you mean material.E?"),
     "a key unlike any": (edited(("E = 3e4", "E = 3e4\nstiffness = 2")),
-                         "material.stiffness is not a key of [material] (its keys: name, E, nu, gamma, density, formulation)"),
+                         "material.stiffness is not a key of [material] (its keys: name, E, nu, gamma, density, "
+                         "formulation)"),
     "a key of a region": (edited(('side = "x = min"', 'side = "x = min"\nwithn = 0.01')),
                           "hold[1].withn is not a key of [hold[1]]; did you mean hold[1].within?"),
     "a key of a tool": (edited(SCALPEL.replace("moves = 3", "moves = 3\nstrat = 2")),
