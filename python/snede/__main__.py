@@ -32,7 +32,7 @@ from snede import _command_line
 from snede import _output_folder as output_folder
 
 METHODS = ("cg", "ncg", "newton", "dynamic")
-SCENE_OPTIONS = ("divisions", "mesh_size", "speed")  # apply to the scenes whose OPTIONS name them
+SCENE_OPTIONS = ("divisions", "mesh_size", "speed", "formulation")  # apply to the scenes whose OPTIONS name them
 
 
 def _positive_float(text: str) -> float:
@@ -85,6 +85,10 @@ def _parser() -> argparse.ArgumentParser:
     run.add_argument("scene", help="cantilever, cylinder, slab, needle, needle3d, cut, sheet-cut, membrane-cut, "
                                       "path/to/scene.toml or path/to/scene.py")
     run.add_argument("--material", choices=MATERIAL_NAMES, help="material model (default: the scene's)")
+    run.add_argument("--formulation", choices=("p1", "smoothed"),
+                     help="p1: the thesis's linear simplex; smoothed: strains averaged over patches, free of "
+                          "volumetric locking (docs/results/locking.md); tetrahedra and plane triangles (default: "
+                          "the scene's)")
     run.add_argument("--method", choices=METHODS,
                      help="cg: linear CG (linear material); ncg: nonlinear CG; newton: truncated Newton; "
                           "dynamic: damped explicit dynamics (default: the scene's)")
@@ -186,7 +190,7 @@ def _command(parser, args, unknown, petsc) -> int:
         return 0
     scenes = builders()
     if args.scene.endswith(scene_file.SUFFIX):
-        module, build = scene_file, lambda: scene_file.load(args.scene, args.material)
+        module, build = scene_file, lambda: scene_file.load(args.scene, args.material, args.formulation)
     elif args.scene in scenes:
         module = scenes[args.scene]
         build = partial(module.build, args)

@@ -49,7 +49,7 @@ def run(out: Path = Path("out"), progress: bool = True) -> int:
     from snede.scenes import builders
 
     print(f"snede {snede.__version__} on PETSc {'.'.join(map(str, snede.PETSc.Sys.getVersion()))}\n")
-    defaults = argparse.Namespace(material=None, divisions=None, mesh_size=None, speed=None)
+    defaults = argparse.Namespace(material=None, divisions=None, mesh_size=None, speed=None, formulation=None)
     summaries = [run_scene.run(module.build(defaults), None, None, out, progress) for module in builders().values()]
     run_scene.print_table(summaries)
     print()

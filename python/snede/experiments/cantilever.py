@@ -78,15 +78,16 @@ def elastica_tip(load: float, young: float = YOUNG) -> tuple[float, float]:
     return height * LENGTH, (1 - length) * LENGTH
 
 
-def cantilever_body(n: int, material, load: float = LOAD, mesh=None):
+def cantilever_body(n: int, material, load: float = LOAD, mesh=None, formulation: str = "p1"):
     """The §3.3 beam on snede.meshing.box with n × n/4 × n/4 cubes (6 tetrahedra each), or on
     ``mesh`` (the same beam meshed otherwise), fixed at x = 0, ``load`` newtons along −y split
-    over the tip nodes (x = l). Returns (body, tip vertex indices)."""
+    over the tip nodes (x = l), in ``formulation`` (snede.formulations()). Returns (body, tip
+    vertex indices)."""
     if n < 4 or n % 4:
         raise ValueError(f"divisions along the length must be a positive multiple of 4, got {n}")
     if mesh is None:
         mesh = snede.meshing.box((LENGTH, HEIGHT, DEPTH), (n, n // 4, n // 4))
-    body = snede.Body(mesh, material)
+    body = snede.Body(mesh, material, formulation=formulation)
     body.fix(np.isclose(mesh.points[:, 0], 0.0))
     tip = np.flatnonzero(np.isclose(mesh.points[:, 0], LENGTH))
     body.add_nodal_force(tip, (0.0, -load / len(tip), 0.0))

@@ -1,6 +1,7 @@
-"""Accuracy against wall time over mesh size × stopping tolerance × solver, for the §3.3
-cantilever (linear) and the Table 4.2 cylinder (neo-Hookean under gravity): the Pareto
-frontier and the knobs to pick for 1 %, 5 % and 20 % error.
+"""Accuracy against wall time over mesh size × formulation × stopping tolerance × solver, for the
+§3.3 cantilever (linear) and the Table 4.2 cylinder (neo-Hookean under gravity): the Pareto
+frontier and the knobs to pick for 1 %, 5 % and 20 % error. The formulation (issue 35) is
+"p1" on every mesh and "smoothed" (snede.formulations()) on the coarser ones.
 
     .venv/bin/python -m snede.experiments.tradeoff [--quick] [--out DIR]
 
@@ -36,6 +37,7 @@ class MeshChoice:
     label: str
     h: float
     build: Callable[[], tuple]
+    formulation: str = "p1"
 
 
 @dataclass
@@ -50,11 +52,11 @@ class Scene:
     reference_rtol: float
 
 
-def cylinder_body(mesh, material=None, density: float = 1000.0):
+def cylinder_body(mesh, material=None, density: float = 1000.0, formulation: str = "p1"):
     """The Table 4.2 cylinder (Table 4.1 parameters: neo-Hookean E = 1e4 Pa, ν = 0.3 unless
     another material is given; ρ = 1000 kg/m³) fixed at its x = min face and sagging under
     gravity 9.8 m/s² along −z. Returns (body, tip vertex indices at x = max)."""
-    body = snede.Body(mesh, material or snede.NeoHookean(1e4, 0.3), density=density)
+    body = snede.Body(mesh, material or snede.NeoHookean(1e4, 0.3), density=density, formulation=formulation)
     body.fix(np.isclose(mesh.points[:, 0], mesh.points[:, 0].min()))
     body.add_gravity((0.0, 0.0, -9.8))
     return body, np.flatnonzero(np.isclose(mesh.points[:, 0], mesh.points[:, 0].max()))
@@ -64,38 +66,47 @@ def tip_sag(body, tip) -> float:
     return float(-body.displacement[tip, 2].mean())
 
 
-def cylinder_choice(h: float, file: str | None = None) -> MeshChoice:
+def labelled(label: str, formulation: str) -> str:
+    return label if formulation == "p1" else f"{label} {formulation}"
+
+
+def cylinder_choice(h: float, file: str | None = None, formulation: str = "p1") -> MeshChoice:
     def build():
         mesh = snede.Mesh.read(MESHES / file) if file else snede.meshing.cylinder(CYLINDER_LENGTH, CYLINDER_RADIUS, h,
                                                                                    seed=1)
-        body, tip = cylinder_body(mesh)
+        body, tip = cylinder_body(mesh, formulation=formulation)
         return body, lambda b: tip_sag(b, tip)
 
-    return MeshChoice(file or f"gmsh h={h:g}", h, build)
+    return MeshChoice(labelled(file or f"gmsh h={h:g}", formulation), h, build, formulation)
 
 
-def cantilever_choice(n: int) -> MeshChoice:
+def cantilever_choice(n: int, formulation: str = "p1") -> MeshChoice:
     def build():
-        body, tip = cantilever_body(n, snede.LinearElastic(YOUNG, 0.0))
+        body, tip = cantilever_body(n, snede.LinearElastic(YOUNG, 0.0), formulation=formulation)
         return body, lambda b: float(tip_deflections(b, tip).mean())
 
-    return MeshChoice(f"{n}×{n // 4}×{n // 4}", LENGTH / n, build)
+    return MeshChoice(labelled(f"{n}×{n // 4}×{n // 4}", formulation), LENGTH / n, build, formulation)
 
 
 def scenes(quick: bool) -> list[Scene]:
     cantilever_runs = (4, 8) if quick else (8, 12, 16, 24, 32, 48)
+    cantilever_smoothed = (4,) if quick else (8, 12, 16, 24)
     cantilever_references = (12, 16, 24) if quick else (32, 48, 72)
     if quick:
-        cylinder_runs = [cylinder_choice(0.03), cylinder_choice(0.02)]
+        cylinder_runs = [cylinder_choice(0.03), cylinder_choice(0.02), cylinder_choice(0.03, formulation="smoothed")]
         cylinder_references = [cylinder_choice(h) for h in (0.015, 0.0106, 0.0075)]
     else:
         cylinder_runs = [cylinder_choice(0.016), cylinder_choice(0.0112, "cylinder_small.msh"), cylinder_choice(0.008),
-                         cylinder_choice(0.0054, "cylinder_large.msh"), cylinder_choice(0.004)]
+                         cylinder_choice(0.0054, "cylinder_large.msh"), cylinder_choice(0.004),
+                         cylinder_choice(0.016, formulation="smoothed"),
+                         cylinder_choice(0.0112, "cylinder_small.msh", formulation="smoothed"),
+                         cylinder_choice(0.008, formulation="smoothed")]
         cylinder_references = [cylinder_choice(h) for h in (0.005, 0.0035, 0.0025)]
     return [
         Scene("cantilever", "LinearElastic E = 1e6 Pa, ν = 0, 3 N at the tip (§3.3)",
               ("cg", "ncg", "newton", "dynamic"),
-              [cantilever_choice(n) for n in cantilever_runs], [cantilever_choice(n) for n in cantilever_references],
+              [cantilever_choice(n) for n in cantilever_runs] + [cantilever_choice(n, "smoothed") for n in cantilever_smoothed],
+              [cantilever_choice(n) for n in cantilever_references],
               lambda body, prefix: snede.StaticSolver(body, "cg", preconditioner="none",
                                                       rtol=1e-9, criterion="6.8", max_iterations=100000,
                                                       options_prefix=prefix).solve(),
@@ -172,7 +183,8 @@ def run_grid(scene: Scene, tolerances, ref: dict) -> list[dict]:
                 outcome = run_solve(lambda: solve(body, solver, rtol, ref["damping"], f"{scene.name}_{solver}"))
                 value = probe(body)
                 rows.append({
-                    "scene": scene.name, "mesh": choice.label, "h": choice.h, "cells": body.mesh.n_cells,
+                    "scene": scene.name, "mesh": choice.label, "formulation": choice.formulation, "h": choice.h,
+                    "cells": body.mesh.n_cells,
                     "points": body.mesh.n_points, "solver": solver, "rtol": rtol, "converged": outcome.converged,
                     "reason": outcome.reason, "iterations": outcome.iterations,
                     "linear_iterations": outcome.linear_iterations, "seconds": outcome.seconds,
@@ -199,11 +211,11 @@ def recommendations(rows: list[dict], scene: str) -> list[dict]:
         if good:
             best = min(good, key=lambda r: r["seconds"])
             picks.append({"scene": scene, "target_pct": target, **{k: best[k] for k in (
-                "mesh", "cells", "solver", "rtol", "seconds", "error_pct")}})
+                "mesh", "formulation", "cells", "solver", "rtol", "seconds", "error_pct")}})
         else:
             best = min((row for row in rows if row["converged"]), key=lambda r: r["error_pct"])
             picks.append({"scene": scene, "target_pct": target, "mesh": "not reached in this grid",
-                          "cells": None, "solver": None, "rtol": None, "seconds": None,
+                          "formulation": None, "cells": None, "solver": None, "rtol": None, "seconds": None,
                           "error_pct": None, "best_error_pct": best["error_pct"]})
     return picks
 
@@ -288,7 +300,8 @@ def unreached_sentence(picks: list[dict]) -> str:
     return ("* Not reached in this grid: " + ", ".join(f"{p['target_pct']:g} % on the {p['scene']} (best "
                                                        f"{p['best_error_pct']:.2g} %)" for p in missed)
             + ". P1 tetrahedra in bending converge slowly (order in the reference table), so 1 % needs meshes "
-              "well beyond 10⁵ tetrahedra here, which is why the references are extrapolated.")
+              "well beyond 10⁵ tetrahedra here, which is why the references are extrapolated; the smoothed "
+              "formulation bends more accurately on the same mesh.")
 
 
 def plot(all_rows: list[dict], scene_names, path: Path) -> None:
@@ -325,7 +338,7 @@ RUN_COLUMNS = [Column("mesh", "mesh"), Column("cells", "cells"), Column("solver"
                Column("rtol", "rtol", "{:g}"), Column("iterations", "iterations"),
                Column("seconds", "seconds", "{:.3f}"), Column("error_pct", "error %", "{:.3g}")]
 PICK_COLUMNS = [Column("scene", "scene"), Column("target_pct", "target error %", "{:g}"), Column("mesh", "mesh"),
-                Column("cells", "cells"), Column("solver", "solver"), Column("rtol", "rtol", "{:g}"),
+                Column("formulation", "formulation"), Column("cells", "cells"), Column("solver", "solver"), Column("rtol", "rtol", "{:g}"),
                 Column("seconds", "seconds", "{:.3f}"), Column("error_pct", "error %", "{:.3g}"),
                 Column("best_error_pct", "best error reached %", "{:.3g}")]
 REFERENCE_COLUMNS = [
@@ -338,7 +351,7 @@ REFERENCE_COLUMNS = [
 
 def describe(scene_list, references, rows, picks, tolerances, quick: bool, minutes: float) -> str:
     lines = [
-        "# Accuracy against time: mesh size × tolerance × solver", "",
+        "# Accuracy against time: mesh size × formulation × tolerance × solver", "",
         "Regenerate with `.venv/bin/python -m snede.experiments.tradeoff" + (" --quick`" if quick else "`")
         + " (this file, `tradeoff.csv` with every run, `tradeoff.png`)."
         + (" **Quick run: reduced sizes.**" if quick else
@@ -352,7 +365,10 @@ def describe(scene_list, references, rows, picks, tolerances, quick: bool, minut
         "time is the solve's own (`SolveResult.seconds`), from rest, without mesh generation. Every solver stops at "
         "criterion (6.9) (the default: ‖r‖ ≤ rtol·√(‖f_ext‖² + ‖f_react‖²)); dynamic relaxation uses the CFL "
         "time step and η = 2√λ₁ with λ₁ estimated by the Rayleigh quotient of the reference solution "
-        "(§4.1; an optimistic choice a user would have to tune). Hollow markers in the figure: not converged.", ""]
+        "(§4.1; an optimistic choice a user would have to tune). Hollow markers in the figure: not converged. "
+        "The formulation (issue 35, docs/results/locking.md) is \"p1\" unless the mesh's label names "
+        "\"smoothed\" (strains averaged over edge and vertex patches); the reference is p1's, extrapolated, "
+        "which both converge to.", ""]
     reference_rows = []
     for scene in scene_list:
         ref = references[scene.name]

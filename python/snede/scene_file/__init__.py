@@ -13,15 +13,15 @@ from snede.scene_file.reading import SceneFileError
 from snede.scene_file.recipe import read
 from snede.scene_file.scene import build
 
-OPTIONS = ()  # the command line's scene options (--divisions, --speed, --mesh-size) apply to no scene file
+OPTIONS = ("formulation",)  # of the command line's scene options only --formulation applies to scene files
 SUFFIX = ".toml"
 
 
-def load(path, material: str | None = None):
+def load(path, material: str | None = None, formulation: str | None = None):
     """The scene of the file ``path`` (a ``snede.scenes.Scene``), its mesh made, its body held
-    and loaded, its tools' paths checked against the body; ``material`` (the command line's
-    ``--material``) replaces the file's material model."""
-    return build(read(path), material)
+    and loaded, its tools' paths checked against the body; ``material`` and ``formulation`` (the
+    command line's ``--material`` and ``--formulation``) replace the file's."""
+    return build(read(path), material, formulation)
 
 
 __all__ = ["OPTIONS", "SUFFIX", "SceneFileError", "load", "read"]

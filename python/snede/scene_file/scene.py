@@ -125,13 +125,14 @@ def largest_displacement(body) -> float:
     return float(np.linalg.norm(body.displacement, axis=1).max())
 
 
-def build(recipe: Recipe, material_name: str | None = None) -> Scene:
+def build(recipe: Recipe, material_name: str | None = None, formulation: str | None = None) -> Scene:
     """The scene of ``recipe``; ``material_name`` (the command line's ``--material``) replaces
-    the file's material model, its parameters kept."""
+    the file's material model, its parameters kept, and ``formulation`` (``--formulation``) the
+    file's formulation."""
     mesh = recipe.mesh()
     m = recipe.material
     body = snede.Body(mesh, material(material_name or m.name, m.E, m.nu, m.gamma), density=m.density,
-                      formulation=m.formulation)
+                      formulation=formulation or m.formulation)
     held = np.zeros(mesh.n_points, dtype=bool)
     for region, displacement in recipe.holds:
         vertices = _picked(recipe, region, mesh)

@@ -7,7 +7,7 @@ from snede.scenes import Scene, material
 
 LENGTH, HEIGHT, DEPTH, YOUNG, LOAD = 1.2, 0.2, 0.3, 1e6, 3.0
 VIEW = (20.0, 30.0, 0.0, "y")  # the picture's camera: y up, the beam bending down across the picture
-OPTIONS = ("divisions",)  # the scene options it uses (the command line refuses the others)
+OPTIONS = ("divisions", "formulation")  # the scene options it uses (the command line refuses the others)
 DESCRIPTION = "§3.3 cantilever beam, 3 N tip load, analytic tip deflection 8.64 mm"
 
 
@@ -23,7 +23,7 @@ def build(options) -> Scene:
     if n % 4:
         raise ValueError(f"--divisions for the cantilever must be a multiple of 4 (n × n/4 × n/4 cubes), got {n}")
     mesh = snede.meshing.box((LENGTH, HEIGHT, DEPTH), (n, n // 4, n // 4))
-    body = snede.Body(mesh, material(options.material or "linear", YOUNG, 0.0), density=1000.0)
+    body = snede.Body(mesh, material(options.material or "linear", YOUNG, 0.0), density=1000.0, formulation=getattr(options, "formulation", None) or "p1")
     x = mesh.points
     body.fix(held(x))
     tip = np.flatnonzero(np.isclose(x[:, 0], LENGTH))

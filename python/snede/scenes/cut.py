@@ -28,7 +28,7 @@ AT, DEPTH = 0.25, 0.7  # where the blade enters (fraction of the length), how de
 # the last two moves), and a blade 0.3 h past a layer of vertices cuts the grid more cleanly
 # than one halfway between two layers.
 STEP, OFFSET = 0.75, 0.3
-OPTIONS = ("divisions",)  # the scene options it uses (the command line refuses the others)
+OPTIONS = ("divisions", "formulation")  # the scene options it uses (the command line refuses the others)
 DESCRIPTION = "§3.2 scalpel cut 70 % into a soft beam sagging under gravity, relaxed after each step"
 METHODS = ("cg", "ncg", "newton")
 VIEW = (12.0, -70.0)  # camera (elevation, azimuth): the side and the top, where the V opens
@@ -180,7 +180,8 @@ def build(options) -> Scene:
     if n % 4:
         raise ValueError(f"--divisions for the cut must be a multiple of 4 (n × n/4 × n/4 cubes), got {n}")
     mesh = snede.meshing.box((LENGTH, WIDTH, HEIGHT), (n, n // 4, n // 4))
-    body = snede.Body(mesh, material(options.material or "neohookean", YOUNG, POISSON), density=DENSITY)
+    body = snede.Body(mesh, material(options.material or "neohookean", YOUNG, POISSON), density=DENSITY,
+                      formulation=getattr(options, "formulation", None) or "p1")
     body.fix(held(mesh.points))
     body.add_gravity((0.0, 0.0, -9.81))
     cut = Cut(body, n)

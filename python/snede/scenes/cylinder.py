@@ -8,7 +8,7 @@ import snede
 from snede.scenes import Scene, material
 
 MESHES = Path(__file__).resolve().parents[3] / "meshes"
-OPTIONS = ("mesh_size",)  # the scene options it uses (the command line refuses the others)
+OPTIONS = ("mesh_size", "formulation")  # the scene options it uses (the command line refuses the others)
 DESCRIPTION = "§4.2 soft cylinder under gravity (Table 4.1 parameters), no analytic solution"
 ETA_CRIT = {"linear": 17.0, "stvk": 20.0, "neohookean": 21.0, "veronda": 27.0}  # Table 4.4
 
@@ -19,7 +19,7 @@ def build(options) -> Scene:
     else:
         mesh = snede.Mesh.read(MESHES / "cylinder_small.msh")
     name = options.material or "neohookean"
-    body = snede.Body(mesh, material(name, 1e4, 0.3, 8.0), density=1000.0)
+    body = snede.Body(mesh, material(name, 1e4, 0.3, 8.0), density=1000.0, formulation=getattr(options, "formulation", None) or "p1")
     x0 = mesh.points[:, 0].min()
 
     def held(points) -> np.ndarray:  # the end x = x0

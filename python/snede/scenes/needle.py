@@ -15,7 +15,7 @@ from snede.plotting import animate, draw_2d
 from snede.scenes import Scene, material
 from snede.scenes.needle_slab import DEPTH, DIRECTION, ENTRY, POISSON, YOUNG, h, held, needle_for, slab_body
 
-OPTIONS = ("divisions", "speed")  # the scene options it uses (the command line refuses the others)
+OPTIONS = ("divisions", "speed", "formulation")  # the scene options it uses (the command line refuses the others)
 DESCRIPTION = "§6.8.1 needle inserted 70 mm into the slab: stick-slip friction, bisection at the tip"
 H_START, H_REF, SPEED, FRAMES = 3, 6, 0.1, 40
 METHODS = ("cg", "ncg", "newton")
@@ -128,7 +128,7 @@ def build(options) -> Scene:
     name = options.material or "linear"
     h_start = _h_start(options.divisions)
     speed = getattr(options, "speed", None) or SPEED
-    body = slab_body(h_start, material(name, YOUNG, POISSON))
+    body = slab_body(h_start, material(name, YOUNG, POISSON), formulation=getattr(options, "formulation", None) or "p1")
     insertion = Insertion(body, speed)
     return Scene(
         name="needle", description=DESCRIPTION, body=body, default_method="cg" if name == "linear" else "newton",

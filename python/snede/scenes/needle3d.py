@@ -28,17 +28,17 @@ YOUNG, POISSON = 34e3, 0.34
 # on one line of vertices.
 ENTRY, DIRECTION = (-0.005, 0.0513, 0.0489), (1.0, 0.0, 0.0)
 DIVISIONS, SPEED, FRAMES = 64, 0.5, 20
-OPTIONS = ("divisions", "speed")  # the scene options it uses (the command line refuses the others)
+OPTIONS = ("divisions", "speed", "formulation")  # the scene options it uses (the command line refuses the others)
 DESCRIPTION = "§6.9 needle (r = 1 mm) inserted 70 mm into a 10 cm cube: refined along the shaft, stick-slip"
 METHODS = ("cg", "newton")
 VIEW = (20.0, -60.0)
 
 
-def cube(material_):
+def cube(material_, formulation: str = "p1"):
     """The cube: the 2 × 2 × 2 Kuhn box bisected 3 times (384 tetrahedra), fixed at the bottom."""
     mesh = snede.meshing.box((SIZE, SIZE, SIZE), (2, 2, 2))
     mesh.refine_uniform(3)
-    body = snede.Body(mesh, material_)
+    body = snede.Body(mesh, material_, formulation=formulation)
     body.fix(held(mesh.points))
     return body
 
@@ -178,7 +178,7 @@ def build(options) -> Scene:
     if divisions < 4:
         raise ValueError(f"--divisions for needle3d sets h_ref = 0.1 m / divisions and must be at least 4, got {divisions}")
     speed = getattr(options, "speed", None) or SPEED
-    body = cube(material(name, YOUNG, POISSON))
+    body = cube(material(name, YOUNG, POISSON), getattr(options, "formulation", None) or "p1")
     insertion = Insertion(body, SIZE / divisions, speed)
     return Scene(
         name="needle3d", description=DESCRIPTION, body=body, default_method="cg" if name == "linear" else "newton",

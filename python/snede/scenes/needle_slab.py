@@ -30,12 +30,13 @@ def held(points, fixed: str = "right") -> np.ndarray:
     raise ValueError(f"fixed must be 'right' or 'bottom', got {fixed!r}")
 
 
-def slab_body(h_start: int, material=None, *, fixed: str = "right") -> "snede.Body":
+def slab_body(h_start: int, material=None, *, fixed: str = "right", formulation: str = "p1") -> "snede.Body":
     """The slab meshed with right triangles of leg h_{h_start} (2·4^h_start cells), held on the
     right side (``fixed="right"``, §6.8.1) or at the bottom (``"bottom"``, Figure 6.12)."""
     n = 2 ** h_start
     mesh = snede.meshing.rectangle((SIZE, SIZE), (n, n))
-    body = snede.Body(mesh, material or snede.LinearElastic(YOUNG, POISSON), density=1000.0, thickness=THICKNESS)
+    body = snede.Body(mesh, material or snede.LinearElastic(YOUNG, POISSON), density=1000.0, thickness=THICKNESS,
+                      formulation=formulation)
     body.fix(held(mesh.points, fixed))
     return body
 

@@ -27,7 +27,7 @@ YOUNG, POISSON, DENSITY = 5e4, 0.3, 1000.0
 STRETCH = 0.08  # the grips pull the sheet this much longer, half at each end
 DEPTH = 0.6  # how far down the scalpel goes, as a fraction of the height
 SWAY = 0.12  # the S-curve's amplitude, as a fraction of the length
-OPTIONS = ("divisions",)  # the scene options it uses (the command line refuses the others)
+OPTIONS = ("divisions", "formulation")  # the scene options it uses (the command line refuses the others)
 DESCRIPTION = "§5.2 Delaunay cut along an S-curve into a stretched plane-stress sheet, relaxed after each move"
 METHODS = ("cg", "ncg", "newton")
 FRAMES = 30  # about this many frames in the series and the animation, besides the stretched sheet
@@ -166,7 +166,7 @@ def build(options) -> Scene:
         raise ValueError(f"--divisions for the sheet-cut must be a multiple of 5 (n × 3n/5 squares), got {n}")
     name = options.material or "linear"
     mesh = snede.meshing.rectangle((LENGTH, HEIGHT), (n, 3 * n // 5))
-    body = snede.Body(mesh, material(name, YOUNG, POISSON), density=DENSITY, thickness=THICKNESS)
+    body = snede.Body(mesh, material(name, YOUNG, POISSON), density=DENSITY, thickness=THICKNESS, formulation=getattr(options, "formulation", None) or "p1")
     x = mesh.points
     pull = 0.5 * STRETCH * LENGTH
     body.fix(np.isclose(x[:, 0], 0.0), (-pull, 0.0))  # the grips: clamped, pulled apart

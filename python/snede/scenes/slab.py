@@ -10,7 +10,7 @@ from snede.scenes import Scene, material
 
 SIZE, THICKNESS, DEPTH, TOTAL_FORCE = 0.1, 0.01, 0.07, 0.2
 PLOT_SCALE = 20.0  # the slab moves half a millimetre: exaggerated in the picture
-OPTIONS = ("divisions",)  # the scene options it uses (the command line refuses the others)
+OPTIONS = ("divisions", "formulation")  # the scene options it uses (the command line refuses the others)
 DESCRIPTION = "§6.8.1 plane-stress slab with a needle-like line load (Figure 6.4 shape)"
 
 
@@ -32,7 +32,8 @@ def build(options) -> Scene:
     if n % 2:
         raise ValueError(f"--divisions for the slab must be even (the load line is y = 0.05), got {n}")
     mesh = snede.meshing.rectangle((SIZE, SIZE), (n, n))
-    body = snede.Body(mesh, material(options.material or "linear", 34e3, 0.34), density=1000.0, thickness=THICKNESS)
+    body = snede.Body(mesh, material(options.material or "linear", 34e3, 0.34), density=1000.0, thickness=THICKNESS,
+                      formulation=getattr(options, "formulation", None) or "p1")
     x = mesh.points
     body.fix(held(x))
     line = np.flatnonzero(np.isclose(x[:, 1], SIZE / 2) & (x[:, 0] <= DEPTH + 1e-12))

@@ -114,6 +114,7 @@ def test_cli_prints_a_line_per_move(tmp_path):
     (("--material", "linear"), "nonlinear material"),
     (("--method", "cg"), "solves with newton"),
     (("--speed", "1"), "--speed does not apply to the membrane-cut scene"),
+    (("--formulation", "smoothed"), "--formulation does not apply to the membrane-cut scene"),
 ])
 def test_bad_options_give_a_message(args, message, tmp_path):
     out = run_cli("run", "membrane-cut", *args, "--out", str(tmp_path))
