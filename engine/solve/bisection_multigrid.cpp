@@ -312,6 +312,12 @@ void BisectionMultigrid::configure(PC pc, const SolverOptions& options, const st
   SNEDE_PETSC(KSPSetOperators(coarse, coarse_[0]->model->tangent(), coarsest_matrix_->mat()));
 }
 
+bool BisectionMultigrid::prefer_positive_definite() {
+  if (coarse_at_rest_) return false;
+  coarse_at_rest_ = true;
+  return true;
+}
+
 void BisectionMultigrid::update(Vec u, Mat) {
   const int d = fine_.dim();
   ReadView fine_state(u);
@@ -320,7 +326,8 @@ void BisectionMultigrid::update(Vec u, Mat) {
       WriteView state(level->state);
       for (std::size_t i = 0; i < level->vertex.size(); ++i)
         for (int k = 0; k < d; ++k)
-          state.span()[i * d + k] = fine_state.span()[static_cast<std::size_t>(level->vertex[i]) * d + k];
+          state.span()[i * d + k] =
+              coarse_at_rest_ ? 0.0 : fine_state.span()[static_cast<std::size_t>(level->vertex[i]) * d + k];
     }
     Model& model = *level->model;
     model.set_linearization_point(level->state);

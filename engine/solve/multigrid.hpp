@@ -46,6 +46,10 @@ class Multigrid {
   // that do not need it) was filled at u: matrix-free levels take the state, Galerkin levels
   // recompute their products with the matrix.
   virtual void update(Vec u, Mat assembled_tangent) = 0;
+  // The preconditioner was found indefinite (CG met negative curvature in it). Levels that can
+  // make their operators positive definite switch to that from the next update() on and return
+  // true; false if nothing would change.
+  virtual bool prefer_positive_definite() { return false; }
 };
 
 // Levels of any mesh (grid_multigrid.hpp, aggregation_multigrid.hpp) whose coarse operators are

@@ -602,15 +602,23 @@ PetscErrorCode StaticSolver::jacobian_callback(SNES snes, Vec x, Mat J, Mat P, v
 PetscErrorCode StaticSolver::descent_direction_callback(SNESLineSearch line_search, Vec /*u*/, Vec step,
                                                         PetscBool* changed, void* context) {
   return petsc_callback("snede Newton direction", [&] {
-    callback_owner<StaticSolver>(context, "StaticSolver");
+    StaticSolver& self = callback_owner<StaticSolver>(context, "StaticSolver");
     *changed = PETSC_FALSE;
     SNES snes = nullptr;
     Vec residual = nullptr;
     SNEDE_PETSC(SNESLineSearchGetSNES(line_search, &snes));
     SNEDE_PETSC(SNESGetFunction(snes, &residual, nullptr, nullptr));
+    // An indefinite multigrid preconditioner is made positive definite for the next Newton
+    // steps where its levels can be (bisection_multigrid.hpp).
+    KSP linear = nullptr;
+    KSPConvergedReason linear_reason = KSP_CONVERGED_ITERATING;
+    SNEDE_PETSC(SNESGetKSP(snes, &linear));
+    SNEDE_PETSC(KSPGetConvergedReason(linear, &linear_reason));
     // Newton moves to u − λ·step: downhill iff F·step > 0 (F = ∇Π, §2.4.3).
     PetscScalar slope = 0;
     SNEDE_PETSC(VecDot(residual, step, &slope));
+    if ((linear_reason == KSP_DIVERGED_INDEFINITE_PC || !(slope > 0)) && self.multigrid_)
+      self.multigrid_->prefer_positive_definite();
     if (slope > 0) return;
     // Truncated Newton (§2.4.3) stops CG at the first direction of non-positive curvature and
     // keeps its iterate so far, or at the first iteration takes the steepest descent. PETSc's CG

@@ -572,18 +572,9 @@ def test_dynamic_relaxation_reaches_the_static_answer_after_a_cut():
     assert np.abs(body.displacement - static).max() <= 1e-4 * np.abs(static).max()
 
 
-@pytest.mark.xfail(strict=True, reason=(
-    "engine bug (solve/bisection_multigrid.cpp, both formulations): the 'mg' preconditioner on a "
-    "bisection hierarchy rediscretises each coarse level at the injected state, and under a larger "
-    "load that coarse tangent is indefinite (P1 and smoothed: a negative eigenvalue of about -45 on "
-    "the 120-cell level at the converged state, whose fine tangent is positive definite, smallest "
-    "eigenvalue 0.8), so Newton's CG stops with DIVERGED_INDEFINITE_PC and the solve ends "
-    "DIVERGED_LINE_SEARCH where 'none', 'gamg' and 'jacobi' converge. Reproducer: "
-    "m = snede.meshing.box((1, .4, .4), (5, 2, 2)); m.refine_uniform(3); "
-    "b = snede.Body(m, snede.NeoHookean(1e4, 0.49), density=30.0, formulation='smoothed'); "
-    "b.fix(np.isclose(m.points[:, 0], 0)); b.add_gravity((0, 0, -9.81)); "
-    "snede.StaticSolver(b, 'newton', rtol=1e-8, preconditioner='mg').solve().converged -> False"))
 def test_bisection_multigrid_under_a_load_that_bends_the_beam_a_quarter_of_its_length():
+    """Under this load a coarse level linearised at the injected fine state is indefinite (P1 and
+    smoothed alike): the solver then linearises the coarse levels at rest and converges."""
     body = loaded_beam(3, levels=3, density=30.0)
     reference = loaded_beam(3, levels=3, density=30.0)
     assert snede.StaticSolver(reference, "newton", rtol=1e-8, preconditioner="none").solve().converged
