@@ -608,6 +608,18 @@ PetscErrorCode StaticSolver::descent_direction_callback(SNESLineSearch line_sear
     Vec residual = nullptr;
     SNEDE_PETSC(SNESLineSearchGetSNES(line_search, &snes));
     SNEDE_PETSC(SNESGetFunction(snes, &residual, nullptr, nullptr));
+    // The step onto the allowed motions (6.7): a preconditioner that is not itself projected
+    // (Jacobi's diagonal scaling, GAMG, multigrid) gives a truncated CG iterate components off a
+    // sliding vertex's line, and the update would leave it (a box with 49 vertices sliding along
+    // random directions: Jacobi's Newton stopped with DIVERGED_LINE_SEARCH, mg took 39 iterations
+    // of a linear problem where no preconditioner took 5). The slope F·step is unchanged, F
+    // being projected already.
+    auto project = [&](Vec v) {
+      WriteView values(v);
+      self.model_.constraints().project(values.span());
+    };
+    project(step);
+    *changed = PETSC_TRUE;
     // An indefinite multigrid preconditioner is made positive definite for the next Newton
     // steps where its levels can be (bisection_multigrid.hpp).
     KSP linear = nullptr;
@@ -634,6 +646,7 @@ PetscErrorCode StaticSolver::descent_direction_callback(SNESLineSearch line_sear
     SNEDE_PETSC(KSPGetPC(ksp, &pc));
     SNEDE_PETSC(KSPGetOperators(ksp, &tangent, nullptr));
     SNEDE_PETSC(PCApply(pc, residual, step));
+    project(step);
     SNEDE_PETSC(VecDot(residual, step, &slope));
     if (!(slope > 0)) {  // an indefinite preconditioner
       SNEDE_PETSC(VecCopy(residual, step));
