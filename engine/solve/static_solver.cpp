@@ -452,6 +452,12 @@ SolveResult StaticSolver::solve_linear() {
   if (needs_matrix_) assembled_->assemble(model_, u);
   if (multigrid_) multigrid_->update(u, assembled_ ? assembled_->mat() : nullptr);
   SNEDE_PETSC(KSPSolve(ksp_, rhs, step));
+  {
+    // Onto the allowed motions (6.7), as Newton's steps (descent_direction_callback): CG's
+    // iterate under a preconditioner that is not projected leaves sliding vertices' lines.
+    WriteView values(step);
+    model_.constraints().project(values.span());
+  }
   SNEDE_PETSC(VecAXPY(u, 1.0, step));
   KSPConvergedReason reason;
   PetscInt iterations = 0;
