@@ -1,7 +1,8 @@
 // Benchmark (not a test): element-loop throughput of ElasticBody per material (§2.3, §4.3),
 // and the linear tangent product against an assembled BAIJ(3) product in the same run.
 //
-//     build/cpp/kernel_throughput [n ...]        (default: 26 55, Kuhn boxes of 6n³ tetrahedra)
+//     build/cpp/kernel_throughput [--formulation p1|smoothed] [n ...]
+//                                       (default: p1; 26 55, Kuhn boxes of 6n³ tetrahedra)
 //
 // For each box and material prints million tetrahedra per second (one core, best of several
 // calls) for the energy, the internal forces and the tangent action, then ns per tetrahedron
@@ -16,6 +17,7 @@
 #include <cstdlib>
 #include <random>
 #include <set>
+#include <string>
 #include <vector>
 
 #include "core/error.hpp"
@@ -90,7 +92,7 @@ struct LinearAgainstBaij {
   double n_cells, shell_ns, baij_ns;
 };
 
-LinearAgainstBaij run_box(int n) {
+LinearAgainstBaij run_box(int n, Formulation formulation) {
   Mesh mesh = box_of_side(0.1, n);
   const double n_cells = static_cast<double>(mesh.n_cells());
   std::mt19937 rng(0);
@@ -103,7 +105,7 @@ LinearAgainstBaij run_box(int n) {
                                            NeoHookean(3e3, 0.3), VerondaWestmann(3e3, 0.3, 2.0)};
   double linear_tangent_seconds = 0;
   for (const Material& material : materials) {
-    ElasticBody body(mesh, material, 1000.0, 0.0);
+    ElasticBody body(mesh, material, 1000.0, 0.0, formulation);
     EvaluationReport report;
     const double t_energy = best_seconds(repeats, [&] { body.energy(u, report); });
     const double t_force = best_seconds(repeats, [&] { body.internal_forces(u, out, report); });
@@ -124,14 +126,20 @@ LinearAgainstBaij run_box(int n) {
 
 int main(int argc, char** argv) {
   std::vector<int> divisions;
-  for (int i = 1; i < argc; ++i) divisions.push_back(std::atoi(argv[i]));
+  Formulation formulation = Formulation::p1;
+  for (int i = 1; i < argc; ++i) {
+    if (std::string(argv[i]) == "--formulation" && i + 1 < argc)
+      formulation = parse_formulation(argv[++i]);
+    else
+      divisions.push_back(std::atoi(argv[i]));
+  }
   if (divisions.empty()) divisions = {26, 55};
   int petsc_argc = 1;
   snede::PetscSession petsc(&petsc_argc, &argv);
   std::printf("| tetrahedra | material | energy M/s | force M/s | tangent M/s | tangent ns/tet | flagged |\n");
   std::printf("|---|---|---|---|---|---|---|\n");
   std::vector<LinearAgainstBaij> linear;
-  for (int n : divisions) linear.push_back(run_box(n));
+  for (int n : divisions) linear.push_back(run_box(n, formulation));
   std::printf("\n| tetrahedra | linear tangent ns/tet | BAIJ(3) MatMult ns/tet | tangent / BAIJ |\n|---|---|---|---|\n");
   for (const LinearAgainstBaij& row : linear)
     std::printf("| %9.0f | %8.2f | %8.2f | %5.2f |\n", row.n_cells, row.shell_ns, row.baij_ns, row.shell_ns / row.baij_ns);
