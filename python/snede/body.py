@@ -182,6 +182,8 @@ class Body:
 
     # -- constraints, loads and state (the model, §3.1, §6.6) ----------------------------
     def _vertices(self, vertices) -> np.ndarray:
+        if isinstance(vertices, str):  # a named group of the mesh
+            return self.mesh.group_vertices(vertices)
         array = np.atleast_1d(np.asarray(vertices))
         if array.dtype == bool:
             if array.shape != (self.mesh.n_points,):
@@ -192,7 +194,8 @@ class Body:
         return _checks.index_array(array, "vertices", self.mesh.n_points, "a vertex of the mesh")
 
     def fix(self, vertices, value=None) -> None:
-        """Fix vertices (indices or a boolean mask) at displacement ``value``: None for zero,
+        """Fix vertices (indices, a boolean mask, or the name of one of the mesh's boundary or
+        cell groups: ``mesh.boundary_groups``, ``mesh.cell_groups``) at displacement ``value``: None for zero,
         one (dim,) vector for all, or (n_vertices, dim). The state is moved onto it."""
         vertices = self._vertices(vertices)
         if value is None:
@@ -244,6 +247,34 @@ class Body:
         """Add a force (newtons) to load channel ``channel``: one (dim,) vector on every listed
         vertex, or (n_vertices, dim)."""
         self._model.add_nodal_force(str(channel), self._vertices(vertices), np.asarray(force, dtype=np.float64))
+
+    def add_traction(self, faces, traction, channel: str = "nodal") -> None:
+        """Add a uniform traction (force per unit area of the reference boundary, a (dim,)
+        vector) on boundary faces — the name of one of ``mesh.boundary_groups`` or (n, cell_dim)
+        vertex indices — lumped to their vertices: each face's force (traction × area; edges in
+        2D and on membranes: × length × thickness) split equally among its corners."""
+        if isinstance(faces, str):
+            groups = self.mesh.boundary_groups
+            if faces not in groups:
+                raise KeyError(f"no boundary group {faces!r} in this mesh (its boundary groups: "
+                               f"{', '.join(sorted(groups)) or 'none'})")
+            faces = groups[faces]
+        faces = np.asarray(faces)
+        cell_dim = self.mesh.cell_dim
+        if faces.dtype.kind not in "iu" or faces.ndim != 2 or faces.shape[1] != cell_dim:
+            raise ValueError(f"faces must be a boundary group's name or (n, {cell_dim}) vertex indices, got "
+                             f"{faces.shape} {faces.dtype}")
+        traction = np.broadcast_to(np.asarray(traction, dtype=np.float64), (self.dim,))
+        corners = self.mesh.points[_checks.index_array(faces, "faces", self.mesh.n_points, "a vertex of the mesh")]
+        if cell_dim == 3:
+            measure = 0.5 * np.linalg.norm(np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]), axis=1)
+        else:
+            measure = np.linalg.norm(corners[:, 1] - corners[:, 0], axis=1) * self.thickness
+        forces = np.zeros((self.mesh.n_points, self.dim))
+        for corner in range(cell_dim):
+            np.add.at(forces, faces[:, corner], np.outer(measure / cell_dim, traction))
+        loaded = np.unique(faces)
+        self.add_nodal_force(loaded, forces[loaded], channel)
 
     def set_nodal_forces(self, vertices, force, channel: str = "nodal") -> None:
         """Replace the whole channel ``channel`` by these forces (other channels unchanged)."""

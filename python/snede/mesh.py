@@ -151,6 +151,51 @@ class Mesh(MeshEdits):
             self._cell_ids_revision = revision
         return self._cell_ids
 
+    # -- named groups (mesh_groups.py) -----------------------------------------------------
+    @property
+    def _group_store(self):
+        store = getattr(self, "_groups", None)
+        if store is None:
+            from snede.mesh_groups import MeshGroups
+
+            store = self._groups = MeshGroups()
+        return store
+
+    @property
+    def cell_groups(self) -> dict[str, np.ndarray]:
+        """Named groups of cells, name → rows of ``cells``: gmsh's physical groups of the file's
+        dimension (or a VTK file's integer cell data), and those added by ``add_cell_group``. They
+        follow refinement and cuts (a cell takes its parent's groups)."""
+        return self._group_store.cell_groups(self)
+
+    @property
+    def boundary_groups(self) -> dict[str, np.ndarray]:
+        """Named groups of boundary faces, name → (n, cell_dim) vertex indices: gmsh's physical
+        groups one dimension lower than the cells, and those added by ``add_boundary_group``.
+        They follow refinement (a face takes its parent's groups); the faces cuts open form the
+        group ``"incision"`` (present, maybe empty, once any group is given)."""
+        return self._group_store.boundary_groups(self)
+
+    def add_cell_group(self, name: str, rows) -> None:
+        """Name a group of cells: ``rows`` of ``cells`` (indices or a boolean mask)."""
+        self._group_store.add_cells(self, name, rows)
+
+    def add_boundary_group(self, name: str, faces) -> None:
+        """Name a group of boundary faces, (n, cell_dim) vertex indices (e.g. from
+        ``faces_where(..., interior=False)`` or ``boundary_patch``); a face that is not on the
+        boundary is refused."""
+        self._group_store.add_faces(self, name, faces)
+
+    def group_vertices(self, name: str) -> np.ndarray:
+        """The vertices of the named boundary or cell group (boundary groups first), sorted;
+        a KeyError listing the names if there is none."""
+        for groups, rows_to_vertices in ((self.boundary_groups, lambda faces: faces),
+                                         (self.cell_groups, lambda rows: self.cells[rows])):
+            if name in groups:
+                return np.unique(rows_to_vertices(groups[name]))
+        known = sorted(set(self.boundary_groups) | set(self.cell_groups))
+        raise KeyError(f"no group {name!r} in this mesh (its groups: {', '.join(known) or 'none'})")
+
     # -- queries -----------------------------------------------------------------------
     def boundary_faces(self) -> np.ndarray:
         """(n_faces, cell_dim) vertex indices of the boundary faces (edges of triangles, in 2D
@@ -429,7 +474,7 @@ class Mesh(MeshEdits):
                     raise ValueError(f"{path}: the series has no steps (yet): no mesh to read")
                 return steps[-1].mesh
 
-        points, blocks = mesh_files.read_blocks(Path(path))
+        points, blocks, groups = mesh_files.read_blocks(Path(path))
         kind = "tetra" if "tetra" in blocks else "triangle"
         if kind not in blocks:
             raise ValueError(f"{path}: no tetrahedra or triangles (cell types: {sorted(blocks)})")
@@ -443,9 +488,27 @@ class Mesh(MeshEdits):
                               stacklevel=2)
                 cells = cells[~collapsed]
         try:
-            return cls(points, cells)
+            mesh = cls(points, cells)
         except ValueError as error:  # keep the type (InvalidMesh is one), name the file
             raise type(error)(f"{path}: {error}") from None
+        mesh._add_file_groups(path, kind, groups)
+        return mesh
+
+    def _add_file_groups(self, path, kind: str, groups) -> None:
+        """A file's groups of cells (of the mesh's kind) and of boundary faces (one dimension
+        lower); a face group that is not on the boundary (an interface inside) is left out with a
+        warning."""
+        face_kind = {"tetra": "triangle", "triangle": "line"}[kind]
+        rows = {tuple(cell): row for row, cell in enumerate(np.sort(self.cells, axis=1).tolist())}
+        for cell_type, name, cells in groups:
+            if cell_type == kind:
+                keys = [tuple(cell) for cell in np.sort(cells, axis=1).tolist()]
+                self.add_cell_group(name, [rows[key] for key in keys if key in rows])
+            elif cell_type == face_kind:
+                try:
+                    self.add_boundary_group(name, cells)
+                except ValueError as error:
+                    warnings.warn(f"{path}: {error}; the group is left out", stacklevel=3)
 
     def write(self, path) -> None:
         """Write with meshio; the format follows the file extension (.msh, .vtu, .xdmf, ...)."""

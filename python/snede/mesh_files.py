@@ -21,20 +21,23 @@ MESHIO_FORMATS = {".msh": "gmsh", ".vtk": "vtk", ".vtu": "vtu", ".mesh": "medit"
 GMSH_SUFFIXES = (".msh", ".vtk", ".stl", ".mesh", ".off")
 
 
-def read_blocks(path: Path) -> tuple[np.ndarray, dict[str, np.ndarray]]:
-    """The points and cell blocks of the first reader that reads ``path``; a ValueError naming
-    the file and why each reader failed if none does. OSError (permissions, a folder) passes."""
+def read_blocks(path: Path) -> tuple[np.ndarray, dict[str, np.ndarray], list]:
+    """The points, cell blocks and named groups of the first reader that reads ``path``; a
+    ValueError naming the file and why each reader failed if none does. OSError (permissions, a
+    folder) passes. Groups are (cell type, name, (m, corners) vertex indices) triples: gmsh's
+    physical groups, or a VTK file's integer cell data (``"array=value"``); only meshio's
+    reader gives them."""
     reasons = []
     for name, reader in _readers(path):
         try:
-            points, blocks = reader(path)
+            points, blocks, *groups = reader(path)
         except OSError:
             raise
         except Exception as error:  # meshio's parsers fail in many ways
             reasons.append(f"{name}: {_reason(error)}")
             continue
         if len(points):
-            return points, blocks
+            return points, blocks, groups[0] if groups else []
         reasons.append(f"{name}: no points in it")
     raise ValueError(f"{path}: could not read this file as a mesh ({'; '.join(reasons)})")
 
@@ -72,8 +75,39 @@ def _meshio_reader(file_format: str | None):
         except SystemExit:
             lines = printed.getvalue().strip().splitlines()
             raise ValueError(lines[-1] if lines else "could not parse it") from None
-        return np.asarray(data.points), collect((block.type, block.data) for block in data.cells)
+        return np.asarray(data.points), collect((block.type, block.data) for block in data.cells), _groups(data)
     return read
+
+
+#: the cell types groups are read for, with their dimension (gmsh's physical groups are per dimension)
+_GROUP_TYPES = {"tetra": 3, "triangle": 2, "line": 1}
+
+
+def _groups(data) -> list:
+    """(cell type, name, cells) for each physical group of a gmsh file (named by the file's
+    $PhysicalNames, else "physical <tag>"), or each value of an integer cell-data array of other
+    formats with at most 64 values ("array=value")."""
+    groups = []
+    physical = data.cell_data.get("gmsh:physical")
+    if physical is not None:
+        names = {(int(value[0]), int(value[1])): name for name, value in data.field_data.items() if len(value) >= 2}
+        for block, tags in zip(data.cells, physical):
+            dim = _GROUP_TYPES.get(block.type)
+            if dim is None:
+                continue
+            tags = np.asarray(tags)
+            for tag in np.unique(tags):
+                groups.append((block.type, names.get((int(tag), dim), f"physical {int(tag)}"), block.data[tags == tag]))
+        return groups
+    for array_name, arrays in data.cell_data.items():
+        for block, values in zip(data.cells, arrays):
+            values = np.asarray(values)
+            if block.type not in _GROUP_TYPES or values.ndim != 1 or values.dtype.kind not in "iu":
+                continue
+            distinct = np.unique(values)
+            if len(distinct) <= 64:
+                groups += [(block.type, f"{array_name}={int(v)}", block.data[values == v]) for v in distinct]
+    return groups
 
 
 def read_with_gmsh(path: Path):

@@ -10,6 +10,7 @@ import numpy as np
 
 from snede import meshing
 from snede.mesh import Mesh
+from snede.mesh_groups import copy_groups
 from snede.scene_file.reading import (BOOLEAN, COUNT, COUNTS_3, POINT, POSITIVE, POSITIVE_3, SEED, TEXT, Table,
                                       choice, integer_kind)
 
@@ -49,7 +50,11 @@ def read_mesh(table: Table, folder: Path) -> Callable[[], Mesh]:
     target = table.get("target_cells", COUNT, None)
 
     def moved(mesh: Mesh) -> Mesh:
-        return mesh if scale == 1.0 and not shift.any() else Mesh(mesh.points * scale + shift, mesh.cells)
+        if scale == 1.0 and not shift.any():
+            return mesh
+        result = Mesh(mesh.points * scale + shift, mesh.cells)
+        copy_groups(mesh, result)  # a file's named groups
+        return result
 
     if source == "file":
         path = _existing(table, "file", folder)

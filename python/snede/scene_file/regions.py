@@ -1,6 +1,7 @@
 """The regions of a scene file that ``[[hold]]`` and ``[[loads.force]]`` tables pick vertices
-with: one key of ``side = "x = min"``, ``box = {min, max}``, ``plane = {point, normal}`` or
-``patch = {point, radius}``, and ``within`` (a distance, for a side or a plane)."""
+with: one key of ``side = "x = min"``, ``box = {min, max}``, ``plane = {point, normal}``,
+``patch = {point, radius}`` or ``group = "name"`` (one of the mesh's named groups, e.g. a gmsh
+physical group of the file), and ``within`` (a distance, for a side or a plane)."""
 from __future__ import annotations
 
 import re
@@ -11,7 +12,7 @@ import numpy as np
 
 from snede.scene_file.reading import DIRECTION, NON_NEGATIVE, POINT, POSITIVE, REFUSED, Kind, Table
 
-KINDS = ("side", "box", "plane", "patch")
+KINDS = ("side", "box", "plane", "patch", "group")
 _SIDE = re.compile(r"^\s*([xyz])\s*=\s*(min|max)\s*$")
 SIDE = Kind('a side such as "x = min" or "z = max"', lambda v: v if isinstance(v, str) and _SIDE.match(v) else REFUSED)
 EXACT = 1e-6  # ``within`` of a side or a plane by default, times the mesh's largest extent
@@ -57,6 +58,16 @@ def _plane(point, normal, within: float | None):
     return pick
 
 
+GROUP = Kind("the name of one of the mesh's groups (a string)", lambda v: v if isinstance(v, str) and v else REFUSED)
+
+
+def _group(mesh, name: str) -> np.ndarray:
+    try:
+        return mesh.group_vertices(name)
+    except KeyError as error:
+        raise ValueError(error.args[0]) from None
+
+
 def read_region(table: Table) -> Region:
     """The region of a ``[[hold]]`` or ``[[loads.force]]`` table."""
     kind = table.one_of(KINDS)
@@ -66,6 +77,9 @@ def read_region(table: Table) -> Region:
     if kind == "side":
         side = table.get("side", SIDE)
         return Region(key, f'side "{side}"{close}', _side(side, within))
+    if kind == "group":
+        name = table.get("group", GROUP)
+        return Region(key, f'group "{name}"', lambda mesh: _group(mesh, name))
     shape = table.table(kind)
     if kind == "box":
         low, high = np.array(shape.get("min", POINT)), np.array(shape.get("max", POINT))

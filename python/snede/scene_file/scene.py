@@ -167,7 +167,10 @@ def build(recipe: Recipe, material_name: str | None = None, formulation: str | N
 
 
 def _picked(recipe: Recipe, region, mesh) -> np.ndarray:
-    vertices = region.pick(mesh)
+    try:
+        vertices = region.pick(mesh)
+    except ValueError as error:  # a group the mesh does not have
+        raise SceneFileError(f"{recipe.source}: {region.key}: {error}") from None
     if len(vertices) == 0:
         raise SceneFileError(f"{recipe.source}: {region.key} ({region.description}) picks no vertex of the mesh "
                              f"(it spans {np.round(mesh.points.min(axis=0), 6).tolist()} to "

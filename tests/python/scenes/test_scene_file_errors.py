@@ -84,7 +84,7 @@ MISTAKES = {
     "a side that is none": (edited(('"x = min"', '"left"')),
                             'hold[1].side must be a side such as "x = min" or "z = max", got "left"'),
     "two regions in one hold": (edited(("side", "patch = {point = [0, 0, 0], radius = 1}\nside")),
-                                "hold[1] needs exactly one of side, box, plane, patch, got side, patch"),
+                                "hold[1] needs exactly one of side, box, plane, patch, group, got side, patch"),
     "an empty box": (edited(('side = "x = min"', "box = {min = [0, 0, 0], max = [1, -1, 1]}")),
                      "hold[1].box.max must be at least hold[1].box.min in every coordinate"),
     "a region that picks nothing": (edited(('side = "x = min"', "box = {min = [1, 1, 1], max = [2, 2, 2]}")),

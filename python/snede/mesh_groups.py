@@ -1,0 +1,204 @@
+"""Named groups of a mesh (issue 34): cell groups (name → rows of ``mesh.cells``) and boundary
+groups (name → boundary faces), from a file's gmsh physical groups or VTK cell data, or given by
+the user.
+
+Groups are kept against a reference: the mesh's cells and boundary faces (their corners) when a
+group was last given, each with the groups it belongs to. They are resolved against the mesh as
+it is now by where things lie: a cell takes the groups of the reference cell that contains its
+centroid, a boundary face those of the reference boundary face its centroid lies on. So the
+groups follow every edit without the engine knowing them: bisection's children lie in their
+parents, a cut's copies where the cells were, and a face a cut opens lies on no reference
+boundary face: it joins the group ``"incision"``. A vertex moved by node snapping (a fraction of
+an edge) keeps its cells in their groups: a centroid just outside every reference simplex (within
+a quarter of one) takes the nearest.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+#: the boundary group of the faces that cuts opened
+INCISION = "incision"
+# A centroid this far outside every reference simplex (in barycentric weight) takes the nearest.
+_NEAREST = 0.25
+
+
+class MeshGroups:
+    """The groups of one mesh, resolved lazily and cached per connectivity revision."""
+
+    def __init__(self):
+        self._cells = None  # (n, cell_dim + 1, dim) reference cells' corners
+        self._faces = None  # (m, cell_dim, dim) reference boundary faces' corners
+        self._cell_members: dict[str, np.ndarray] = {}  # name → (n,) bool
+        self._face_members: dict[str, np.ndarray] = {}  # name → (m,) bool, "incision" among them
+        self._cache: dict = {}
+
+    def __bool__(self) -> bool:
+        return self._cells is not None
+
+    def add_cells(self, mesh, name: str, rows) -> None:
+        name = _name(name)
+        rows = _rows(rows, mesh.n_cells, f"cell group {name!r}", "rows of mesh.cells")
+        self._rebase(mesh)
+        member = np.zeros(mesh.n_cells, dtype=bool)
+        member[rows] = True
+        self._cell_members[name] = member
+
+    def add_faces(self, mesh, name: str, faces) -> None:
+        name = _name(name)
+        if name == INCISION:
+            raise ValueError(f"{INCISION!r} is the group of the faces cuts open; give the group another name")
+        faces = np.asarray(faces)
+        if faces.dtype.kind not in "iu" or faces.ndim != 2 or faces.shape[1] != mesh.cell_dim:
+            raise ValueError(f"boundary group {name!r} must be (n, {mesh.cell_dim}) vertex indices, got "
+                             f"{faces.shape} {faces.dtype}")
+        self._rebase(mesh)
+        boundary = mesh.boundary_faces()
+        place = {tuple(face): k for k, face in enumerate(np.sort(boundary, axis=1).tolist())}
+        keys = [tuple(face) for face in np.sort(faces, axis=1).tolist()]
+        missing = [key for key in keys if key not in place]
+        if missing:
+            raise ValueError(f"boundary group {name!r}: {len(missing)} face(s) are not boundary faces of the mesh, "
+                             f"e.g. {list(missing[0])}")
+        member = np.zeros(len(boundary), dtype=bool)
+        member[[place[key] for key in keys]] = True
+        self._face_members[name] = member
+
+    def cell_groups(self, mesh) -> dict[str, np.ndarray]:
+        return self._resolved(mesh)[0]
+
+    def boundary_groups(self, mesh) -> dict[str, np.ndarray]:
+        return self._resolved(mesh)[1]
+
+    def _rebase(self, mesh) -> None:
+        """The mesh as it is now becomes the reference, every group resolved onto it."""
+        if self._cells is not None:
+            cells, faces = self._resolved(mesh)
+            boundary = np.sort(mesh.boundary_faces(), axis=1)
+            place = {tuple(face): k for k, face in enumerate(boundary.tolist())}
+            self._cell_members = {name: np.isin(np.arange(mesh.n_cells), rows) for name, rows in cells.items()}
+            self._face_members = {}
+            for name, group in faces.items():
+                member = np.zeros(len(boundary), dtype=bool)
+                member[[place[tuple(face)] for face in np.sort(group, axis=1).tolist()]] = True
+                self._face_members[name] = member
+        else:
+            self._face_members = {INCISION: np.zeros(len(mesh.boundary_faces()), dtype=bool)}
+        self._cells = mesh.points[mesh.cells]
+        self._faces = mesh.points[mesh.boundary_faces()]
+        self._cache.clear()
+
+    def _resolved(self, mesh):
+        if self._cells is None:
+            return {}, {}
+        key = (mesh._impl.revision, mesh.n_points)
+        if self._cache.get("key") != key:
+            cells = mesh.points[mesh.cells]
+            parents = _containing(cells.mean(axis=1), self._cells)
+            cell_groups = {name: np.flatnonzero((parents >= 0) & member[np.maximum(parents, 0)])
+                           for name, member in self._cell_members.items()}
+            faces = mesh.boundary_faces()
+            parents = _containing(mesh.points[faces].mean(axis=1), self._faces)
+            face_groups = {name: faces[(parents >= 0) & member[np.maximum(parents, 0)]]
+                           for name, member in self._face_members.items()}
+            face_groups[INCISION] = faces[(parents < 0) | ((parents >= 0) & self._face_members[INCISION][
+                np.maximum(parents, 0)])]
+            self._cache = {"key": key, "value": (cell_groups, face_groups)}
+        return self._cache["value"]
+
+
+def copy_groups(source, target) -> None:
+    """``source``'s groups onto ``target``, a mesh with the same vertices and cells in the same
+    order (moved or scaled, say)."""
+    for name, rows in source.cell_groups.items():
+        target.add_cell_group(name, rows)
+    for name, faces in source.boundary_groups.items():
+        if name != INCISION:
+            target.add_boundary_group(name, faces)
+
+
+def _name(name) -> str:
+    if not isinstance(name, str) or not name:
+        raise ValueError(f"a group's name must be a non-empty string, got {name!r}")
+    return name
+
+
+def _rows(rows, n: int, what: str, of: str) -> np.ndarray:
+    array = np.atleast_1d(np.asarray(rows))
+    if array.dtype == bool:
+        if array.shape != (n,):
+            raise ValueError(f"{what}: a boolean mask must have shape ({n},), got {array.shape}")
+        return np.flatnonzero(array)
+    if array.dtype.kind not in "iu" or array.ndim != 1 or (len(array) and (array.min() < 0 or array.max() >= n)):
+        raise ValueError(f"{what} must be indices into the {n} {of}, got {array.dtype} {array.shape}")
+    return array
+
+
+def _containing(points: np.ndarray, simplices: np.ndarray) -> np.ndarray:
+    """For each point (q, dim), the index of a simplex of ``simplices`` (s, k, dim) containing it
+    (k = dim + 1: volume simplices; k ≤ dim: faces or edges, the point within a hundredth of the
+    simplex's size off it), the nearest within a quarter of a simplex (in barycentric weight) if
+    none does, else −1. Candidates come from a uniform grid over the simplices' bounding boxes:
+    first the exact boxes, then, for the points left, boxes grown by a quarter."""
+    q, s = len(points), len(simplices)
+    found = np.full(q, -1, dtype=np.int64)
+    if q == 0 or s == 0:
+        return found
+    low, high = simplices.min(axis=1), simplices.max(axis=1)
+    extent = (high - low).max(axis=1)
+    # The grid: a typical simplex's size, coarse enough that the largest spans at most 16 cells.
+    size = max(float(np.median(extent)), float(extent.max()) / 16, 1e-300)
+    edges = np.transpose(simplices[:, 1:] - simplices[:, :1], (0, 2, 1))  # (s, dim, k − 1)
+    # (EᵀE)⁻¹Eᵀ per simplex: a point's weights on the edges by least squares (exact for volumes)
+    inverse = np.linalg.solve(np.einsum("sij,sik->sjk", edges, edges), np.transpose(edges, (0, 2, 1)))
+    for grow, slack in ((0.0, 1e-9), (_NEAREST, _NEAREST)):
+        left = np.flatnonzero(found < 0)
+        if len(left) == 0:
+            break
+        margin = (grow * extent + 1e-9 * size)[:, None]
+        pairs_point, pairs_simplex = _candidate_pairs(points[left], low - margin, high + margin, size)
+        if len(pairs_point) == 0:
+            continue
+        offset = points[left][pairs_point] - simplices[pairs_simplex, 0]
+        weights = np.einsum("njd,nd->nj", inverse[pairs_simplex], offset)
+        worst = np.minimum(1 - weights.sum(axis=1), weights.min(axis=1, initial=np.inf))
+        if simplices.shape[1] <= points.shape[1]:  # a face or an edge: the point must lie on it
+            off = np.linalg.norm(offset - np.einsum("ndj,nj->nd", edges[pairs_simplex], weights), axis=1)
+            worst = np.where(off <= 1e-2 * extent[pairs_simplex], worst, -np.inf)
+        # Per point the candidate whose smallest weight is largest.
+        order = np.lexsort((-worst, pairs_point))
+        first = np.r_[True, pairs_point[order][1:] != pairs_point[order][:-1]]
+        best_point, best_simplex = pairs_point[order][first], pairs_simplex[order][first]
+        inside = worst[order][first] >= -slack
+        found[left[best_point[inside]]] = best_simplex[inside]
+    return found
+
+
+def _candidate_pairs(points, low, high, size):
+    """(point, simplex) pairs with the point in the simplex's box [low, high], found through a
+    uniform grid of spacing ``size`` (every simplex registered in each grid cell its box touches)."""
+    origin = low.min(axis=0)
+    first = np.floor((low - origin) / size).astype(np.int64)
+    last = np.floor((high - origin) / size).astype(np.int64)
+    span = last - first + 1
+    shape = np.maximum(last.max(axis=0) + 1, 1)
+    keys, owners = [], []
+    for offset in np.ndindex(*span.max(axis=0)):
+        offset = np.asarray(offset)
+        touched = np.all(offset < span, axis=1)
+        cell = first[touched] + offset
+        keys.append(np.ravel_multi_index(cell.T, shape))
+        owners.append(np.flatnonzero(touched))
+    keys, owners = np.concatenate(keys), np.concatenate(owners)
+    order = np.argsort(keys, kind="stable")
+    keys, owners = keys[order], owners[order]
+    cell = np.floor((points - origin) / size).astype(np.int64)
+    outside = np.any((cell < 0) | (cell >= shape), axis=1)
+    point_keys = np.ravel_multi_index(np.clip(cell, 0, shape - 1).T, shape)
+    start, stop = np.searchsorted(keys, point_keys, "left"), np.searchsorted(keys, point_keys, "right")
+    stop[outside] = start[outside]
+    counts = stop - start
+    pairs_point = np.repeat(np.arange(len(points)), counts)
+    within = np.arange(counts.sum()) - np.repeat(np.cumsum(counts) - counts, counts)
+    pairs_simplex = owners[np.repeat(start, counts) + within]
+    in_box = np.all((points[pairs_point] >= low[pairs_simplex]) & (points[pairs_point] <= high[pairs_simplex]), axis=1)
+    return pairs_point[in_box], pairs_simplex[in_box]
