@@ -53,3 +53,22 @@ def elements(gmsh, dim: int = -1) -> tuple[np.ndarray, list[tuple[str, np.ndarra
     blocks = [(TYPES[kind][0], index_of_tag[corners.astype(np.int64)].reshape(-1, TYPES[kind][1]))
               for kind, corners in zip(map(int, kinds), nodes) if kind in TYPES]
     return coords.reshape(-1, 3), blocks
+
+
+def physical_groups(gmsh) -> list[tuple[str, str, np.ndarray]]:
+    """The current model's physical groups as (meshio's cell type, name, (m, corners) vertex
+    indices) triples, in the node order of ``elements``; a group without a name is
+    "physical <tag>"."""
+    tags, _, _ = gmsh.model.mesh.getNodes()
+    tags = tags.astype(np.int64)
+    index_of_tag = np.zeros(int(tags.max(initial=0)) + 1, dtype=np.int64)
+    index_of_tag[tags] = np.arange(len(tags))
+    groups = []
+    for dim, tag in gmsh.model.getPhysicalGroups():
+        name = gmsh.model.getPhysicalName(dim, tag) or f"physical {tag}"
+        for entity in gmsh.model.getEntitiesForPhysicalGroup(dim, tag):
+            kinds, _, nodes = gmsh.model.mesh.getElements(dim, entity)
+            for kind, corners in zip(map(int, kinds), nodes):
+                if kind in TYPES:
+                    groups.append((TYPES[kind][0], name, index_of_tag[corners.astype(np.int64)].reshape(-1, TYPES[kind][1])))
+    return groups

@@ -25,8 +25,8 @@ def read_blocks(path: Path) -> tuple[np.ndarray, dict[str, np.ndarray], list]:
     """The points, cell blocks and named groups of the first reader that reads ``path``; a
     ValueError naming the file and why each reader failed if none does. OSError (permissions, a
     folder) passes. Groups are (cell type, name, (m, corners) vertex indices) triples: gmsh's
-    physical groups, or a VTK file's integer cell data (``"array=value"``); only meshio's
-    reader gives them."""
+    physical groups (from meshio's reader or gmsh's), or a VTK file's integer cell data
+    (``"array=value"``)."""
     reasons = []
     for name, reader in _readers(path):
         try:
@@ -118,7 +118,8 @@ def read_with_gmsh(path: Path):
         except Exception as error:
             raise ValueError("; ".join(_gmsh.errors(gmsh)) or str(error)) from None
         points, blocks = _gmsh.elements(gmsh)
-    return points, collect(blocks)
+        groups = _gmsh.physical_groups(gmsh)
+    return points, collect(blocks), groups
 
 
 # -- VTK legacy POLYDATA ------------------------------------------------------------------------

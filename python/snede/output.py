@@ -91,7 +91,12 @@ class SeriesWriter:
         """Write a mesh without a body (a surface mesh, a mesh being edited) with its
         ``aspect_ratio`` and ``min_angle`` (radians; the smallest dihedral angle for tetrahedra)
         cell fields, an optional (n_points, dim) ``displacement``, extra cell fields and
-        ``point_fields`` (their names as ``write`` says)."""
+        ``point_fields`` (their names as ``write`` says). The mesh's named groups go along: a
+        cell field ``group:<name>`` (1 on the group's cells) per cell group, a point field
+        ``group:<name>`` (1 on its faces' vertices) per boundary group."""
+        cell_fields = {**_group_fields(mesh.cell_groups, mesh.n_cells), **cell_fields}
+        boundary = {name: np.unique(faces) for name, faces in mesh.boundary_groups.items()}
+        point_fields = {**_group_fields(boundary, mesh.n_points), **(point_fields or {})}
         u, points, fields = _step_arrays(mesh, displacement, point_fields, cell_fields)
         self._impl.write_step(float(time), mesh._impl, u, fields, points)
 
@@ -106,6 +111,16 @@ class SeriesWriter:
         vertices' values, in PETSc's global vertex order, and the point field ``serial_vertex``."""
         u, points, fields = agreed(part.comm, lambda: _step_arrays(part.local, displacement, point_fields, cell_fields))
         self._impl.write_distributed_step(float(time), part._impl, u, fields, points)
+
+
+def _group_fields(groups: dict, n: int) -> dict:
+    """{"group:<name>": (n,) indicator of the group's rows} for a mesh's named groups."""
+    fields = {}
+    for name, rows in groups.items():
+        indicator = np.zeros(n)
+        indicator[rows] = 1.0
+        fields[f"group:{name}"] = indicator
+    return fields
 
 
 def _step_arrays(mesh, displacement, point_fields, cell_fields):

@@ -191,3 +191,41 @@ force = [0.0, 0.0, -0.01]
     scene.write_text(scene.read_text().replace('group = "loaded"', 'group = "top"'))
     with pytest.raises(snede.scene_file.SceneFileError, match="no group 'top'"):
         scene_file.load(scene)
+
+
+def test_the_output_series_carries_the_groups(tmp_path):
+    from snede.output import SeriesWriter, read_series
+
+    mesh = snede.Mesh.read(gmsh_box(tmp_path, size=0.1))
+    body = snede.Body(mesh, snede.LinearElastic(1e6, 0.3))
+    writer = SeriesWriter(tmp_path / "groups")
+    writer.write(body, 0.0)
+    mesh.refine_uniform(1)
+    writer.write(body, 1.0)
+    for step in read_series(writer.xdmf_path):
+        left = step.cell_fields["group:left"]
+        assert set(np.unique(left)) == {0.0, 1.0} and 0 < left.sum() < len(left)
+        clamped = step.point_fields["group:clamped"]
+        assert np.all(np.isclose(step.mesh.points[clamped == 1, 0], 0.0))
+    assert read_series(writer.xdmf_path)[-1].cell_fields["group:left"].sum() == len(mesh.cell_groups["left"])
+
+
+def test_gmsh_s_own_reader_gives_the_groups_too(tmp_path):
+    """A gmsh format-1 file (which meshio cannot read): its physical regions, unnamed in that
+    format, come as "physical <number>" through gmsh's reader."""
+    import gmsh
+
+    path = gmsh_box(tmp_path, size=0.1)
+    gmsh.initialize(readConfigFiles=False, interruptible=False)
+    try:
+        gmsh.option.setNumber("General.Terminal", 0)
+        gmsh.merge(str(path))
+        gmsh.option.setNumber("Mesh.MshFileVersion", 1.0)
+        gmsh.write(str(tmp_path / "box1.msh"))
+    finally:
+        gmsh.finalize()
+    mesh = snede.Mesh.read(tmp_path / "box1.msh")
+    assert len(mesh.cell_groups) == 2 and all(name.startswith("physical ") for name in mesh.cell_groups)
+    assert len(mesh.boundary_groups) == 3  # two physical surfaces and "incision"
+    volumes = sorted(volume(mesh, rows) for rows in mesh.cell_groups.values())
+    assert volumes == pytest.approx([0.02, 0.02], rel=1e-12)
