@@ -55,17 +55,23 @@ def elements(gmsh, dim: int = -1) -> tuple[np.ndarray, list[tuple[str, np.ndarra
     return coords.reshape(-1, 3), blocks
 
 
+def unnamed_group(dim: int, tag: int) -> str:
+    """The name of a physical group the file does not name: gmsh's (dimension, tag), in gmsh's
+    words, e.g. "physical volume 1" (a volume and a surface may share a tag)."""
+    return f"physical {('point', 'curve', 'surface', 'volume')[dim]} {tag}"
+
+
 def physical_groups(gmsh) -> list[tuple[str, str, np.ndarray]]:
     """The current model's physical groups as (meshio's cell type, name, (m, corners) vertex
-    indices) triples, in the node order of ``elements``; a group without a name is
-    "physical <tag>"."""
+    indices) triples, in the node order of ``elements``; a group without a name as
+    ``unnamed_group`` calls it."""
     tags, _, _ = gmsh.model.mesh.getNodes()
     tags = tags.astype(np.int64)
     index_of_tag = np.zeros(int(tags.max(initial=0)) + 1, dtype=np.int64)
     index_of_tag[tags] = np.arange(len(tags))
     groups = []
     for dim, tag in gmsh.model.getPhysicalGroups():
-        name = gmsh.model.getPhysicalName(dim, tag) or f"physical {tag}"
+        name = gmsh.model.getPhysicalName(dim, tag) or unnamed_group(dim, tag)
         for entity in gmsh.model.getEntitiesForPhysicalGroup(dim, tag):
             kinds, _, nodes = gmsh.model.mesh.getElements(dim, entity)
             for kind, corners in zip(map(int, kinds), nodes):

@@ -496,19 +496,19 @@ class Mesh(MeshEdits):
 
     def _add_file_groups(self, path, kind: str, groups) -> None:
         """A file's groups of cells (of the mesh's kind) and of boundary faces (one dimension
-        lower); a face group that is not on the boundary (an interface inside) is left out with a
-        warning."""
+        lower); a face group that is not on the boundary (an interface inside), or one whose name
+        a group of the other dimension took, is left out with a warning."""
         face_kind = {"tetra": "triangle", "triangle": "line"}[kind]
         rows = {tuple(cell): row for row, cell in enumerate(np.sort(self.cells, axis=1).tolist())}
         for cell_type, name, cells in groups:
-            if cell_type == kind:
-                keys = [tuple(cell) for cell in np.sort(cells, axis=1).tolist()]
-                self.add_cell_group(name, [rows[key] for key in keys if key in rows])
-            elif cell_type == face_kind:
-                try:
+            try:
+                if cell_type == kind:
+                    keys = [tuple(cell) for cell in np.sort(cells, axis=1).tolist()]
+                    self.add_cell_group(name, [rows[key] for key in keys if key in rows])
+                elif cell_type == face_kind:
                     self.add_boundary_group(name, cells)
-                except ValueError as error:
-                    warnings.warn(f"{path}: {error}; the group is left out", stacklevel=3)
+            except ValueError as error:  # an interface inside, a name given to two dimensions
+                warnings.warn(f"{path}: {error}; the group is left out", stacklevel=3)
 
     def write(self, path) -> None:
         """Write with meshio; the format follows the file extension (.msh, .vtu, .xdmf, ...)."""

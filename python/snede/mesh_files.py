@@ -85,7 +85,7 @@ _GROUP_TYPES = {"tetra": 3, "triangle": 2, "line": 1}
 
 def _groups(data) -> list:
     """(cell type, name, cells) for each physical group of a gmsh file (named by the file's
-    $PhysicalNames, else "physical <tag>"), or each value of an integer cell-data array of other
+    $PhysicalNames, else as ``_gmsh.unnamed_group``), or each value of an integer cell-data array of other
     formats with at most 64 values ("array=value")."""
     groups = []
     physical = data.cell_data.get("gmsh:physical")
@@ -97,9 +97,12 @@ def _groups(data) -> list:
                 continue
             tags = np.asarray(tags)
             for tag in np.unique(tags):
-                groups.append((block.type, names.get((int(tag), dim), f"physical {int(tag)}"), block.data[tags == tag]))
+                groups.append((block.type, names.get((int(tag), dim), _gmsh.unnamed_group(dim, int(tag))),
+                               block.data[tags == tag]))
         return groups
     for array_name, arrays in data.cell_data.items():
+        if array_name.startswith("gmsh:"):  # gmsh's elementary entities are not groups
+            continue
         for block, values in zip(data.cells, arrays):
             values = np.asarray(values)
             if block.type not in _GROUP_TYPES or values.ndim != 1 or values.dtype.kind not in "iu":

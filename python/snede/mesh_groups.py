@@ -37,6 +37,8 @@ class MeshGroups:
 
     def add_cells(self, mesh, name: str, rows) -> None:
         name = _name(name)
+        if name == INCISION or name in self._face_members:
+            raise ValueError(f"{name!r} names a boundary group already: one name, one group (bodies take names)")
         rows = _rows(rows, mesh.n_cells, f"cell group {name!r}", "rows of mesh.cells")
         self._rebase(mesh)
         member = np.zeros(mesh.n_cells, dtype=bool)
@@ -47,7 +49,11 @@ class MeshGroups:
         name = _name(name)
         if name == INCISION:
             raise ValueError(f"{INCISION!r} is the group of the faces cuts open; give the group another name")
+        if name in self._cell_members:
+            raise ValueError(f"{name!r} names a cell group already: one name, one group (bodies take names)")
         faces = np.asarray(faces)
+        if faces.size == 0:
+            faces = np.zeros((0, mesh.cell_dim), dtype=np.int64)
         if faces.dtype.kind not in "iu" or faces.ndim != 2 or faces.shape[1] != mesh.cell_dim:
             raise ValueError(f"boundary group {name!r} must be (n, {mesh.cell_dim}) vertex indices, got "
                              f"{faces.shape} {faces.dtype}")
@@ -97,7 +103,7 @@ class MeshGroups:
             cell_groups = {name: np.flatnonzero((parents >= 0) & member[np.maximum(parents, 0)])
                            for name, member in self._cell_members.items()}
             faces = mesh.boundary_faces()
-            parents = _containing(mesh.points[faces].mean(axis=1), self._faces)
+            parents = _containing(mesh.points[faces].mean(axis=1), self._faces, mesh.points[faces])
             face_groups = {name: faces[(parents >= 0) & member[np.maximum(parents, 0)]]
                            for name, member in self._face_members.items()}
             face_groups[INCISION] = faces[(parents < 0) | ((parents >= 0) & self._face_members[INCISION][
@@ -124,6 +130,8 @@ def _name(name) -> str:
 
 def _rows(rows, n: int, what: str, of: str) -> np.ndarray:
     array = np.atleast_1d(np.asarray(rows))
+    if array.size == 0 and array.ndim == 1:
+        return np.zeros(0, dtype=np.int64)
     if array.dtype == bool:
         if array.shape != (n,):
             raise ValueError(f"{what}: a boolean mask must have shape ({n},), got {array.shape}")
@@ -133,13 +141,17 @@ def _rows(rows, n: int, what: str, of: str) -> np.ndarray:
     return array
 
 
-def _containing(points: np.ndarray, simplices: np.ndarray) -> np.ndarray:
+def _containing(points: np.ndarray, simplices: np.ndarray, oriented: np.ndarray | None = None) -> np.ndarray:
     """For each point (q, dim), the index of a simplex of ``simplices`` (s, k, dim) containing it
     (k = dim + 1: volume simplices; k ≤ dim: faces or edges, the point within a hundredth of the
-    simplex's size off it), the nearest within a quarter of a simplex (in barycentric weight) if
-    none does, else −1. Candidates come from a uniform grid over the simplices' bounding boxes:
-    first the exact boxes, then, for the points left, boxes grown by a quarter."""
-    q, s = len(points), len(simplices)
+    simplex's size off it), else the nearest within a quarter of a simplex (in barycentric
+    weight), else −1. A face or edge is then also taken up to a quarter of its size off its
+    plane: a surface cell flipped across a crease, a boundary vertex moved by node snapping. With
+    ``oriented`` (q, k, dim), each point's own face, that nearest one must be parallel to it
+    (within 25°), so that a face a cut opened next to the boundary does not pass for boundary.
+    Candidates come from a uniform grid over the simplices' bounding boxes: first the exact
+    boxes, then, for the points left, boxes grown by a quarter."""
+    q, (s, k, dim) = len(points), simplices.shape
     found = np.full(q, -1, dtype=np.int64)
     if q == 0 or s == 0:
         return found
@@ -150,7 +162,10 @@ def _containing(points: np.ndarray, simplices: np.ndarray) -> np.ndarray:
     edges = np.transpose(simplices[:, 1:] - simplices[:, :1], (0, 2, 1))  # (s, dim, k − 1)
     # (EᵀE)⁻¹Eᵀ per simplex: a point's weights on the edges by least squares (exact for volumes)
     inverse = np.linalg.solve(np.einsum("sij,sik->sjk", edges, edges), np.transpose(edges, (0, 2, 1)))
-    for grow, slack in ((0.0, 1e-9), (_NEAREST, _NEAREST)):
+    lower = k <= dim
+    if lower and oriented is not None:
+        directions, own_directions = _direction(simplices), _direction(oriented)
+    for grow, slack, off_limit in ((0.0, 1e-9, 1e-2), (_NEAREST, _NEAREST, _NEAREST)):
         left = np.flatnonzero(found < 0)
         if len(left) == 0:
             break
@@ -161,9 +176,13 @@ def _containing(points: np.ndarray, simplices: np.ndarray) -> np.ndarray:
         offset = points[left][pairs_point] - simplices[pairs_simplex, 0]
         weights = np.einsum("njd,nd->nj", inverse[pairs_simplex], offset)
         worst = np.minimum(1 - weights.sum(axis=1), weights.min(axis=1, initial=np.inf))
-        if simplices.shape[1] <= points.shape[1]:  # a face or an edge: the point must lie on it
+        if lower:  # a face or an edge: the point must lie on it, or near it and parallel
             off = np.linalg.norm(offset - np.einsum("ndj,nj->nd", edges[pairs_simplex], weights), axis=1)
-            worst = np.where(off <= 1e-2 * extent[pairs_simplex], worst, -np.inf)
+            near = off <= off_limit * extent[pairs_simplex]
+            if grow and oriented is not None:
+                alignment = np.abs(np.einsum("nd,nd->n", directions[pairs_simplex], own_directions[left][pairs_point]))
+                near &= alignment >= np.cos(np.radians(25))
+            worst = np.where(near, worst, -np.inf)
         # Per point the candidate whose smallest weight is largest.
         order = np.lexsort((-worst, pairs_point))
         first = np.r_[True, pairs_point[order][1:] != pairs_point[order][:-1]]
@@ -171,6 +190,15 @@ def _containing(points: np.ndarray, simplices: np.ndarray) -> np.ndarray:
         inside = worst[order][first] >= -slack
         found[left[best_point[inside]]] = best_simplex[inside]
     return found
+
+
+def _direction(simplices: np.ndarray) -> np.ndarray:
+    """A unit vector that orients each face: a triangle's normal, an edge's direction."""
+    if simplices.shape[1] == 3 and simplices.shape[2] == 3:
+        vector = np.cross(simplices[:, 1] - simplices[:, 0], simplices[:, 2] - simplices[:, 0])
+    else:
+        vector = simplices[:, 1] - simplices[:, 0]
+    return vector / np.linalg.norm(vector, axis=1)[:, None]
 
 
 def _candidate_pairs(points, low, high, size):

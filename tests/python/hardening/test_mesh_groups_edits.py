@@ -346,13 +346,6 @@ def test_refinement_after_a_flip_keeps_group_areas():
     assert cell_measure(sheet, sheet.cell_groups["a"]) == pytest.approx(before, rel=1e-12)
 
 
-@pytest.mark.xfail(strict=True, reason=(
-    "a surface's cells that an edit moves off the reference surface (here flip_edge across a box crease, which "
-    "the engine allows) belong to no group, so groups that partitioned the cells no longer do: "
-    "s, _ = snede.meshing.boundary_surface(snede.meshing.box((1,1,1),(2,2,2))); "
-    "s.add_cell_group('all', np.ones(48, bool)); s.flip_edge(0, 4); s.refine_uniform(1); "
-    "s.flip_edge(0, 1) (the crease x = y = 0) is done; len(s.cell_groups['all']) == 94 of 96 cells "
-    "(the face test's 1e-2 off-surface tolerance, not the cells' quarter-simplex nearest rule, applies)"))
 def test_a_flip_across_a_crease_keeps_every_surface_cell_in_a_group():
     surface, _ = snede.meshing.boundary_surface(snede.meshing.box((1.0, 1.0, 1.0), (2, 2, 2)))
     surface.add_cell_group("all", np.ones(surface.n_cells, dtype=bool))
@@ -424,13 +417,6 @@ def test_delaunay_cutter_opens_an_incision_and_keeps_the_user_groups():
     assert cell_measure(mesh, np.arange(mesh.n_cells)) == pytest.approx(1.0, rel=1e-12)
 
 
-@pytest.mark.xfail(strict=True, reason=(
-    "faces that moved off the reference boundary (a moved or snapped boundary vertex) leave their group and join "
-    "'incision' although nothing was cut: m = snede.meshing.ellipsoid(h=0.012, seed=1); "
-    "m.add_boundary_group('skin', m.boundary_faces()); c = snede.TetrahedralCutter(m); "
-    "c.cut([np.array([[0.005, y, -0.1], [0.005, y, 0.1]]) for y in (-0.06, 0.0, 0.01)]); "
-    "m.boundary_groups['incision'] has 69 faces, c.incision_faces() 58: 11 skin faces next to snapped vertices "
-    "are 'incision', and 'skin' lost about 3 % of its area (the face test allows 1e-2 of a face's size off it)"))
 def test_tetrahedral_cutter_on_a_curved_body_puts_only_the_lips_in_incision():
     mesh = snede.meshing.ellipsoid(h=0.012, seed=1)
     mesh.add_boundary_group("skin", mesh.boundary_faces())
@@ -442,12 +428,6 @@ def test_tetrahedral_cutter_on_a_curved_body_puts_only_the_lips_in_incision():
     assert keys(mesh.boundary_groups["skin"]) == keys(mesh.boundary_faces()) - keys(cutter.incision_faces())
 
 
-@pytest.mark.xfail(strict=True, reason=(
-    "a boundary vertex moved a fifth of an edge off the boundary takes its faces out of their group and into "
-    "'incision': s = snede.meshing.rectangle((1,1),(4,4)); "
-    "s.add_boundary_group('bottom', s.faces_where(lambda x: np.isclose(x[:,1],0), interior=False)); "
-    "s.move_vertex(10, point=(0.5, -0.05)) (vertex 10 is (0.5, 0)); len(s.boundary_groups['bottom']) == 2 (was 4), "
-    "len(s.boundary_groups['incision']) == 2; cells get a quarter-simplex tolerance, faces only 1e-2"))
 def test_a_moved_boundary_vertex_keeps_its_faces_in_their_group():
     sheet = snede.meshing.rectangle((1.0, 1.0), (4, 4))
     sheet.add_boundary_group("bottom", sheet.faces_where(lambda x: np.isclose(x[:, 1], 0.0), interior=False))
@@ -520,11 +500,6 @@ def test_missing_groups_are_key_errors_listing_the_known_ones(box):
         body.add_traction("core", (0.0, 0.0, 1.0))
 
 
-@pytest.mark.xfail(strict=True, reason=(
-    "a cell group may be named 'incision' (or share a boundary group's name) and is then shadowed: "
-    "m = snede.meshing.box((1,1,1),(2,2,2)); m.add_cell_group('incision', [0]); "
-    "m.group_vertices('incision') returns [] (the empty boundary 'incision'), not the 4 vertices of cell 0, "
-    "and Body.fix('incision') fixes nothing"))
 def test_a_cell_group_named_incision_is_refused_or_reachable(box):
     try:
         box.add_cell_group("incision", [0])
@@ -533,11 +508,6 @@ def test_a_cell_group_named_incision_is_refused_or_reachable(box):
     np.testing.assert_array_equal(box.group_vertices("incision"), np.sort(box.cells[0]))
 
 
-@pytest.mark.xfail(strict=True, reason=(
-    "a name used by both a cell and a boundary group is accepted, and the cell group is unreachable by name: "
-    "m = snede.meshing.box((1,1,1),(2,2,2)); m.add_cell_group('a', [0]); "
-    "m.add_boundary_group('a', m.boundary_faces()[:1]); m.group_vertices('a') gives the face's 3 vertices; "
-    "Body.fix('a') / add_nodal_force('a') silently use the boundary group"))
 def test_a_name_shared_by_a_cell_and_a_boundary_group_is_refused(box):
     box.add_cell_group("a", [0])
     with pytest.raises(ValueError):

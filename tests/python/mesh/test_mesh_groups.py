@@ -212,7 +212,8 @@ def test_the_output_series_carries_the_groups(tmp_path):
 
 def test_gmsh_s_own_reader_gives_the_groups_too(tmp_path):
     """A gmsh format-1 file (which meshio cannot read): its physical regions, unnamed in that
-    format, come as "physical <number>" through gmsh's reader."""
+    format, come as "physical volume <number>" and "physical surface <number>" through gmsh's
+    reader."""
     import gmsh
 
     path = gmsh_box(tmp_path, size=0.1)
@@ -225,7 +226,8 @@ def test_gmsh_s_own_reader_gives_the_groups_too(tmp_path):
     finally:
         gmsh.finalize()
     mesh = snede.Mesh.read(tmp_path / "box1.msh")
-    assert len(mesh.cell_groups) == 2 and all(name.startswith("physical ") for name in mesh.cell_groups)
+    assert len(mesh.cell_groups) == 2 and all(name.startswith("physical volume ") for name in mesh.cell_groups)
+    assert all(name.startswith("physical surface ") for name in mesh.boundary_groups if name != "incision")
     assert len(mesh.boundary_groups) == 3  # two physical surfaces and "incision"
     volumes = sorted(volume(mesh, rows) for rows in mesh.cell_groups.values())
     assert volumes == pytest.approx([0.02, 0.02], rel=1e-12)
