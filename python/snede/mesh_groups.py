@@ -2,8 +2,8 @@
 groups (name → boundary faces), from a file's gmsh physical groups or VTK cell data, or given by
 the user.
 
-Groups are kept against a reference: the mesh's cells and boundary faces (their corners) when a
-group was last given, each with the groups it belongs to. They are resolved against the mesh as
+Groups are kept against a reference: the mesh's cells and boundary faces (their corners) when the
+groups were last given or resolved, each with the groups it belongs to. They are resolved against the mesh as
 it is now by where things lie: a cell takes the groups of the reference cell that contains its
 centroid, a boundary face those of the reference boundary face its centroid lies on. So the
 groups follow every edit without the engine knowing them: bisection's children lie in their
@@ -44,6 +44,7 @@ class MeshGroups:
         member = np.zeros(mesh.n_cells, dtype=bool)
         member[rows] = True
         self._cell_members[name] = member
+        self._cache.clear()
 
     def add_faces(self, mesh, name: str, faces) -> None:
         name = _name(name)
@@ -68,6 +69,7 @@ class MeshGroups:
         member = np.zeros(len(boundary), dtype=bool)
         member[[place[key] for key in keys]] = True
         self._face_members[name] = member
+        self._cache.clear()
 
     def cell_groups(self, mesh) -> dict[str, np.ndarray]:
         return self._resolved(mesh)[0]
@@ -78,37 +80,35 @@ class MeshGroups:
     def _rebase(self, mesh) -> None:
         """The mesh as it is now becomes the reference, every group resolved onto it."""
         if self._cells is not None:
-            cells, faces = self._resolved(mesh)
-            boundary = np.sort(mesh.boundary_faces(), axis=1)
-            place = {tuple(face): k for k, face in enumerate(boundary.tolist())}
-            self._cell_members = {name: np.isin(np.arange(mesh.n_cells), rows) for name, rows in cells.items()}
-            self._face_members = {}
-            for name, group in faces.items():
-                member = np.zeros(len(boundary), dtype=bool)
-                member[[place[tuple(face)] for face in np.sort(group, axis=1).tolist()]] = True
-                self._face_members[name] = member
-        else:
-            self._face_members = {INCISION: np.zeros(len(mesh.boundary_faces()), dtype=bool)}
+            self._resolved(mesh)  # which re-bases
+            return
+        self._face_members = {INCISION: np.zeros(len(mesh.boundary_faces()), dtype=bool)}
         self._cells = mesh.points[mesh.cells]
         self._faces = mesh.points[mesh.boundary_faces()]
         self._cache.clear()
 
     def _resolved(self, mesh):
+        """The groups on the mesh as it is now, which then becomes the reference: resolving
+        after each edit keeps the groups exact through edits that do not nest (a flip, a
+        collapse), whose cells straddle the reference's, when refinement follows."""
         if self._cells is None:
             return {}, {}
         key = (mesh._impl.revision, mesh.n_points)
         if self._cache.get("key") != key:
             cells = mesh.points[mesh.cells]
             parents = _containing(cells.mean(axis=1), self._cells)
-            cell_groups = {name: np.flatnonzero((parents >= 0) & member[np.maximum(parents, 0)])
-                           for name, member in self._cell_members.items()}
+            self._cell_members = {name: (parents >= 0) & member[np.maximum(parents, 0)]
+                                  for name, member in self._cell_members.items()}
             faces = mesh.boundary_faces()
-            parents = _containing(mesh.points[faces].mean(axis=1), self._faces, mesh.points[faces])
-            face_groups = {name: faces[(parents >= 0) & member[np.maximum(parents, 0)]]
-                           for name, member in self._face_members.items()}
-            face_groups[INCISION] = faces[(parents < 0) | ((parents >= 0) & self._face_members[INCISION][
-                np.maximum(parents, 0)])]
-            self._cache = {"key": key, "value": (cell_groups, face_groups)}
+            corners = mesh.points[faces]
+            parents = _containing(corners.mean(axis=1), self._faces, corners)
+            members = {name: (parents >= 0) & member[np.maximum(parents, 0)] for name, member in self._face_members.items()}
+            members[INCISION] |= parents < 0
+            self._face_members = members
+            self._cells, self._faces = cells, corners
+            value = ({name: np.flatnonzero(member) for name, member in self._cell_members.items()},
+                     {name: faces[member] for name, member in self._face_members.items()})
+            self._cache = {"key": key, "value": value}
         return self._cache["value"]
 
 
