@@ -131,14 +131,13 @@ Workspace<D>& workspace() {
 // Pass 2 over one patch family: out[k] = kernel(F̃_k as a batch, H̃_k, …) for batch_width patches
 // per call. Patches of zero measure (vertices no element uses) give 0. A patch with det F̃ ≤ 0
 // under a material that forbids inversion, or with a non-finite result, gives 0 and its first
-// element is reported. Returns whether any patch was inverted that way.
+// element is reported.
 template <int D, class M, class FirstElement, class Kernel>
-[[gnu::flatten]] bool evaluate_patches(const M&, std::span<const double> H, std::span<const double> measure,
+[[gnu::flatten]] void evaluate_patches(const M&, std::span<const double> H, std::span<const double> measure,
                                        const FirstElement& first_element, std::vector<double>& out,
                                        EvaluationReport& report, const Kernel& kernel) {
   const std::size_t n = measure.size();
   out.assign(n * D * D, 0.0);
-  bool any_inverted = false;
   for (std::size_t k0 = 0; k0 < n; k0 += batch_width) {
     const Tensor<Batch, D> Hb = load_patches<D>(H, k0, n);
     const Tensor<Batch, D> R = kernel(Hb, k0);
@@ -149,7 +148,6 @@ template <int D, class M, class FirstElement, class Kernel>
       if (!(measure[k] > 0)) continue;
       if (inverted >> lane & 1) {
         report.inverted.push_back(first_element(k));
-        any_inverted = true;
         continue;
       }
       if (!(finite >> lane & 1)) {
@@ -160,7 +158,6 @@ template <int D, class M, class FirstElement, class Kernel>
         for (int j = 0; j < D; ++j) out[k * D * D + i * D + j] = R(i, j)[lane];
     }
   }
-  return any_inverted;
 }
 
 // Pass 3: out += sign · |e| P_e Z⁻ᵀ as node columns, P_e = Σ shares of the patch tensors.

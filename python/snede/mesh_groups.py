@@ -32,9 +32,6 @@ class MeshGroups:
         self._face_members: dict[str, np.ndarray] = {}  # name → (m,) bool, "incision" among them
         self._cache: dict = {}
 
-    def __bool__(self) -> bool:
-        return self._cells is not None
-
     def add_cells(self, mesh, name: str, rows) -> None:
         name = _name(name)
         if name == INCISION or name in self._face_members:
