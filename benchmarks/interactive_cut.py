@@ -46,7 +46,8 @@ def block(refinements: int):
     body.fix(np.isclose(mesh.points[:, 0], 0.0))
     body.add_gravity((0.0, 0.0, -9.81))
     x = 0.061
-    return body, lambda y: [(x, y, -0.02), (x, y, 0.05)], (-0.004, 0.034)
+    grasped = np.isclose(mesh.points[:, 0], 0.12)
+    return body, lambda y: [(x, y, -0.02), (x, y, 0.05)], (-0.004, 0.034), (grasped, (0.0, 0.0, 1e-3))
 
 
 def organ(target: int):
@@ -61,7 +62,10 @@ def organ(target: int):
     x = 0.5 * (low[0] + high[0]) + 1e-4 * np.ptp(mesh.points[:, 0])  # off any vertex layer
     margin = 0.1 * (high[1] - low[1])
     span = (low[2] - margin, high[2] + margin)
-    return body, lambda y: [(x, y, span[0]), (x, y, span[1])], (low[1] - margin, high[1] + margin)
+    lowest = mesh.points[np.argmin(z)]
+    grasped = np.linalg.norm(mesh.points - lowest, axis=1) <= 0.1 * np.ptp(z)
+    return (body, lambda y: [(x, y, span[0]), (x, y, span[1])], (low[1] - margin, high[1] + margin),
+            (grasped, (1e-3, 0.0, 0.0)))
 
 
 MESHES = {
@@ -72,23 +76,33 @@ MESHES = {
 }
 
 
-def run(make, preconditioner: str, moves: int) -> dict:
-    body, blade, (start, stop) = make()
-    # "mg:aggregation" forces aggregation levels on a mesh that has a bisection hierarchy.
+def run(make, preconditioner: str, moves: int, tool: str) -> dict:
+    body, blade, (start, stop), (grasped, drag) = make()
+    # "mg:aggregation" forces aggregation levels on a mesh that has a bisection hierarchy;
+    # "mg/0" builds the levels anew for every solve (-static_mg_refresh_ratio 0).
+    label = preconditioner
+    preconditioner, _, refresh = preconditioner.partition("/")
     name, _, coarsening = preconditioner.partition(":")
     options = {"mg_coarsening": coarsening} if coarsening else {}
+    if refresh:
+        options["mg_refresh_ratio"] = refresh
     solver = snede.StaticSolver(body, "newton", rtol=RTOL, preconditioner=name, petsc_options=options)
     began = time.perf_counter()
     relaxed = solver.solve()
-    row = {"pc": preconditioner, "cells": body.mesh.n_cells, "relax_s": time.perf_counter() - began,
+    row = {"pc": label, "cells": body.mesh.n_cells, "relax_s": time.perf_counter() - began,
            "relax_cg_per_newton": relaxed.linear_iterations / max(relaxed.iterations, 1),
            "converged": relaxed.converged, "source": solver.multigrid_source}
-    cutter = snede.TetrahedralCutter(body)
-    cutter.move(blade(start))
+    if tool == "scalpel":
+        cutter = snede.TetrahedralCutter(body)
+        cutter.move(blade(start))
+        tool_moves = [lambda y=y: cutter.move(blade(y)) for y in np.linspace(start, stop, moves + 1)[1:]]
+    else:
+        held = body.displacement[grasped]
+        tool_moves = [lambda k=k: body.fix(grasped, held + k * np.asarray(drag)) for k in range(1, moves + 1)]
     cut_s, follow_s, solve_s, newton, cg, failures = [], [], [], [], [], []
-    for y in np.linspace(start, stop, moves + 1)[1:]:
+    for move in tool_moves:
         began = time.perf_counter()
-        cutter.move(blade(y))
+        move()
         middle = time.perf_counter()
         result = solver.solve()
         end = time.perf_counter()
@@ -114,8 +128,12 @@ def main() -> None:
     parser.add_argument("--meshes", nargs="+", choices=sorted(MESHES), default=["block24k", "block98k", "organ20k",
                                                                                  "organ60k"])
     parser.add_argument("--preconditioners", nargs="+", default=["none", "gamg", "mg", "mg:aggregation"],
-                        help="PC names; mg:aggregation forces aggregation levels where bisection levels exist")
+                        help="PC names; mg:aggregation forces aggregation levels where bisection levels exist; "
+                             "mg/R sets -static_mg_refresh_ratio R (0: new levels for every solve)")
     parser.add_argument("--moves", type=int, default=24)
+    parser.add_argument("--tool", choices=["scalpel", "grasper"], default="scalpel",
+                        help="scalpel: the blade cuts through the body; grasper: a patch of the body (the block's "
+                             "free end, the liver's lowest tenth) is dragged 1 mm per move (up, sideways)")
     parser.add_argument("--quick", action="store_true", help="block24k and organ20k, 8 moves, none and mg")
     # Options starting with a single '-' are PETSc's (-static_snes_lag_preconditioner 2, -log_view).
     arguments, petsc_arguments = parser.parse_known_args()
@@ -126,7 +144,8 @@ def main() -> None:
     meshes, preconditioners, moves = arguments.meshes, arguments.preconditioners, arguments.moves
     if arguments.quick:
         meshes, preconditioners, moves = ["block24k", "organ20k"], ["none", "mg"], 8
-    print(f"Newton rtol {RTOL:g} after each of {moves} moves; ms are medians per move; Hz = moves / (cut + solve)")
+    print(f"{arguments.tool}: Newton rtol {RTOL:g} after each of {moves} moves; ms are medians per move; "
+          "Hz = moves / (cut + solve)")
     for name in meshes:
         print(f"\n{name}")
         header = (f"{'pc':>14} {'levels from':>21} {'cells':>7} | {'cut ms':>7} {'follow ms':>9} {'solve ms':>8} "
@@ -135,7 +154,7 @@ def main() -> None:
         print(header)
         print("-" * len(header))
         for preconditioner in preconditioners:
-            row = run(MESHES[name], preconditioner, moves)
+            row = run(MESHES[name], preconditioner, moves, arguments.tool)
             source = row["source"] if row["source"] == row["source_after"] else f"{row['source']}>{row['source_after']}"
             print(f"{row['pc']:>14} {source or '-':>21} {row['cells_after']:>7} | {row['cut_ms']:>7.1f} "
                   f"{row['follow_ms']:>9.1f} {row['solve_ms']:>8.1f} {row['worst_ms']:>8.1f} | {row['newton']:>6g} "

@@ -68,6 +68,7 @@ StaticSolver::StaticSolver(Model& model, StaticOptions options, const Refinement
       options_(std::move(options)),
       option_database_(options_.options_prefix, options_.petsc_options),
       hierarchy_(hierarchy),
+      reuse_(number_option("mg_refresh_ratio", PreconditionerReuse::default_refresh_ratio)),
       piece_holding_(model.body().mesh()) {
   if (options_.stopping.rtol <= 0 || !std::isfinite(options_.stopping.rtol))
     throw std::invalid_argument("rtol must be positive, got " + std::to_string(options_.stopping.rtol));
@@ -94,6 +95,9 @@ StaticSolver::StaticSolver(Model& model, StaticOptions options, const Refinement
                                 "nonlinear CG ('ncg') takes none");
   // Jacobi reads the shell's diagonal (MatGetDiagonal), mg builds its own levels (and needs
   // entries only for Galerkin levels); every other PC needs entries.
+  if (pc_type_ != PCMG && option_database_.string_option(options_.options_prefix + "mg_refresh_ratio"))
+    throw std::invalid_argument("-" + options_.options_prefix + "mg_refresh_ratio applies to the preconditioner 'mg'; "
+                                "this solver's is '" + pc_type_ + "'");
   pc_needs_matrix_ = pc_type_ != PCNONE && pc_type_ != PCJACOBI && pc_type_ != PCMG;
   needs_matrix_ = pc_needs_matrix_;
   register_line_searches();
@@ -306,18 +310,6 @@ void StaticSolver::build_multigrid() {
   if (coarsening == "bisection" && !hierarchy_)
     throw std::invalid_argument(prefix + "mg_coarsening bisection: this mesh has no bisection hierarchy (refine it "
                                 "with mesh.refine_uniform or refine_around first, or use grid or aggregation)");
-  auto number_option = [&](const std::string& name, double fallback) {
-    const std::optional<std::string> text = option_database_.string_option(options_.options_prefix + name);
-    if (!text) return fallback;
-    try {
-      std::size_t used = 0;
-      const double value = std::stod(*text, &used);
-      if (used != text->size()) throw std::invalid_argument(*text);
-      return value;
-    } catch (const std::exception&) {
-      throw std::invalid_argument(prefix + name + " must be a number, got '" + *text + "'");
-    }
-  };
   multigrid_.reset();
   if (coarsening != "aggregation" && coarsening != "grid" && hierarchy_) {
     try {
@@ -348,6 +340,19 @@ void StaticSolver::build_multigrid() {
       throw std::invalid_argument(prefix + name + " applies to " + applies_to + " levels; these are " + source +
                                   " levels (-" + options_.options_prefix + "mg_coarsening chooses)");
   needs_matrix_ = pc_needs_matrix_ || multigrid_->needs_assembled_tangent();
+}
+
+double StaticSolver::number_option(const std::string& name, double fallback) const {
+  const std::optional<std::string> text = option_database_.string_option(options_.options_prefix + name);
+  if (!text) return fallback;
+  try {
+    std::size_t used = 0;
+    const double value = std::stod(*text, &used);
+    if (used != text->size()) throw std::invalid_argument(*text);
+    return value;
+  } catch (const std::exception&) {
+    throw std::invalid_argument("-" + options_.options_prefix + name + " must be a number, got '" + *text + "'");
+  }
 }
 
 void StaticSolver::set_up_multigrid(PC pc) {
@@ -382,8 +387,9 @@ void StaticSolver::refill_preconditioner(SNES snes, Vec x) {
   SNEDE_PETSC(SNESGetLagPreconditioner(snes, &lag));
   SNEDE_PETSC(SNESGetIterationNumber(snes, &iteration));
   // Galerkin levels kept through a solve (solve_nonlinear) are rebuilt when the last linear
-  // solve failed with them: kept levels made Newton's line search fail on the 63k liver.
-  if (keeps_levels_through_solve_ && iteration > 0 && lag == -1) {
+  // solve failed with them (of this solve, or of the earlier one whose levels it reuses): kept
+  // levels made Newton's line search fail on the 63k liver.
+  if (keeps_levels_through_solve_ && lag == -1) {
     KSPConvergedReason last = KSP_CONVERGED_ITERATING;
     SNEDE_PETSC(KSPGetConvergedReason(ksp(), &last));
     if (last < 0) {
@@ -398,7 +404,20 @@ void StaticSolver::refill_preconditioner(SNES snes, Vec x) {
   if (lagged) return;
   if (assembled_) assembled_->assemble(model_, x);
   if (multigrid_) multigrid_->update(x, assembled_ ? assembled_->mat() : nullptr);
+  mark_filled();
+}
+
+void StaticSolver::mark_filled() {
+  ++preconditioner_fills_;
   preconditioner_filled_ = true;
+  filled_in_this_solve_ = true;
+  filled_at_scale_ = system_scale_;
+  filled_for_constraints_ = model_.constraints().projection_fingerprint();
+}
+
+bool StaticSolver::filled_for_current_system() const {
+  return preconditioner_filled_ && filled_at_scale_ == system_scale_ &&
+         filled_for_constraints_ == model_.constraints().projection_fingerprint();
 }
 
 double StaticSolver::current_tolerance() const {
@@ -449,8 +468,13 @@ SolveResult StaticSolver::solve_linear() {
   SNEDE_PETSC(VecScale(rhs, -1.0 / system_scale_));
   SNEDE_PETSC(VecSet(step, 0.0));
   const ScaledOperator scaled(model_, system_scale_);
-  if (needs_matrix_) assembled_->assemble(model_, u);
-  if (multigrid_) multigrid_->update(u, assembled_ ? assembled_->mat() : nullptr);
+  // Linear CG solves linear elasticity, whose tangent does not depend on the state: what was
+  // filled for an earlier solve of the same system is the same matrix.
+  if (!filled_for_current_system()) {
+    if (needs_matrix_) assembled_->assemble(model_, u);
+    if (multigrid_) multigrid_->update(u, assembled_ ? assembled_->mat() : nullptr);
+    mark_filled();
+  }
   SNEDE_PETSC(KSPSolve(ksp_, rhs, step));
   {
     // Onto the allowed motions (6.7), as Newton's steps (descent_direction_callback): CG's
@@ -482,14 +506,17 @@ SolveResult StaticSolver::solve_nonlinear() {
   PetscInt iterations = 0, linear = 0;
   const ScaledOperator scaled(model_, system_scale_);
   // Galerkin levels (an assembled tangent, its products with the interpolation, a coarse
-  // factorisation) are built at the first Newton iteration of each solve — after each tool
-  // move — and kept through the solve's other iterations, unless the options lag otherwise:
-  // rebuilding them cost more than the CG iterations they save (docs/results/interactive.md).
+  // factorisation) are built at the first Newton iteration of a solve and kept through its other
+  // iterations, unless the options lag otherwise: rebuilding them cost more than the CG
+  // iterations they save (docs/results/interactive.md). While the mesh and the projections stay
+  // the same, the next solves keep them too, until they show their age (preconditioner_reuse.hpp).
   keeps_levels_through_solve_ = multigrid_ && multigrid_->needs_assembled_tangent() &&
                                 !option_database_.string_option(options_.options_prefix + "snes_lag_preconditioner");
+  filled_in_this_solve_ = false;
   if (keeps_levels_through_solve_) {
-    SNEDE_PETSC(SNESSetLagPreconditioner(snes_, -2));
-    preconditioner_filled_ = false;
+    const bool reuse = filled_for_current_system() && reuse_.keep();
+    SNEDE_PETSC(SNESSetLagPreconditioner(snes_, reuse ? -1 : -2));
+    if (!reuse) preconditioner_filled_ = false;
   }
   auto run = [&] {
     SNEDE_PETSC(SNESSolve(snes_, nullptr, u));
@@ -534,6 +561,8 @@ SolveResult StaticSolver::solve_nonlinear() {
   result.reason = std::string(SNESConvergedReasons[reason]);
   result.converged = reason > 0;
   finish(result, start, start_flops);
+  if (keeps_levels_through_solve_)
+    reuse_.record(result.iterations, result.linear_iterations, result.converged, filled_in_this_solve_);
   return result;
 }
 

@@ -19,6 +19,7 @@
 #include "solve/multigrid.hpp"
 #include "topology/refinement_hierarchy.hpp"
 #include "solve/model.hpp"
+#include "solve/preconditioner_reuse.hpp"
 #include "solve/tangent_assembly.hpp"
 #include "solve/solve_result.hpp"
 #include "solve/stopping.hpp"
@@ -77,6 +78,9 @@ class StaticSolver {
   // Seconds the last solve spent following mesh and constraint changes before iterating: new
   // vectors, the assembled tangent's sparsity, the multigrid levels (0 when nothing changed).
   double follow_seconds() const { return follow_seconds_; }
+  // Times the preconditioner was filled (assembled tangent, multigrid levels at a state) since
+  // the solver was made: reuse across Newton iterations and solves keeps it below their count.
+  std::size_t preconditioner_fills() const { return preconditioner_fills_; }
 
  private:
   void create_objects();
@@ -127,7 +131,17 @@ class StaticSolver {
   // mg: remembers Chebyshev's estimates once the PC has made them (after a solve).
   void remember_smoother_bounds();
   bool preconditioner_filled_ = false;  // filled since it was made (for lagging)
-  bool keeps_levels_through_solve_ = false;  // Galerkin levels built once per solve (solve_nonlinear)
+  double filled_at_scale_ = 0;          // the system scale it was filled with
+  std::uint64_t filled_for_constraints_ = 0;  // ... and the constraints' projection fingerprint
+  bool filled_in_this_solve_ = false;
+  std::size_t preconditioner_fills_ = 0;
+  // Whether the filled preconditioner is that of the current system (scale and projections).
+  bool filled_for_current_system() const;
+  void mark_filled();
+  // A number from the option database (-<prefix>name), or `fallback`.
+  double number_option(const std::string& name, double fallback) const;
+  bool keeps_levels_through_solve_ = false;  // Galerkin levels kept through a solve (solve_nonlinear)
+  PreconditionerReuse reuse_;                // ... and through the next ones while they serve
   std::uint64_t generation_ = 0;
   StoppingRule rule_;  // the stopping rule of the current solve, scaled to the model
   double external_norm_ = 0;

@@ -52,9 +52,14 @@ class StaticSolver(RunsOnRanks):
       background grid over the reference configuration, with one copy of a grid node per
       connected piece of the fine vertices it reaches (virtual nodes: a cut never ties the
       lips), and a Galerkin coarse operator from the tangent assembled by the element kernels,
-      built once per solve; ``-static_mg_coarsening aggregation`` takes rigid-motion aggregates
-      instead. Levels are rebuilt at the first solve after a mesh or constraint change;
-      ``follow_seconds`` says what that cost. ``multigrid_source`` says which kind is in use
+      built at the first Newton iteration of a solve and kept through the next solves while the
+      mesh and the constraints' projections stay the same (a grasper dragging a patch held at a
+      moving displacement), until a solve needs more than ``-static_mg_refresh_ratio`` (default
+      1.5; 0: new levels for every solve) times the CG iterations per Newton iteration of the
+      solve that built them, or fails; ``-static_mg_coarsening aggregation`` takes rigid-motion
+      aggregates instead. Levels are made anew at the first solve after a mesh or constraint
+      change; ``follow_seconds`` says what that cost, ``preconditioner_fills`` how often the
+      preconditioner was filled. ``multigrid_source`` says which kind is in use
       (``"bisection"``, ``"grid"``, ``"aggregation"``), ``multigrid_levels`` and
       ``multigrid_unknowns`` the levels' sizes; ``-static_mg_coarsening`` chooses (default
       ``auto``: bisection when it applies, else grid), ``-static_mg_grid_width``,
@@ -163,8 +168,8 @@ class StaticSolver(RunsOnRanks):
 
     @property
     def multigrid_source(self) -> str:
-        """What made the ``"mg"`` levels: ``"bisection"`` (the mesh's refinement tree) or
-        ``"aggregation"`` (any mesh); empty for other preconditioners."""
+        """What made the ``"mg"`` levels: ``"bisection"`` (the mesh's refinement tree), ``"grid"``
+        or ``"aggregation"`` (any mesh); empty for other preconditioners."""
         return self._engine.multigrid_source
 
     @property
@@ -172,6 +177,12 @@ class StaticSolver(RunsOnRanks):
         """Seconds the last ``solve()`` spent following a change of the mesh or of the
         constraints before iterating (new vectors, assembled tangent, multigrid levels)."""
         return self._engine.follow_seconds
+
+    @property
+    def preconditioner_fills(self) -> int:
+        """How many times this solver filled its preconditioner (an assembled tangent, multigrid
+        levels at a state) since it was made: less than once per solve where it reuses one."""
+        return self._engine.preconditioner_fills
 
     @property
     def ksp(self):
