@@ -37,6 +37,11 @@ constexpr double on_side = 1e-6;
 // No edit may leave a triangle turned 75° or more from the uncut surface's normal at a corner.
 const double facing_cosine = std::cos(75.0 * std::acos(-1.0) / 180);
 
+// Where neighbouring triangles turn by this much or more the surface has a crease (a box's
+// edge, a coarse ridge): no flip, removal or move of a node there, which would cut across it
+// (a chord through the body); the incision puts its nodes on the path there instead.
+const double crease_cosine = std::cos(30.0 * std::acos(-1.0) / 180);
+
 }  // namespace
 
 SurfaceCutter::SurfaceCutter(Mesh& mesh, Model* model, SurfaceCutterOptions options)
@@ -168,6 +173,26 @@ bool SurfaceCutter::keeps_facing(VertexId v, const Point3& x, VertexId merging_i
     }
   }
   return true;
+}
+
+bool SurfaceCutter::is_crease(VertexId p, VertexId q) const {
+  const Connectivity& c = mesh_.connectivity();
+  const std::vector<ElementId> wings = elements_with_edge(c, p, q);
+  if (wings.size() != 2) return false;
+  std::array<Point3, 2> n;
+  const double length = distance(reference(p), reference(q));
+  for (int k = 0; k < 2; ++k) {
+    const auto t = c.element(wings[k]).simplex.oriented_vertices();
+    n[k] = doubled_normal(reference(t[0]), reference(t[1]), reference(t[2]));
+    // A triangle squeezed flat (an active node closing in on a vertex) has no direction to bend.
+    if (norm(n[k]) <= 1e-6 * length * length) return false;
+  }
+  return !(dot(n[0], n[1]) > crease_cosine * norm(n[0]) * norm(n[1]));
+}
+
+bool SurfaceCutter::on_crease(VertexId v) const {
+  const std::vector<Wedge> star = wedges(v);
+  return std::any_of(star.begin(), star.end(), [&](const Wedge& w) { return is_crease(v, w.y) || is_crease(v, w.z); });
 }
 
 bool SurfaceCutter::on_boundary(VertexId v) const { return touches_boundary(mesh_.connectivity(), v); }
@@ -569,12 +594,20 @@ VertexId SurfaceCutter::split(VertexId a, VertexId b, double t) {
   return result.vertex;
 }
 
-void SurfaceCutter::advance(VertexId b, const Segment& from, const Segment& to, PlanarCutReport& report) {
+void SurfaceCutter::advance(VertexId b, Segment from, const Segment& to, PlanarCutReport& report) {
   for (int attempt = 0; attempt < 64 && incision_at(b); ++attempt) {
     const std::vector<StarHit> hits = hits_in_star(b, to);
     if (!hits.empty()) {
       if (branches(b, to, options_.eps_entry).size() >= 2) {
         branch(b, to, options_.eps_entry, report);
+        return;
+      }
+      if (on_crease(b)) {
+        // Moving b would take the crease along: the incision goes on from a node at the hit.
+        if (distance(reference_at(hits.front().wedge, b, hits.front().weights), reference(b)) < crease_step()) return;
+        const VertexId next = cut_to_hit(b, hits.front(), report);
+        if (next < 0) ++report.stuck;
+        else split_incision(next, report);
         return;
       }
       std::optional<Wedge> blocking;
@@ -603,7 +636,6 @@ void SurfaceCutter::advance(VertexId b, const Segment& from, const Segment& to, 
       return;
     }
     const Wedge& w = crossing->wedge;
-    move_active_to(b, w, {0.4, 0.6 * (1 - crossing->mu), 0.6 * crossing->mu});
     // An edge not to be flipped ends the incision there (Figure 5.13): a boundary edge (the
     // exit), or one with another active node across it.
     const std::vector<ElementId> wings = elements_with_edge(mesh_.connectivity(), w.y, w.z);
@@ -611,14 +643,52 @@ void SurfaceCutter::advance(VertexId b, const Segment& from, const Segment& to, 
       return e != w.element && touches_active(e);
     });
     if (is_boundary_edge(w.element, b) || across_active) {
+      move_active_to(b, w, {0.4, 0.6 * (1 - crossing->mu), 0.6 * crossing->mu});
       end_at_edge(b, w.y, w.z, crossing->mu, report);
       return;
     }
+    if (on_crease(b) || is_crease(w.y, w.z)) {
+      // Neither b nor the edge may move across the crease: a node where the path crosses it.
+      const VertexId next = cut_to_edge(b, w.y, w.z, crossing->mu, report);
+      if (next < 0) {
+        ++report.stuck;
+        return;
+      }
+      // The new node is where the scalpel crossed: it sweeps on from there.
+      from = {lerp(from.head, to.head, crossing->time), lerp(from.tail, to.tail, crossing->time)};
+      b = next;
+      continue;
+    }
+    move_active_to(b, w, {0.4, 0.6 * (1 - crossing->mu), 0.6 * crossing->mu});
     if (!clear_link_edge(b, w.y, w.z, report)) {
       ++report.stuck;
       return;
     }
   }
+}
+
+VertexId SurfaceCutter::cut_to_edge(VertexId b, VertexId y, VertexId z, double mu, PlanarCutReport& report) {
+  const Point3 at = lerp(reference(y), reference(z), mu);
+  // An end of the edge near the crossing is the node, if it can carry the incision.
+  const auto usable = [&](VertexId v) {
+    return distance(at, reference(v)) < crease_step() && !incision_vertices_.count(v) && !on_boundary(v) &&
+           active_neighbours(v, b).empty();
+  };
+  VertexId next = usable(y) ? y : usable(z) ? z : -1;
+  if (next < 0) {
+    // Not onto an end that cannot carry it (as insert_at keeps a side's new node off its ends).
+    if ((next = split(y, z, std::clamp(mu, 0.05, 0.95))) < 0) return -1;
+    ++report.nodes_inserted;
+  }
+  open_from(b, {next}, report);
+  return incision_at(next) ? next : -1;
+}
+
+VertexId SurfaceCutter::cut_to_hit(VertexId b, const StarHit& hit, PlanarCutReport& report) {
+  const VertexId next = insert_at(hit.wedge, b, hit.weights, report);
+  if (next < 0 || !has_edge(mesh_.connectivity(), b, next)) return -1;
+  open_from(b, {next}, report);
+  return incision_at(next) ? next : -1;
 }
 
 bool SurfaceCutter::clear_link_edge(VertexId b, VertexId y, VertexId z, PlanarCutReport& report) {
@@ -633,6 +703,7 @@ bool SurfaceCutter::clear_link_edge(VertexId b, VertexId y, VertexId z, PlanarCu
 
 bool SurfaceCutter::move_active_to(VertexId b, const Wedge& w, std::array<double, 3> weights,
                                    std::optional<Wedge>* blocking) {
+  if (on_crease(b)) return false;  // it would take the crease along, off the surface
   const std::array<VertexId, 3> parents{b, w.y, w.z};
   // Part of the way when the whole way would flatten or fold a triangle of the star.
   for (double fraction : {1.0, 0.75, 0.5, 0.25}) {
@@ -658,7 +729,7 @@ bool SurfaceCutter::move_active_to(VertexId b, const Wedge& w, std::array<double
 bool SurfaceCutter::flip(VertexId p, VertexId q, PlanarCutReport& report) {
   const Connectivity& c = mesh_.connectivity();
   const std::vector<ElementId> wings = elements_with_edge(c, p, q);
-  if (wings.size() != 2) return false;
+  if (wings.size() != 2 || is_crease(p, q)) return false;
   std::vector<VertexId> quad{p, q};
   std::vector<Point3> old_normals;
   for (ElementId e : wings) {
@@ -687,7 +758,7 @@ bool SurfaceCutter::flip(VertexId p, VertexId q, PlanarCutReport& report) {
 
 bool SurfaceCutter::remove_node(VertexId v, PlanarCutReport& report) {
   // §5.3.2: active nodes stay, and so do the nodes that separate two of them.
-  if (is_active(v) || active_neighbours(v, -1).size() > 1) return false;
+  if (is_active(v) || active_neighbours(v, -1).size() > 1 || on_crease(v)) return false;
   std::vector<VertexId> link;
   for (const Wedge& w : wedges(v)) link.insert(link.end(), {w.y, w.z});
   // The new triangles must face the way the surface does, as those of moves and flips.

@@ -18,6 +18,12 @@
 //    spoke. Then the active triangles are flipped to the unfolded Delaunay criterion, interior
 //    nodes within ε_edge of the active node removed, and the incision split (Figure 5.5) where
 //    its cut edges, unfolded about the active node, fail the empty-circle test;
+//  * where the surface has a crease (neighbouring triangles turned by 30° or more: a box's
+//    edge, a coarse ridge) no flip, node removal or node move crosses it, since each would
+//    make a chord through the body; the incision puts a node on the scalpel's path where the
+//    swept scalpel crosses the crease (§5.3.1's nodes on the path), and a node on a crease
+//    stays there: its incision goes on from a new node at the scalpel's hit once that is
+//    ε_edge/4 away (no shorter cut edge);
 //  * the scalpel meeting an active node's triangles in several places far apart branches the
 //    incision (Figure 5.14): a new active node at each place, the edges to them dissected;
 //  * an incision ends where its active node reaches an edge it may not flip (Figure 5.13,
@@ -36,8 +42,9 @@
 // Edits that others make to the mesh between moves keep the incisions right, as for the 2D
 // cutter (IncisionWatch): an incision whose tip they took away ends, and the next move raises
 // IncisionLost naming it.
-// Departures from the thesis: the new incision nodes go on the cut edges (a chord of the
-// path), not onto the path itself; a node separating two incisions annihilates them only when
+// Departures from the thesis: the incision split's new nodes go on the cut edges (a chord of
+// the path), not onto the path itself, which they approach where the surface is flatter than a
+// crease; a node separating two incisions annihilates them only when
 // it is within ε_edge, and the edge case inserts the node where the scalpel crosses the edge
 // rather than on the extrapolated path.
 #pragma once
@@ -134,6 +141,13 @@ class SurfaceCutter {
   // Whether a triangle with this normal and corners faces the way the uncut surface does there.
   bool faces_surface(const Point3& normal, VertexId a, VertexId b, VertexId c) const;
   bool keeps_facing(VertexId v, const Point3& x, VertexId merging_into = -1, Wedge* refused_by = nullptr) const;
+  // Whether the surface bends at interior edge (p, q) by 30° or more (its two
+  // triangles' normals), and whether it does at one of v's spokes: v sits on a crease.
+  bool is_crease(VertexId p, VertexId q) const;
+  bool on_crease(VertexId v) const;
+  // The shortest cut edge a crease makes: a node on a crease waits until the scalpel is this
+  // far from it.
+  double crease_step() const { return options_.eps_edge / 4; }
   bool is_boundary_edge(ElementId triangle, VertexId opposite) const;
   Point3 reference_at(const Wedge& w, VertexId b, const std::array<double, 3>& weights) const;
   Point3 deformed_at(const Wedge& w, VertexId b, const std::array<double, 3>& weights) const;
@@ -170,7 +184,14 @@ class SurfaceCutter {
   // Dissects the edges from a to `ends` (after splitting a lone interior one, so that it
   // opens); `ends` become the active nodes in place of a.
   void open_from(VertexId a, const std::vector<VertexId>& ends, PlanarCutReport& report);
-  void advance(VertexId b, const Segment& from, const Segment& to, PlanarCutReport& report);
+  void advance(VertexId b, Segment from, const Segment& to, PlanarCutReport& report);
+  // §5.3.1's incision nodes on the scalpel's path where it crosses a crease: b's incision
+  // goes on from a node where the swept scalpel crosses link edge (y, z) of b's star (a new
+  // one, or y or z when within crease_step of the crossing). Returns the new active node, or -1.
+  VertexId cut_to_edge(VertexId b, VertexId y, VertexId z, double mu, PlanarCutReport& report);
+  // b's incision goes on from a new node where the scalpel meets b's star (b on a crease
+  // stays there). Returns the new active node, or -1.
+  VertexId cut_to_hit(VertexId b, const StarHit& hit, PlanarCutReport& report);
   // Hits of `scalpel` in a's star farther than `apart` from a and from each other, or nothing
   // when fewer than two (Figure 5.14).
   std::vector<StarHit> branches(VertexId a, const Segment& scalpel, double apart) const;
