@@ -5,6 +5,7 @@
 #include <numeric>
 
 #include "core/error.hpp"
+#include "core/growable_vec.hpp"
 #include "core/norms.hpp"
 #include "core/petsc_util.hpp"
 #include "solve/stopping.hpp"
@@ -25,10 +26,13 @@ Model::~Model() {
 }
 
 void Model::create_vectors() {
+  create_growable_vec(n_dofs(), dim(), u_.out());
+  create_growable_vec(n_dofs(), dim(), u_linearization_.out());
+  create_tangent();
+}
+
+void Model::create_tangent() {
   const PetscInt n = n_dofs();
-  SNEDE_PETSC(VecCreateSeq(PETSC_COMM_SELF, n, u_.out()));
-  SNEDE_PETSC(VecSetBlockSize(u_, dim()));
-  SNEDE_PETSC(VecDuplicate(u_, u_linearization_.out()));
   SNEDE_PETSC(MatCreateShell(PETSC_COMM_SELF, n, n, n, n, this, tangent_.out()));
   SNEDE_PETSC(MatShellSetOperation(tangent_, MATOP_MULT, reinterpret_cast<void (*)(void)>(tangent_mult_callback)));
   SNEDE_PETSC(MatShellSetOperation(tangent_, MATOP_GET_DIAGONAL,
@@ -267,24 +271,17 @@ void Model::on_change(const Connectivity&, const ConnectivityChange& change) {
   }
   std::vector<Vec*> fields{u_.slot()};
   fields.insert(fields.end(), carried_fields_.begin(), carried_fields_.end());
-  if (n_new == n_points_) {  // same rows (moves, removals, reused ids): in place, O(events)
-    for (Vec* field : fields) replay_vertex_events(WriteView(*field).span(), dim(), change.vertex_events);
-    return;
+  if (n_new != n_points_) {
+    // New Vecs over the old ones' storage while it has room (core/growable_vec.hpp): the
+    // reissue costs the rows added, not a copy of every row. The linearization point keeps
+    // its rows, as in a change of the same size: a solver sets it before it linearizes.
+    for (Vec* field : fields) resize_growable_vec(field, n_dofs());
+    resize_growable_vec(u_linearization_.slot(), n_dofs());
+    n_points_ = n_new;
+    create_tangent();
+    ++generation_;
   }
-  std::vector<std::vector<double>> values;
-  for (Vec* field : fields) {
-    std::vector<double>& v = values.emplace_back(vec_values(*field));
-    v.resize(body_.n_dofs(), 0.0);
-    replay_vertex_events(v, dim(), change.vertex_events);
-  }
-  for (Vec* field : fields) SNEDE_PETSC(VecDestroy(field));
-  u_linearization_.reset();
-  tangent_.reset();
-  n_points_ = n_new;
-  create_vectors();
-  for (std::size_t i = 1; i < fields.size(); ++i) SNEDE_PETSC(VecDuplicate(u_, fields[i]));
-  ++generation_;
-  for (std::size_t i = 0; i < fields.size(); ++i) set_vec_values(*fields[i], values[i]);
+  for (Vec* field : fields) replay_vertex_events(WriteView(*field).span(), dim(), change.vertex_events);  // O(events)
 }
 
 }  // namespace snede

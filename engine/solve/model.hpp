@@ -7,7 +7,7 @@
 // carried field (a dynamic solver's velocity) — an added vertex gets the weighted sum of its
 // parents' values, a vertex moved by parents is re-interpolated, a removed vertex is taken
 // out of the problem (held at zero) — and reissues vector and shell sizes when the vertex
-// count changed.
+// count changed, in time proportional to the vertices added (the vectors keep spare room).
 //
 // The static problem is min Π(u) = Π_int(u) − f_extᵀu under the constraints. PETSc sees
 //   F(u) = P ∇Π(u) + (I − P)(u − anchor)      (residual; zero exactly at the solution)
@@ -101,6 +101,7 @@ class Model : public ConnectivityWatcher {
 
  private:
   void create_vectors();
+  void create_tangent();
   void tangent_mult(Vec d, Vec out);
   static PetscErrorCode tangent_mult_callback(Mat A, Vec d, Vec out);
   // The shell's MatGetDiagonal (for PCJACOBI): the diagonal of J without forming J.
