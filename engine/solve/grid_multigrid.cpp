@@ -184,6 +184,17 @@ GridMultigrid::GridMultigrid(Model& fine, double grid_width)
         }
       }
   }
+  // Without the exact zeros of the copies' columns (a free vertex has one non-zero of its
+  // copy's three columns): they would cost every restriction and interpolation.
+  PetscInt kept = 0;
+  for (PetscInt row = 0, k = 0; row < n_rows; ++row) {
+    for (; k < row_start[row + 1]; ++k)
+      if (values[k] != 0) {
+        columns[kept] = columns[k];
+        values[kept++] = values[k];
+      }
+    row_start[row + 1] = kept;
+  }
   SNEDE_PETSC(MatCreate(PETSC_COMM_SELF, interpolation_.out()));
   SNEDE_PETSC(MatSetSizes(interpolation_, n_rows, n_unknowns_, n_rows, n_unknowns_));
   SNEDE_PETSC(MatSetType(interpolation_, MATSEQAIJ));
