@@ -18,7 +18,7 @@
 //    spoke. Then the active triangles are flipped to the unfolded Delaunay criterion, interior
 //    nodes within ε_edge of the active node removed, and the incision split (Figure 5.5) where
 //    its cut edges, unfolded about the active node, fail the empty-circle test;
-//  * where the surface has a crease (neighbouring triangles turned by 30° or more: a box's
+//  * where the surface has a crease (neighbouring triangles turned by 45° or more: a box's
 //    edge, a coarse ridge) no flip, node removal or node move crosses it, since each would
 //    make a chord through the body; the incision puts a node on the scalpel's path where the
 //    swept scalpel crosses the crease (§5.3.1's nodes on the path), and a node on a crease
@@ -141,8 +141,11 @@ class SurfaceCutter {
   // Whether a triangle with this normal and corners faces the way the uncut surface does there.
   bool faces_surface(const Point3& normal, VertexId a, VertexId b, VertexId c) const;
   bool keeps_facing(VertexId v, const Point3& x, VertexId merging_into = -1, Wedge* refused_by = nullptr) const;
-  // Whether the surface bends at interior edge (p, q) by 30° or more (its two
-  // triangles' normals), and whether it does at one of v's spokes: v sits on a crease.
+  // Whether interior edge (p, q) bends by 45° or more (its two triangles' normals).
+  bool bends(VertexId p, VertexId q) const;
+  // Whether edge (p, q) is on a crease: it bends, and both ends are crease vertices (so that
+  // triangles the cutter squeezed on a smooth surface make no crease); and whether one of v's
+  // spokes is: v sits on a crease.
   bool is_crease(VertexId p, VertexId q) const;
   bool on_crease(VertexId v) const;
   // The shortest cut edge a crease makes: a node on a crease waits until the scalpel is this
@@ -225,6 +228,10 @@ class SurfaceCutter {
   void settle(const Connectivity& c, const IncisionWatch::Fates& fates);
   // The uncut surface's normal at a vertex another edit added or moved, as follow() does.
   void carry_normal(const VertexEvent& event);
+  // Whether a vertex made with these parents is a crease vertex.
+  void carry_crease(VertexId v, const VertexParents& parents);
+  // What the cutter keeps about a vertex that is gone.
+  void forget(VertexId v);
 
   Mesh& mesh_;
   Model* model_;
@@ -238,6 +245,9 @@ class SurfaceCutter {
   bool rebuild_grid_ = true;
   std::unordered_set<VertexId> incision_vertices_;
   std::unordered_map<VertexId, Point3> surface_normals_;
+  // The vertices where the uncut surface bends at a spoke (by 45° or more), and those made on
+  // edges between two of them or as their copies since.
+  std::unordered_set<VertexId> crease_vertices_;
   std::vector<VertexId> touched_;
   std::unordered_set<ElementId> refused_;  // this move enters none of these (refused, or where an incision ended)
   IncisionWatch watch_;                    // last: it refers to the sets above
