@@ -23,9 +23,15 @@ RefinementHierarchy::~RefinementHierarchy() { mesh_.connectivity().remove_watche
 void RefinementHierarchy::init(const Connectivity& connectivity) {
   nodes_.clear();
   roots_.clear();
+  root_grid_.clear();
   node_of_element_.assign(connectivity.element_capacity(), no_id);
-  for (ElementId e : connectivity.element_ids())
-    roots_.push_back(add_node(initial_labelling(mesh_, connectivity.element(e).simplex), no_id, e));
+  for (ElementId e : connectivity.element_ids()) add_root(initial_labelling(mesh_, connectivity.element(e).simplex), e);
+  n_points_seen_ = mesh_.n_points();
+}
+
+void RefinementHierarchy::add_root(const TaggedSimplex& label, ElementId element) {
+  roots_.push_back(add_node(label, no_id, element));
+  if (root_grid_.built()) root_grid_.add(roots_.back());
 }
 
 NodeId RefinementHierarchy::add_node(const TaggedSimplex& label, NodeId parent, ElementId element) {
@@ -104,15 +110,41 @@ void RefinementHierarchy::on_change(const Connectivity& connectivity, const Conn
     }
     expected_.clear();
   } else {
-    for (ElementId e : change.added_elements)
-      roots_.push_back(add_node(initial_labelling(mesh_, connectivity.element(e).simplex), no_id, e));
+    for (ElementId e : change.added_elements) add_root(initial_labelling(mesh_, connectivity.element(e).simplex), e);
   }
   for (const auto& [e, old_simplex] : change.changed_elements) {
     const NodeId old_node = node_of_element_[e];
     const TaggedSimplex label = relabelled(nodes_[old_node].label, old_simplex, connectivity.element(e).simplex);
     nodes_[old_node].element = no_id;
-    roots_.push_back(add_node(label, no_id, e));
+    add_root(label, e);
   }
+  // A root's box follows its vertices: a moved vertex, or a removed one whose id comes back
+  // elsewhere, makes the grid stale.
+  for (const VertexEvent& event : change.vertex_events)
+    if (event.kind != VertexEventKind::added || event.vertex < n_points_seen_) root_grid_.clear();
+  n_points_seen_ = mesh_.n_points();
+}
+
+BoundingBox RefinementHierarchy::padded_box(NodeId root) const {
+  const TaggedSimplex& label = nodes_[root].label;
+  const int d = label.dim;
+  BoundingBox box;
+  double size = 0;
+  for (int k = 0; k < d; ++k) {
+    box.lo[k] = box.hi[k] = mesh_.point(label.vertex[0])[k];
+    for (int i = 1; i <= d; ++i) {
+      box.lo[k] = std::min(box.lo[k], mesh_.point(label.vertex[i])[k]);
+      box.hi[k] = std::max(box.hi[k], mesh_.point(label.vertex[i])[k]);
+    }
+    size = std::max(size, box.hi[k] - box.lo[k]);
+  }
+  // A point on_face_tolerance outside in barycentric terms is at most that times the simplex's
+  // diameter (√d · size) away: the padding is far wider.
+  for (int k = 0; k < d; ++k) {
+    box.lo[k] -= 1e3 * on_face_tolerance * size;
+    box.hi[k] += 1e3 * on_face_tolerance * size;
+  }
+  return box;
 }
 
 std::array<double, max_dimension + 1> RefinementHierarchy::barycentric(const TaggedSimplex& label,
@@ -141,11 +173,14 @@ std::vector<NodeId> RefinementHierarchy::roots_containing(std::span<const double
   if (x.size() != static_cast<std::size_t>(mesh_.dim()))
     throw std::invalid_argument("locate: the point has " + std::to_string(x.size()) + " coordinates, the mesh is " +
                                 std::to_string(mesh_.dim()) + "-D");
+  if (!root_grid_.built() || root_grid_.n_added() > root_grid_.n_built() / 4)
+    root_grid_.build(mesh_.dim(), roots_, [this](NodeId r) { return padded_box(r); });
   std::vector<NodeId> found;
-  for (NodeId r : roots_) {
+  for (NodeId r : root_grid_.candidates(x)) {
     const auto lambda = barycentric(nodes_[r].label, x);
     if (*std::min_element(lambda.begin(), lambda.begin() + mesh_.dim() + 1) >= -on_face_tolerance) found.push_back(r);
   }
+  std::sort(found.begin(), found.end());  // in the order of roots_, as a scan finds them
   return found;
 }
 

@@ -15,11 +15,10 @@
 #include <vector>
 
 #include "mesh/mesh.hpp"
+#include "topology/root_grid.hpp"
 #include "topology/tagged_simplex.hpp"
 
 namespace snede {
-
-using NodeId = std::int32_t;
 
 struct RefinementNode {
   TaggedSimplex label;
@@ -54,7 +53,8 @@ class RefinementHierarchy : public ConnectivityWatcher {
   // it into the half on x's side of each bisecting hyperplane. x: (dim,).
   std::vector<ElementId> locate_all(std::span<const double> x) const;
   // The same in two steps, for repeated queries at one point while the mesh is refined:
-  // the roots containing x (a scan of all roots), then the descent from them.
+  // the roots containing x (those near x, found through a grid over the roots' boxes, built
+  // on first use and after a change that moved a vertex), then the descent from them.
   std::vector<NodeId> roots_containing(std::span<const double> x) const;
   std::vector<ElementId> locate_all(std::span<const double> x, std::span<const NodeId> roots) const;
   // One live element containing x, or no_id if x is outside the mesh.
@@ -67,6 +67,10 @@ class RefinementHierarchy : public ConnectivityWatcher {
 
  private:
   NodeId add_node(const TaggedSimplex& label, NodeId parent, ElementId element);
+  void add_root(const TaggedSimplex& label, ElementId element);
+  // The box of the root's simplex at the current coordinates, padded by more than the
+  // barycentric tolerance of point location.
+  BoundingBox padded_box(NodeId root) const;
   void attach(ElementId e, NodeId n);
   // x's barycentric coordinates in the node's simplex, in label order (x0..xd).
   std::array<double, max_dimension + 1> barycentric(const TaggedSimplex& label, std::span<const double> x) const;
@@ -82,6 +86,8 @@ class RefinementHierarchy : public ConnectivityWatcher {
   std::vector<NodeId> roots_;
   std::vector<NodeId> node_of_element_;  // indexed by element id
   std::vector<ExpectedSplit> expected_;
+  mutable RootGrid root_grid_;
+  VertexId n_points_seen_ = 0;  // ids below this may be in roots' labels: reusing one moves a root
 };
 
 }  // namespace snede

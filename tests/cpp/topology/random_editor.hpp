@@ -30,6 +30,7 @@ class RandomEditor {
   RandomEditor& operator=(const RandomEditor&) = delete;
 
   std::size_t n_forced_splits() const { return bisection_.n_forced_splits(); }
+  Bisection& bisector() { return bisection_; }
 
   // Keeps the size near where it started: more splits and insertions when small, more
   // collapses and removals when big. Flips and removals only on triangle meshes.

@@ -2,11 +2,14 @@
 // connectivity (§7.4).
 #include <gtest/gtest.h>
 
+#include <Eigen/Dense>
+
 #include <random>
 
 #include "mesh/traversal.hpp"
 #include "topology/dissect.hpp"
 #include "topology/refine_around.hpp"
+#include "topology/random_editor.hpp"
 #include "topology/refinement_checks.hpp"
 
 namespace snede {
@@ -56,6 +59,54 @@ TEST(RefinementHierarchy, LocatesRandomPointsLikeAScan) {
   const std::vector<double> vertex{0.5, 0.5, 0.0}, outside{0.5, 0.5, -0.01};
   EXPECT_EQ(bisection.hierarchy().locate_all(vertex), containing_by_scan(mesh, vertex));
   EXPECT_EQ(bisection.hierarchy().locate(outside), no_id);
+}
+
+// The roots whose label simplex contains x, by a scan of all roots: what roots_containing
+// did before it had a grid (barycentric coordinates at the current coordinates, ≥ −1e-10).
+std::vector<NodeId> roots_by_scan(const Mesh& mesh, const RefinementHierarchy& tree, const std::vector<double>& x) {
+  std::vector<NodeId> found;
+  for (NodeId r : tree.roots()) {
+    const TaggedSimplex& label = tree.node(r).label;
+    const std::vector<double> x0 = coordinates(mesh, label.vertex[0]);
+    Eigen::Matrix3d edges;
+    Eigen::Vector3d offset;
+    for (int k = 0; k < 3; ++k) {
+      for (int i = 1; i <= 3; ++i) edges(k, i - 1) = coordinates(mesh, label.vertex[i])[k] - x0[k];
+      offset(k) = x[k] - x0[k];
+    }
+    const Eigen::Vector3d mu = edges.partialPivLu().solve(offset);
+    if (std::min({1 - mu.sum(), mu(0), mu(1), mu(2)}) >= -1e-10) found.push_back(r);
+  }
+  return found;
+}
+
+// Point location finds the roots near x through a grid over their boxes, kept through edits:
+// new roots join it, moved or reused vertices make it stale. After every edit of a random
+// sequence (snaps move vertices, collapses free ids that splits reuse) and of a sequence of
+// dissections alone (new roots, no vertex moved: the grid is kept and grows), it finds the roots
+// a scan finds; refine_around's locations in between keep the grid in use.
+TEST(RefinementHierarchy, FindsTheRootsAScanFindsThroughRandomEdits) {
+  std::mt19937 random(8);
+  std::uniform_real_distribution<double> coordinate(-0.05, 1.05), interior(0.3, 0.7);
+  std::size_t n_found = 0;
+  for (const bool only_dissections : {false, true}) {
+    Mesh mesh = shuffled_jittered_cube(3, 0.2, 7);
+    RandomEditor editor(mesh, 7);
+    const RefinementHierarchy& tree = editor.bisector().hierarchy();
+    for (int step = 0; step < 300; ++step) {
+      if (step % 25 == 0)
+        refine_around(editor.bisector(), std::vector<double>{interior(random), 0.5, 0.5}, 0.1);
+      else
+        editor.edit(only_dissections ? dissection : editor.choose(static_cast<double>(mesh.n_cells()) / 162));
+      for (int i = 0; i < 5; ++i) {
+        const std::vector<double> x{coordinate(random), coordinate(random), coordinate(random)};
+        const std::vector<NodeId> expected = roots_by_scan(mesh, tree, x);
+        ASSERT_EQ(tree.roots_containing(x), expected) << "after step " << step << (only_dissections ? " of dissections" : "");
+        n_found += expected.size();
+      }
+    }
+  }
+  EXPECT_GT(n_found, 2000u);
 }
 
 TEST(RefinementHierarchy, ChildrenHalveTheirParentAndLeavesAreTheElements) {
