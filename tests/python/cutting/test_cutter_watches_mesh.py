@@ -2,8 +2,8 @@
 moves (collapses, splits, flips, bisection, vertex removals, dissections) keep the cutter's
 state right, or its next move raises IncisionLost naming what changed.
 
-Also the tetrahedral cutter's incision across refinement, and the surface cutter's active node
-advancing on a coarse closed surface (issue 32 item 4).
+Also the tetrahedral cutter's incision across refinement. The surface cutter's active node on
+coarse closed surfaces (issue 32 item 4) is in test_surface_creases.py.
 
 The references are independent of the cutters' books: the lips and cut faces are found from
 the cells alone (boundary edges or faces off the square's or the box's sides), the path from
@@ -229,45 +229,3 @@ def test_refinement_mid_cut_keeps_every_face_of_a_tetrahedral_incision():
     cutter.move([[0.43, 0.8, -1.0], [0.43, 0.8, 2.0]])
     mesh.validate()
     assert pairs(cutter.incision_faces()) == cut_faces(mesh)
-
-
-def coarse_box_surface():
-    """A coarse closed surface: the 276 triangles bounding a 3 × 3 × 10 grid of the unit box."""
-    return snede.meshing.boundary_surface(snede.meshing.box((1, 1, 1), (3, 3, 10)))[0]
-
-
-def advancing_moves(mesh, scalpels):
-    """(moves, advanced): the moves in which the scalpel moved while an incision was cutting
-    (its tip has lips), and those after which every such tip that is still active has moved.
-    From the scalpels and the mesh alone, not the cutter's report."""
-    cutter = snede.SurfaceCutter(mesh)
-    eps = 1e-9
-    moves = advanced = 0
-    previous = None
-    for scalpel in scalpels:
-        lipped = set(np.unique(mesh.boundary_faces()))
-        tips = {v: mesh.points[v].copy() for v in cutter.active_nodes if v in lipped}
-        cutter.move(scalpel)
-        mesh.validate()
-        if tips and np.abs(scalpel - previous).max() > eps:
-            moves += 1
-            advanced += all(np.abs(mesh.points[v] - x).max() > eps for v, x in tips.items() if v in cutter.active_nodes)
-        previous = scalpel
-    return moves, advanced
-
-
-def test_the_surface_cutter_advances_on_a_coarse_closed_surface():
-    """Issue 32 item 4: on a coarse 276-triangle surface the active node stuck in most moves of
-    a scalpel moved in steps smaller than an edge (0.034, against edges of 0.1 to 0.42): it
-    advanced in 31 of 133 moves of these four paths; 92 now (docs/results/surface_cut.md)."""
-    moves = advanced = 0
-    for tilt in (0.05, 0.1, 0.2, 0.3):
-        mesh = coarse_box_surface()
-        assert mesh.n_cells == 276
-        # A scalpel through the box, leaning along its length and moved along it: incisions on
-        # the faces y = 0 and y = 1, the first entering across the edge of the face z = 0.
-        scalpels = np.array([[[0.2, -0.5, z - tilt], [0.6, 1.5, z + tilt]] for z in np.linspace(-0.1, 1.1, 36)])
-        path_moves, path_advanced = advancing_moves(mesh, scalpels)
-        moves, advanced = moves + path_moves, advanced + path_advanced
-    assert moves >= 120
-    assert advanced >= 0.6 * moves, f"the node advanced in {advanced} of {moves} moves"
