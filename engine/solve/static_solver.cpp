@@ -10,6 +10,7 @@
 
 #include "core/error.hpp"
 #include "core/interrupt.hpp"
+#include "core/log_event.hpp"
 #include "core/norms.hpp"
 #include "core/petsc_util.hpp"
 #include "solve/aggregation_multigrid.hpp"
@@ -272,6 +273,8 @@ void StaticSolver::follow_mesh_changes() {
 Mat StaticSolver::preconditioning_matrix() {
   if (!needs_matrix_) return model_.tangent();
   if (!assembled_) {
+    static const PetscLogEvent event = log_event("SnedeTangentSparsity");
+    ScopedEvent logged(event);
     // GAMG works on AIJ; a membrane's compressed elements must not make the PC indefinite.
     assembled_ = std::make_unique<AssembledTangent>(model_, MatrixFormat::aij, MembraneTangent::positive_part);
     set_rigid_body_near_null_space(model_, assembled_->mat());
@@ -313,6 +316,8 @@ void StaticSolver::build_multigrid() {
   multigrid_.reset();
   if (coarsening != "aggregation" && coarsening != "grid" && hierarchy_) {
     try {
+      static const PetscLogEvent event = log_event("SnedeBisectionLevels");
+      ScopedEvent logged(event);
       multigrid_ = std::make_unique<BisectionMultigrid>(model_, *hierarchy_, max_levels);
     } catch (const std::invalid_argument&) {
       // No conforming coarser cut (a mesh never refined, or one that was cut or flipped since):
@@ -322,6 +327,8 @@ void StaticSolver::build_multigrid() {
   }
   if (!multigrid_ && coarsening != "aggregation") {
     if (max_levels > 2) throw std::invalid_argument(prefix + "pc_mg_levels: grid coarsening gives 2 levels");
+    static const PetscLogEvent event = log_event("SnedeGridLevels");
+    ScopedEvent logged(event);
     multigrid_ = std::make_unique<GridMultigrid>(model_, number_option("mg_grid_width", GridMultigrid::default_grid_width));
   }
   const std::string smoothing =
@@ -402,12 +409,20 @@ void StaticSolver::refill_preconditioner(SNES snes, Vec x) {
   // every k-th iteration.
   const bool lagged = (lag == -1 || (lag > 1 && iteration % lag != 0)) && preconditioner_filled_;
   if (lagged) return;
-  if (assembled_) assembled_->assemble(model_, x);
-  if (multigrid_) multigrid_->update(x, assembled_ ? assembled_->mat() : nullptr);
-  mark_filled();
+  fill_preconditioner(x);
 }
 
-void StaticSolver::mark_filled() {
+void StaticSolver::fill_preconditioner(Vec u) {
+  if (assembled_) {
+    static const PetscLogEvent event = log_event("SnedeTangentAssembly");
+    ScopedEvent logged(event);
+    assembled_->assemble(model_, u);
+  }
+  if (multigrid_) {
+    static const PetscLogEvent event = log_event("SnedeLevelsUpdate");
+    ScopedEvent logged(event);
+    multigrid_->update(u, assembled_ ? assembled_->mat() : nullptr);
+  }
   ++preconditioner_fills_;
   preconditioner_filled_ = true;
   filled_in_this_solve_ = true;
@@ -427,9 +442,17 @@ double StaticSolver::current_tolerance() const {
 SolveResult StaticSolver::solve() {
   // A piece with rigid motions has no unique static solution: refused before any set-up, as no
   // method or preconditioner would converge (Newton spun to its iteration limit).
-  piece_holding_.require_held(model_.constraints());
+  {
+    static const PetscLogEvent event = log_event("SnedePieceCheck");
+    ScopedEvent logged(event);
+    piece_holding_.require_held(model_.constraints());
+  }
   const double follow_start = wall_seconds();
-  follow_mesh_changes();
+  {
+    static const PetscLogEvent event = log_event("SnedeFollowMesh");
+    ScopedEvent logged(event);
+    follow_mesh_changes();
+  }
   follow_seconds_ = wall_seconds() - follow_start;
   history_.clear();
   external_norm_ = euclidean_norm(model_.external_forces());
@@ -470,11 +493,7 @@ SolveResult StaticSolver::solve_linear() {
   const ScaledOperator scaled(model_, system_scale_);
   // Linear CG solves linear elasticity, whose tangent does not depend on the state: what was
   // filled for an earlier solve of the same system is the same matrix.
-  if (!filled_for_current_system()) {
-    if (needs_matrix_) assembled_->assemble(model_, u);
-    if (multigrid_) multigrid_->update(u, assembled_ ? assembled_->mat() : nullptr);
-    mark_filled();
-  }
+  if (!filled_for_current_system()) fill_preconditioner(u);
   SNEDE_PETSC(KSPSolve(ksp_, rhs, step));
   {
     // Onto the allowed motions (6.7), as Newton's steps (descent_direction_callback): CG's

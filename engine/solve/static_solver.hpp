@@ -137,7 +137,9 @@ class StaticSolver {
   std::size_t preconditioner_fills_ = 0;
   // Whether the filled preconditioner is that of the current system (scale and projections).
   bool filled_for_current_system() const;
-  void mark_filled();
+  // The assembled tangent and the multigrid levels at the state u (logged as SnedeTangentAssembly
+  // and SnedeLevelsUpdate), and the fill remembered for reuse.
+  void fill_preconditioner(Vec u);
   // A number from the option database (-<prefix>name), or `fallback`.
   double number_option(const std::string& name, double fallback) const;
   bool keeps_levels_through_solve_ = false;  // Galerkin levels kept through a solve (solve_nonlinear)
