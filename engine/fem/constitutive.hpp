@@ -16,6 +16,7 @@
 
 #include <concepts>
 #include <type_traits>
+#include <utility>
 
 #include "fem/batch.hpp"
 #include "fem/tensor.hpp"
@@ -74,23 +75,58 @@ Gradient<T, R, D> first_piola(const M& m, const Gradient<T, R, D>& F) {
     return m.template first_piola<T, D>(F);
 }
 
+// The material's ∂S/∂C at one C as a map of H (its stress_tangent(C)); nothing for a material
+// written in F.
+template <class T, class M>
+struct StressTangentOf {
+  struct type {};
+};
+template <class T, WrittenInC M>
+struct StressTangentOf<T, M> {
+  using type = decltype(std::declval<const M&>().stress_tangent(std::declval<const Tensor<T, 3>&>()));
+};
+
+// dP(F)[dF] as a linear map of dF at one F, with the work that depends on F alone done once
+// (C, S, the material's ∂S/∂C at C, plane stress's c₃₃ and its derivative's denominator): an
+// element stiffness applies it to D² (or more) directions.
+template <class T, int D, class M, int R>
+class FirstPiolaTangent {
+ public:
+  FirstPiolaTangent(const M& m, const Gradient<T, R, D>& F) : m_(m), F_(F) {
+    if constexpr (WrittenInC<M>) {
+      const Tensor<T, 3> C = right_cauchy_green_3d<T, D>(m, F);
+      S_ = m.stress(C).template topLeftCorner<D, D>();
+      dS_of_ = m.stress_tangent(C);
+      if constexpr (D == 2) {
+        Tensor<T, 3> e33 = Tensor<T, 3>::Zero();
+        e33(2, 2) = T(1);
+        c33_slope_ = dS_of_(e33)(2, 2);
+      }
+    }
+  }
+  Gradient<T, R, D> operator()(const Gradient<T, R, D>& dF) const {
+    if constexpr (WrittenInC<M>) {
+      Tensor<T, 3> H = Tensor<T, 3>::Zero();
+      H.template topLeftCorner<D, D>() = dF.transpose() * F_ + F_.transpose() * dF;
+      if constexpr (D == 2) H(2, 2) = -dS_of_(H)(2, 2) / c33_slope_;
+      const Tensor<T, D> dS = dS_of_(H).template topLeftCorner<D, D>();
+      return dF * S_ + F_ * dS;
+    } else {
+      return m_.template first_piola_derivative<T, D>(F_, dF);
+    }
+  }
+
+ private:
+  const M& m_;
+  Gradient<T, R, D> F_;
+  Tensor<T, D> S_;
+  typename StressTangentOf<T, M>::type dS_of_;
+  T c33_slope_{};  // (∂S/∂C : e₃⊗e₃)₃₃ (plane stress)
+};
+
 template <class T, int D, class M, int R>
 Gradient<T, R, D> first_piola_derivative(const M& m, const Gradient<T, R, D>& F, const Gradient<T, R, D>& dF) {
-  if constexpr (WrittenInC<M>) {
-    const Tensor<T, 3> C = right_cauchy_green_3d<T, D>(m, F);
-    Tensor<T, 3> H = Tensor<T, 3>::Zero();
-    H.template topLeftCorner<D, D>() = dF.transpose() * F + F.transpose() * dF;
-    if constexpr (D == 2) {
-      Tensor<T, 3> e33 = Tensor<T, 3>::Zero();
-      e33(2, 2) = T(1);
-      H(2, 2) = -m.stress_derivative(C, H)(2, 2) / m.stress_derivative(C, e33)(2, 2);
-    }
-    const Tensor<T, D> S = m.stress(C).template topLeftCorner<D, D>();
-    const Tensor<T, D> dS = m.stress_derivative(C, H).template topLeftCorner<D, D>();
-    return dF * S + F * dS;
-  } else {
-    return m.template first_piola_derivative<T, D>(F, dF);
-  }
+  return FirstPiolaTangent<T, D, M, R>(m, F)(dF);
 }
 
 }  // namespace snede

@@ -10,6 +10,7 @@
 #include "core/counted.hpp"
 #include "core/error.hpp"
 #include "core/log_event.hpp"
+#include "fem/block_stiffness.hpp"
 #include "fem/linear_elastic_kernel.hpp"
 #include "fem/local_dofs.hpp"
 #include "fem/membrane_loops.hpp"
@@ -175,6 +176,33 @@ template <int D, class M>
   double total = 0;
   for (int lane = 0; lane < batch_width; ++lane) total += sums[lane];
   return infinite ? std::numeric_limits<double>::infinity() : total;
+}
+
+// Calls visit(e, vertices, K_e) for every live element with its stiffness at u
+// (fem/block_stiffness.hpp), leaving out inverted elements of a material that forbids
+// inversion. Flattened like the loops above: the block's kernels inlined into one body.
+template <int D, class M>
+[[gnu::flatten]] void visit_block_stiffness(const ElementStream<D>& stream, const M& material, std::span<const double> u,
+                                            const ElasticBody::StiffnessVisitor& visit) {
+  const M m = material;  // a local copy, as in accumulate_blocks
+  const std::span<const ElementBlock<D>> blocks = stream.blocks();
+  LaneStiffness<D> K;
+  for (std::size_t b = 0; b < blocks.size(); ++b) {
+    prefetch_ahead<D>(blocks, b);
+    const ElementBlock<D>& block = blocks[b];
+    LaneMask lanes = ElementStream<D>::live_lanes(block);
+    Tensor<Batch, D> U;
+    if constexpr (!is_linear_elastic<M>) U = gather_differences<D>(u, block);
+    if constexpr (M::forbids_inversion) lanes &= ~inverted_lanes<D>(block, U);
+    if (!lanes) continue;
+    block_stiffness<D>(m, block, U, K);
+    for (int lane = 0; lane < batch_width; ++lane) {
+      if (!(lanes >> lane & 1)) continue;
+      const ElementId e = static_cast<ElementId>(b * batch_width + lane);
+      const auto vertices = stream.vertices(e);
+      visit(e, std::span<const VertexId>(vertices.data(), D + 1), std::span<const double>(K[lane]));
+    }
+  }
 }
 
 template <int D>
@@ -450,35 +478,7 @@ void ElasticBody::for_each_element_stiffness(std::span<const double> u, const St
     return dim() == 2 ? smoothed_for_each_patch_stiffness<2>(stream_2d_, patches<2>(), material_, u, visit)
                       : smoothed_for_each_patch_stiffness<3>(stream_3d_, patches<3>(), material_, u, visit);
   with_material_and_dimension(material_, dim(), [&](const auto& m, auto dimension) {
-    constexpr int D = decltype(dimension)::value, n = (D + 1) * D;
-    using Material = std::decay_t<decltype(m)>;
-    const std::span<const ElementBlock<D>> blocks = stream<D>().blocks();
-    std::array<std::array<double, n * n>, batch_width> K;
-    for (std::size_t b = 0; b < blocks.size(); ++b) {
-      const ElementBlock<D>& block = blocks[b];
-      LaneMask lanes = ElementStream<D>::live_lanes(block);
-      const Tensor<Batch, D> U = gather_differences<D>(u, block);
-      if (Material::forbids_inversion) lanes &= ~inverted_lanes<D>(block, U);
-      if (!lanes) continue;
-      for (int column = 0; column < n; ++column) {
-        const Tensor<Batch, D> G = tangent_kernel<Batch, D>(m, block.reference, U, unit_differences<Batch, D, D>(column));
-        for (int lane = 0; lane < batch_width; ++lane)
-          for (int k = 0; k < D; ++k) {
-            double node_0 = 0;
-            for (int j = 1; j <= D; ++j) {
-              K[lane][static_cast<std::size_t>(j * D + k) * n + column] = G(k, j - 1)[lane];
-              node_0 -= G(k, j - 1)[lane];
-            }
-            K[lane][static_cast<std::size_t>(k) * n + column] = node_0;
-          }
-      }
-      for (int lane = 0; lane < batch_width; ++lane) {
-        if (!(lanes >> lane & 1)) continue;
-        const ElementId e = static_cast<ElementId>(b * batch_width + lane);
-        const auto vertices = stream<D>().vertices(e);
-        visit(e, std::span<const VertexId>(vertices.data(), D + 1), std::span<const double>(K[lane]));
-      }
-    }
+    visit_block_stiffness<decltype(dimension)::value>(stream<decltype(dimension)::value>(), m, u, visit);
   });
 }
 

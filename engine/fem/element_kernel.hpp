@@ -45,13 +45,21 @@ Tensor<T, D> element_force_columns(const M& m, const ElementReference<D, S>& ref
   return T(-ref.measure) * P * ref.Z_inv.transpose().template cast<T>();
 }
 
+// The tangent action on the direction whose gradient is dF (= dU Z⁻¹) through dP_of, the
+// FirstPiolaTangent at the element's F (formed once for several directions: an element
+// stiffness, whose unit directions have their dF without a product).
+template <class T, int D, class Tangent, class S>
+Tensor<T, D> tangent_columns_of_gradient(const Tangent& dP_of, const ElementReference<D, S>& ref, const Tensor<T, D>& dF) {
+  const Tensor<T, D> dP = dP_of(dF);
+  return T(ref.measure) * dP * inverse_shape<T>(ref).transpose();
+}
+
 // Tangent action on nodes 1..D as columns (node 0: minus the sum); ∂²(energy)/∂u² · d.
 template <class T, int D, class M, class S>
 Tensor<T, D> element_tangent_columns(const M& m, const ElementReference<D, S>& ref, const Tensor<T, D>& U,
                                      const Tensor<T, D>& dU) {
-  const auto& Z_inv = inverse_shape<T>(ref);
-  const Tensor<T, D> dP = first_piola_derivative<T, D>(m, deformation_gradient<T, D>(ref, U), Tensor<T, D>(dU * Z_inv));
-  return T(ref.measure) * dP * Z_inv.transpose();
+  return tangent_columns_of_gradient<T, D>(FirstPiolaTangent<T, D, M, D>(m, deformation_gradient<T, D>(ref, U)), ref,
+                                          Tensor<T, D>(dU * inverse_shape<T>(ref)));
 }
 
 }  // namespace snede

@@ -11,12 +11,18 @@
 
 namespace snede {
 
+// K_e applied to the direction whose gradient is dH = dU Z⁻¹, on nodes 1..D as columns.
+template <class T, int D, class S>
+Tensor<T, D> linear_stiffness_columns_of_gradient(const LinearElastic& m, const ElementReference<D, S>& ref,
+                                                  const Tensor<T, D>& dH) {
+  return m.stress_of_gradient<T, D>(dH, T(ref.measure)) * inverse_shape<T>(ref).transpose();
+}
+
 // K_e applied to dU, on nodes 1..D as columns (node 0: minus their sum).
 template <class T, int D, class S>
 Tensor<T, D> linear_stiffness_columns(const LinearElastic& m, const ElementReference<D, S>& ref,
                                       const Tensor<T, D>& dU) {
-  const auto& Z_inv = inverse_shape<T>(ref);
-  return m.stress_of_gradient<T, D>(dU * Z_inv, T(ref.measure)) * Z_inv.transpose();
+  return linear_stiffness_columns_of_gradient<T, D>(m, ref, Tensor<T, D>(dU * inverse_shape<T>(ref)));
 }
 
 template <class T, int D, class S>

@@ -32,14 +32,26 @@ struct NeoHookean {
     const T J = sqrt(C.determinant());
     return T(lame.mu) * identity<T, 3>() + (T(lame.lambda) * (J - T(1)) * J - T(lame.mu)) * inverse<T, 3>(C);
   }
+  // ∂S/∂C : H at one C, with C⁻¹ and the coefficients computed once (an element stiffness
+  // applies it to several H).
   template <class T>
-  Tensor<T, 3> stress_derivative(const Tensor<T, 3>& C, const Tensor<T, 3>& H) const {
+  struct StressTangent {
+    Tensor<T, 3> C_inv;
+    T minus_a, b;  // −(λ (J − 1) J − μ) and λ/2 (2J − 1) J
+    Tensor<T, 3> operator()(const Tensor<T, 3>& H) const {
+      const Tensor<T, 3> C_inv_H_C_inv = C_inv * H * C_inv;
+      return minus_a * C_inv_H_C_inv + b * double_dot<T, 3>(C_inv, H) * C_inv;
+    }
+  };
+  template <class T>
+  StressTangent<T> stress_tangent(const Tensor<T, 3>& C) const {
     using std::sqrt;
     const T J = sqrt(C.determinant());
-    const Tensor<T, 3> C_inv = inverse<T, 3>(C);
-    const Tensor<T, 3> C_inv_H_C_inv = C_inv * H * C_inv;
-    return -(T(lame.lambda) * (J - T(1)) * J - T(lame.mu)) * C_inv_H_C_inv +
-           T(0.5 * lame.lambda) * (T(2) * J - T(1)) * J * double_dot<T, 3>(C_inv, H) * C_inv;
+    return {inverse<T, 3>(C), -(T(lame.lambda) * (J - T(1)) * J - T(lame.mu)), T(0.5 * lame.lambda) * (T(2) * J - T(1)) * J};
+  }
+  template <class T>
+  Tensor<T, 3> stress_derivative(const Tensor<T, 3>& C, const Tensor<T, 3>& H) const {
+    return stress_tangent<T>(C)(H);
   }
   // Plane stress: with C = diag(C₂, c), d = det C₂ and s = √c, S₃₃ = 0 reads
   // (μ + λ d) s² − λ √d s − μ = 0, whose positive root is taken (closed form), divided by μ

@@ -25,9 +25,21 @@ struct StVenantKirchhoff {
   Tensor<T, 3> stress(const Tensor<T, 3>& C) const {
     return T(lame.mu) * (C - identity<T, 3>()) + T(0.5 * lame.lambda) * (C.trace() - T(3)) * identity<T, 3>();
   }
+  // ∂S/∂C : H, the same at every C.
   template <class T>
-  Tensor<T, 3> stress_derivative(const Tensor<T, 3>&, const Tensor<T, 3>& H) const {
-    return T(lame.mu) * H + T(0.5 * lame.lambda) * H.trace() * identity<T, 3>();
+  struct StressTangent {
+    double mu = 0, half_lambda = 0;
+    Tensor<T, 3> operator()(const Tensor<T, 3>& H) const {
+      return T(mu) * H + T(half_lambda) * H.trace() * identity<T, 3>();
+    }
+  };
+  template <class T>
+  StressTangent<T> stress_tangent(const Tensor<T, 3>&) const {
+    return {lame.mu, 0.5 * lame.lambda};
+  }
+  template <class T>
+  Tensor<T, 3> stress_derivative(const Tensor<T, 3>& C, const Tensor<T, 3>& H) const {
+    return stress_tangent<T>(C)(H);
   }
   // Plane stress: S₃₃ = μ (c − 1) + λ/2 (tr C₂ + c − 3) = 0 is linear in c = C₃₃, so
   // c = 1 − λ/2 (tr C₂ − 2) / (μ + λ/2) (closed form).

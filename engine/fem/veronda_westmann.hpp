@@ -46,14 +46,27 @@ struct VerondaWestmann {
     return (T(2 * lame.mu) * exp(T(gamma) * (i1 - T(3))) - T(lame.mu) * i1) * identity<T, 3>() + T(lame.mu) * C +
            T(0.5 * lame.lambda) * (i3 - T(1)) * inverse<T, 3>(C);
   }
+  // ∂S/∂C : H at one C, with C⁻¹, ι₃ and the exponential computed once (an element stiffness
+  // applies it to several H).
+  template <class T>
+  struct StressTangent {
+    Tensor<T, 3> C_inv;
+    T trace_coefficient, i3;  // μ (2γ e^{γ(ι₁−3)} − 1), ι₃
+    double mu = 0, half_lambda = 0;
+    Tensor<T, 3> operator()(const Tensor<T, 3>& H) const {
+      return trace_coefficient * H.trace() * identity<T, 3>() + T(mu) * H +
+             T(half_lambda) * (i3 * double_dot<T, 3>(C_inv, H) * C_inv - (i3 - T(1)) * (C_inv * H * C_inv));
+    }
+  };
+  template <class T>
+  StressTangent<T> stress_tangent(const Tensor<T, 3>& C) const {
+    using std::exp;
+    const T e = exp(T(gamma) * (C.trace() - T(3)));
+    return {inverse<T, 3>(C), T(lame.mu) * (T(2 * gamma) * e - T(1)), C.determinant(), lame.mu, 0.5 * lame.lambda};
+  }
   template <class T>
   Tensor<T, 3> stress_derivative(const Tensor<T, 3>& C, const Tensor<T, 3>& H) const {
-    using std::exp;
-    const T i3 = C.determinant();
-    const Tensor<T, 3> C_inv = inverse<T, 3>(C);
-    const T e = exp(T(gamma) * (C.trace() - T(3)));
-    return T(lame.mu) * (T(2 * gamma) * e - T(1)) * H.trace() * identity<T, 3>() + T(lame.mu) * H +
-           T(0.5 * lame.lambda) * (i3 * double_dot<T, 3>(C_inv, H) * C_inv - (i3 - T(1)) * (C_inv * H * C_inv));
+    return stress_tangent<T>(C)(H);
   }
   // Plane stress: with C = diag(C₂, c), t = tr C₂, d = det C₂,
   // S₃₃(c) = 2μ e^{γ(t + c − 3)} − μ t + λ/2 (d − 1/c), strictly increasing in c, from −∞
