@@ -410,17 +410,15 @@ void smoothed_for_each_patch_stiffness(const ElementStream<D>& stream, const Str
         b[std::lower_bound(nodes.begin(), nodes.end(), vertices[0]) - nodes.begin()] += weight * corner0;
       }
       // The material's tangent A[(r, c), (s, d)] = ∂P_rc/∂F_sd at F̃, D² derivatives once per
-      // patch; then T_b[(r, c), s] = Σ_d A[(r, c), (s, d)] b_b[d] per node and
-      // K[(a, r), (b, s)] = |k| Σ_c b_a[c] T_b[(r, c), s] per pair (not one derivative per column).
+      // patch from one FirstPiolaTangent; then T_b[(r, c), s] = Σ_d A[(r, c), (s, d)] b_b[d] per
+      // node and K[(a, r), (b, s)] = |k| Σ_c b_a[c] T_b[(r, c), s] per pair (not one derivative
+      // per column).
+      const FirstPiolaTangent<double, D, M, D> dP_of(part, F);
       Eigen::Matrix<double, D * D, D * D> A;
       for (int sd = 0; sd < D * D; ++sd) {
         Tensor<double, D> dF = Tensor<double, D>::Zero();
         dF(sd / D, sd % D) = 1;
-        Tensor<double, D> dP;
-        if constexpr (is_linear_elastic<M>)
-          dP = part.template stress_of_gradient<double, D>(dF);
-        else
-          dP = first_piola_derivative<double, D>(part, F, dF);
+        const Tensor<double, D> dP = dP_of(dF);
         for (int rc = 0; rc < D * D; ++rc) A(rc, sd) = dP(rc / D, rc % D);
       }
       const int count = static_cast<int>(nodes.size()), n = count * D;
