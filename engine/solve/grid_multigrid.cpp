@@ -160,6 +160,31 @@ GridMultigrid::GridMultigrid(Model& fine, double grid_width)
   }
   n_nodes_ = n_copies;
   n_unknowns_ = first_column.back();
+  // The same interpolation by vertex blocks (d × d, a copy's columns from the left), for the
+  // Galerkin product; copies without columns (all their vertices fixed) give no block.
+  const int dd = d * d;
+  blocks_.dim = d;
+  blocks_.first_column = first_column;
+  blocks_.start.assign(n + 1, 0);
+  for (std::size_t k = 0; k < n_copies; ++k)
+    if (first_column[k + 1] > first_column[k])
+      for (std::size_t m = start[k]; m < start[k + 1]; ++m) ++blocks_.start[members[m] / slots + 1];
+  std::partial_sum(blocks_.start.begin(), blocks_.start.end(), blocks_.start.begin());
+  blocks_.copy.resize(blocks_.start.back());
+  blocks_.block.assign(blocks_.start.back() * dd, 0.0);
+  std::vector<std::size_t> next_entry(blocks_.start.begin(), blocks_.start.end() - 1);
+  for (std::size_t k = 0; k < n_copies; ++k) {
+    const std::size_t rows = (start[k + 1] - start[k]) * d;
+    const PetscInt columns = first_column[k + 1] - first_column[k];
+    if (columns == 0) continue;
+    for (std::size_t m = start[k]; m < start[k + 1]; ++m) {
+      const std::size_t entry = next_entry[members[m] / slots]++;
+      blocks_.copy[entry] = static_cast<PetscInt>(k);
+      for (int i = 0; i < d; ++i)
+        for (PetscInt p = 0; p < columns; ++p)
+          blocks_.block[entry * dd + i * d + p] = Q[k][static_cast<std::size_t>(p) * rows + (m - start[k]) * d + i];
+    }
+  }
 
   // P in CSR, filled copy by copy: the columns grow with the copy, so each row comes out sorted.
   const auto n_rows = static_cast<PetscInt>(n * d);
@@ -205,6 +230,10 @@ std::vector<std::size_t> GridMultigrid::level_sizes() const { return {n_nodes_, 
 
 std::vector<std::size_t> GridMultigrid::level_unknowns() const {
   return {static_cast<std::size_t>(n_unknowns_), static_cast<std::size_t>(fine_.n_dofs())};
+}
+
+std::unique_ptr<CoarseProduct> GridMultigrid::galerkin_product(Mat finer, PetscInt) const {
+  return block_galerkin_product(finer, blocks_);
 }
 
 void GridMultigrid::configure(PC pc, const SolverOptions& options, const std::vector<double>&) {

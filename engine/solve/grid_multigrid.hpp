@@ -33,10 +33,15 @@ class GridMultigrid final : public GalerkinMultigrid {
   std::vector<std::size_t> level_unknowns() const override;
   void configure(PC pc, const SolverOptions& options, const std::vector<double>& smoother_bounds = {}) override;
 
+ protected:
+  // By vertex blocks (galerkin_product.hpp): the fine matrix is the assembled tangent.
+  std::unique_ptr<CoarseProduct> galerkin_product(Mat finer, PetscInt level) const override;
+
  private:
   std::size_t n_nodes_ = 0;
   PetscInt n_unknowns_ = 0;
   MatHandle interpolation_;
+  BlockInterpolation blocks_;  // the same, vertex by vertex
 };
 
 }  // namespace snede

@@ -87,8 +87,7 @@ void GalerkinMultigrid::configure_levels(PC pc, std::vector<Mat> interpolations,
   SNEDE_PETSC(PCSetType(pc, PCMG));
   SNEDE_PETSC(PCMGSetLevels(pc, n, nullptr));
   SNEDE_PETSC(PCMGSetType(pc, PC_MG_MULTIPLICATIVE));
-  // The products are snede's own (update()), not PCMG's: PETSc's default PtAP algorithm for AIJ
-  // took twice as long as "rap" (P transposed once, then R·(A·P)) on the grid levels.
+  // The products are snede's own (update(), galerkin_product.hpp), not PCMG's.
   SNEDE_PETSC(PCMGSetGalerkin(pc, PC_MG_GALERKIN_NONE));
   for (PetscInt l = 1; l < n; ++l) {
     SNEDE_PETSC(PCMGSetInterpolation(pc, l, interpolations[l - 1]));
@@ -105,33 +104,29 @@ void GalerkinMultigrid::configure_levels(PC pc, std::vector<Mat> interpolations,
   coarse_.clear();
 }
 
+std::unique_ptr<CoarseProduct> GalerkinMultigrid::galerkin_product(Mat finer, PetscInt level) const {
+  return petsc_galerkin_product(finer, interpolations_[level]);
+}
+
 void GalerkinMultigrid::update(Vec, Mat assembled_tangent) {
   if (!pc_) throw std::logic_error("GalerkinMultigrid::update before configure");
   if (!assembled_tangent) throw std::logic_error("Galerkin levels need the assembled tangent");
   if (assembled_tangent == fine_matrix_) {
-    for (MatHandle& product : coarse_) SNEDE_PETSC(MatProductNumeric(product));
+    for (auto& product : coarse_) product->recompute();
     return;
   }
   coarse_.clear();
   Mat finer = assembled_tangent;
   for (auto level = static_cast<PetscInt>(interpolations_.size()) - 1; level >= 0; --level) {
-    MatHandle product;
-    SNEDE_PETSC(MatProductCreate(finer, interpolations_[level], nullptr, product.out()));
-    SNEDE_PETSC(MatProductSetType(product, MATPRODUCT_PtAP));
-    SNEDE_PETSC(MatProductSetAlgorithm(product, MATPRODUCTALGORITHMRAP));
-    SNEDE_PETSC(MatProductSetFill(product, PETSC_DEFAULT));
-    SNEDE_PETSC(MatProductSetFromOptions(product));
-    SNEDE_PETSC(MatProductSymbolic(product));
-    SNEDE_PETSC(MatProductNumeric(product));
-    SNEDE_PETSC(MatSetOption(product, MAT_SYMMETRIC, PETSC_TRUE));
+    std::unique_ptr<CoarseProduct> product = galerkin_product(finer, level);
     KSP solver = nullptr;
     if (level == 0) {
       SNEDE_PETSC(PCMGGetCoarseSolve(pc_, &solver));
     } else {
       SNEDE_PETSC(PCMGGetSmoother(pc_, level, &solver));
     }
-    SNEDE_PETSC(KSPSetOperators(solver, product, product));
-    finer = product;
+    SNEDE_PETSC(KSPSetOperators(solver, product->matrix(), product->matrix()));
+    finer = product->matrix();
     coarse_.push_back(std::move(product));
   }
   fine_matrix_ = assembled_tangent;

@@ -8,10 +8,12 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "core/petsc_handle.hpp"
 #include "core/solver_options.hpp"
+#include "solve/galerkin_product.hpp"
 #include "solve/model.hpp"
 
 namespace snede {
@@ -61,7 +63,7 @@ class GalerkinMultigrid : public Multigrid {
   bool matches_mesh(const Model& fine) const override;
   bool follow_constraints() override { return false; }
   bool needs_assembled_tangent() const override { return true; }
-  // Recomputes R A P level by level from the refilled fine matrix (numeric only while the
+  // Recomputes Pᵀ A P level by level from the refilled fine matrix (numeric only while the
   // matrices are those of the first call: the mesh has not changed).
   void update(Vec u, Mat assembled_tangent) override;
 
@@ -72,6 +74,9 @@ class GalerkinMultigrid : public Multigrid {
   // a changing mesh are rebuilt after every edit, and a cut's slivers change the spectrum), LU
   // on the coarsest level, and coarse operators from update().
   void configure_levels(PC pc, std::vector<Mat> interpolations, const SolverOptions& options);
+  // The Galerkin product of `finer` with the interpolation into it from `level` (0: the
+  // coarsest): PETSc's, unless the levels know their interpolation in vertex blocks.
+  virtual std::unique_ptr<CoarseProduct> galerkin_product(Mat finer, PetscInt level) const;
   Model& fine_;
 
  private:
@@ -80,7 +85,7 @@ class GalerkinMultigrid : public Multigrid {
   PC pc_ = nullptr;                      // the PCMG of the last configure_levels (owned by its KSP)
   std::vector<Mat> interpolations_;      // coarsest first
   Mat fine_matrix_ = nullptr;            // the fine matrix the products were made with
-  std::vector<MatHandle> coarse_;        // R A P per coarse level, finest coarse level first
+  std::vector<std::unique_ptr<CoarseProduct>> coarse_;  // Pᵀ A P per coarse level, finest coarse level first
 };
 
 // Chebyshev/Jacobi on one smoothed level: with `largest_bound` > 0 the bounds are fixed from

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "core/csr_matrix.hpp"
 #include "core/error.hpp"
 #include "core/petsc_util.hpp"
 #include "mesh/traversal.hpp"
@@ -103,33 +104,6 @@ void for_each_projected_element_matrix(const Model& model, std::span<const doubl
         }
     visit(e, vertices, std::span<const double>(projected));
   });
-}
-
-// A SeqAIJ matrix's arrays, owned by the matrix itself (a petsc4py handle may outlive the
-// AssembledTangent that made it: Body.assemble_tangent).
-struct CsrArrays {
-  std::vector<PetscInt> row_start, columns;
-  std::vector<PetscScalar> values;
-};
-
-// An AIJ matrix over `csr` (sorted columns) as it is, which frees it when it is destroyed.
-MatHandle matrix_over(std::unique_ptr<CsrArrays> csr, PetscInt rows) {
-  MatHandle A;
-  SNEDE_PETSC(MatCreateSeqAIJWithArrays(PETSC_COMM_SELF, rows, rows, csr->row_start.data(), csr->columns.data(),
-                                        csr->values.data(), A.out()));
-  PetscContainer owner = nullptr;
-  SNEDE_PETSC(PetscContainerCreate(PETSC_COMM_SELF, &owner));
-  SNEDE_PETSC(PetscContainerSetPointer(owner, csr.get()));
-  SNEDE_PETSC(PetscContainerSetUserDestroy(owner, [](void* arrays) -> PetscErrorCode {
-    delete static_cast<CsrArrays*>(arrays);
-    return 0;
-  }));
-  csr.release();  // the container frees it from now on
-  const PetscErrorCode composed = PetscObjectCompose(reinterpret_cast<PetscObject>(A.get()), "snede_csr_arrays",
-                                                     reinterpret_cast<PetscObject>(owner));
-  PetscContainerDestroy(&owner);  // A holds its own reference
-  SNEDE_PETSC(composed);
-  return A;
 }
 
 // The (I − P) blocks from the P blocks of projection_blocks.
@@ -226,7 +200,7 @@ AssembledTangent::AssembledTangent(const Model& model, MatrixFormat format, Memb
     csr->row_start.back() = static_cast<PetscInt>(at);
     csr->values.assign(at, 0.0);
     row_start_ = csr->row_start;
-    A_ = matrix_over(std::move(csr), rows);
+    A_ = matrix_owning(std::move(csr), rows, rows);
     SNEDE_PETSC(MatSetBlockSize(A_, d));
   }
   SNEDE_PETSC(MatSetOption(A_, MAT_SYMMETRIC, PETSC_TRUE));

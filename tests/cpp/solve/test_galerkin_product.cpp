@@ -1,0 +1,144 @@
+// The Galerkin product by vertex blocks (galerkin_product.hpp) against PETSc's MatPtAP on the
+// same matrices: a random symmetric matrix in vertex blocks over a random vertex graph, and a
+// random block interpolation whose copies have 1 to dim columns (a constrained copy has fewer;
+// half the others' blocks a weight times the identity, as a free vertex's),
+// turned into the scalar AIJ interpolation PETSc multiplies with. Also after new values in A
+// (recompute keeps the structure), in 2D and 3D.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <random>
+#include <set>
+#include <vector>
+
+#include "core/error.hpp"
+#include "solve/galerkin_product.hpp"
+
+using namespace snede;
+
+namespace {
+
+struct Problem {
+  int d;
+  PetscInt n_vertices;
+  std::vector<std::set<PetscInt>> neighbours;  // symmetric, itself included
+  MatHandle A, P;
+  BlockInterpolation blocks;
+};
+
+// A with each vertex's rows over all components of its sorted neighbours (AssembledTangent's
+// layout); symmetric values drawn from `random`.
+void fill_A(Problem& problem, std::mt19937& random) {
+  const int d = problem.d;
+  std::uniform_real_distribution<double> value(-1.0, 1.0);
+  std::vector<PetscInt> row_start{0}, columns;
+  for (PetscInt v = 0; v < problem.n_vertices; ++v)
+    for (int i = 0; i < d; ++i) {
+      for (PetscInt w : problem.neighbours[v])
+        for (int j = 0; j < d; ++j) columns.push_back(w * d + j);
+      row_start.push_back(static_cast<PetscInt>(columns.size()));
+    }
+  const PetscInt rows = problem.n_vertices * d;
+  if (!problem.A) {
+    SNEDE_PETSC(MatCreate(PETSC_COMM_SELF, problem.A.out()));
+    SNEDE_PETSC(MatSetSizes(problem.A, rows, rows, rows, rows));
+    SNEDE_PETSC(MatSetType(problem.A, MATSEQAIJ));
+    SNEDE_PETSC(MatSeqAIJSetPreallocationCSR(problem.A, row_start.data(), columns.data(), nullptr));
+  }
+  for (PetscInt r = 0; r < rows; ++r)
+    for (PetscInt k = row_start[r]; k < row_start[r + 1]; ++k) {
+      const PetscInt c = columns[k];
+      if (c < r) continue;
+      const double x = value(random) + (c == r ? 10.0 : 0.0);
+      SNEDE_PETSC(MatSetValue(problem.A, r, c, x, INSERT_VALUES));
+      SNEDE_PETSC(MatSetValue(problem.A, c, r, x, INSERT_VALUES));
+    }
+  SNEDE_PETSC(MatAssemblyBegin(problem.A, MAT_FINAL_ASSEMBLY));
+  SNEDE_PETSC(MatAssemblyEnd(problem.A, MAT_FINAL_ASSEMBLY));
+}
+
+Problem random_problem(int d, std::mt19937& random) {
+  Problem problem{d, 60, {}, {}, {}, {}};
+  problem.neighbours.resize(problem.n_vertices);
+  std::uniform_int_distribution<PetscInt> vertex(0, problem.n_vertices - 1);
+  for (PetscInt v = 0; v < problem.n_vertices; ++v) {
+    problem.neighbours[v].insert(v);
+    for (int k = 0; k < 4; ++k) {
+      const PetscInt w = vertex(random);
+      problem.neighbours[v].insert(w);
+      problem.neighbours[w].insert(v);
+    }
+  }
+  fill_A(problem, random);
+  // 14 copies with 1..d columns; each vertex in up to 3 of them.
+  const PetscInt copies = 14;
+  std::uniform_int_distribution<int> columns(1, d), count(0, 3);
+  std::uniform_int_distribution<PetscInt> copy(0, copies - 1);
+  std::uniform_real_distribution<double> weight(-1.0, 1.0);
+  std::bernoulli_distribution coin(0.5);
+  BlockInterpolation& b = problem.blocks;
+  b.dim = d;
+  b.first_column.assign(1, 0);
+  for (PetscInt c = 0; c < copies; ++c) b.first_column.push_back(b.first_column.back() + columns(random));
+  b.start.assign(1, 0);
+  for (PetscInt v = 0; v < problem.n_vertices; ++v) {
+    std::set<PetscInt> mine;
+    for (int k = count(random); k > 0; --k) mine.insert(copy(random));
+    for (PetscInt c : mine) {
+      b.copy.push_back(c);
+      // Half the blocks of copies with d columns are a weight times the identity (a free vertex).
+      const bool identity_times = b.columns(c) == d && coin(random);
+      const double s = weight(random);
+      for (int i = 0; i < d; ++i)
+        for (int p = 0; p < d; ++p)
+          b.block.push_back(identity_times ? (i == p ? s : 0.0) : p < b.columns(c) ? weight(random) : 0.0);
+    }
+    b.start.push_back(b.copy.size());
+  }
+  // The same interpolation as a scalar AIJ matrix.
+  const PetscInt rows = problem.n_vertices * d, unknowns = b.first_column.back();
+  SNEDE_PETSC(MatCreateSeqAIJ(PETSC_COMM_SELF, rows, unknowns, 3 * d, nullptr, problem.P.out()));
+  for (PetscInt v = 0; v < problem.n_vertices; ++v)
+    for (std::size_t t = b.start[v]; t < b.start[v + 1]; ++t)
+      for (int i = 0; i < d; ++i)
+        for (PetscInt p = 0; p < b.columns(b.copy[t]); ++p)
+          SNEDE_PETSC(MatSetValue(problem.P, v * d + i, b.first_column[b.copy[t]] + p, b.block[t * d * d + i * d + p],
+                                  INSERT_VALUES));
+  SNEDE_PETSC(MatAssemblyBegin(problem.P, MAT_FINAL_ASSEMBLY));
+  SNEDE_PETSC(MatAssemblyEnd(problem.P, MAT_FINAL_ASSEMBLY));
+  return problem;
+}
+
+// The largest difference between two square matrices' entries, over the largest entry.
+double relative_difference(Mat X, Mat Y) {
+  PetscInt n = 0;
+  SNEDE_PETSC(MatGetSize(X, &n, nullptr));
+  double largest = 0, difference = 0;
+  for (PetscInt r = 0; r < n; ++r)
+    for (PetscInt c = 0; c < n; ++c) {
+      PetscScalar x = 0, y = 0;
+      SNEDE_PETSC(MatGetValues(X, 1, &r, 1, &c, &x));
+      SNEDE_PETSC(MatGetValues(Y, 1, &r, 1, &c, &y));
+      largest = std::max(largest, std::abs(y));
+      difference = std::max(difference, std::abs(x - y));
+    }
+  return difference / largest;
+}
+
+}  // namespace
+
+class BlockGalerkinProduct : public ::testing::TestWithParam<int> {};
+
+TEST_P(BlockGalerkinProduct, EqualsPetscsProductBeforeAndAfterNewValues) {
+  std::mt19937 random(7 + GetParam());
+  Problem problem = random_problem(GetParam(), random);
+  const auto blocks = block_galerkin_product(problem.A, problem.blocks);
+  const auto reference = petsc_galerkin_product(problem.A, problem.P);
+  EXPECT_LT(relative_difference(blocks->matrix(), reference->matrix()), 1e-14);
+  fill_A(problem, random);
+  blocks->recompute();
+  reference->recompute();
+  EXPECT_LT(relative_difference(blocks->matrix(), reference->matrix()), 1e-14);
+}
+
+INSTANTIATE_TEST_SUITE_P(Dimensions, BlockGalerkinProduct, ::testing::Values(2, 3));
