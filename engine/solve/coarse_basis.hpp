@@ -3,10 +3,12 @@
 
 #include <cstdint>
 #include <numeric>
+#include <span>
 #include <utility>
 #include <vector>
 
 #include "mesh/mesh.hpp"
+#include "mesh/traversal.hpp"
 
 namespace snede {
 
@@ -38,9 +40,15 @@ class DisjointSets {
 // column-major) and sets R = Qᵀ block (k × m, row-major).
 std::vector<double> orthonormal_columns(const std::vector<double>& block, std::size_t rows, int m,
                                         std::vector<double>& R);
+// The same Q without R, into `Q` (its storage reused: the grid levels call this per node copy);
+// returns the number of columns kept.
+std::size_t orthonormalise_columns(std::span<const double> block, std::size_t rows, int m, std::vector<double>& Q);
 
 // The mean length of the cells' edges in the reference configuration (an edge shared by
 // several cells counts once per cell); 0 for a mesh without cells.
 double mean_edge_length(const Mesh& mesh);
+// The same from the cells of `stars` (the mesh's cells in the same order), without listing them
+// again.
+double mean_edge_length(const Mesh& mesh, const VertexStars& stars);
 
 }  // namespace snede

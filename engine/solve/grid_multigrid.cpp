@@ -4,11 +4,13 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <numeric>
 #include <span>
 #include <stdexcept>
 #include <string>
 
+#include "core/csr_matrix.hpp"
 #include "core/error.hpp"
 #include "mesh/traversal.hpp"
 #include "solve/coarse_basis.hpp"
@@ -88,28 +90,35 @@ GridMultigrid::GridMultigrid(Model& fine, double grid_width)
         low[k] = std::min(low[k], mesh.point(v)[k]);
         high[k] = std::max(high[k], mesh.point(v)[k]);
       }
-  double width = grid_width * mean_edge_length(mesh);
+  // The stars list every cell once: the mean edge length reads them rather than the mesh again.
+  const VertexStars stars = all_vertex_stars(mesh.connectivity(), mesh.n_points());
+  double width = grid_width * mean_edge_length(mesh, stars);
   for (int k = 0; k < d; ++k) width = std::max(width, (high[k] - low[k]) / 1e6);  // at most 10⁶ nodes a side
   const KuhnGrid grid(d, low, high, width);
   std::vector<GridWeights> weights(n);
+  // The node of each (vertex, slot) pair the vertex uses, -1 for the others.
+  std::vector<std::int64_t> used_node(n * slots, -1);
   for (VertexId v = 0; v < mesh.n_points(); ++v)
-    if (mesh.is_vertex(v)) weights[v] = grid.locate(mesh.point(v));
+    if (mesh.is_vertex(v)) {
+      weights[v] = grid.locate(mesh.point(v));
+      for (int s = 0; s < slots; ++s)
+        if (weights[v].node[s] >= 0 && weights[v].weight[s] > negligible_weight) used_node[v * slots + s] = weights[v].node[s];
+    }
 
   // Virtual nodes: (vertex, slot) pairs on the same grid node are one copy of it when a fine
   // edge joins them, so that each copy spans one connected piece of the node's fine vertices.
   DisjointSets copies(n * slots);
-  auto uses = [&](VertexId v, int s) { return weights[v].node[s] >= 0 && weights[v].weight[s] > negligible_weight; };
   auto join = [&](VertexId i, VertexId j) {
     for (int s = 0; s < slots; ++s) {
-      if (!uses(i, s)) continue;
+      const std::int64_t node = used_node[i * slots + s];
+      if (node < 0) continue;
       for (int t = 0; t < slots; ++t)
-        if (uses(j, t) && weights[i].node[s] == weights[j].node[t])
+        if (used_node[j * slots + t] == node)
           copies.unite(static_cast<std::int32_t>(i * slots + s), static_cast<std::int32_t>(j * slots + t));
     }
   };
   // Each edge once (from its lower end), found in the vertex stars: an edge lies in about five
   // tetrahedra, and this runs after every edit.
-  const VertexStars stars = all_vertex_stars(mesh.connectivity(), mesh.n_points());
   std::vector<VertexId> last_seen_from(n, no_id);
   for (VertexId i = 0; i < mesh.n_points(); ++i)
     for (std::size_t e = stars.start[i]; e < stars.start[i + 1]; ++e)
@@ -121,17 +130,16 @@ GridMultigrid::GridMultigrid(Model& fine, double grid_width)
   // Members of each copy, in vertex order.
   std::vector<std::int32_t> copy_of(n * slots, -1);
   std::vector<std::size_t> count;
-  for (std::size_t v = 0; v < n; ++v)
-    for (int s = 0; s < slots; ++s) {
-      if (!mesh.is_vertex(static_cast<VertexId>(v)) || !uses(static_cast<VertexId>(v), s)) continue;
-      const std::int32_t root = copies.find(static_cast<std::int32_t>(v * slots + s));
-      if (copy_of[root] < 0) {
-        copy_of[root] = static_cast<std::int32_t>(count.size());
-        count.push_back(0);
-      }
-      copy_of[v * slots + s] = copy_of[root];
-      ++count[copy_of[root]];
+  for (std::size_t i = 0; i < n * slots; ++i) {
+    if (used_node[i] < 0) continue;
+    const std::int32_t root = copies.find(static_cast<std::int32_t>(i));
+    if (copy_of[root] < 0) {
+      copy_of[root] = static_cast<std::int32_t>(count.size());
+      count.push_back(0);
     }
+    copy_of[i] = copy_of[root];
+    ++count[copy_of[root]];
+  }
   const std::size_t n_copies = count.size();
   std::vector<std::size_t> start(n_copies + 1, 0);
   for (std::size_t k = 0; k < n_copies; ++k) start[k + 1] = start[k] + count[k];
@@ -140,29 +148,56 @@ GridMultigrid::GridMultigrid(Model& fine, double grid_width)
     if (copy_of[i] >= 0) members[fill[copy_of[i]]++] = i;
 
   // Each copy's columns: weight · P_v for its vertices, orthonormalised (a copy whose vertices
-  // are all fixed has none; sliding ones keep the directions they allow).
-  std::vector<std::vector<double>> Q(n_copies);
+  // are all fixed has none; sliding ones keep the directions they allow). They are kept by
+  // member, d × d row-major with the copy's columns from the left (BlockInterpolation's blocks).
+  const int dd = d * d;
+  std::vector<double> member_block(members.size() * dd, 0.0);
   std::vector<PetscInt> first_column(n_copies + 1, 0);
-  std::vector<double> block, R, P(static_cast<std::size_t>(d) * d);
+  std::vector<double> projections(members.size() * dd), block, Q;
   for (std::size_t k = 0; k < n_copies; ++k) {
+    bool all_free = true;
+    for (std::size_t m = start[k]; m < start[k + 1]; ++m) {
+      const std::span<double> P(projections.data() + m * dd, dd);
+      fine.constraints().projection_block(static_cast<VertexId>(members[m] / slots), P);
+      for (int i = 0; i < d; ++i)
+        for (int j = 0; j < d; ++j) all_free = all_free && P[i * d + j] == (i == j ? 1.0 : 0.0);
+    }
+    // Free vertices only: column j is the weights on the j components, orthogonal to the
+    // others, so Gram-Schmidt only divides it by its norm — the same operations, done here
+    // without the zeros (which leave its sums unchanged).
+    double sum_of_squares = 0;
+    for (std::size_t m = start[k]; all_free && m < start[k + 1]; ++m) {
+      const double w = weights[members[m] / slots].weight[members[m] % slots];
+      sum_of_squares += w * w;
+    }
+    if (all_free && sum_of_squares > 0) {
+      const double norm = std::sqrt(sum_of_squares);
+      for (std::size_t m = start[k]; m < start[k + 1]; ++m) {
+        const double q = weights[members[m] / slots].weight[members[m] % slots] / norm;
+        for (int i = 0; i < d; ++i) member_block[m * dd + i * d + i] = q;
+      }
+      first_column[k + 1] = first_column[k] + d;
+      continue;
+    }
     const std::size_t rows = (start[k + 1] - start[k]) * d;
     block.assign(rows * d, 0.0);
     for (std::size_t m = start[k]; m < start[k + 1]; ++m) {
-      const auto v = static_cast<VertexId>(members[m] / slots);
-      const double w = weights[v].weight[members[m] % slots];
-      fine.constraints().projection_block(v, P);
+      const double w = weights[members[m] / slots].weight[members[m] % slots];
       const std::size_t row = (m - start[k]) * d;
       for (int i = 0; i < d; ++i)
-        for (int j = 0; j < d; ++j) block[static_cast<std::size_t>(j) * rows + row + i] = w * P[i * d + j];
+        for (int j = 0; j < d; ++j) block[static_cast<std::size_t>(j) * rows + row + i] = w * projections[m * dd + i * d + j];
     }
-    Q[k] = orthonormal_columns(block, rows, d, R);
-    first_column[k + 1] = first_column[k] + static_cast<PetscInt>(rows ? Q[k].size() / rows : 0);
+    const std::size_t columns = orthonormalise_columns(block, rows, d, Q);
+    for (std::size_t m = start[k]; m < start[k + 1]; ++m)
+      for (int i = 0; i < d; ++i)
+        for (std::size_t p = 0; p < columns; ++p)
+          member_block[m * dd + i * d + p] = Q[p * rows + (m - start[k]) * d + i];
+    first_column[k + 1] = first_column[k] + static_cast<PetscInt>(columns);
   }
   n_nodes_ = n_copies;
   n_unknowns_ = first_column.back();
-  // The same interpolation by vertex blocks (d × d, a copy's columns from the left), for the
-  // Galerkin product; copies without columns (all their vertices fixed) give no block.
-  const int dd = d * d;
+  // The same interpolation by vertex blocks, each vertex's in copy order, for the Galerkin
+  // product; copies without columns (all their vertices fixed) give no block.
   blocks_.dim = d;
   blocks_.first_column = first_column;
   blocks_.start.assign(n + 1, 0);
@@ -171,59 +206,41 @@ GridMultigrid::GridMultigrid(Model& fine, double grid_width)
       for (std::size_t m = start[k]; m < start[k + 1]; ++m) ++blocks_.start[members[m] / slots + 1];
   std::partial_sum(blocks_.start.begin(), blocks_.start.end(), blocks_.start.begin());
   blocks_.copy.resize(blocks_.start.back());
-  blocks_.block.assign(blocks_.start.back() * dd, 0.0);
+  blocks_.block.resize(blocks_.start.back() * dd);
   std::vector<std::size_t> next_entry(blocks_.start.begin(), blocks_.start.end() - 1);
   for (std::size_t k = 0; k < n_copies; ++k) {
-    const std::size_t rows = (start[k + 1] - start[k]) * d;
-    const PetscInt columns = first_column[k + 1] - first_column[k];
-    if (columns == 0) continue;
+    if (first_column[k + 1] == first_column[k]) continue;
     for (std::size_t m = start[k]; m < start[k + 1]; ++m) {
       const std::size_t entry = next_entry[members[m] / slots]++;
       blocks_.copy[entry] = static_cast<PetscInt>(k);
-      for (int i = 0; i < d; ++i)
-        for (PetscInt p = 0; p < columns; ++p)
-          blocks_.block[entry * dd + i * d + p] = Q[k][static_cast<std::size_t>(p) * rows + (m - start[k]) * d + i];
+      std::copy_n(member_block.begin() + static_cast<std::ptrdiff_t>(m * dd), dd,
+                  blocks_.block.begin() + static_cast<std::ptrdiff_t>(entry * dd));
     }
   }
 
-  // P in CSR, filled copy by copy: the columns grow with the copy, so each row comes out sorted.
+  // P in CSR from the blocks, vertex by vertex: a vertex's copies ascend, so each row comes out
+  // sorted. Without the exact zeros of the copies' columns (a free vertex has one non-zero of
+  // its copy's three columns): they would cost every restriction and interpolation.
   const auto n_rows = static_cast<PetscInt>(n * d);
-  std::vector<PetscInt> row_start(static_cast<std::size_t>(n_rows) + 1, 0);
-  for (std::size_t i = 0; i < n * slots; ++i)
-    if (copy_of[i] >= 0)
-      for (int r = 0; r < d; ++r)
-        row_start[(i / slots) * d + r + 1] += first_column[copy_of[i] + 1] - first_column[copy_of[i]];
-  std::partial_sum(row_start.begin(), row_start.end(), row_start.begin());
-  std::vector<PetscInt> columns(static_cast<std::size_t>(row_start.back()));
-  std::vector<double> values(columns.size());
-  std::vector<PetscInt> next(row_start.begin(), row_start.end() - 1);
-  for (std::size_t k = 0; k < n_copies; ++k) {
-    const std::size_t rows = (start[k + 1] - start[k]) * d;
-    for (std::size_t m = start[k]; m < start[k + 1]; ++m)
-      for (int i = 0; i < d; ++i) {
-        const std::size_t row = (m - start[k]) * d + i;
-        PetscInt& at = next[(members[m] / slots) * d + i];
-        for (PetscInt p = 0; p < first_column[k + 1] - first_column[k]; ++p, ++at) {
-          columns[at] = first_column[k] + p;
-          values[at] = Q[k][static_cast<std::size_t>(p) * rows + row];
+  auto csr = std::make_unique<CsrArrays>();
+  csr->row_start.reserve(static_cast<std::size_t>(n_rows) + 1);
+  csr->row_start.push_back(0);
+  csr->columns.reserve(blocks_.block.size() / d);
+  csr->values.reserve(blocks_.block.size() / d);
+  for (std::size_t v = 0; v < n; ++v)
+    for (int i = 0; i < d; ++i) {
+      for (std::size_t entry = blocks_.start[v]; entry < blocks_.start[v + 1]; ++entry) {
+        const PetscInt k = blocks_.copy[entry];
+        for (PetscInt p = 0; p < blocks_.columns(k); ++p) {
+          const double value = blocks_.block[entry * dd + i * d + p];
+          if (value == 0) continue;
+          csr->columns.push_back(first_column[k] + p);
+          csr->values.push_back(value);
         }
       }
-  }
-  // Without the exact zeros of the copies' columns (a free vertex has one non-zero of its
-  // copy's three columns): they would cost every restriction and interpolation.
-  PetscInt kept = 0;
-  for (PetscInt row = 0, k = 0; row < n_rows; ++row) {
-    for (; k < row_start[row + 1]; ++k)
-      if (values[k] != 0) {
-        columns[kept] = columns[k];
-        values[kept++] = values[k];
-      }
-    row_start[row + 1] = kept;
-  }
-  SNEDE_PETSC(MatCreate(PETSC_COMM_SELF, interpolation_.out()));
-  SNEDE_PETSC(MatSetSizes(interpolation_, n_rows, n_unknowns_, n_rows, n_unknowns_));
-  SNEDE_PETSC(MatSetType(interpolation_, MATSEQAIJ));
-  SNEDE_PETSC(MatSeqAIJSetPreallocationCSR(interpolation_, row_start.data(), columns.data(), values.data()));
+      csr->row_start.push_back(static_cast<PetscInt>(csr->columns.size()));
+    }
+  interpolation_ = matrix_owning(std::move(csr), n_rows, n_unknowns_);
 }
 
 std::vector<std::size_t> GridMultigrid::level_sizes() const { return {n_nodes_, fine_.body().mesh().n_cells()}; }
