@@ -16,6 +16,7 @@
 #include "core/petsc_util.hpp"
 #include "mesh/element_quality.hpp"
 #include "solve/dynamic_relaxation.hpp"
+#include "solve/failed_solve.hpp"
 #include "solve/static_solver.hpp"
 #include "solve/stopping.hpp"
 
@@ -497,7 +498,7 @@ void DistributedStatic::run_petsc(const std::string& method, const std::string& 
     }
   }
   SNEDE_PETSC(SNESSetFromOptions(snes));
-  SNEDE_PETSC(SNESSolve(snes, nullptr, u_));
+  solve_through(ksp, [&] { SNEDE_PETSC(SNESSolve(snes, nullptr, u_)); });
   SNESConvergedReason reason = SNES_CONVERGED_ITERATING;
   SNEDE_PETSC(SNESGetConvergedReason(snes, &reason));
   PetscInt iterations = 0, linear = 0;

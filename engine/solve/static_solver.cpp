@@ -15,6 +15,7 @@
 #include "core/petsc_util.hpp"
 #include "solve/aggregation_multigrid.hpp"
 #include "solve/bisection_multigrid.hpp"
+#include "solve/failed_solve.hpp"
 #include "solve/grid_multigrid.hpp"
 #include "solve/tangent_assembly.hpp"
 
@@ -494,7 +495,7 @@ SolveResult StaticSolver::solve_linear() {
   // Linear CG solves linear elasticity, whose tangent does not depend on the state: what was
   // filled for an earlier solve of the same system is the same matrix.
   if (!filled_for_current_system()) fill_preconditioner(u);
-  SNEDE_PETSC(KSPSolve(ksp_, rhs, step));
+  solve_through(ksp_, [&] { SNEDE_PETSC(KSPSolve(ksp_, rhs, step)); });
   {
     // Onto the allowed motions (6.7), as Newton's steps (descent_direction_callback): CG's
     // iterate under a preconditioner that is not projected leaves sliding vertices' lines.
@@ -538,7 +539,7 @@ SolveResult StaticSolver::solve_nonlinear() {
     if (!reuse) preconditioner_filled_ = false;
   }
   auto run = [&] {
-    SNEDE_PETSC(SNESSolve(snes_, nullptr, u));
+    solve_through(ksp(), [&] { SNEDE_PETSC(SNESSolve(snes_, nullptr, u)); });
     PetscInt its = 0, lits = 0;
     SNEDE_PETSC(SNESGetConvergedReason(snes_, &reason));
     SNEDE_PETSC(SNESGetIterationNumber(snes_, &its));
