@@ -95,11 +95,11 @@ StaticSolver::StaticSolver(Model& model, StaticOptions options, const Refinement
   if (options_.method == StaticMethod::nonlinear_cg && pc_type_ != PCNONE)
     throw std::invalid_argument("a preconditioner ('" + pc_type_ + "') applies to the CG of methods 'cg' and 'newton'; "
                                 "nonlinear CG ('ncg') takes none");
-  // Jacobi reads the shell's diagonal (MatGetDiagonal), mg builds its own levels (and needs
-  // entries only for Galerkin levels); every other PC needs entries.
   if (pc_type_ != PCMG && option_database_.string_option(options_.options_prefix + "mg_refresh_ratio"))
     throw std::invalid_argument("-" + options_.options_prefix + "mg_refresh_ratio applies to the preconditioner 'mg'; "
                                 "this solver's is '" + pc_type_ + "'");
+  // Jacobi reads the shell's diagonal (MatGetDiagonal), mg builds its own levels (and needs
+  // entries only for Galerkin levels); every other PC needs entries.
   pc_needs_matrix_ = pc_type_ != PCNONE && pc_type_ != PCJACOBI && pc_type_ != PCMG;
   needs_matrix_ = pc_needs_matrix_;
   register_line_searches();

@@ -99,6 +99,13 @@ class StaticSolver {
   // Newton's Jacobian callback: the assembled tangent (or the multigrid levels) are refilled
   // unless the SNES lags the preconditioner at this iteration (-<prefix>snes_lag_preconditioner).
   void refill_preconditioner(SNES snes, Vec x);
+  // Whether the filled preconditioner is that of the current system (scale and projections).
+  bool filled_for_current_system() const;
+  // The assembled tangent and the multigrid levels at the state u (logged as SnedeTangentAssembly
+  // and SnedeLevelsUpdate), and the fill remembered for reuse.
+  void fill_preconditioner(Vec u);
+  // A number from the option database (-<prefix>name), or `fallback`.
+  double number_option(const std::string& name, double fallback) const;
   double current_tolerance() const;
   SolveResult solve_linear();
   SolveResult solve_nonlinear();
@@ -135,13 +142,6 @@ class StaticSolver {
   std::uint64_t filled_for_constraints_ = 0;  // ... and the constraints' projection fingerprint
   bool filled_in_this_solve_ = false;
   std::size_t preconditioner_fills_ = 0;
-  // Whether the filled preconditioner is that of the current system (scale and projections).
-  bool filled_for_current_system() const;
-  // The assembled tangent and the multigrid levels at the state u (logged as SnedeTangentAssembly
-  // and SnedeLevelsUpdate), and the fill remembered for reuse.
-  void fill_preconditioner(Vec u);
-  // A number from the option database (-<prefix>name), or `fallback`.
-  double number_option(const std::string& name, double fallback) const;
   bool keeps_levels_through_solve_ = false;  // Galerkin levels kept through a solve (solve_nonlinear)
   PreconditionerReuse reuse_;                // ... and through the next ones while they serve
   std::uint64_t generation_ = 0;
