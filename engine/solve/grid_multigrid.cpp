@@ -72,11 +72,15 @@ class KuhnGrid {
 
 }  // namespace
 
+void GridMultigrid::require_valid_width(double grid_width) {
+  if (!(grid_width > 0) || !std::isfinite(grid_width))
+    throw std::invalid_argument("mg_grid_width must be positive (mean edge lengths), got " + std::to_string(grid_width));
+}
+
 GridMultigrid::GridMultigrid(Model& fine, double grid_width)
     : GalerkinMultigrid(fine) {
   const Mesh& mesh = fine.body().mesh();
-  if (!(grid_width > 0) || !std::isfinite(grid_width))
-    throw std::invalid_argument("mg_grid_width must be positive (mean edge lengths), got " + std::to_string(grid_width));
+  require_valid_width(grid_width);
   // A fine vertex uses the d + 1 nodes of its grid simplex (its slots); a cell has cell_dim + 1
   // corners (3 on a membrane in 3D).
   const int d = mesh.dim(), slots = d + 1, corners = mesh.cell_dim() + 1;

@@ -25,6 +25,8 @@ class GridMultigrid final : public GalerkinMultigrid {
   explicit GridMultigrid(Model& fine, double grid_width = default_grid_width);
   // Measured 2, 3 and 4 in benchmarks/interactive_cut.py; 3 was fastest on the block and the liver.
   static constexpr double default_grid_width = 3.0;
+  // Throws std::invalid_argument naming mg_grid_width unless `grid_width` is positive and finite.
+  static void require_valid_width(double grid_width);
 
   const char* source() const override { return "grid"; }
   int n_levels() const override { return 2; }

@@ -340,11 +340,17 @@ void StaticSolver::build_multigrid() {
     multigrid_ = std::make_unique<AggregationMultigrid>(
         model_, max_levels, smoothing == "true",
         number_option("mg_aggregate_width", AggregationMultigrid::default_aggregate_width));
-  // An option for another kind of levels than those made is a mistake the user should hear of.
+  // An option for another kind of levels than those made is a mistake the user should hear of,
+  // except the grid's width on bisection levels chosen by "auto": grid levels take over after
+  // the first cut or flip (checked now all the same).
   const std::string source = multigrid_->source();
+  const bool grid_may_follow = source == "bisection" && coarsening == "auto";
+  if (grid_may_follow)
+    GridMultigrid::require_valid_width(number_option("mg_grid_width", GridMultigrid::default_grid_width));
   for (const auto& [name, applies_to] : {std::pair<std::string, std::string>{"mg_aggregate_width", "aggregation"},
                                          {"mg_aggregation_smoothing", "aggregation"}, {"mg_grid_width", "grid"}})
-    if (source != applies_to && option_database_.string_option(options_.options_prefix + name))
+    if (source != applies_to && !(applies_to == "grid" && grid_may_follow) &&
+        option_database_.string_option(options_.options_prefix + name))
       throw std::invalid_argument(prefix + name + " applies to " + applies_to + " levels; these are " + source +
                                   " levels (-" + options_.options_prefix + "mg_coarsening chooses)");
   needs_matrix_ = pc_needs_matrix_ || multigrid_->needs_assembled_tangent();

@@ -238,6 +238,32 @@ def test_mg_continues_through_a_cut_of_a_bisected_mesh():
     assert result.iterations < plain.iterations / 3
 
 
+def test_the_grid_width_set_on_a_bisected_mesh_applies_to_the_grid_levels_after_a_cut():
+    """With "auto", grid levels take over from bisection levels after the first cut: their width
+    may be set from the start (and is checked at once); a narrower grid has more coarse unknowns."""
+    coarse_unknowns = {}
+    for width in (2.0, 4.0):
+        mesh = snede.meshing.box((0.4, 0.1, 0.1), (4, 1, 1))
+        mesh.refine_uniform(6)
+        body = held_body(mesh)
+        solver, first, _ = solve(body, preconditioner="mg", petsc_options={"mg_grid_width": width})
+        assert first.converged and solver.multigrid_source == "bisection"
+        body.displacement = np.zeros_like(body.displacement)
+        snede.TetrahedralCutter(body).cut_triangle([[0.2, -0.5, 0.6], [0.2, 0.6, 0.6], [0.2, 0.05, 0.05]])
+        body.displacement = np.zeros_like(body.displacement)
+        assert solver.solve().converged
+        assert solver.multigrid_source == "grid"
+        coarse_unknowns[width] = solver.multigrid_unknowns[0]
+    assert coarse_unknowns[2.0] > 2 * coarse_unknowns[4.0], coarse_unknowns
+    mesh = snede.meshing.box((0.4, 0.1, 0.1), (4, 1, 1))
+    mesh.refine_uniform(6)
+    with pytest.raises(ValueError, match="mg_grid_width must be positive"):
+        snede.StaticSolver(held_body(mesh), "cg", preconditioner="mg", petsc_options={"mg_grid_width": -1})
+    with pytest.raises(ValueError, match="mg_grid_width applies to grid levels; these are bisection"):
+        snede.StaticSolver(held_body(mesh), "cg", preconditioner="mg",
+                           petsc_options={"mg_coarsening": "bisection", "mg_grid_width": 2})
+
+
 @pytest.mark.parametrize("options", [{"mg_coarsening": "aggregation", "mg_aggregation_smoothing": "true"},
                                      {"mg_coarsening": "aggregation", "mg_aggregate_width": 4.0},
                                      {"mg_grid_width": 2.0}])
