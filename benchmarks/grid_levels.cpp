@@ -9,14 +9,12 @@
 // construction (best of several) and the share of the mesh passes the constructor starts with
 // that can be timed alone (mean edge length, vertex stars).
 #include <algorithm>
-#include <array>
-#include <chrono>
 #include <cstdio>
 #include <cstdlib>
-#include <set>
 #include <string>
 #include <vector>
 
+#include "best_seconds.hpp"
 #include "core/petsc_session.hpp"
 #include "fem/elastic_body.hpp"
 #include "mesh/traversal.hpp"
@@ -30,50 +28,15 @@
 namespace {
 
 using namespace snede;
+using benchmarks::best_seconds;
 
 constexpr double side = 0.1;
 
-// Seconds of the fastest of `repeats` calls (after one warm-up call).
-template <class Work>
-double best_seconds(int repeats, Work&& work) {
-  work();
-  double best = 1e300;
-  for (int r = 0; r < repeats; ++r) {
-    const auto start = std::chrono::steady_clock::now();
-    work();
-    best = std::min(best, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
-  }
-  return best;
-}
-
 Mesh cut_block(int levels) {
-  Mesh unit = testing::kuhn_cube(16);
-  std::vector<double> points = unit.points();
-  for (double& x : points) x *= side;
-  std::vector<std::int64_t> cells;
-  for (VertexId v : unit.cells()) cells.push_back(v);
-  Mesh mesh(3, std::move(points), cells);
+  Mesh mesh = testing::kuhn_cube(16, side);
   if (levels > 0) Bisection(mesh).refine_uniform(levels);
-  // The faces on x = side/2 with y below side/2, each once.
-  const std::vector<VertexId> corners = mesh.cells();
-  std::set<std::array<VertexId, 3>> faces;
-  for (std::size_t c = 0; c < corners.size(); c += 4)
-    for (int skip = 0; skip < 4; ++skip) {
-      std::array<VertexId, 3> face{};
-      int k = 0;
-      bool on_cut = true;
-      for (int a = 0; a < 4; ++a) {
-        if (a == skip) continue;
-        const auto x = mesh.point(corners[c + a]);
-        on_cut = on_cut && x[0] == side / 2 && x[1] <= side / 2;
-        face[k++] = corners[c + a];
-      }
-      std::sort(face.begin(), face.end());
-      if (on_cut) faces.insert(face);
-    }
-  std::vector<VertexId> face_vertices;
-  for (const auto& face : faces) face_vertices.insert(face_vertices.end(), face.begin(), face.end());
-  dissect(mesh, face_vertices);
+  // Half the mid-plane: the faces on x = side/2 with y below side/2.
+  dissect(mesh, testing::faces_on_plane_x(mesh, side / 2, side / 2));
   return mesh;
 }
 

@@ -14,7 +14,6 @@
 #include <petscmat.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <random>
@@ -22,6 +21,7 @@
 #include <string>
 #include <vector>
 
+#include "best_seconds.hpp"
 #include "core/error.hpp"
 #include "core/petsc_handle.hpp"
 #include "core/petsc_session.hpp"
@@ -31,28 +31,7 @@
 namespace {
 
 using namespace snede;
-
-// Seconds of the fastest of `repeats` calls (after one warm-up call).
-template <class Work>
-double best_seconds(int repeats, Work&& work) {
-  work();
-  double best = 1e300;
-  for (int r = 0; r < repeats; ++r) {
-    const auto start = std::chrono::steady_clock::now();
-    work();
-    best = std::min(best, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
-  }
-  return best;
-}
-
-Mesh box_of_side(double side, int n) {
-  Mesh unit = testing::kuhn_cube(n);
-  std::vector<double> points = unit.points();
-  for (double& x : points) x *= side;
-  std::vector<std::int64_t> cells;
-  for (VertexId v : unit.cells()) cells.push_back(v);
-  return Mesh(3, std::move(points), cells);
-}
+using benchmarks::best_seconds;
 
 // The BAIJ(3) matrix Σ_e K_e, preallocated exactly from the vertex graph.
 Mat assembled_baij(const ElasticBody& body, std::span<const double> u) {
@@ -95,7 +74,7 @@ struct LinearAgainstBaij {
 };
 
 LinearAgainstBaij run_box(int n, Formulation formulation) {
-  Mesh mesh = box_of_side(0.1, n);
+  Mesh mesh = testing::kuhn_cube(n, 0.1);
   const double n_cells = static_cast<double>(mesh.n_cells());
   std::mt19937 rng(0);
   std::normal_distribution<double> normal;

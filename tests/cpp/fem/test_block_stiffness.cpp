@@ -18,6 +18,7 @@
 #include <set>
 
 #include "fem/elastic_body.hpp"
+#include "fem/material_fixtures.hpp"
 #include "topology/edit_checks.hpp"
 #include "topology/refinement_checks.hpp"
 
@@ -27,14 +28,6 @@ namespace {
 using namespace snede::testing;
 
 constexpr double tolerance = 1e-13;
-
-std::vector<Material> all_materials() {
-  return {LinearElastic(3e3, 0.3), StVenantKirchhoff(3e3, 0.3), NeoHookean(3e3, 0.45), VerondaWestmann(3e3, 0.3, 2.0)};
-}
-
-const char* name_of(const Material& material) {
-  return std::visit([](const auto& m) { return std::decay_t<decltype(m)>::name; }, material);
-}
 
 // κ₂(F)² of element e at u, F from the mesh's points.
 double conditioning(const Mesh& mesh, ElementId e, std::span<const double> u) {

@@ -32,6 +32,7 @@
 #include <set>
 
 #include "fem/elastic_body.hpp"
+#include "fem/material_fixtures.hpp"
 #include "topology/edit_checks.hpp"
 #include "topology/random_editor.hpp"
 
@@ -41,14 +42,6 @@ namespace {
 using namespace snede::testing;
 
 constexpr double tolerance = 1e-14;
-
-std::vector<Material> all_materials() {
-  return {LinearElastic(3e3, 0.3), StVenantKirchhoff(3e3, 0.3), NeoHookean(3e3, 0.45), VerondaWestmann(3e3, 0.3, 2.0)};
-}
-
-const char* name_of(const Material& material) {
-  return std::visit([](const auto& m) { return std::decay_t<decltype(m)>::name; }, material);
-}
 
 // Everything an element-by-element loop gives, with the sums of absolute contributions that
 // scale its round-off.

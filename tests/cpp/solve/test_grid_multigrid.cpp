@@ -20,35 +20,14 @@ using namespace snede;
 
 namespace {
 
-// The faces of the unit cube's mesh on x = 1/2 with y at most `y_end` (1: the whole plane).
-std::vector<VertexId> mid_plane_faces(const Mesh& mesh, double y_end) {
-  const std::vector<VertexId> corners = mesh.cells();
-  std::set<std::array<VertexId, 3>> faces;
-  for (std::size_t c = 0; c < corners.size(); c += 4)
-    for (int skip = 0; skip < 4; ++skip) {
-      std::array<VertexId, 3> face{};
-      int k = 0;
-      bool on_cut = true;
-      for (int a = 0; a < 4; ++a) {
-        if (a == skip) continue;
-        on_cut = on_cut && mesh.point(corners[c + a])[0] == 0.5 && mesh.point(corners[c + a])[1] <= y_end;
-        face[k++] = corners[c + a];
-      }
-      std::sort(face.begin(), face.end());
-      if (on_cut) faces.insert(face);
-    }
-  std::vector<VertexId> flat;
-  for (const auto& face : faces) flat.insert(flat.end(), face.begin(), face.end());
-  return flat;
-}
-
 Mesh bisected(Mesh mesh) {
   Bisection(mesh).refine_uniform(1);
   return mesh;
 }
 
 Mesh cut(Mesh mesh, double y_end) {
-  dissect(mesh, mid_plane_faces(mesh, y_end));
+  // The faces on x = 1/2 with y at most `y_end` (1: the whole plane).
+  dissect(mesh, snede::testing::faces_on_plane_x(mesh, 0.5, y_end));
   return mesh;
 }
 

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <map>
 #include <numeric>
@@ -33,13 +34,37 @@ inline Mesh right_triangle_square(int n) {
   return mesh_of(2, points, grid_triangles(n, n));
 }
 
-// The unit cube as n³ Kuhn-split cubes (Figure 6.13).
-inline Mesh kuhn_cube(int n) {
+// The cube [0, side]³ as n³ Kuhn-split cubes (Figure 6.13).
+inline Mesh kuhn_cube(int n, double side = 1.0) {
   std::vector<double> points;
   for (int i = 0; i <= n; ++i)
     for (int j = 0; j <= n; ++j)
-      for (int k = 0; k <= n; ++k) points.insert(points.end(), {double(i) / n, double(j) / n, double(k) / n});
+      for (int k = 0; k <= n; ++k)
+        points.insert(points.end(), {double(i) / n * side, double(j) / n * side, double(k) / n * side});
   return mesh_of(3, points, kuhn_box(n));
+}
+
+// The faces of a tetrahedral mesh on the plane x = `x` whose corners all have y ≤ `y_end`,
+// each once, as vertex triples one after another (what dissect takes).
+inline std::vector<VertexId> faces_on_plane_x(const Mesh& mesh, double x, double y_end) {
+  const std::vector<VertexId> corners = mesh.cells();
+  std::set<std::array<VertexId, 3>> faces;
+  for (std::size_t c = 0; c < corners.size(); c += 4)
+    for (int skip = 0; skip < 4; ++skip) {
+      std::array<VertexId, 3> face{};
+      int k = 0;
+      bool on_plane = true;
+      for (int a = 0; a < 4; ++a) {
+        if (a == skip) continue;
+        on_plane = on_plane && mesh.point(corners[c + a])[0] == x && mesh.point(corners[c + a])[1] <= y_end;
+        face[k++] = corners[c + a];
+      }
+      std::sort(face.begin(), face.end());
+      if (on_plane) faces.insert(face);
+    }
+  std::vector<VertexId> flat;
+  for (const auto& face : faces) flat.insert(flat.end(), face.begin(), face.end());
+  return flat;
 }
 
 // The same cube with its vertex ids shuffled and interior vertices moved by up to `jitter`
