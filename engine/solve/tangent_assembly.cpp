@@ -10,7 +10,6 @@
 #include <string>
 #include <vector>
 
-#include "core/csr_matrix.hpp"
 #include "core/error.hpp"
 #include "core/petsc_util.hpp"
 #include "mesh/traversal.hpp"
@@ -199,7 +198,7 @@ AssembledTangent::AssembledTangent(const Model& model, MatrixFormat format, Memb
       }
     csr->row_start.back() = static_cast<PetscInt>(at);
     csr->values.assign(at, 0.0);
-    row_start_ = csr->row_start;
+    csr_ = csr.get();  // owned by A_ from the next line on, as long as A_ lives
     A_ = matrix_owning(std::move(csr), rows, rows);
     SNEDE_PETSC(MatSetBlockSize(A_, d));
   }
@@ -241,7 +240,7 @@ void AssembledTangent::assemble(const Model& model, Vec u) {
   if (format_ == MatrixFormat::aij) {
     PetscScalar* values = nullptr;
     SNEDE_PETSC(MatSeqAIJGetArray(A_, &values));
-    std::fill(values, values + row_start_.back(), 0.0);
+    std::fill(values, values + csr_->row_start.back(), 0.0);
     std::vector<std::int32_t> patch_ranks;
     for_each_projected_element_matrix(model, x.span(), P, [&](ElementId e, std::span<const VertexId> vertices,
                                                               std::span<const double> element_matrix) {
@@ -251,7 +250,7 @@ void AssembledTangent::assemble(const Model& model, Vec u) {
                                            : block_rank_.data() + static_cast<std::size_t>(e) * corners * corners;
       for (int a = 0; a < corners; ++a)
         for (int i = 0; i < d; ++i) {
-          PetscScalar* row = values + row_start_[static_cast<std::size_t>(vertices[a]) * d + i];
+          PetscScalar* row = values + csr_->row_start[static_cast<std::size_t>(vertices[a]) * d + i];
           const double* K_row = K.data() + static_cast<std::size_t>(a * d + i) * n;
           for (int b = 0; b < corners; ++b)
             for (int j = 0; j < d; ++j) row[d * ranks[a * corners + b] + j] += K_row[b * d + j];
@@ -261,7 +260,7 @@ void AssembledTangent::assemble(const Model& model, Vec u) {
     for (std::size_t v = 0; v < self_rank_.size(); ++v)
       for (int i = 0; i < d; ++i)
         for (int j = 0; j < d; ++j)
-          values[row_start_[v * d + i] + d * self_rank_[v] + j] += complement[(v * d + i) * d + j];
+          values[csr_->row_start[v * d + i] + d * self_rank_[v] + j] += complement[(v * d + i) * d + j];
     SNEDE_PETSC(MatSeqAIJRestoreArray(A_, &values));
   } else {
     SNEDE_PETSC(MatZeroEntries(A_));

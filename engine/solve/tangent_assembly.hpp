@@ -11,6 +11,7 @@
 #include <span>
 #include <vector>
 
+#include "core/csr_matrix.hpp"
 #include "core/petsc_handle.hpp"
 #include "solve/model.hpp"
 
@@ -42,7 +43,7 @@ class AssembledTangent {
   MembraneTangent membranes_;
   std::uint64_t revision_;
   MatHandle A_;
-  std::vector<PetscInt> row_start_;       // AIJ: offset of each scalar row's first value
+  const CsrArrays* csr_ = nullptr;        // AIJ: A_'s own arrays (row starts: each scalar row's first value)
   std::vector<std::int32_t> block_rank_;  // per element id and block (a, b): b's place among
                                           // a's sorted neighbours
   std::vector<std::int32_t> self_rank_;   // per vertex: its own place among its neighbours
