@@ -7,6 +7,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "core/log_event.hpp"
 #include "core/petsc_util.hpp"
 #include "topology/refine_around.hpp"
 #include "topology/refine_near_segment.hpp"
@@ -61,15 +62,10 @@ NeedleInsertion::NeedleInsertion(Model& model, Bisection* bisection, const Point
       throw std::invalid_argument("h_ref must be positive and finite, got " + std::to_string(*options_.h_ref));
     if (!bisection_) throw std::invalid_argument("h_ref needs the mesh's bisection");
   }
-  // The needle's line from the entry point must meet the body.
-  const Mesh& mesh = model_.body().mesh();
-  const std::vector<double> u = vec_values(model_.displacement());
-  double reach = 0;
-  for (VertexId v = 0; v < mesh.n_points(); ++v)
-    if (mesh.is_vertex(v)) reach = std::max(reach, distance(deformed_point(mesh, u, v), entry_));
-  if (shaft_crossings(mesh, u, entry_, point_at(2 * reach)).empty() && !reference_position(mesh, u, entry_))
+  if (!first_contact())
     throw std::invalid_argument("the needle from entry " + point_text(entry_, dim_) + " along " +
                                 point_text(direction_, dim_) + " never meets the body");
+  const Mesh& mesh = model_.body().mesh();
   // The bisection's hierarchy serves the "mg" preconditioner (-needle_pc_type mg).
   solver_ = std::make_unique<StaticSolver>(model_, std::move(solver_options),
                                            bisection_ ? &bisection_->hierarchy() : nullptr);
@@ -109,6 +105,25 @@ void NeedleInsertion::record_rate(double distance) {
 }
 
 Point NeedleInsertion::point_at(double s) const { return plus_scaled(entry_, s, direction_); }
+
+std::optional<double> NeedleInsertion::first_contact() const {
+  const Mesh& mesh = model_.body().mesh();
+  const std::vector<double> u = vec_values(model_.displacement());
+  if (reference_position(mesh, u, entry_)) return 0.0;
+  double reach = 0;
+  for (VertexId v = 0; v < mesh.n_points(); ++v)
+    if (mesh.is_vertex(v)) reach = std::max(reach, distance(deformed_point(mesh, u, v), entry_));
+  std::optional<double> first;
+  for (const ShaftCrossing& c : shaft_crossings(mesh, u, entry_, point_at(2 * reach)))
+    if (c.on_boundary && (!first || c.s < *first)) first = c.s;
+  return first;
+}
+
+double NeedleInsertion::surface_depth() const {
+  const std::optional<double> s = first_contact();
+  if (!s) throw std::invalid_argument("the needle's line no longer meets the body");
+  return *s;
+}
 
 double NeedleInsertion::along(const Point& x) const { return dot(minus(x, entry_), direction_); }
 
@@ -191,6 +206,8 @@ NeedleStepReport NeedleInsertion::settle() {
 
 void NeedleInsertion::refine_at_tip() {
   if (!options_.h_ref || depth_ <= 0) return;
+  static const PetscLogEvent event = log_event("SnedeNeedleRefine");
+  const ScopedEvent timed(event);
   const std::vector<double> u = vec_values(model_.displacement());
   // Refinement works in the reference configuration: around the material point under the
   // deformed tip, and in 3D along the shaft's image since the last update, within r of it.
@@ -214,6 +231,8 @@ void NeedleInsertion::add_node(NeedleNode node) {
 
 int NeedleInsertion::intercept_nodes() {
   if (depth_ <= 0) return 0;
+  static const PetscLogEvent event = log_event("SnedeNeedleIntercept");
+  const ScopedEvent timed(event);
   const std::vector<double> u = vec_values(model_.displacement());
   const std::vector<ShaftCrossing> crossings = shaft_crossings(model_.body().mesh(), u, entry_, tip());
   double body_entry = depth_;
@@ -393,6 +412,8 @@ void NeedleInsertion::apply_friction() {
 }
 
 int NeedleInsertion::rearrange(NeedleStepReport& report) {
+  static const PetscLogEvent event = log_event("SnedeNeedleRearrange");
+  const ScopedEvent timed(event);
   const int released = update_thresholds();
   report.released += released;
   const std::vector<double> u = vec_values(model_.displacement());

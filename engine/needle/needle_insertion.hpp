@@ -106,6 +106,9 @@ class NeedleInsertion : public ConnectivityWatcher {
   Point direction() const { return direction_; }
   double depth() const { return depth_; }
   Point tip() const { return point_at(depth_); }
+  // How far from the entry point the shaft's line first meets the deformed body: 0 when the
+  // entry point is inside it. Throws std::invalid_argument if it no longer meets the body.
+  double surface_depth() const;
   // Force the needle exerts on the body at each needle node: support reaction plus friction,
   // (n_needle_nodes, dim), in the order of needle_nodes().
   std::vector<double> needle_forces();
@@ -118,6 +121,9 @@ class NeedleInsertion : public ConnectivityWatcher {
 
  private:
   Point point_at(double s) const;       // the point s along the axis from the entry point
+  // Where the line from the entry point first meets the deformed body (0 from inside), along
+  // it; nothing if it misses. O(n): scans the mesh.
+  std::optional<double> first_contact() const;
   double along(const Point& x) const;   // position along the shaft from the entry point
   double across(const Point& x) const;  // offset from the shaft (signed in 2D)
   // Component i of vertex v's entry in a nodal array (n_points, dim).

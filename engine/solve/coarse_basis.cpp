@@ -1,7 +1,10 @@
 #include "solve/coarse_basis.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+
+#include "mesh/element_quality.hpp"
 
 namespace snede {
 namespace {
@@ -85,8 +88,18 @@ double mean_edge_length(const Mesh& mesh) {
                              [&](std::size_t c) { return connectivity.element(cells[c]).simplex.oriented_vertices(); });
 }
 
-double mean_edge_length(const Mesh& mesh, const VertexStars& stars) {
-  return mean_edge_length_of(mesh, stars.vertices.size(), [&](std::size_t c) -> const auto& { return stars.vertices[c]; });
+double vertex_spacing(const Mesh& mesh, const VertexStars& stars) {
+  const int cell_dim = mesh.cell_dim(), d = mesh.dim(), corners = cell_dim + 1;
+  double measure = 0;
+  std::array<double, (max_dimension + 1) * 3> coordinates{};
+  for (const auto& vertices : stars.vertices) {
+    for (int a = 0; a < corners; ++a)
+      for (int k = 0; k < d; ++k) coordinates[a * d + k] = mesh.point(vertices[a])[k];
+    measure += std::abs(cell_measure(cell_dim, d, std::span<const double>(coordinates.data(), static_cast<std::size_t>(corners * d))));
+  }
+  std::size_t n_vertices = 0;
+  for (std::size_t v = 0; v + 1 < stars.start.size(); ++v) n_vertices += stars.start[v + 1] > stars.start[v];
+  return n_vertices ? std::pow(measure / static_cast<double>(n_vertices), 1.0 / cell_dim) : 0.0;
 }
 
 }  // namespace snede

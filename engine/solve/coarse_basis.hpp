@@ -47,8 +47,12 @@ std::size_t orthonormalise_columns(std::span<const double> block, std::size_t ro
 // The mean length of the cells' edges in the reference configuration (an edge shared by
 // several cells counts once per cell); 0 for a mesh without cells.
 double mean_edge_length(const Mesh& mesh);
-// The same from the cells of `stars` (the mesh's cells in the same order), without listing them
-// again.
-double mean_edge_length(const Mesh& mesh, const VertexStars& stars);
+
+// The mesh's vertex spacing, (measure of its cells / number of their vertices)^(1 / cell_dim)
+// in the reference configuration, from the cells of `stars` (the mesh's cells): the edge of a cube (square) per vertex. On a graded mesh
+// (refined along a needle's shaft) it follows where the volume is, while the mean edge length
+// follows where the edges are; a coarse grid sized by it has about as many nodes per fine
+// vertex on any mesh. 0 for a mesh without cells.
+double vertex_spacing(const Mesh& mesh, const VertexStars& stars);
 
 }  // namespace snede

@@ -74,7 +74,7 @@ class KuhnGrid {
 
 void GridMultigrid::require_valid_width(double grid_width) {
   if (!(grid_width > 0) || !std::isfinite(grid_width))
-    throw std::invalid_argument("mg_grid_width must be positive (mean edge lengths), got " + std::to_string(grid_width));
+    throw std::invalid_argument("mg_grid_width must be positive (vertex spacings), got " + std::to_string(grid_width));
 }
 
 GridMultigrid::GridMultigrid(Model& fine, double grid_width)
@@ -94,9 +94,9 @@ GridMultigrid::GridMultigrid(Model& fine, double grid_width)
         low[k] = std::min(low[k], mesh.point(v)[k]);
         high[k] = std::max(high[k], mesh.point(v)[k]);
       }
-  // The stars list every cell once: the mean edge length reads them rather than the mesh again.
+  // The stars list every cell once: the spacing reads them rather than the mesh again.
   const VertexStars stars = all_vertex_stars(mesh.connectivity(), mesh.n_points());
-  double width = grid_width * mean_edge_length(mesh, stars);
+  double width = grid_width * vertex_spacing(mesh, stars);
   for (int k = 0; k < d; ++k) width = std::max(width, (high[k] - low[k]) / 1e6);  // at most 10⁶ nodes a side
   const KuhnGrid grid(d, low, high, width);
   std::vector<GridWeights> weights(n);

@@ -20,11 +20,14 @@ namespace snede {
 
 class GridMultigrid final : public GalerkinMultigrid {
  public:
-  // Two levels: `fine`'s mesh (volume or membrane) and a grid `grid_width` mean edge lengths wide.
+  // Two levels: `fine`'s mesh (volume or membrane) and a grid `grid_width` vertex spacings wide
+  // (coarse_basis.hpp: the edge of a cube per fine vertex).
   // Throws std::invalid_argument for a non-positive width.
   explicit GridMultigrid(Model& fine, double grid_width = default_grid_width);
-  // Measured 2, 3 and 4 in benchmarks/interactive_cut.py; 3 was fastest on the block and the liver.
-  static constexpr double default_grid_width = 3.0;
+  // 4 spacings is 3 mean edge lengths on a uniform mesh, the fastest of 2, 3 and 4 in
+  // benchmarks/interactive_cut.py on the block and the liver; on a mesh refined along a needle's
+  // shaft, 3 mean edge lengths made a coarse level larger than the fine one (needle3d_rates.py).
+  static constexpr double default_grid_width = 4.0;
   // Throws std::invalid_argument naming mg_grid_width unless `grid_width` is positive and finite.
   static void require_valid_width(double grid_width);
 

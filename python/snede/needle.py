@@ -228,6 +228,30 @@ class NeedleInsertion:
         return np.asarray(self._impl.tip)
 
     @property
+    def surface_depth(self) -> float:
+        """How far from ``entry`` the shaft's line first meets the deformed body (0 when
+        ``entry`` is inside it): ``advance(surface_depth - depth)`` brings the tip to the
+        surface in one update. Scans the mesh; ValueError if the line no longer meets the body."""
+        return self._impl.surface_depth
+
+    @property
+    def preconditioner_fills(self) -> int:
+        """How many times the needle's solver filled its preconditioner (see
+        :attr:`snede.StaticSolver.preconditioner_fills`)."""
+        return self._impl.preconditioner_fills
+
+    @property
+    def multigrid_source(self) -> str:
+        """What made the needle solver's ``"mg"`` levels at its last solve (see
+        :attr:`snede.StaticSolver.multigrid_source`)."""
+        return self._impl.multigrid_source
+
+    @property
+    def multigrid_unknowns(self) -> list[int]:
+        """Unknowns per level of the needle solver's ``"mg"`` levels, coarsest first."""
+        return list(self._impl.multigrid_unknowns)
+
+    @property
     def entry(self) -> np.ndarray:
         return np.asarray(self._impl.entry)
 

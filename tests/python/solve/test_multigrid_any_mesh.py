@@ -357,3 +357,41 @@ def test_a_needle_into_a_gmsh_mesh_with_mg_gives_the_plain_insertion(gmsh_cylind
     assert all(report.converged for report in plain + reports)
     assert body.mesh.n_cells == plain_body.mesh.n_cells > gmsh_cylinder.n_cells  # refined alike
     assert relative_difference(body.displacement, plain_body.displacement) < 1e-5
+
+
+def test_auto_does_not_take_bisection_levels_whose_coarsest_is_the_file_mesh(gmsh_cylinder):
+    # Refined locally (as a needle does), a mesh read from a file gets a bisection hierarchy whose
+    # coarsest level is that mesh: a direct solve on it would cost more than the whole grid
+    # levels. A mesh bisected from a small box keeps its bisection levels.
+    mesh = snede.Mesh(gmsh_cylinder.points, gmsh_cylinder.cells)
+    mesh.refine_around((0.05, 0.0, 0.0), 0.002)
+    body = held_body(mesh)
+    solver, result, _ = solve(body, preconditioner="mg")
+    assert result.converged
+    assert solver.multigrid_source == "grid"
+    assert solver.multigrid_unknowns[0] <= max(1000, solver.multigrid_unknowns[-1] // 16)
+    box = snede.meshing.box((0.1, 0.1, 0.1), (2, 2, 2))
+    box.refine_uniform(2)
+    box.refine_around((0.05, 0.05, 0.05), 0.01)
+    assert solve(held_body(box), preconditioner="mg")[0].multigrid_source == "bisection"
+
+
+def test_grid_levels_on_a_mesh_refined_along_a_line_stay_much_coarser_than_it():
+    # A needle's refinement puts most edges in a thin tube: a grid sized by the mean edge length
+    # (the old rule: 3 of them) had a fifth as many unknowns as the mesh; sized by the vertex
+    # spacing, it has about as few per fine unknown as on a uniform mesh (4 spacings: a 64th of
+    # the vertices), and the solve still reaches the plain answer.
+    mesh = snede.meshing.box((0.1, 0.1, 0.1), (3, 3, 3))
+    mesh.refine_uniform(2)
+    mesh.refine_near_segment((0.0, 0.0513, 0.0489), (0.07, 0.0513, 0.0489), 0.1 / 64, 1e-3)
+    uniform = snede.meshing.box((0.1, 0.1, 0.1), (3, 3, 3))
+    uniform.refine_uniform(5)
+    ratios = []
+    for m in (mesh, uniform):
+        body = held_body(m)
+        solver, result, u = solve(body, preconditioner="mg", petsc_options={"mg_coarsening": "grid"})
+        assert result.converged
+        assert relative_difference(u, solve(body)[2]) < 1e-6
+        ratios.append(solver.multigrid_unknowns[-1] / solver.multigrid_unknowns[0])
+    assert ratios[0] >= 16 and ratios[1] >= 16
+    assert 0.5 < ratios[0] / ratios[1] < 2
