@@ -95,6 +95,7 @@ StaticSolver::StaticSolver(Model& model, StaticOptions options, const Refinement
   pc_type_ = option_database_.string_option(options_.options_prefix + "pc_type")
                  .value_or(options_.preconditioner.empty() ? std::string("auto") : options_.preconditioner);
   if (pc_type_ == "auto") {
+    automatic_ = true;
     pc_type_ = automatic_preconditioner(model, options_.method);
     // -<prefix>pc_type auto is snede's: PETSc, which reads the option again, must see the choice.
     if (option_database_.string_option(options_.options_prefix + "pc_type"))
@@ -230,6 +231,25 @@ void StaticSolver::create_objects() {
 
 void StaticSolver::follow_mesh_changes() {
   const bool resized = generation_ != model_.generation();
+  // A needle's refinement grows a mesh of a few hundred cells, where "auto" chose no
+  // preconditioner, past the size where multigrid pays: choose again, with solver objects made
+  // afresh for the new choice.
+  if (resized && automatic_) {
+    const std::string chosen = automatic_preconditioner(model_, options_.method);
+    if (chosen != pc_type_) {
+      pc_type_ = chosen;
+      if (option_database_.string_option(options_.options_prefix + "pc_type"))
+        option_database_.set_string_option(options_.options_prefix + "pc_type", pc_type_);
+      needs_matrix_ = pc_needs_matrix_;  // false: the automatic choices are none and mg
+      assembled_.reset();
+      multigrid_.reset();
+      preconditioner_filled_ = false;
+      ksp_.reset();
+      snes_.reset();
+      create_objects();
+      return;
+    }
+  }
   const bool stale_matrix = needs_matrix_ && (!assembled_ || !assembled_->matches(model_));
   const bool stale_multigrid = multigrid_ && !multigrid_->matches(model_);
   if (!resized && !stale_matrix && !stale_multigrid) return;

@@ -129,6 +129,7 @@ class StaticSolver {
   SnesHandle snes_;  // nonlinear methods only
   VecHandle residual_;
   std::string pc_type_;
+  bool automatic_ = false;             // pc_type_ was chosen by "auto": chosen again as the mesh grows
   bool pc_needs_matrix_ = false;       // the PC type needs entries (not none, jacobi or mg)
   bool needs_matrix_ = false;          // the PC needs an assembled tangent (that, or Galerkin mg)
   std::unique_ptr<AssembledTangent> assembled_;  // that tangent, for the current mesh

@@ -299,6 +299,24 @@ def test_auto_takes_multigrid_where_it_pays():
     assert snede.StaticSolver(small_membrane, "newton").preconditioner == "none"
 
 
+@pytest.mark.parametrize("method", ["cg", "newton"])
+def test_auto_chooses_again_when_the_mesh_grows_past_where_multigrid_pays(method):
+    # A needle refines a mesh of a few hundred cells to tens of thousands: "auto" chose no
+    # preconditioner for the first and must not keep that choice for the second.
+    material = snede.LinearElastic(1e5, 0.3) if method == "cg" else snede.NeoHookean(1e5, 0.3)
+    mesh = snede.meshing.box((0.4, 0.1, 0.1), (4, 1, 1))
+    body = held_body(mesh, material)
+    solver = snede.StaticSolver(body, method, rtol=1e-8)
+    assert solver.preconditioner == "none" and solver.solve().converged
+    mesh.refine_uniform(6)
+    assert mesh.n_cells >= 1000
+    result = solver.solve()
+    assert result.converged
+    assert solver.preconditioner == "mg" and solver.multigrid_source != ""
+    u = body.displacement.copy()
+    assert relative_difference(u, solve(body, method)[2]) < 1e-6
+
+
 def test_bad_coarsening_options_are_refused_naming_them(gmsh_cylinder):
     body = held_body(gmsh_cylinder)
     with pytest.raises(ValueError, match="mg_coarsening must be auto, bisection, aggregation or grid, got 'tree'"):
