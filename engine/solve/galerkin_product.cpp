@@ -29,30 +29,16 @@ class PetscGalerkin final : public CoarseProduct {
   MatHandle product_;
 };
 
-// A SeqAIJ matrix's arrays, read-only, for the duration of a scope.
-class CsrRead {
+// A's arrays (csr_matrix.hpp), which must be vertex blocks: SeqBAIJ with block size d.
+class VertexBlocks : public CsrView {
  public:
-  explicit CsrRead(Mat m) : m_(m) {
-    PetscBool done = PETSC_FALSE;
-    SNEDE_PETSC(MatGetRowIJ(m_, 0, PETSC_FALSE, PETSC_FALSE, &rows, &start, &column, &done));
-    if (!done) throw std::logic_error("a Galerkin product by vertex blocks needs a SeqAIJ matrix");
-    SNEDE_PETSC(MatSeqAIJGetArrayRead(m_, &value));
+  VertexBlocks(Mat A, int d) : CsrView(A) {
+    PetscInt block_size = 0;
+    SNEDE_PETSC(MatGetBlockSize(A, &block_size));
+    if (!blocked || block_size != d)
+      throw std::logic_error("a Galerkin product by vertex blocks needs a SeqBAIJ matrix of block size " +
+                             std::to_string(d));
   }
-  ~CsrRead() {
-    MatSeqAIJRestoreArrayRead(m_, &value);
-    PetscBool done = PETSC_FALSE;
-    MatRestoreRowIJ(m_, 0, PETSC_FALSE, PETSC_FALSE, &rows, &start, &column, &done);
-  }
-  CsrRead(const CsrRead&) = delete;
-  CsrRead& operator=(const CsrRead&) = delete;
-
-  PetscInt rows = 0;
-  const PetscInt* start = nullptr;
-  const PetscInt* column = nullptr;
-  const PetscScalar* value = nullptr;
-
- private:
-  Mat m_;
 };
 
 // Pᵀ A P vertex block by vertex block, in two passes: the rows of A·P of each fine vertex (its
@@ -62,20 +48,12 @@ class CsrRead {
 class BlockGalerkin final : public CoarseProduct {
  public:
   BlockGalerkin(Mat A, const BlockInterpolation& P) : A_(A), P_(P), d_(P.dim) {
-    const CsrRead a(A);
+    const VertexBlocks a(A, d_);
     const auto n = static_cast<PetscInt>(P.start.size()) - 1;
-    if (a.rows != n * d_) throw std::logic_error("block Galerkin product: A and P do not match");
-    a_nonzeros_ = a.start[a.rows];
-    // A's vertex structure: vertex v's neighbours are its first row's columns, every d-th.
-    a_start_.assign(static_cast<std::size_t>(n) + 1, 0);
-    for (PetscInt v = 0; v < n; ++v) {
-      const PetscInt length = a.start[v * d_ + 1] - a.start[v * d_];
-      for (int i = 1; i < d_; ++i)
-        if (a.start[v * d_ + i + 1] - a.start[v * d_ + i] != length)
-          throw std::logic_error("block Galerkin product: A's rows of vertex " + std::to_string(v) + " differ");
-      for (PetscInt k = 0; k < length; k += d_) a_neighbour_.push_back(a.column[a.start[v * d_] + k] / d_);
-      a_start_[v + 1] = a_neighbour_.size();
-    }
+    if (a.rows != n) throw std::logic_error("block Galerkin product: A and P do not match");
+    // A's vertex structure: its block rows.
+    a_start_.assign(a.start, a.start + n + 1);
+    a_neighbour_.assign(a.column, a.column + a.start[n]);
     // A free vertex's block is its weight times the identity (the copy's d columns): one
     // multiplication per entry of A's block instead of d.
     scalar_.assign(P.copy.size(), 0.0);
@@ -155,8 +133,8 @@ class BlockGalerkin final : public CoarseProduct {
   }
 
   void recompute() override {
-    const CsrRead a(A_);
-    if (a.start[a.rows] != a_nonzeros_)
+    const VertexBlocks a(A_, d_);
+    if (static_cast<std::size_t>(a.start[a.rows]) != a_neighbour_.size())
       throw std::logic_error("block Galerkin product: the fine matrix changed its structure since it was set up");
     if (d_ == 3) {
       multiply<3>(a);
@@ -172,17 +150,16 @@ class BlockGalerkin final : public CoarseProduct {
 
  private:
   template <int D>
-  void multiply(const CsrRead& a) {
+  void multiply(const VertexBlocks& a) {
     constexpr int DD = D * D;
     const auto n = static_cast<PetscInt>(P_.start.size()) - 1;
     std::vector<double> accumulator(static_cast<std::size_t>(P_.n_copies()) * DD, 0.0);
     // A·P, vertex by vertex: Σ over neighbours w of A_vw P_w.
-    double A_block[DD];
+    double A_block[DD];  // row by row
     for (PetscInt v = 0; v < n; ++v) {
       for (std::size_t k = a_start_[v]; k < a_start_[v + 1]; ++k) {
-        const auto rank = static_cast<PetscInt>(k - a_start_[v]);
         for (int i = 0; i < D; ++i)
-          for (int j = 0; j < D; ++j) A_block[i * D + j] = a.value[a.start[v * D + i] + rank * D + j];
+          for (int j = 0; j < D; ++j) A_block[i * D + j] = a.value[k * DD + j * D + i];
         const PetscInt w = a_neighbour_[k];
         for (std::size_t t = P_.start[w]; t < P_.start[w + 1]; ++t) {
           double* sum = accumulator.data() + static_cast<std::size_t>(P_.copy[t]) * DD;
@@ -242,8 +219,7 @@ class BlockGalerkin final : public CoarseProduct {
   int d_;
   std::vector<double> scalar_;    // per entry of P: s where its block is s·I
   std::vector<char> is_scalar_;
-  PetscInt a_nonzeros_ = 0;
-  std::vector<std::size_t> a_start_;  // per fine vertex: its neighbours in A
+  std::vector<std::size_t> a_start_;  // per fine vertex: its neighbours in A (A's block rows)
   std::vector<PetscInt> a_neighbour_;
   std::vector<std::size_t> ap_start_;  // per fine vertex: the copies of its row of A·P
   std::vector<PetscInt> ap_copy_;

@@ -1,5 +1,5 @@
 // Galerkin coarse operators Pᵀ A P of multigrid levels (multigrid.hpp). Two ways to compute one:
-// PETSc's sparse product (any A and P), and snede's own for an interpolation given vertex by
+// PETSc's sparse product (AIJ matrices), and snede's own for an interpolation given vertex by
 // vertex in dim × dim blocks (the grid levels, grid_multigrid.hpp), which works on A's vertex
 // blocks — a ninth of the index work of a scalar product, and the structure found once per mesh.
 #pragma once
@@ -39,9 +39,9 @@ class CoarseProduct {
 // PETSc's default on the grid levels.
 std::unique_ptr<CoarseProduct> petsc_galerkin_product(Mat A, Mat P);
 
-// Pᵀ A P for A assembled in vertex blocks (every row of a vertex has the same columns: all dim
-// components of its neighbours, sorted; AssembledTangent's layout) and P given by `blocks`.
-// `blocks` must outlive the product.
+// Pᵀ A P for A a SeqBAIJ matrix of block size dim (AssembledTangent's MatrixFormat::baij: a
+// block per pair of neighbouring vertices) and P given by `blocks`. `blocks` must outlive the
+// product. Throws std::logic_error for any other A.
 std::unique_ptr<CoarseProduct> block_galerkin_product(Mat A, const BlockInterpolation& blocks);
 
 }  // namespace snede

@@ -37,9 +37,12 @@ class GridMultigrid final : public GalerkinMultigrid {
   std::vector<std::size_t> level_sizes() const override;
   std::vector<std::size_t> level_unknowns() const override;
   void configure(PC pc, const SolverOptions& options, const std::vector<double>& smoother_bounds = {}) override;
+  // Block storage: the Galerkin product reads the vertex blocks, and the smoother's products
+  // with the fine matrix are faster on it than on AIJ (0.45 against 0.99 ms at 98k tetrahedra).
+  MatrixFormat assembled_tangent_format() const override { return MatrixFormat::baij; }
 
  protected:
-  // By vertex blocks (galerkin_product.hpp): the fine matrix is the assembled tangent.
+  // By vertex blocks (galerkin_product.hpp): the fine matrix is the assembled tangent, in BAIJ.
   std::unique_ptr<CoarseProduct> galerkin_product(Mat finer, PetscInt level) const override;
 
  private:

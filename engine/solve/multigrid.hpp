@@ -15,6 +15,7 @@
 #include "core/solver_options.hpp"
 #include "solve/galerkin_product.hpp"
 #include "solve/model.hpp"
+#include "solve/tangent_assembly.hpp"
 
 namespace snede {
 
@@ -41,6 +42,8 @@ class Multigrid {
   // Whether the PC's preconditioning matrix must be the assembled fine tangent (Galerkin
   // levels are products with it) rather than the shell.
   virtual bool needs_assembled_tangent() const = 0;
+  // The format that assembled tangent must have: what the levels' Galerkin products read.
+  virtual MatrixFormat assembled_tangent_format() const { return MatrixFormat::aij; }
   // Makes `pc` a PCMG over these levels. `smoother_bounds`: Chebyshev's largest eigenvalue per
   // smoothed level (finest last) from an earlier set-up with as many levels; empty: estimate.
   virtual void configure(PC pc, const SolverOptions& options, const std::vector<double>& smoother_bounds) = 0;
@@ -89,8 +92,11 @@ class GalerkinMultigrid : public Multigrid {
 };
 
 // Chebyshev/Jacobi on one smoothed level: with `largest_bound` > 0 the bounds are fixed from
-// it (an earlier estimate, with a safety factor), else Chebyshev estimates them.
-void set_chebyshev_jacobi_smoother(KSP smoother, const SolverOptions& options, double largest_bound);
+// it (an earlier estimate, with a safety factor), else Chebyshev estimates them. With
+// `point_blocks`, Jacobi inverts the level matrix's diagonal blocks (PCPBJACOBI: an assembled
+// matrix with the block size of a vertex) rather than its diagonal.
+void set_chebyshev_jacobi_smoother(KSP smoother, const SolverOptions& options, double largest_bound,
+                                   bool point_blocks = false);
 // The largest eigenvalues Chebyshev estimated on the smoothed levels of a PCMG (finest last);
 // empty if a level did not estimate (fixed bounds, another smoother).
 std::vector<double> chebyshev_estimates(PC pc);

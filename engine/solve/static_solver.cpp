@@ -304,8 +304,11 @@ Mat StaticSolver::preconditioning_matrix() {
   if (!assembled_) {
     static const PetscLogEvent event = log_event("SnedeTangentSparsity");
     ScopedEvent logged(event);
-    // GAMG works on AIJ; a membrane's compressed elements must not make the PC indefinite.
-    assembled_ = std::make_unique<AssembledTangent>(model_, MatrixFormat::aij, MembraneTangent::positive_part);
+    // GAMG works on AIJ, Galerkin levels on what their products read; a membrane's compressed
+    // elements must not make the PC indefinite.
+    const MatrixFormat format =
+        pc_needs_matrix_ || !multigrid_ ? MatrixFormat::aij : multigrid_->assembled_tangent_format();
+    assembled_ = std::make_unique<AssembledTangent>(model_, format, MembraneTangent::positive_part);
     set_rigid_body_near_null_space(model_, assembled_->mat());
     preconditioner_filled_ = false;
   }

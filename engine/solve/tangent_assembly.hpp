@@ -34,22 +34,23 @@ class AssembledTangent {
   // Whether the mesh is still the one this matrix was made for (no edit since).
   bool matches(const Model& model) const;
   // Fills the matrix with J at u, scaled by the model's operator scale s as the shell is.
-  // AIJ values are added straight into PETSc's value array at offsets found once per mesh.
+  // Values are added straight into PETSc's value array at offsets found once per mesh (AIJ or
+  // BAIJ alike).
   void assemble(const Model& model, Vec u);
   Mat mat() const { return A_; }
 
  private:
-  MatrixFormat format_;
   MembraneTangent membranes_;
   std::uint64_t revision_;
   MatHandle A_;
-  const CsrArrays* csr_ = nullptr;        // AIJ: A_'s own arrays (row starts: each scalar row's first value)
   std::vector<std::int32_t> block_rank_;  // per element id and block (a, b): b's place among
                                           // a's sorted neighbours
   std::vector<std::int32_t> self_rank_;   // per vertex: its own place among its neighbours
   bool patches_ = false;                  // a smoothed formulation's patches: blocks to two edges
   std::vector<std::size_t> neighbour_start_;  // patches only: each vertex's sorted neighbours (CSR)
   std::vector<VertexId> neighbours_;
+  // J's entries at u, scaled, added into A_'s arrays (zeroed first).
+  void add_entries(const Model& model, Vec u, const CsrView& A) const;
   // Each block's place among its row's neighbours, for a patch's sorted vertices (count²).
   const std::int32_t* patch_block_ranks(std::span<const VertexId> vertices, std::vector<std::int32_t>& ranks) const;
 };

@@ -1,9 +1,10 @@
 // The Galerkin product by vertex blocks (galerkin_product.hpp) against PETSc's MatPtAP on the
-// same matrices: a random symmetric matrix in vertex blocks over a random vertex graph, and a
-// random block interpolation whose copies have 1 to dim columns (a constrained copy has fewer;
-// half the others' blocks a weight times the identity, as a free vertex's),
-// turned into the scalar AIJ interpolation PETSc multiplies with. Also after new values in A
-// (recompute keeps the structure), in 2D and 3D.
+// same matrices: a random symmetric BAIJ matrix over a random vertex graph (an AIJ copy for
+// PETSc, whose product takes no BAIJ), and a random block interpolation whose copies have 1 to
+// dim columns (a constrained copy has fewer; half the others' blocks a weight times the
+// identity, as a free vertex's), turned into the scalar AIJ interpolation PETSc multiplies
+// with. Also after new values in A (recompute keeps the structure), in 2D and 3D; and an AIJ A
+// is refused.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -22,43 +23,48 @@ struct Problem {
   int d;
   PetscInt n_vertices;
   std::vector<std::set<PetscInt>> neighbours;  // symmetric, itself included
-  MatHandle A, P;
+  MatHandle A, A_aij, P;  // A in blocks of d × d, and the same values in AIJ
   BlockInterpolation blocks;
 };
 
-// A with each vertex's rows over all components of its sorted neighbours (AssembledTangent's
-// layout); symmetric values drawn from `random`.
+// A with a d × d block for every pair of neighbours (AssembledTangent's BAIJ layout); symmetric
+// values drawn from `random`; then its AIJ copy.
 void fill_A(Problem& problem, std::mt19937& random) {
   const int d = problem.d;
   std::uniform_real_distribution<double> value(-1.0, 1.0);
-  std::vector<PetscInt> row_start{0}, columns;
-  for (PetscInt v = 0; v < problem.n_vertices; ++v)
-    for (int i = 0; i < d; ++i) {
-      for (PetscInt w : problem.neighbours[v])
-        for (int j = 0; j < d; ++j) columns.push_back(w * d + j);
-      row_start.push_back(static_cast<PetscInt>(columns.size()));
-    }
+  std::vector<PetscInt> block_start{0}, block_columns;
+  for (PetscInt v = 0; v < problem.n_vertices; ++v) {
+    block_columns.insert(block_columns.end(), problem.neighbours[v].begin(), problem.neighbours[v].end());
+    block_start.push_back(static_cast<PetscInt>(block_columns.size()));
+  }
   const PetscInt rows = problem.n_vertices * d;
   if (!problem.A) {
     SNEDE_PETSC(MatCreate(PETSC_COMM_SELF, problem.A.out()));
     SNEDE_PETSC(MatSetSizes(problem.A, rows, rows, rows, rows));
-    SNEDE_PETSC(MatSetType(problem.A, MATSEQAIJ));
-    SNEDE_PETSC(MatSeqAIJSetPreallocationCSR(problem.A, row_start.data(), columns.data(), nullptr));
+    SNEDE_PETSC(MatSetType(problem.A, MATSEQBAIJ));
+    SNEDE_PETSC(MatSeqBAIJSetPreallocationCSR(problem.A, d, block_start.data(), block_columns.data(), nullptr));
   }
-  for (PetscInt r = 0; r < rows; ++r)
-    for (PetscInt k = row_start[r]; k < row_start[r + 1]; ++k) {
-      const PetscInt c = columns[k];
-      if (c < r) continue;
-      const double x = value(random) + (c == r ? 10.0 : 0.0);
-      SNEDE_PETSC(MatSetValue(problem.A, r, c, x, INSERT_VALUES));
-      SNEDE_PETSC(MatSetValue(problem.A, c, r, x, INSERT_VALUES));
-    }
+  for (PetscInt v = 0; v < problem.n_vertices; ++v)
+    for (PetscInt w : problem.neighbours[v])
+      for (int i = 0; i < d; ++i)
+        for (int j = 0; j < d; ++j) {
+          const PetscInt r = v * d + i, c = w * d + j;
+          if (c < r) continue;
+          const double x = value(random) + (c == r ? 10.0 : 0.0);
+          SNEDE_PETSC(MatSetValue(problem.A, r, c, x, INSERT_VALUES));
+          SNEDE_PETSC(MatSetValue(problem.A, c, r, x, INSERT_VALUES));
+        }
   SNEDE_PETSC(MatAssemblyBegin(problem.A, MAT_FINAL_ASSEMBLY));
   SNEDE_PETSC(MatAssemblyEnd(problem.A, MAT_FINAL_ASSEMBLY));
+  if (problem.A_aij) {
+    SNEDE_PETSC(MatConvert(problem.A, MATSEQAIJ, MAT_REUSE_MATRIX, problem.A_aij.slot()));
+  } else {
+    SNEDE_PETSC(MatConvert(problem.A, MATSEQAIJ, MAT_INITIAL_MATRIX, problem.A_aij.out()));
+  }
 }
 
 Problem random_problem(int d, std::mt19937& random) {
-  Problem problem{d, 60, {}, {}, {}, {}};
+  Problem problem{d, 60, {}, {}, {}, {}, {}};
   problem.neighbours.resize(problem.n_vertices);
   std::uniform_int_distribution<PetscInt> vertex(0, problem.n_vertices - 1);
   for (PetscInt v = 0; v < problem.n_vertices; ++v) {
@@ -133,12 +139,18 @@ TEST_P(BlockGalerkinProduct, EqualsPetscsProductBeforeAndAfterNewValues) {
   std::mt19937 random(7 + GetParam());
   Problem problem = random_problem(GetParam(), random);
   const auto blocks = block_galerkin_product(problem.A, problem.blocks);
-  const auto reference = petsc_galerkin_product(problem.A, problem.P);
+  const auto reference = petsc_galerkin_product(problem.A_aij, problem.P);
   EXPECT_LT(relative_difference(blocks->matrix(), reference->matrix()), 1e-14);
   fill_A(problem, random);
   blocks->recompute();
   reference->recompute();
   EXPECT_LT(relative_difference(blocks->matrix(), reference->matrix()), 1e-14);
+}
+
+TEST_P(BlockGalerkinProduct, RefusesAnAijMatrix) {
+  std::mt19937 random(11 + GetParam());
+  const Problem problem = random_problem(GetParam(), random);
+  EXPECT_THROW(block_galerkin_product(problem.A_aij, problem.blocks), std::logic_error);
 }
 
 INSTANTIATE_TEST_SUITE_P(Dimensions, BlockGalerkinProduct, ::testing::Values(2, 3));
