@@ -46,3 +46,19 @@ def test_the_surface_depth_is_zero_from_inside_and_a_line_that_misses_is_refused
     assert inside.surface_depth == 0.0
     with pytest.raises(ValueError, match="never meets the body"):
         needle_into(cylinder, (-0.01, 0.05, 0.0))
+
+
+@pytest.mark.parametrize("coarsening", [None, "bisection"])
+def test_the_needle_takes_grid_levels_unless_told_otherwise(coarsening):
+    # Its refinement changes the mesh at nearly every update: grid levels are rebuilt more
+    # cheaply than bisection levels (benchmarks/needle3d_rates.py --haptic).
+    mesh = snede.meshing.box((0.1, 0.1, 0.1), (2, 2, 2))
+    mesh.refine_uniform(3)
+    body = snede.Body(mesh, snede.LinearElastic(34e3, 0.34))
+    body.fix(np.isclose(mesh.points[:, 2], 0.0))
+    options = {"mg_coarsening": coarsening} if coarsening else {}
+    needle = snede.NeedleInsertion(body, (-0.005, 0.0513, 0.0489), (1.0, 0.0, 0.0),
+                                   snede.FrictionProfile.figure_6_4(), radius=1e-3, h_ref=0.1 / 16, petsc_options=options)
+    for _ in range(3):
+        assert needle.advance(0.01).converged
+    assert needle.multigrid_source == (coarsening or "grid")
