@@ -148,6 +148,7 @@ void bind_solve(py::module_& m) {
       .def_property_readonly("multigrid_source", &StaticSolver::multigrid_source)
       .def_property_readonly("follow_seconds", &StaticSolver::follow_seconds)
       .def_property_readonly("preconditioner_fills", &StaticSolver::preconditioner_fills)
+      .def_property_readonly("multigrid_builds", &StaticSolver::multigrid_builds)
       .def("solve", &StaticSolver::solve)
       .def_property_readonly("ksp", [](const StaticSolver& s) { return to_petsc4py(s.ksp()); })
       .def_property_readonly("snes", [](const StaticSolver& s) {

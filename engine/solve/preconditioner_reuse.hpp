@@ -3,7 +3,9 @@
 // from the previous state; while the mesh and the constraints' projections stay the same (a
 // grasper dragging, a blade moving through an incision it already made), the levels of an
 // earlier solve — the assembled tangent at that state, its Galerkin products, the coarse
-// factorisation, the smoothers' bounds — still precondition the tangent well. They are kept
+// factorisation, the smoothers' bounds — still precondition the tangent well. When only the
+// projections change (a needle's stick-slip), the levels keep their interpolation and are
+// refilled at the new state (static_solver.cpp). They are kept
 // until the preconditioner shows its age: a solve that needed more than `refresh_ratio` times
 // the CG iterations per Newton iteration of the solve that built them, or one that failed.
 #pragma once

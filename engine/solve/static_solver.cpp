@@ -104,7 +104,7 @@ StaticSolver::StaticSolver(Model& model, StaticOptions options, const Refinement
   if (options_.method == StaticMethod::nonlinear_cg && pc_type_ != PCNONE)
     throw std::invalid_argument("a preconditioner ('" + pc_type_ + "') applies to the CG of methods 'cg' and 'newton'; "
                                 "nonlinear CG ('ncg') takes none");
-  if (pc_type_ != PCMG && option_database_.string_option(options_.options_prefix + "mg_refresh_ratio"))
+  if (pc_type_ != PCMG && !automatic_ && option_database_.string_option(options_.options_prefix + "mg_refresh_ratio"))
     throw std::invalid_argument("-" + options_.options_prefix + "mg_refresh_ratio applies to the preconditioner 'mg'; "
                                 "this solver's is '" + pc_type_ + "'");
   // Jacobi reads the shell's diagonal (MatGetDiagonal), mg builds its own levels (and needs
@@ -254,17 +254,13 @@ void StaticSolver::follow_mesh_changes() {
   const bool stale_multigrid = multigrid_ && !multigrid_->matches(model_);
   if (!resized && !stale_matrix && !stale_multigrid) return;
   if (!resized && !stale_matrix && multigrid_->matches_mesh(model_)) {
-    // Only the constraints changed (a needle's stick-slip): the same levels take them over (new
-    // levels if one is no longer held), on a fresh PC; the solver objects stay as they are.
-    PC pc = nullptr;
-    SNEDE_PETSC(KSPGetPC(ksp(), &pc));
-    SNEDE_PETSC(PCSetType(pc, PCNONE));
-    if (multigrid_->follow_constraints()) {
-      configure_multigrid(pc);
-    } else {
-      set_up_multigrid(pc);
-    }
-    SNEDE_PETSC(PCSetFromOptions(pc));
+    // Only the constraints changed (a needle's stick-slip): a change of a few vertices. Galerkin
+    // levels that Newton keeps across solves keep their interpolation, made for the earlier
+    // constraints, and are refilled at the next solve (fine matrix and Galerkin products, no new
+    // grid or structure); Newton's step is projected onto the allowed motions. They take the
+    // constraints over once they show their age (solve_nonlinear).
+    if (lags_constraint_changes()) return;
+    take_over_constraints();
     return;
   }
   generation_ = model_.generation();
@@ -392,6 +388,7 @@ void StaticSolver::build_multigrid() {
       throw std::invalid_argument(prefix + name + " applies to " + applies_to + " levels; these are " + source +
                                   " levels (-" + options_.options_prefix + "mg_coarsening chooses)");
   needs_matrix_ = pc_needs_matrix_ || multigrid_->needs_assembled_tangent();
+  ++multigrid_builds_;
 }
 
 double StaticSolver::number_option(const std::string& name, double fallback) const {
@@ -478,6 +475,27 @@ void StaticSolver::fill_preconditioner(Vec u) {
 bool StaticSolver::filled_for_current_system() const {
   return preconditioner_filled_ && filled_at_scale_ == system_scale_ &&
          filled_for_constraints_ == model_.constraints().projection_fingerprint();
+}
+
+bool StaticSolver::keeps_galerkin_levels() const {
+  return snes_ && options_.method == StaticMethod::newton && multigrid_ && multigrid_->needs_assembled_tangent() &&
+         !option_database_.string_option(options_.options_prefix + "snes_lag_preconditioner");
+}
+
+bool StaticSolver::lags_constraint_changes() const { return keeps_galerkin_levels() && reuse_.keep(); }
+
+void StaticSolver::take_over_constraints() {
+  // The same levels take the constraints over (new levels if one is no longer held), on a fresh
+  // PC; the solver objects stay as they are.
+  PC pc = nullptr;
+  SNEDE_PETSC(KSPGetPC(ksp(), &pc));
+  SNEDE_PETSC(PCSetType(pc, PCNONE));
+  if (multigrid_->follow_constraints()) {
+    configure_multigrid(pc);
+  } else {
+    set_up_multigrid(pc);
+  }
+  SNEDE_PETSC(PCSetFromOptions(pc));
 }
 
 double StaticSolver::current_tolerance() const {
@@ -574,11 +592,14 @@ SolveResult StaticSolver::solve_nonlinear() {
   // iterations, unless the options lag otherwise: rebuilding them cost more than the CG
   // iterations they save (docs/results/interactive.md). While the mesh and the projections stay
   // the same, the next solves keep them too, until they show their age (preconditioner_reuse.hpp).
-  keeps_levels_through_solve_ = multigrid_ && multigrid_->needs_assembled_tangent() &&
-                                !option_database_.string_option(options_.options_prefix + "snes_lag_preconditioner");
+  // After a change of constraints alone (a needle's stick-slip) the levels are refilled with
+  // the interpolation of the earlier constraints (follow_mesh_changes) until they show their
+  // age: then they take the constraints of now over.
+  keeps_levels_through_solve_ = keeps_galerkin_levels();
   filled_in_this_solve_ = false;
   if (keeps_levels_through_solve_) {
     const bool reuse = filled_for_current_system() && reuse_.keep();
+    if (!reuse_.keep() && !multigrid_->matches(model_)) take_over_constraints();
     SNEDE_PETSC(SNESSetLagPreconditioner(snes_, reuse ? -1 : -2));
     if (!reuse) preconditioner_filled_ = false;
   }
@@ -626,7 +647,9 @@ SolveResult StaticSolver::solve_nonlinear() {
   result.converged = reason > 0;
   finish(result, start, start_flops);
   if (keeps_levels_through_solve_)
-    reuse_.record(result.iterations, result.linear_iterations, result.converged, filled_in_this_solve_);
+    // Levels refilled on an interpolation of earlier constraints do not set a new baseline.
+    reuse_.record(result.iterations, result.linear_iterations, result.converged,
+                  filled_in_this_solve_ && multigrid_->matches(model_));
   return result;
 }
 

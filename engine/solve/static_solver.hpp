@@ -81,6 +81,10 @@ class StaticSolver {
   // Times the preconditioner was filled (assembled tangent, multigrid levels at a state) since
   // the solver was made: reuse across Newton iterations and solves keeps it below their count.
   std::size_t preconditioner_fills() const { return preconditioner_fills_; }
+  // Times multigrid levels were made (a grid, aggregates or a cut through the bisection tree,
+  // with their interpolations) since the solver was made: after a mesh change, or a change of
+  // constraints the levels could not take over in place.
+  std::size_t multigrid_builds() const { return multigrid_builds_; }
 
  private:
   void create_objects();
@@ -101,6 +105,12 @@ class StaticSolver {
   void refill_preconditioner(SNES snes, Vec x);
   // Whether the filled preconditioner is that of the current system (scale and projections).
   bool filled_for_current_system() const;
+  // Whether Newton keeps Galerkin levels through a solve and across solves (solve_nonlinear).
+  bool keeps_galerkin_levels() const;
+  // Whether Galerkin levels keep their interpolation when only the constraints changed.
+  bool lags_constraint_changes() const;
+  // The levels take changed constraints over (follow_constraints), or are made anew for them.
+  void take_over_constraints();
   // The assembled tangent and the multigrid levels at the state u (logged as SnedeTangentAssembly
   // and SnedeLevelsUpdate), and the fill remembered for reuse.
   void fill_preconditioner(Vec u);
@@ -143,6 +153,7 @@ class StaticSolver {
   std::uint64_t filled_for_constraints_ = 0;  // ... and the constraints' projection fingerprint
   bool filled_in_this_solve_ = false;
   std::size_t preconditioner_fills_ = 0;
+  std::size_t multigrid_builds_ = 0;
   bool keeps_levels_through_solve_ = false;  // Galerkin levels kept through a solve (solve_nonlinear)
   PreconditionerReuse reuse_;                // ... and through the next ones while they serve
   std::uint64_t generation_ = 0;

@@ -241,6 +241,13 @@ class NeedleInsertion:
         return self._impl.preconditioner_fills
 
     @property
+    def multigrid_builds(self) -> int:
+        """How many times the needle's solver made multigrid levels (see
+        :attr:`snede.StaticSolver.multigrid_builds`): after refinements, not after stick-slip
+        changes, which refill the levels it has."""
+        return self._impl.multigrid_builds
+
+    @property
     def multigrid_source(self) -> str:
         """What made the needle solver's ``"mg"`` levels at its last solve (see
         :attr:`snede.StaticSolver.multigrid_source`)."""

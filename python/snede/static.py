@@ -185,6 +185,15 @@ class StaticSolver(RunsOnRanks):
         return self._engine.preconditioner_fills
 
     @property
+    def multigrid_builds(self) -> int:
+        """How many times this solver made multigrid levels (a grid, aggregates or a cut through
+        the bisection tree, with their interpolations): after a mesh change, or a change of
+        constraints the levels did not take over in place. Newton's Galerkin levels keep their
+        interpolation through changes of constraints alone (a needle's stick-slip) and are only
+        refilled, until they show their age (``-static_mg_refresh_ratio``)."""
+        return self._engine.multigrid_builds
+
+    @property
     def ksp(self):
         """The petsc4py KSP: linear CG's, or Newton's inner one."""
         return self._engine.ksp

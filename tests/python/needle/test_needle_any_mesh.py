@@ -62,3 +62,24 @@ def test_the_needle_takes_grid_levels_unless_told_otherwise(coarsening):
     for _ in range(3):
         assert needle.advance(0.01).converged
     assert needle.multigrid_source == (coarsening or "grid")
+
+
+def test_stick_slip_changes_refill_the_levels_instead_of_making_new_ones(cylinder):
+    # Without refinement the mesh stays the same: each rearrangement changes constraints only,
+    # and the Galerkin levels keep their interpolation (refilled at the new state) until they
+    # show their age. The insertion is the one without a preconditioner.
+    def insertion(options):
+        mesh = snede.Mesh(cylinder.points, cylinder.cells)
+        body = snede.Body(mesh, snede.NeoHookean(1e4, 0.3))
+        body.fix(np.isclose(mesh.points[:, 0], 0.1))
+        needle = snede.NeedleInsertion(body, (-0.01, 0.001, 0.002), (1.0, 0.0, 0.0), snede.FrictionProfile.uniform(200.0),
+                                       radius=1e-3, method="newton", rtol=1e-8, petsc_options=options)
+        reports = [needle.advance(needle.surface_depth)] + [needle.advance(0.005) for _ in range(8)]
+        assert all(report.converged for report in reports)
+        return body, needle, sum(report.rearrangements for report in reports)
+
+    body, needle, solves = insertion({})
+    plain_body, _, _ = insertion({"pc_type": "none"})
+    assert needle.multigrid_source == "grid"
+    assert solves >= 20 and needle.multigrid_builds <= solves // 4
+    assert np.linalg.norm(body.displacement - plain_body.displacement) <= 1e-5 * np.linalg.norm(plain_body.displacement)
