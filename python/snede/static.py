@@ -195,10 +195,12 @@ class StaticSolver(RunsOnRanks):
 
     @property
     def ksp(self):
-        """The petsc4py KSP: linear CG's, or Newton's inner one."""
+        """The petsc4py KSP: linear CG's, or Newton's inner one. Made afresh (what was set on
+        the old one through petsc4py is lost; command-line options are read again) when the
+        preconditioner "auto" chooses again after the mesh grew or shrank past 1 000 cells."""
         return self._engine.ksp
 
     @property
     def snes(self):
-        """The petsc4py SNES (None for linear CG)."""
+        """The petsc4py SNES (None for linear CG); made afresh as :attr:`ksp` is."""
         return self._engine.snes
