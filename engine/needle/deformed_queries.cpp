@@ -29,11 +29,17 @@ bool boxes_miss(const std::vector<Point>& corners, const Point& lo, const Point&
   return false;
 }
 
-// Edge p–q against segment a–b in the plane: the parameter along a→b, or none.
-std::optional<double> crossing_2d(const Point& a, const Point& b, const Point& p, const Point& q) {
-  const Point ab = minus(b, a);
-  const double dp = cross2(ab, minus(p, a)), dq = cross2(ab, minus(q, a));
-  if ((dp > 0 && dq > 0) || (dp < 0 && dq < 0) || (dp == 0 && dq == 0)) return std::nullopt;
+// Which side of the line through a along ab the point p is on (the signed area, × |ab|).
+double side_of(const Point& a, const Point& ab, const Point& p) { return cross2(ab, minus(p, a)); }
+
+// An edge whose ends are on one side of the line (sides dp, dq), or on it, does not cross it.
+bool misses_line(double dp, double dq) { return (dp > 0 && dq > 0) || (dp < 0 && dq < 0) || (dp == 0 && dq == 0); }
+
+// Edge p–q, its ends on sides dp, dq of the line, against segment a–b in the plane: the
+// parameter along a→b, or none.
+std::optional<double> crossing_2d(const Point& a, const Point& b, const Point& p, const Point& q, double dp,
+                                  double dq) {
+  if (misses_line(dp, dq)) return std::nullopt;
   const Point pq = minus(q, p);
   const double da = cross2(pq, minus(a, p)), db = cross2(pq, minus(b, p));
   if ((da > 0 && db > 0) || (da < 0 && db < 0)) return std::nullopt;
@@ -50,6 +56,18 @@ std::optional<double> crossing_3d(const Point& a, const Point& b, const Point& p
                s2 = triple(ab, minus(r, a), minus(p, a));
   if ((s0 < 0 || s1 < 0 || s2 < 0) && (s0 > 0 || s1 > 0 || s2 > 0)) return std::nullopt;  // passes beside it
   return va / (va - vb);
+}
+
+// x is beyond the triangle's bounding box by more than a millionth of its size: then one of
+// its barycentric coordinates is far below reference_position's −1e-12, and the division
+// that computes them is skipped.
+bool outside_box(const Point& x, const Point& p0, const Point& p1, const Point& p2) {
+  for (int k = 0; k < 2; ++k) {
+    const double lo = std::min({p0[k], p1[k], p2[k]}), hi = std::max({p0[k], p1[k], p2[k]});
+    const double margin = 1e-6 * (hi - lo);
+    if (x[k] < lo - margin || x[k] > hi + margin) return true;
+  }
+  return false;
 }
 
 }  // namespace
@@ -74,6 +92,7 @@ std::optional<Point> reference_position(const Mesh& mesh, std::span<const double
     const Simplex& t = c.element(e).simplex;
     const Point p0 = deformed_point(mesh, u, t.vertex(0)), p1 = deformed_point(mesh, u, t.vertex(1)),
                 p2 = deformed_point(mesh, u, t.vertex(2));
+    if (d == 2 && outside_box(x, p0, p1, p2)) continue;
     if (d == 2) {
       const double area = cross2(minus(p1, p0), minus(p2, p0));
       if (area == 0) continue;
@@ -115,6 +134,14 @@ std::vector<ShaftCrossing> shaft_crossings(const Mesh& mesh, std::span<const dou
     hi[k] = std::max(a[k], b[k]);
   }
   const Connectivity& c = mesh.connectivity();
+  // 2D: each vertex's side of the line, once (not once per edge): most edges have both ends
+  // on one side and are passed over before their corners are looked at (issue 33).
+  std::vector<double> side;
+  if (d == 2) {
+    side.resize(static_cast<std::size_t>(mesh.n_points()));
+    for (VertexId v = 0; v < mesh.n_points(); ++v)
+      if (mesh.is_vertex(v)) side[v] = side_of(a, ab, deformed_point(mesh, u, v));
+  }
   std::vector<Point> corners(d);
   std::vector<VertexId> ids(d);
   for (ElementId e = 0; e < c.element_capacity(); ++e) {
@@ -123,13 +150,15 @@ std::vector<ShaftCrossing> shaft_crossings(const Mesh& mesh, std::span<const dou
       const FaceId f = c.element(e).faces[j];
       const Face& face = c.face(f);
       if (face.mate != no_id && face.mate < f) continue;  // each interior face once
+      if (d == 2 && misses_line(side[face.simplex.vertex(0)], side[face.simplex.vertex(1)])) continue;
       for (int i = 0; i < d; ++i) {
         ids[i] = face.simplex.vertex(i);
         corners[i] = deformed_point(mesh, u, ids[i]);
       }
       if (boxes_miss(corners, lo, hi, d)) continue;
-      const std::optional<double> t = d == 2 ? crossing_2d(a, b, corners[0], corners[1])
-                                             : crossing_3d(a, b, corners[0], corners[1], corners[2]);
+      const std::optional<double> t =
+          d == 2 ? crossing_2d(a, b, corners[0], corners[1], side[ids[0]], side[ids[1]])
+                 : crossing_3d(a, b, corners[0], corners[1], corners[2]);
       if (!t) continue;
       // The corner nearest the shaft's line (ties: the lower id, for determinism).
       int nearest = 0;

@@ -1,5 +1,7 @@
 #include "solve/model.hpp"
 
+#include <petsc/private/petscimpl.h>  // PetscObjectStateGet: a Vec's write count
+
 #include <cmath>
 #include <limits>
 #include <numeric>
@@ -57,12 +59,12 @@ void Model::set_gravity(std::span<const double> g) {
   for (double x : g)
     if (!std::isfinite(x)) throw std::invalid_argument("gravity must be finite, got " + std::to_string(x));
   gravity_.assign(g.begin(), g.end());
-  external_valid_ = false;
+  loads_changed();
 }
 
 void Model::clear_gravity() {
   gravity_.clear();
-  external_valid_ = false;
+  loads_changed();
 }
 
 std::vector<double>& Model::channel(const std::string& name) {
@@ -89,7 +91,7 @@ void Model::add_nodal_force(const std::string& name, std::span<const VertexId> v
   for (std::size_t i = 0; i < vertices.size(); ++i)
     for (int k = 0; k < dim(); ++k)
       f[static_cast<std::size_t>(vertices[i]) * dim() + k] += forces[(one_for_all ? 0 : i * dim()) + k];
-  external_valid_ = false;
+  loads_changed();
 }
 
 void Model::set_nodal_forces(const std::string& name, std::span<const VertexId> vertices,
@@ -100,13 +102,13 @@ void Model::set_nodal_forces(const std::string& name, std::span<const VertexId> 
 
 void Model::clear_channel(const std::string& name) {
   channels_.erase(name);
-  external_valid_ = false;
+  loads_changed();
 }
 
 void Model::clear_loads() {
   gravity_.clear();
   channels_.clear();
-  external_valid_ = false;
+  loads_changed();
 }
 
 std::vector<std::string> Model::load_channels() const {
@@ -147,27 +149,46 @@ double Model::potential_energy(Vec u, EvaluationReport& report) {
   return internal - std::inner_product(f.begin(), f.end(), x.span().begin(), 0.0);
 }
 
+void Model::loads_changed() {
+  external_valid_ = false;
+  gradient_.valid = false;
+}
+
+Model::GradientKey Model::key_of(Vec u) {
+  GradientKey key;
+  SNEDE_PETSC(PetscObjectGetId(reinterpret_cast<PetscObject>(u), &key.vec));
+  SNEDE_PETSC(PetscObjectStateGet(reinterpret_cast<PetscObject>(u), &key.state));
+  return key;
+}
+
 void Model::residual(Vec u, Vec F, EvaluationReport& report) {
-  ReadView x(u);
-  WriteView r(F);
-  body_.internal_forces(x.span(), r.span(), report);
-  const std::vector<double>& f = external_forces();
-  std::vector<double> reaction(r.span().size());
-  for (std::size_t i = 0; i < f.size(); ++i) {
-    r.span()[i] = -r.span()[i] - f[i];  // ∇Π = −f_int − f_ext
-    reaction[i] = r.span()[i];
+  const std::size_t errors_before = report.domain_errors.size();
+  {
+    ReadView x(u);
+    WriteView r(F);
+    body_.internal_forces(x.span(), r.span(), report);
+    const std::vector<double>& f = external_forces();
+    gradient_.values.resize(r.span().size());
+    for (std::size_t i = 0; i < f.size(); ++i) {
+      r.span()[i] = -r.span()[i] - f[i];  // ∇Π = −f_int − f_ext
+      gradient_.values[i] = r.span()[i];
+    }
+    std::vector<double> reaction = gradient_.values;
+    constraints_.project_complement(reaction);
+    last_reaction_norm_ = euclidean_norm(reaction);
+    constraints_.project(r.span());
+    // (I − P)(u − anchor): zero while the constraints hold; pulls them back otherwise.
+    std::vector<double> offset(x.span().begin(), x.span().end());
+    std::vector<double> held = offset;
+    constraints_.enforce(held);
+    for (std::size_t i = 0; i < offset.size(); ++i) r.span()[i] += offset[i] - held[i];
   }
-  constraints_.project_complement(reaction);
-  last_reaction_norm_ = euclidean_norm(reaction);
-  constraints_.project(r.span());
-  // (I − P)(u − anchor): zero while the constraints hold; pulls them back otherwise.
-  std::vector<double> offset(x.span().begin(), x.span().end());
-  std::vector<double> held = offset;
-  constraints_.enforce(held);
-  for (std::size_t i = 0; i < offset.size(); ++i) r.span()[i] += offset[i] - held[i];
+  gradient_.valid = report.domain_errors.size() == errors_before;
+  gradient_.key = key_of(u);
 }
 
 std::vector<double> Model::potential_gradient(Vec u) {
+  if (gradient_.valid && gradient_.key == key_of(u)) return gradient_.values;
   EvaluationReport report;
   std::vector<double> g(body_.n_dofs());
   {
@@ -255,7 +276,7 @@ PetscErrorCode Model::tangent_diagonal_callback(Mat A, Vec diagonal) {
 }
 
 void Model::on_change(const Connectivity&, const ConnectivityChange& change) {
-  external_valid_ = false;  // gravity follows the element masses
+  loads_changed();  // gravity follows the element masses
   if (change.vertex_events.empty()) return;
   const VertexId n_new = body_.mesh().n_points();
   constraints_.resize(n_new);

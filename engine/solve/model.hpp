@@ -86,7 +86,9 @@ class Model : public ConnectivityWatcher {
   // Reaction forces (I − P)∇Π(u): what the supports exert on the body.
   void reaction_forces(Vec u, Vec R);
   // ∇Π(u) = −f_int(u) − f_ext, unprojected, (n_points, dim) flattened: at a constrained vertex
-  // in equilibrium, the force its support exerts on the body.
+  // in equilibrium, the force its support exerts on the body. The one residual() computed last
+  // when u, the loads and the mesh are as they were then (a solver's final residual serves the
+  // needle's rearrangement, §6.3.2, without another pass over the elements).
   std::vector<double> potential_gradient(Vec u);
   // u ← P u + (I − P) anchor.
   void enforce_constraints(Vec u) const;
@@ -108,6 +110,20 @@ class Model : public ConnectivityWatcher {
   static PetscErrorCode tangent_diagonal_callback(Mat A, Vec diagonal);
 
   std::vector<double>& channel(const std::string& name);
+  void loads_changed();  // f_ext and the remembered ∇Π are stale
+
+  // A state as PETSc tells it apart: the Vec and its write count.
+  struct GradientKey {
+    PetscObjectId vec = 0;
+    PetscObjectState state = 0;
+    bool operator==(const GradientKey&) const = default;
+  };
+  static GradientKey key_of(Vec u);
+  struct RememberedGradient {
+    std::vector<double> values;  // ∇Π at the state of key
+    GradientKey key;
+    bool valid = false;
+  };
 
   ElasticBody& body_;
   Constraints constraints_;
@@ -117,6 +133,7 @@ class Model : public ConnectivityWatcher {
   std::vector<double> projected_direction_;  // tangent_mult's P d
   std::vector<double> external_;       // cached f_ext
   bool external_valid_ = false;
+  RememberedGradient gradient_;  // from the last residual()
   VertexId n_points_ = 0;
   VecHandle u_;
   VecHandle u_linearization_;

@@ -172,4 +172,23 @@ def test_the_results_page_and_files_are_written(quick):
     assert "| 0.3 | " in text and "| 0.001 | " in text  # Table 6.1's rows
     with open(out / "needle.csv") as stream:
         parts = {row["part"] for row in csv.DictReader(stream)}
-    assert parts == {"reference", "table_6_1", "tables_6_2_6_3", "tables_6_4_6_5", "table_6_6", "figure_6_12"}
+    assert parts == {"reference", "table_6_1", "tables_6_2_6_3", "tables_6_4_6_5", "table_6_5", "table_6_6",
+                     "figure_6_12"}
+
+
+def test_table_6_5_is_timed_in_the_haptic_loop_at_both_tolerances(quick):
+    rows = quick[0]["table_6_5"]
+    assert {row["rtol"] for row in rows} == set(experiment.TIMING_TOLERANCES)
+    for row in rows:
+        assert row["converged"], row["reason"]
+        assert row["rearrangements"] == row["updates"]  # one solve per update (§6.7)
+        assert row["update_rate_hz"] == pytest.approx(row["rearrangements"] / row["cpu_seconds"])
+    by = {(row["rtol"], row["speed"]): row["mean_iterations"] for row in rows}
+    for speed in {row["speed"] for row in rows}:  # the looser ε needs fewer CG iterations
+        assert by[(experiment.THESIS_CG_TOLERANCE, speed)] < by[(experiment.ISSUE_TOLERANCE, speed)]
+
+
+def test_the_table_6_5_section_is_replaced_alone():
+    page = "# page\n\n## Table 6.4: x\n\nfour\n\n## Table 6.5: timings\n\nold\n\n## Table 6.6: y\n\nsix\n"
+    new = experiment.replace_table_6_5(page, ["## Table 6.5: timings", "", "new", ""])
+    assert new == "# page\n\n## Table 6.4: x\n\nfour\n\n## Table 6.5: timings\n\nnew\n\n## Table 6.6: y\n\nsix\n"
