@@ -52,19 +52,7 @@ def insert(h_ref, speed, rtol, args):
 
 
 def row(h_ref, speed, rtol, args):
-    if args.loop == "thesis" and args.method == "cg":
-        result = haptic_row(h_ref, speed, rtol)  # as the results page times it
-    else:
-        report, cpu, _, cells = insert(h_ref, speed, rtol, args)
-        result = {"h_ref": h_ref, "speed": speed, "rtol": rtol, "cells": cells, "updates": report.updates,
-                  "rearrangements": report.rearrangements, "cpu_seconds": cpu,
-                  "update_rate_hz": report.rearrangements / cpu, "mean_iterations": report.mean_iterations,
-                  "max_iterations": report.max_iterations, "converged": report.converged, "reason": report.reason}
-        t_cpu, t_rearrangements, t_rate, t_mean, t_max = THESIS_TABLE_6_5[h_ref][speed]
-        result.update({"thesis_cpu_seconds": t_cpu, "thesis_rearrangements": t_rearrangements,
-                       "thesis_update_rate_hz": t_rate, "thesis_mean_iterations": t_mean,
-                       "thesis_max_iterations": t_max, "rate_ratio": result["update_rate_hz"] / t_rate})
-    r = result
+    r = haptic_row(h_ref, speed, rtol, method=args.method, solves_per_update=1 if args.loop == "thesis" else None)
     state = "" if r["converged"] else f"  NOT converged: {r['reason']}"
     goal = UPDATE_RATE_GOAL * r["thesis_update_rate_hz"]
     print(f"{rtol:<6g} h{h_ref:<3} {speed:>5.2f} {r['updates']:>7} {r['cells']:>6} {r['cpu_seconds']:>7.3f} "
@@ -72,7 +60,7 @@ def row(h_ref, speed, rtol, args):
           f"{r['thesis_cpu_seconds']:>6.2f} {r['thesis_rearrangements']:>7} {r['thesis_update_rate_hz']:>7.1f} "
           f"{r['thesis_mean_iterations']:>7.2f} {r['thesis_max_iterations']:>6} | {r['rate_ratio']:>6.1f} "
           f"{goal:>7.0f}{state}", flush=True)
-    return result
+    return r
 
 
 def summary(rows):

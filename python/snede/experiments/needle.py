@@ -374,13 +374,16 @@ def insertion_rows(settings: Settings, reference_points) -> tuple[list[dict], di
 
 
 # --- Table 6.6 ------------------------------------------------------------------------------
-def haptic_row(h_ref: int, speed: float, rtol: float, h_start: int = 3) -> dict:
+def haptic_row(h_ref: int, speed: float, rtol: float, h_start: int = 3, *, method: str = "cg",
+               solves_per_update: int | None = 1) -> dict:
     """Table 6.5's insertion to 70 mm in the thesis's haptic loop (§6.7, §6.8.5): one solve and
     one rearrangement per update, pending rearrangements carried into the next update, and at
-    70 mm updates in place until no node changes state. CPU seconds of this process over the
-    insertion; the update rate is rearrangements (solves) per CPU second, as the thesis's."""
+    70 mm updates in place until no node changes state (solves_per_update=None: every update
+    relaxes until settled). CPU seconds of this process over the insertion; the update rate is
+    rearrangements (solves) per CPU second, as the thesis's."""
     body = slab_body(h_start)
-    needle = needle_for(body, h_ref, rtol=rtol, round_tolerance=ROUND_TOLERANCE, solves_per_update=1)
+    needle = needle_for(body, h_ref, method=method, rtol=rtol, round_tolerance=ROUND_TOLERANCE,
+                        solves_per_update=solves_per_update)
     cpu = time.process_time()
     report = needle.insert(DEPTH, speed * h(h_ref))
     cpu = time.process_time() - cpu
