@@ -73,8 +73,10 @@ class KuhnGrid {
 }  // namespace
 
 void GridMultigrid::require_valid_width(double grid_width) {
-  if (!(grid_width > 0) || !std::isfinite(grid_width))
-    throw std::invalid_argument("mg_grid_width must be positive (vertex spacings), got " + std::to_string(grid_width));
+  // Narrower than a vertex spacing, the grid has more nodes than the mesh has vertices.
+  if (!(grid_width >= 1) || !std::isfinite(grid_width))
+    throw std::invalid_argument("mg_grid_width must be at least 1 (vertex spacings; a finer grid has more unknowns "
+                                "than the mesh), got " + std::to_string(grid_width));
 }
 
 GridMultigrid::GridMultigrid(Model& fine, double grid_width)

@@ -28,7 +28,7 @@ class GridMultigrid final : public GalerkinMultigrid {
   // benchmarks/interactive_cut.py on the block and the liver; on a mesh refined along a needle's
   // shaft, 3 mean edge lengths made a coarse level larger than the fine one (needle3d_rates.py).
   static constexpr double default_grid_width = 4.0;
-  // Throws std::invalid_argument naming mg_grid_width unless `grid_width` is positive and finite.
+  // Throws std::invalid_argument naming mg_grid_width unless `grid_width` is finite and ≥ 1.
   static void require_valid_width(double grid_width);
 
   const char* source() const override { return "grid"; }

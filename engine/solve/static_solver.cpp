@@ -115,8 +115,11 @@ StaticSolver::StaticSolver(Model& model, StaticOptions options, const Refinement
   create_objects();  // on a bad option the handles release what was made
 }
 
-StaticSolver::~StaticSolver() {
-  // A petsc4py handle may outlive this solver: leave its callbacks without a context.
+StaticSolver::~StaticSolver() { leave_solver_objects(); }
+
+void StaticSolver::leave_solver_objects() noexcept {
+  // A petsc4py handle may outlive this solver or its objects: leave its callbacks without a
+  // context.
   constexpr const char* owner = "StaticSolver";
   if (snes_) {
     SNESSetApplicationContext(snes_, nullptr);  // the line searches find their solver here
@@ -132,6 +135,15 @@ StaticSolver::~StaticSolver() {
         line_search, [](SNESLineSearch, Vec, Vec, PetscBool*, void*) { return orphaned_callback_error(owner); }, nullptr);
   }
   if (ksp_) KSPSetConvergenceTest(ksp_, ksp_converged_callback, nullptr, nullptr);
+  KSP inner = ksp_;
+  if (!inner && snes_) SNESGetKSP(snes_, &inner);
+  if (!inner) return;
+  // Newton's Eisenstat–Walker hooks on its KSP point to the SNES, and multigrid levels' operators
+  // (bisection levels' shells) to models this solver owns.
+  KSPSetPreSolve(inner, nullptr, nullptr);
+  KSPSetPostSolve(inner, nullptr, nullptr);
+  PC pc = nullptr;
+  if (KSPGetPC(inner, &pc) == 0) PCSetType(pc, PCNONE);
 }
 
 KSP StaticSolver::ksp() const {
@@ -143,7 +155,7 @@ KSP StaticSolver::ksp() const {
 
 void StaticSolver::create_objects() {
   generation_ = model_.generation();
-  build_multigrid();  // before the operators: Galerkin levels need the assembled tangent
+  if (!multigrid_) build_multigrid();  // before the operators: Galerkin levels need the assembled tangent
   SNEDE_PETSC(VecDuplicate(model_.displacement(), residual_.out()));
   const char* prefix = options_.options_prefix.c_str();
   if (options_.method == StaticMethod::linear_cg) {
@@ -232,26 +244,14 @@ void StaticSolver::create_objects() {
 }
 
 void StaticSolver::follow_mesh_changes() {
-  const bool resized = generation_ != model_.generation();
   // A needle's refinement grows a mesh of a few hundred cells, where "auto" chose no
-  // preconditioner, past the size where multigrid pays: choose again, with solver objects made
-  // afresh for the new choice.
-  if (resized && automatic_) {
-    const std::string chosen = automatic_preconditioner(model_, options_.method);
-    if (chosen != pc_type_) {
-      pc_type_ = chosen;
-      if (option_database_.string_option(options_.options_prefix + "pc_type"))
-        option_database_.set_string_option(options_.options_prefix + "pc_type", pc_type_);
-      needs_matrix_ = pc_needs_matrix_;  // false: the automatic choices are none and mg
-      assembled_.reset();
-      multigrid_.reset();
-      preconditioner_filled_ = false;
-      ksp_.reset();
-      snes_.reset();
-      create_objects();
-      return;
-    }
+  // preconditioner, past the size where multigrid pays (and collapses or removed pieces may
+  // shrink one): choose again, with solver objects made afresh for the new choice.
+  if (automatic_ && automatic_preconditioner(model_, options_.method) != pc_type_) {
+    choose_preconditioner_again();
+    return;
   }
+  const bool resized = generation_ != model_.generation();
   const bool stale_matrix = needs_matrix_ && (!assembled_ || !assembled_->matches(model_));
   const bool stale_multigrid = multigrid_ && !multigrid_->matches(model_);
   if (!resized && !stale_matrix && !stale_multigrid) return;
@@ -391,6 +391,31 @@ void StaticSolver::build_multigrid() {
                                   " levels (-" + options_.options_prefix + "mg_coarsening chooses)");
   needs_matrix_ = pc_needs_matrix_ || multigrid_->needs_assembled_tangent();
   ++multigrid_builds_;
+}
+
+void StaticSolver::choose_preconditioner_again() {
+  const std::string previous = pc_type_;
+  pc_type_ = automatic_preconditioner(model_, options_.method);
+  // The levels are made before the solver's objects are replaced: an option they refuse (the
+  // -<prefix>mg_ options are checked only once mg is chosen) leaves the solver as it was, and
+  // the next solve refuses it again.
+  needs_matrix_ = pc_needs_matrix_;  // false: the automatic choices are none and mg
+  multigrid_.reset();
+  try {
+    build_multigrid();  // sets needs_matrix_ for Galerkin levels
+  } catch (...) {
+    pc_type_ = previous;
+    multigrid_.reset();
+    throw;
+  }
+  if (option_database_.string_option(options_.options_prefix + "pc_type"))
+    option_database_.set_string_option(options_.options_prefix + "pc_type", pc_type_);
+  assembled_.reset();
+  preconditioner_filled_ = false;
+  leave_solver_objects();
+  ksp_.reset();
+  snes_.reset();
+  create_objects();
 }
 
 double StaticSolver::number_option(const std::string& name, double fallback) const {

@@ -91,6 +91,11 @@ class StaticSolver {
   // After a mesh change: new vectors if the size changed (same solver objects, so a user's
   // handle and options survive), a new assembled tangent if its sparsity is out of date.
   void follow_mesh_changes();
+  // "auto" after the mesh grew or shrank past multigrid_from_cells: the other choice, with new
+  // solver objects (the old ones left to any handle that holds them).
+  void choose_preconditioner_again();
+  // Leaves the KSP/SNES without callbacks into this solver, for handles that outlive it.
+  void leave_solver_objects() noexcept;
   // The matrix the PC is built from: the shell, or an assembled tangent for the current mesh.
   Mat preconditioning_matrix();
   // PC "mg": the levels for the current mesh (bisection when the hierarchy gives them, else a

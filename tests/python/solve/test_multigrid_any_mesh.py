@@ -257,7 +257,7 @@ def test_the_grid_width_set_on_a_bisected_mesh_applies_to_the_grid_levels_after_
     assert coarse_unknowns[2.0] > 2 * coarse_unknowns[4.0], coarse_unknowns
     mesh = snede.meshing.box((0.4, 0.1, 0.1), (4, 1, 1))
     mesh.refine_uniform(6)
-    with pytest.raises(ValueError, match="mg_grid_width must be positive"):
+    with pytest.raises(ValueError, match="mg_grid_width must be at least 1"):
         snede.StaticSolver(held_body(mesh), "cg", preconditioner="mg", petsc_options={"mg_grid_width": -1})
     with pytest.raises(ValueError, match="mg_grid_width applies to grid levels; these are bisection"):
         snede.StaticSolver(held_body(mesh), "cg", preconditioner="mg",
@@ -330,7 +330,8 @@ def test_bad_coarsening_options_are_refused_naming_them(gmsh_cylinder):
                              ({**aggregation, "mg_aggregate_width": -1}, "mg_aggregate_width must be positive"),
                              ({"mg_aggregate_width": 3}, "mg_aggregate_width applies to aggregation levels; these are grid"),
                              ({**aggregation, "mg_grid_width": 3}, "mg_grid_width applies to grid levels; these are aggregation"),
-                             ({"mg_grid_width": 0}, "mg_grid_width must be positive"),
+                             ({"mg_grid_width": 0}, "mg_grid_width must be at least 1"),
+                             ({"mg_grid_width": 0.5}, "mg_grid_width must be at least 1"),
                              ({"mg_coarsening": "grid", "pc_mg_levels": 3}, "grid coarsening gives 2 levels")):
         with pytest.raises(ValueError, match=message):
             snede.StaticSolver(body, "cg", preconditioner="mg", petsc_options=options)
