@@ -150,6 +150,12 @@ void bind_solve(py::module_& m) {
       .def_property_readonly("preconditioner_fills", &StaticSolver::preconditioner_fills)
       .def_property_readonly("multigrid_builds", &StaticSolver::multigrid_builds)
       .def("solve", &StaticSolver::solve)
+      .def(
+          "use_bisection",
+          [](StaticSolver& solver, const Bisection* bisection) {
+            solver.use_hierarchy(bisection ? &bisection->hierarchy() : nullptr);
+          },
+          py::arg("bisection"), py::keep_alive<1, 2>())
       .def_property_readonly("ksp", [](const StaticSolver& s) { return to_petsc4py(s.ksp()); })
       .def_property_readonly("snes", [](const StaticSolver& s) {
         return s.snes() ? to_petsc4py(s.snes()) : py::object(py::none());

@@ -85,6 +85,9 @@ class StaticSolver {
   // with their interpolations) since the solver was made: after a mesh change, or a change of
   // constraints the levels could not take over in place.
   std::size_t multigrid_builds() const { return multigrid_builds_; }
+  // The mesh's bisection hierarchy, once it has one (a mesh first refined after the solver was
+  // made): the next levels, made after that refinement, coarsen along it.
+  void use_hierarchy(const RefinementHierarchy* hierarchy) { hierarchy_ = hierarchy; }
 
  private:
   void create_objects();

@@ -137,6 +137,8 @@ class StaticSolver(RunsOnRanks):
     def solve(self) -> SolveResult:
         if self._distributed is not None:
             return self._solve_distributed()
+        # A mesh refined for the first time after this solver was made has a hierarchy now.
+        self._impl.use_bisection(self.body.mesh._bisection_if_any())
         return SolveResult._from_engine(self._impl.solve())
 
     def _solve_distributed(self) -> SolveResult:
