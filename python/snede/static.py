@@ -57,17 +57,21 @@ class StaticSolver(RunsOnRanks):
       moving displacement), until a solve needs more than ``-static_mg_refresh_ratio`` (default
       1.5; 0: new levels for every solve) times the CG iterations per Newton iteration of the
       solve that built them, or fails; ``-static_mg_coarsening aggregation`` takes rigid-motion
-      aggregates instead. Levels are made anew at the first solve after a mesh or constraint
-      change; ``follow_seconds`` says what that cost, ``preconditioner_fills`` how often the
-      preconditioner was filled. ``multigrid_source`` says which kind is in use
+      aggregates instead. Levels are made anew at the first solve after a mesh change (after a
+      change of constraints alone, Newton's grid or aggregation levels are refilled instead);
+      ``follow_seconds`` says what that cost, ``preconditioner_fills`` how often the
+      preconditioner was filled, ``multigrid_builds`` how often levels were made. ``multigrid_source`` says which kind is in use
       (``"bisection"``, ``"grid"``, ``"aggregation"``), ``multigrid_levels`` and
       ``multigrid_unknowns`` the levels' sizes; ``-static_mg_coarsening`` chooses (default
-      ``auto``: bisection when it applies, else grid), ``-static_mg_grid_width``,
+      ``auto``: bisection when it applies and its coarsest level is at most a sixteenth of
+      the mesh or 1 000 unknowns, else grid), ``-static_mg_grid_width`` (in vertex spacings,
+      (volume / vertices)^(1/d), at least 1, default 4),
       ``-static_mg_aggregate_width`` and ``-static_mg_aggregation_smoothing`` tune the coarse
       spaces. ``-static_mg_levels_ksp_type``, ``-static_pc_mg_levels`` and the other
       ``-static_mg_*`` options of PETSc's PCMG tune it (docs/results/interactive.md).
       ``"auto"``: ``"mg"`` for cg and newton on meshes of 1 000 cells or more, membranes
-      included (where it measured faster than no preconditioner), else ``"none"``.
+      included (where it measured faster than no preconditioner), else ``"none"``; chosen
+      again when the mesh crosses that size (a needle's refinement grows it).
       On a membrane every preconditioner assembled from element matrices takes each element's
       positive part (compressed, wrinkling elements are indefinite). None (default):
       ``-static_pc_type`` if given, else ``"auto"``. ``-static_pc_type`` on the command line wins
