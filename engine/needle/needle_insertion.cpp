@@ -15,6 +15,14 @@
 namespace snede {
 namespace {
 
+// Where the shaft first crosses the body's boundary, along it: the nearest boundary crossing.
+std::optional<double> first_boundary_crossing(const std::vector<ShaftCrossing>& crossings) {
+  std::optional<double> first;
+  for (const ShaftCrossing& c : crossings)
+    if (c.on_boundary && (!first || c.s < *first)) first = c.s;
+  return first;
+}
+
 std::string point_text(const Point& x, int dim) {
   std::ostringstream text;
   text << "(";
@@ -120,10 +128,7 @@ std::optional<double> NeedleInsertion::first_contact() const {
   double reach = 0;
   for (VertexId v = 0; v < mesh.n_points(); ++v)
     if (mesh.is_vertex(v)) reach = std::max(reach, distance(deformed_point(mesh, u, v), entry_));
-  std::optional<double> first;
-  for (const ShaftCrossing& c : shaft_crossings(mesh, u, entry_, point_at(2 * reach)))
-    if (c.on_boundary && (!first || c.s < *first)) first = c.s;
-  return first;
+  return first_boundary_crossing(shaft_crossings(mesh, u, entry_, point_at(2 * reach)));
 }
 
 double NeedleInsertion::surface_depth() const {
@@ -242,14 +247,8 @@ int NeedleInsertion::intercept_nodes() {
   const ScopedEvent timed(event);
   const std::vector<double> u = vec_values(model_.displacement());
   const std::vector<ShaftCrossing> crossings = shaft_crossings(model_.body().mesh(), u, entry_, tip());
-  double body_entry = depth_;
-  bool on_boundary = false;
-  for (const ShaftCrossing& c : crossings)
-    if (c.on_boundary && c.s < body_entry) {
-      body_entry = c.s;
-      on_boundary = true;
-    }
-  body_entry_ = on_boundary ? body_entry : 0.0;
+  const std::optional<double> body_entry = first_boundary_crossing(crossings);
+  body_entry_ = body_entry && *body_entry < depth_ ? *body_entry : 0.0;
   int added = 0;
   for (const ShaftCrossing& c : crossings) {
     const VertexId v = c.near;
