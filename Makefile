@@ -14,8 +14,8 @@ meshes: setup
 	@.venv/bin/python -m snede.canonical_meshes
 
 benchmark: setup
-	@.venv/bin/python benchmarks/connectivity_build.py
-	@.venv/bin/python benchmarks/fem_throughput.py
+	@.venv/bin/python studies/benchmarks/connectivity_build.py
+	@.venv/bin/python studies/benchmarks/fem_throughput.py
 
 clean:
 	rm -rf build

@@ -15,7 +15,7 @@ if [ $cpp_status -eq 0 ]; then
   cpp_status=${PIPESTATUS[0]}
 fi
 
-.venv/bin/python -m pytest -q tests/python tests/mpi 2>&1 | tee build/pytest.log
+.venv/bin/python -m pytest -q tests/python tests/studies tests/mpi 2>&1 | tee build/pytest.log
 py_status=${PIPESTATUS[0]}
 
 mpi_status=0

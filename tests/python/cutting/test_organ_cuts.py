@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 import snede
-from snede.experiments import organ_cuts
+from studies.experiments import organ_cuts
 
 
 @pytest.fixture(scope="module")

@@ -10,7 +10,7 @@ import pytest
 
 from surface_checks import check_surface, mean_edge
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[3] / "benchmarks"))
+sys.path.insert(0, str(Path(__file__).resolve().parents[3] / "studies" / "benchmarks"))
 try:
     from surface_incisions import LEANS, advancing_moves, coarse_box, leaning_scalpels, liver2_surface, random_sweeps, \
         tips_left_behind

@@ -16,7 +16,7 @@ THICKNESS, DENSITY = 0.001, 1000.0
 
 
 def organ_mesh(name: str, target_tets: int) -> snede.Mesh:
-    sys.path.insert(0, str(Path(__file__).resolve().parents[3] / "benchmarks"))
+    sys.path.insert(0, str(Path(__file__).resolve().parents[3] / "studies" / "benchmarks"))
     try:
         from organ_meshes import organ_mesh as make
     finally:

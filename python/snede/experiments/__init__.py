@@ -1,3 +1,0 @@
-"""Experiments that regenerate the tables and figures under ``docs/results/``: each module
-runs with ``python -m snede.experiments.<name> [--quick] [--out DIR]`` and exposes
-``main(argv)`` for tests."""
