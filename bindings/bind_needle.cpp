@@ -1,5 +1,6 @@
 #include "bindings.hpp"
 #include "needle/needle_insertion.hpp"
+#include "record_binding.hpp"
 
 #include <pybind11/stl.h>
 
@@ -19,22 +20,10 @@ std::vector<double> point_vector(const Point& x, int dim) { return {x.begin(), x
 
 std::unique_ptr<NeedleInsertion> make_needle(Model& model, Bisection* bisection, const DoubleArray& entry,
                                              const DoubleArray& direction, const FrictionProfile& friction,
-                                             double static_factor, std::optional<double> h_ref, double radius,
-                                             int max_rearrangements, int solves_per_update, bool extrapolate,
-                                             const std::string& method, double rtol, const std::string& criterion,
-                                             double round_tolerance, int max_iterations, const std::string& prefix,
-                                             const OptionList& petsc_options) {
-  NeedleOptions options;
-  options.static_factor = static_factor;
-  options.h_ref = h_ref;
-  options.radius = radius;
-  options.max_rearrangements = max_rearrangements;
-  options.solves_per_update = solves_per_update;
-  options.extrapolate = extrapolate;
-  return std::make_unique<NeedleInsertion>(
-      model, bisection, point_of(entry, model.dim(), "entry"), point_of(direction, model.dim(), "direction"), friction,
-      options,
-      static_options(method, rtol, criterion, round_tolerance, max_iterations, prefix, petsc_options));
+                                             const NeedleOptions& options, const StaticOptions& solver_options) {
+  return std::make_unique<NeedleInsertion>(model, bisection, point_of(entry, model.dim(), "entry"),
+                                           point_of(direction, model.dim(), "direction"), friction, options,
+                                           solver_options);
 }
 
 py::array_t<double> node_field(const NeedleInsertion& needle, double NeedleNode::*field) {
@@ -54,25 +43,21 @@ void bind_needle(py::module_& m) {
       .def_property_readonly("distances", &FrictionProfile::distances)
       .def_property_readonly("force_per_length", &FrictionProfile::force_per_length);
 
-  py::class_<NeedleStepReport>(m, "NeedleStepReport")
-      .def_readonly("rearrangements", &NeedleStepReport::rearrangements)
-      .def_readonly("slipped", &NeedleStepReport::slipped)
-      .def_readonly("stuck", &NeedleStepReport::stuck)
-      .def_readonly("released", &NeedleStepReport::released)
-      .def_readonly("intercepted", &NeedleStepReport::intercepted)
-      .def_readonly("cells_split", &NeedleStepReport::cells_split)
-      .def_readonly("solver_iterations", &NeedleStepReport::solver_iterations)
-      .def_readonly("max_solver_iterations", &NeedleStepReport::max_solver_iterations)
-      .def_readonly("converged", &NeedleStepReport::converged)
-      .def_readonly("settled", &NeedleStepReport::settled)
-      .def_readonly("reason", &NeedleStepReport::reason)
-      .def_readonly("seconds", &NeedleStepReport::seconds);
+  bind_record<NeedleOptions>(m, "NeedleOptions",
+                             "A needle insertion's settings (snede.NeedleInsertion documents each); the engine's struct.");
+
+  bind_record<NeedleStepReport>(
+      m, "NeedleStepReport",
+      "One update (§6.7). ``rearrangements`` counts the solves (each followed by a rearrangement of the\n"
+      "needle nodes); ``slipped``/``stuck``/``released``/``intercepted`` count node state changes;\n"
+      "``converged`` is False if a solve did not converge (``reason`` ``SOLVE_<PETSc reason>``) or the\n"
+      "rearrangements did not settle within ``max_rearrangements`` (``DIVERGED_REARRANGEMENT_LIMIT``).\n"
+      "``settled`` is False when node states still had to change at the end (with ``solves_per_update``,\n"
+      "carried into the next update).");
 
   py::class_<NeedleInsertion>(m, "NeedleInsertion")
       .def(py::init(&make_needle), py::arg("model"), py::arg("bisection"), py::arg("entry"), py::arg("direction"),
-           py::arg("friction"), py::arg("static_factor"), py::arg("h_ref"), py::arg("radius"), py::arg("max_rearrangements"), py::arg("solves_per_update"), py::arg("extrapolate"),
-           py::arg("method"), py::arg("rtol"), py::arg("criterion"), py::arg("round_tolerance"),
-           py::arg("max_iterations"), py::arg("options_prefix"), py::arg("petsc_options"), py::keep_alive<1, 2>(),
+           py::arg("friction"), py::arg("options"), py::arg("solver_options"), py::keep_alive<1, 2>(),
            py::keep_alive<1, 3>())
       .def("advance", &NeedleInsertion::advance, py::arg("distance"))
       .def("settle", &NeedleInsertion::settle)

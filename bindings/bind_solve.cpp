@@ -2,6 +2,7 @@
 #include "core/error.hpp"
 #include "core/petsc_util.hpp"
 #include "petsc4py_interop.hpp"
+#include "record_binding.hpp"
 #include "solve/model.hpp"
 #include "solve/solve_result.hpp"
 #include "solve/static_solver.hpp"
@@ -22,16 +23,6 @@ py::array_t<double> reactions_of(Model& model) {
   SNEDE_PETSC(VecDuplicate(model.displacement(), R.out()));
   model.reaction_forces(model.displacement(), R);
   return vec_to_array(R, model.dim());
-}
-
-std::unique_ptr<StaticSolver> make_static_solver(Model& model, const std::string& method, double rtol,
-                                                 const std::string& criterion, double round_tolerance,
-                                                 int max_iterations, const std::string& prefix,
-                                                 const OptionList& petsc_options, const std::string& preconditioner,
-                                                 const Bisection* bisection) {
-  StaticOptions options = static_options(method, rtol, criterion, round_tolerance, max_iterations, prefix, petsc_options);
-  options.preconditioner = preconditioner;
-  return std::make_unique<StaticSolver>(model, std::move(options), bisection ? &bisection->hierarchy() : nullptr);
 }
 
 // The shell at u: a petsc4py Mat sharing the model's (it applies J at the last point set).
@@ -72,18 +63,16 @@ StaticOptions static_options(const std::string& method, double rtol, const std::
 }
 
 void bind_solve(py::module_& m) {
-  py::class_<SolveResult>(m, "EngineSolveResult")
-      .def_readonly("converged", &SolveResult::converged)
-      .def_readonly("reason", &SolveResult::reason)
-      .def_readonly("iterations", &SolveResult::iterations)
-      .def_readonly("linear_iterations", &SolveResult::linear_iterations)
-      .def_readonly("residual_norm", &SolveResult::residual_norm)
-      .def_readonly("initial_residual_norm", &SolveResult::initial_residual_norm)
-      .def_readonly("tolerance", &SolveResult::tolerance)
-      .def_readonly("energy", &SolveResult::energy)
-      .def_readonly("seconds", &SolveResult::seconds)
-      .def_readonly("flops", &SolveResult::flops)
-      .def_readonly("residual_history", &SolveResult::residual_history);
+  bind_record<SolveResult>(
+      m, "SolveResult",
+      "``converged`` is False whenever the final state is not trustworthy: PETSc reported divergence,\n"
+      "the iteration limit was hit, or the state holds NaN/Inf or an inverted element of a material\n"
+      "that forbids inversion. ``reason`` is PETSc's converged reason (e.g. ``CONVERGED_FNORM_RELATIVE``,\n"
+      "``DIVERGED_LINE_SEARCH``) or snede's own (``DIVERGED_INVERTED_ELEMENTS``, ``DIVERGED_NONFINITE_STATE``,\n"
+      "``DIVERGED_BLOW_UP``). ``seconds`` is the solve's wall time; ``flops`` counts the floating-point\n"
+      "operations PETSc logged during the solve on this rank, in FLOP (``str(result)`` shows them in\n"
+      "MFLOP, 10⁶ FLOP).")
+      .def("__str__", &summary);
   py::class_<Model>(m, "Model")
       .def(py::init<ElasticBody&>(), py::arg("body"), py::keep_alive<1, 2>())
       .def("fix", [](Model& s, const IndexArray& v, const DoubleArray& values) { s.fix(vertex_ids(v), view(values)); })
@@ -138,10 +127,34 @@ void bind_solve(py::module_& m) {
       .def("tangent_operator", &tangent_operator_at, py::arg("u"))
       .def("assemble_tangent", &assembled_tangent_at, py::arg("u"), py::arg("format"));
 
+  const StaticOptions defaults;
+  py::class_<StaticOptions>(m, "StaticOptions",
+                            "A static solver's settings (snede.StaticSolver documents each); the engine's struct.")
+      .def(py::init([](const std::string& method, double rtol, const std::string& criterion, double round_tolerance,
+                       int max_iterations, const std::string& prefix, const OptionList& petsc_options,
+                       const std::string& preconditioner) {
+             StaticOptions options =
+                 static_options(method, rtol, criterion, round_tolerance, max_iterations, prefix, petsc_options);
+             options.preconditioner = preconditioner;
+             return options;
+           }),
+           py::kw_only(), py::arg("method") = "newton", py::arg("rtol") = defaults.stopping.rtol,
+           py::arg("criterion") = "6.9", py::arg("round_tolerance") = defaults.stopping.round_tolerance,
+           py::arg("max_iterations") = defaults.max_iterations, py::arg("options_prefix") = defaults.options_prefix,
+           py::arg("petsc_options") = OptionList{}, py::arg("preconditioner") = defaults.preconditioner)
+      .def_property_readonly("rtol", [](const StaticOptions& o) { return o.stopping.rtol; })
+      .def_property_readonly("round_tolerance", [](const StaticOptions& o) { return o.stopping.round_tolerance; })
+      .def_readonly("max_iterations", &StaticOptions::max_iterations)
+      .def_readonly("options_prefix", &StaticOptions::options_prefix)
+      .def_readonly("petsc_options", &StaticOptions::petsc_options)
+      .def_readonly("preconditioner", &StaticOptions::preconditioner);
+
   py::class_<StaticSolver>(m, "StaticSolver")
-      .def(py::init(&make_static_solver), py::arg("model"), py::arg("method"), py::arg("rtol"), py::arg("criterion"),
-           py::arg("round_tolerance"), py::arg("max_iterations"), py::arg("options_prefix"), py::arg("petsc_options"),
-           py::arg("preconditioner"), py::arg("bisection"), py::keep_alive<1, 2>(), py::keep_alive<1, 11>())
+      .def(py::init([](Model& model, StaticOptions options, const Bisection* bisection) {
+             return std::make_unique<StaticSolver>(model, std::move(options),
+                                                   bisection ? &bisection->hierarchy() : nullptr);
+           }),
+           py::arg("model"), py::arg("options"), py::arg("bisection"), py::keep_alive<1, 2>(), py::keep_alive<1, 4>())
       .def_property_readonly("preconditioner", &StaticSolver::preconditioner)
       .def_property_readonly("multigrid_levels", &StaticSolver::multigrid_levels)
       .def_property_readonly("multigrid_unknowns", &StaticSolver::multigrid_unknowns)

@@ -68,6 +68,18 @@ struct NeedleOptions {
   // per unit of needle travel (a linear predictor) instead of from the last state.
   bool extrapolate = false;
   std::string friction_channel = "friction";
+
+  // Every field with its name: the one list that bindings and printing read.
+  template <class Visit>
+  static void visit_fields(Visit&& visit) {
+    visit("static_factor", &NeedleOptions::static_factor);
+    visit("h_ref", &NeedleOptions::h_ref);
+    visit("radius", &NeedleOptions::radius);
+    visit("max_rearrangements", &NeedleOptions::max_rearrangements);
+    visit("solves_per_update", &NeedleOptions::solves_per_update);
+    visit("extrapolate", &NeedleOptions::extrapolate);
+    visit("friction_channel", &NeedleOptions::friction_channel);
+  }
 };
 
 struct NeedleStepReport {
@@ -80,6 +92,23 @@ struct NeedleStepReport {
   bool settled = true;           // no needle node changes state at the final solution
   std::string reason = "CONVERGED";
   double seconds = 0;
+
+  // Every field with its name: the one list that bindings and printing read.
+  template <class Visit>
+  static void visit_fields(Visit&& visit) {
+    visit("rearrangements", &NeedleStepReport::rearrangements);
+    visit("solver_iterations", &NeedleStepReport::solver_iterations);
+    visit("max_solver_iterations", &NeedleStepReport::max_solver_iterations);
+    visit("slipped", &NeedleStepReport::slipped);
+    visit("stuck", &NeedleStepReport::stuck);
+    visit("released", &NeedleStepReport::released);
+    visit("intercepted", &NeedleStepReport::intercepted);
+    visit("cells_split", &NeedleStepReport::cells_split);
+    visit("converged", &NeedleStepReport::converged);
+    visit("settled", &NeedleStepReport::settled);
+    visit("reason", &NeedleStepReport::reason);
+    visit("seconds", &NeedleStepReport::seconds);
+  }
 };
 
 class NeedleInsertion : public ConnectivityWatcher {

@@ -19,7 +19,7 @@ from snede._snede import (  # noqa: F401
 )
 from snede.mesh import Mesh, MeshQuality  # noqa: F401
 from snede.body import Body, LockingWarning, formulations  # noqa: F401
-from snede.result import SolveResult  # noqa: F401
+from snede._snede import SolveResult  # noqa: F401
 from snede.static import StaticSolver  # noqa: F401
 from snede.dynamics import DynamicRelaxation  # noqa: F401
 from snede.needle import FrictionProfile, NeedleInsertion  # noqa: F401

@@ -22,7 +22,7 @@ import numpy as np
 
 from snede import _checks, _snede
 from snede.mesh import Mesh
-from snede.result import SolveResult
+from snede._snede import SolveResult
 
 MATERIALS = (_snede.LinearElastic, _snede.StVenantKirchhoff, _snede.NeoHookean, _snede.VerondaWestmann)
 
@@ -151,7 +151,7 @@ class DistributedStatic:
         arguments = agreed(self.part.comm, lambda: (str(method), str(preconditioner), float(rtol),
                                                     _checks.count(max_iterations, "max_iterations"), str(options_prefix),
                                                     str(criterion), float(round_tolerance)))
-        return SolveResult._from_engine(self._impl.solve(*arguments))
+        return self._impl.solve(*arguments)
 
     def set_displacement(self, displacement) -> None:
         """Start the next solve (or relaxation) from ``displacement``, (n_global_vertices, dim) in
@@ -215,4 +215,4 @@ class DistributedRelaxation:
         """Steps until (6.9) or ``max_steps`` (``DIVERGED_MAX_IT``); a blow-up, NaN or an
         inverted element ends the run with that reason, not converged."""
         arguments = agreed(self.problem.part.comm, lambda: (float(rtol), _checks.count(max_steps, "max_steps")))
-        return SolveResult._from_engine(self._impl.run(*arguments))
+        return self._impl.run(*arguments)

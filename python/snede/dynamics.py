@@ -15,7 +15,7 @@ from snede import _checks, _snede
 from snede._petsc import option_list
 from snede.distributed import DistributedRelaxation
 from snede.distributed_body import DistributedBody, RunsOnRanks
-from snede.result import SolveResult
+from snede._snede import SolveResult
 
 
 class DynamicRelaxation(RunsOnRanks):
@@ -75,7 +75,7 @@ class DynamicRelaxation(RunsOnRanks):
     def step(self, n: int = 1) -> SolveResult:
         """Take ``n`` time steps. ``converged`` is False only on divergence (blow-up, NaN,
         inverted elements); ``residual_norm`` is ‖F(u)‖ at the final state."""
-        return SolveResult._from_engine(self._engine.step(_checks.count(n, "n")))
+        return self._engine.step(_checks.count(n, "n"))
 
     def run(self, rtol: float = 1e-3, max_steps: int = 100000) -> SolveResult:
         """Step until ‖F(u)‖ ≤ rtol·√(‖f_ext‖² + ‖f_react‖²) (criterion (6.9)), or
@@ -86,7 +86,7 @@ class DynamicRelaxation(RunsOnRanks):
             result = self._relaxation.run(rtol, max_steps)
             self._distributed.gather_into_body(self._problem)
             return result
-        return SolveResult._from_engine(self._impl.run(float(rtol), _checks.count(max_steps, "max_steps")))
+        return self._impl.run(float(rtol), _checks.count(max_steps, "max_steps"))
 
     def critical_time_step(self, flop_budget: float = 50e6, initial: float | None = None,
                            reduction: float = 0.15, min_steps: int = 200) -> float:

@@ -19,6 +19,7 @@ import numpy as np
 
 from snede import _checks, _snede
 from snede._petsc import option_list
+from snede._snede import NeedleStepReport
 
 
 class FrictionProfile:
@@ -62,34 +63,6 @@ class FrictionProfile:
 
     def __repr__(self) -> str:
         return f"FrictionProfile(distance_from_tip={self.distances.tolist()}, force_per_length={self.force_per_length.tolist()})"
-
-
-@dataclass
-class NeedleStepReport:
-    """One update (§6.7). ``rearrangements`` counts the solves (each followed by a
-    rearrangement of the needle nodes); ``slipped``/``stuck``/``released``/``intercepted``
-    count node state changes; ``converged`` is False if a solve did not converge (``reason``
-    ``SOLVE_<PETSc reason>``) or the rearrangements did not settle within
-    ``max_rearrangements`` (``DIVERGED_REARRANGEMENT_LIMIT``). ``settled`` is False when node
-    states still had to change at the end (with ``solves_per_update``, carried into the next
-    update)."""
-
-    rearrangements: int
-    solver_iterations: int
-    max_solver_iterations: int
-    slipped: int
-    stuck: int
-    released: int
-    intercepted: int
-    cells_split: int
-    converged: bool
-    settled: bool
-    reason: str
-    seconds: float
-
-    @classmethod
-    def _from_engine(cls, r) -> "NeedleStepReport":
-        return cls(**{name: getattr(r, name) for name in cls.__dataclass_fields__})
 
 
 @dataclass
@@ -182,22 +155,25 @@ class NeedleInsertion:
         self.body = body
         self.friction_profile = friction
         bisection = body.mesh._bisection() if h_ref is not None else None
-        self._impl = _snede.NeedleInsertion(
-            body._model, bisection, np.asarray(entry, dtype=np.float64), np.asarray(direction, dtype=np.float64),
-            friction._impl, float(static_factor), None if h_ref is None else float(h_ref), float(radius),
-            max_rearrangements,
-            solves_per_update, bool(extrapolate), method, float(rtol), criterion, float(round_tolerance), max_iterations, options_prefix,
-            option_list(petsc_options))
+        options = _snede.NeedleOptions(static_factor=float(static_factor), h_ref=None if h_ref is None else float(h_ref),
+                                       radius=float(radius), max_rearrangements=max_rearrangements,
+                                       solves_per_update=solves_per_update, extrapolate=bool(extrapolate))
+        solver_options = _snede.StaticOptions(method=method, rtol=float(rtol), criterion=criterion,
+                                              round_tolerance=float(round_tolerance), max_iterations=max_iterations,
+                                              options_prefix=options_prefix, petsc_options=option_list(petsc_options))
+        self._impl = _snede.NeedleInsertion(body._model, bisection, np.asarray(entry, dtype=np.float64),
+                                            np.asarray(direction, dtype=np.float64), friction._impl, options,
+                                            solver_options)
 
     def advance(self, distance: float) -> NeedleStepReport:
         """Move the needle ``distance`` (≥ 0) further in and relax (one update of §6.7)."""
         if not (np.isfinite(distance) and distance >= 0):
             raise ValueError(f"the needle advances by a non-negative, finite distance; got {distance}")
-        return NeedleStepReport._from_engine(self._impl.advance(float(distance)))
+        return self._impl.advance(float(distance))
 
     def settle(self) -> NeedleStepReport:
         """Relax and rearrange without moving the needle."""
-        return NeedleStepReport._from_engine(self._impl.settle())
+        return self._impl.settle()
 
     def insert(self, depth: float, step: float, progress=None) -> InsertionReport:
         """Advance in steps of ``step`` until the tip is ``depth`` from the entry point (the last

@@ -8,7 +8,7 @@ from __future__ import annotations
 from snede import _checks, _snede
 from snede._petsc import option_list
 from snede.distributed_body import DistributedBody, RunsOnRanks
-from snede.result import SolveResult
+from snede._snede import SolveResult
 
 METHODS = ("cg", "ncg", "newton")
 DISTRIBUTED_PRECONDITIONERS = (None, "none", "jacobi", "gamg", "bjacobi", "sor", "lu")
@@ -134,16 +134,18 @@ class StaticSolver(RunsOnRanks):
                                           round_tolerance)
             self._impl = None
             return
-        self._impl = _snede.StaticSolver(body._model, method, float(rtol), criterion, float(round_tolerance),
-                                         max_iterations, options_prefix, option_list(options), preconditioner or "",
-                                         body.mesh._bisection_if_any())
+        settings = _snede.StaticOptions(method=method, rtol=float(rtol), criterion=criterion,
+                                        round_tolerance=float(round_tolerance), max_iterations=max_iterations,
+                                        options_prefix=options_prefix, petsc_options=option_list(options),
+                                        preconditioner=preconditioner or "")
+        self._impl = _snede.StaticSolver(body._model, settings, body.mesh._bisection_if_any())
 
     def solve(self) -> SolveResult:
         if self._distributed is not None:
             return self._solve_distributed()
         # A mesh refined for the first time after this solver was made has a hierarchy now.
         self._impl.use_bisection(self.body.mesh._bisection_if_any())
-        return SolveResult._from_engine(self._impl.solve())
+        return self._impl.solve()
 
     def _solve_distributed(self) -> SolveResult:
         method, rtol, max_iterations, preconditioner, prefix, criterion, round_tolerance = self._distributed_settings

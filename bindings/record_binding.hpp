@@ -1,0 +1,85 @@
+// A report struct of the engine bound as a Python record, from the struct's one list of fields
+// (`Record::visit_fields`): keyword construction, read-write attributes, repr, equality,
+// pickling and, where the engine can combine two reports (`Record::add`), `+`. The engine's
+// structs are the records Python sees; nothing spells their fields a second time (issue 36).
+#pragma once
+
+#include <pybind11/stl.h>
+
+#include <string>
+#include <type_traits>
+
+#include "bindings.hpp"
+
+namespace snede::bindings {
+
+template <class Record>
+py::dict record_fields(const Record& record) {
+  py::dict values;
+  Record::visit_fields([&](const char* name, auto member) { values[name] = py::cast(record.*member); });
+  return values;
+}
+
+// The record from keyword values; a TypeError names an unknown field, as a dataclass's would.
+template <class Record>
+Record record_from(const char* type_name, const py::dict& values) {
+  Record record;
+  py::ssize_t used = 0;
+  Record::visit_fields([&](const char* name, auto member) {
+    if (!values.contains(name)) return;
+    using Field = std::remove_reference_t<decltype(record.*member)>;
+    try {
+      record.*member = values[name].template cast<Field>();
+    } catch (const py::cast_error&) {
+      throw py::type_error(std::string(type_name) + "(): " + name + " cannot be " +
+                           py::cast<std::string>(py::repr(values[name])));
+    }
+    ++used;
+  });
+  if (used == static_cast<py::ssize_t>(values.size())) return record;
+  for (const auto& [key, value] : values) {
+    bool known = false;
+    Record::visit_fields([&](const char* name, auto) { known = known || py::cast<std::string>(py::str(key)) == name; });
+    if (!known)
+      throw py::type_error(std::string(type_name) + "() got an unexpected keyword argument " + py::cast<std::string>(py::repr(key)));
+  }
+  return record;
+}
+
+template <class Record>
+py::class_<Record> bind_record(py::module_& m, const char* type_name, const char* doc) {
+  py::class_<Record> cls(m, type_name, doc);
+  cls.def(py::init([type_name](const py::kwargs& values) { return record_from<Record>(type_name, values); }));
+  Record::visit_fields([&](const char* name, auto member) { cls.def_readwrite(name, member); });
+  cls.def("__repr__", [type_name](const Record& record) {
+    std::string text = std::string(type_name) + "(";
+    const char* separator = "";
+    for (const auto& [name, value] : record_fields(record)) {
+      text += separator + py::cast<std::string>(name) + "=" + py::cast<std::string>(py::repr(value));
+      separator = ", ";
+    }
+    return text + ")";
+  });
+  cls.def(
+      "__eq__",
+      [](const Record& a, const py::object& other) {
+        if (!py::isinstance<Record>(other)) return false;
+        const Record& b = other.cast<const Record&>();
+        bool same = true;
+        Record::visit_fields([&](const char*, auto member) { same = same && a.*member == b.*member; });
+        return same;
+      },
+      py::is_operator());
+  cls.def(py::pickle([](const Record& record) { return record_fields(record); },
+                     [type_name](const py::dict& values) { return record_from<Record>(type_name, values); }));
+  if constexpr (requires(Record& a, const Record& b) { a.add(b); }) {
+    cls.def("__add__", [](const Record& a, const Record& b) {
+      Record sum = a;
+      sum.add(b);
+      return sum;
+    });
+  }
+  return cls;
+}
+
+}  // namespace snede::bindings
