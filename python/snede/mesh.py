@@ -466,13 +466,13 @@ class Mesh(MeshEdits):
         if not Path(path).exists():
             raise FileNotFoundError(f"no mesh file {path}")
         if Path(path).suffix.lower() in (".xdmf", ".xmf"):
-            from snede import output
+            from snede import series_files
 
-            if output._is_series(path):
-                steps = output._read(path, last_only=True)
+            if series_files.is_series(path):
+                steps = series_files.read_steps(path, cls, last_only=True)
                 if not steps:
                     raise ValueError(f"{path}: the series has no steps (yet): no mesh to read")
-                return steps[-1].mesh
+                return steps[-1][1]
 
         points, blocks, groups = mesh_files.read_blocks(Path(path))
         kind = "tetra" if "tetra" in blocks else "triangle"
