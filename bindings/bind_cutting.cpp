@@ -1,5 +1,6 @@
 #include "bindings.hpp"
 #include "cutting/tetrahedral_cutter.hpp"
+#include "solve/cut_model_adapter.hpp"
 
 #include <pybind11/stl.h>
 
@@ -16,7 +17,7 @@ std::unique_ptr<TetrahedralCutter> make_cutter(Mesh& mesh, Model* model, bool sn
   options.degeneracy.large_angle = large_angle;
   options.fix_free_pieces = fix_free_pieces;
   options.max_fragment_elements = max_fragment_elements;
-  return std::make_unique<TetrahedralCutter>(mesh, model, options);
+  return std::make_unique<TetrahedralCutter>(mesh, cut_body_of(model, mesh, "TetrahedralCutter"), options);
 }
 
 }  // namespace

@@ -1,5 +1,6 @@
 #include "bindings.hpp"
 #include "cutting/delaunay_cutter.hpp"
+#include "solve/cut_model_adapter.hpp"
 
 namespace snede::bindings {
 
@@ -25,7 +26,8 @@ void bind_planar_cutting(py::module_& m) {
 
   py::class_<DelaunayCutter>(m, "DelaunayCutter")
       .def(py::init([](Mesh& mesh, Model* model, double eps_edge, double eps_entry, double eps_exit, double angle) {
-             return std::make_unique<DelaunayCutter>(mesh, model, DelaunayCutterOptions{eps_edge, eps_entry, eps_exit, angle});
+             return std::make_unique<DelaunayCutter>(mesh, displacement_of(model, mesh, "DelaunayCutter"),
+                                                     DelaunayCutterOptions{eps_edge, eps_entry, eps_exit, angle});
            }),
            py::arg("mesh"), py::arg("model"), py::arg("eps_edge"), py::arg("eps_entry"), py::arg("eps_exit"),
            py::arg("short_edge_angle"), py::keep_alive<1, 2>(), py::keep_alive<1, 3>())

@@ -1,12 +1,14 @@
 #include "bindings.hpp"
 #include "cutting/surface_cutter.hpp"
+#include "solve/cut_model_adapter.hpp"
 
 namespace snede::bindings {
 
 void bind_surface_cutting(py::module_& m) {
   py::class_<SurfaceCutter>(m, "SurfaceCutter")
       .def(py::init([](Mesh& mesh, Model* model, double eps_edge, double eps_entry, double eps_exit) {
-             return std::make_unique<SurfaceCutter>(mesh, model, SurfaceCutterOptions{eps_edge, eps_entry, eps_exit});
+             return std::make_unique<SurfaceCutter>(mesh, displacement_of(model, mesh, "SurfaceCutter"),
+                                                    SurfaceCutterOptions{eps_edge, eps_entry, eps_exit});
            }),
            py::arg("mesh"), py::arg("model"), py::arg("eps_edge"), py::arg("eps_entry"), py::arg("eps_exit"),
            py::keep_alive<1, 2>(), py::keep_alive<1, 3>())

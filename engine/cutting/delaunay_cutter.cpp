@@ -5,13 +5,14 @@
 #include <limits>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 #include "core/error.hpp"
 #include "core/petsc_util.hpp"
 #include "core/predicates.hpp"
 #include "cutting/cut_thresholds.hpp"
 #include "cutting/incision_star.hpp"
-#include "needle/deformed_queries.hpp"
+#include "mesh/deformed_positions.hpp"
 #include "topology/collapse_edge.hpp"
 #include "topology/dissect.hpp"
 #include "topology/flip_edge.hpp"
@@ -86,9 +87,9 @@ void PlanarCutReport::add(const PlanarCutReport& later) {
   seconds += later.seconds;
 }
 
-DelaunayCutter::DelaunayCutter(Mesh& mesh, Model* model, DelaunayCutterOptions options)
+DelaunayCutter::DelaunayCutter(Mesh& mesh, DisplacementSource displacement, DelaunayCutterOptions options)
     : mesh_(mesh),
-      model_(model),
+      displacement_(std::move(displacement)),
       options_(options),
       watch_(mesh.connectivity(), incision_vertices_,
              [this](const Connectivity& c, const IncisionWatch::Fates& fates) { settle(c, fates); }) {
@@ -96,7 +97,6 @@ DelaunayCutter::DelaunayCutter(Mesh& mesh, Model* model, DelaunayCutterOptions o
   if (mesh.cell_dim() != 2 || mesh.space_dim() != 2)
     throw std::invalid_argument("DelaunayCutter: the mesh must be a 2D triangle mesh, got cell_dim " +
                                 std::to_string(mesh.cell_dim()) + " in " + std::to_string(mesh.space_dim()) + "D");
-  if (model && &model->body().mesh() != &mesh) throw std::invalid_argument("DelaunayCutter: the model's body is on another mesh");
   require(options.short_edge_angle >= 0 && options.short_edge_angle < std::acos(-1.0) / 2,
           "DelaunayCutter: short_edge_angle", "in [0, π/2) radians", options.short_edge_angle);
   // §5.4: thresholds as fractions of the mean edge length.
@@ -113,8 +113,7 @@ DelaunayCutter::Point DelaunayCutter::reference(VertexId v) const {
 }
 
 DelaunayCutter::Point DelaunayCutter::deformed(VertexId v, std::span<const double> u) const {
-  if (u.empty()) return reference(v);
-  const snede::Point x = deformed_point(mesh_, u, v);
+  const Point3 x = deformed_point(mesh_, u, v);
   return {x[0], x[1]};
 }
 
@@ -221,12 +220,8 @@ PlanarCutReport DelaunayCutter::move(std::span<const double> point) {
   std::optional<Point> inside;
   Point target{};
   {
-    std::optional<ReadView> view;
-    std::span<const double> u;
-    if (model_) {
-      view.emplace(model_->displacement());
-      u = view->span();
-    }
+    const DisplacementRead read = displacement_ ? displacement_() : DisplacementRead{};
+    const std::span<const double> u = read.values;
     if (phase_ == Phase::outside && scalpel_) crossing = first_boundary_crossing(*scalpel_, now, u);
     if (phase_ == Phase::cutting)
       target = target_of(now, u);

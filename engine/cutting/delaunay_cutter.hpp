@@ -39,8 +39,8 @@
 #include <unordered_set>
 #include <vector>
 
+#include "cutting/cut_body.hpp"
 #include "cutting/incision_star.hpp"
-#include "solve/model.hpp"
 
 namespace snede {
 
@@ -78,10 +78,10 @@ struct PlanarCutReport {
 
 class DelaunayCutter {
  public:
-  // Cuts `mesh` (triangles in 2D). With a model (whose body is on this mesh) the scalpel moves
-  // in deformed coordinates X + u. Throws std::invalid_argument for another kind of mesh,
-  // negative or non-finite thresholds.
-  DelaunayCutter(Mesh& mesh, Model* model, DelaunayCutterOptions options);
+  // Cuts `mesh` (triangles in 2D). With the displacement of a body on this mesh the scalpel
+  // moves in deformed coordinates X + u; without (an unset source), in the mesh's own. Throws
+  // std::invalid_argument for another kind of mesh, negative or non-finite thresholds.
+  DelaunayCutter(Mesh& mesh, DisplacementSource displacement, DelaunayCutterOptions options);
 
   // Moves the scalpel to `point` (2 numbers, deformed coordinates). Throws
   // std::invalid_argument, before changing anything, for a non-finite point, and IncisionLost
@@ -153,7 +153,7 @@ class DelaunayCutter {
   void settle(const Connectivity& c, const IncisionWatch::Fates& fates);
 
   Mesh& mesh_;
-  Model* model_;
+  DisplacementSource displacement_;
   DelaunayCutterOptions options_;
   Phase phase_ = Phase::outside;
   VertexId active_ = -1;

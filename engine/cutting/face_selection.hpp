@@ -31,7 +31,7 @@
 #include <unordered_map>
 #include <vector>
 
-#include "cutting/deformed_positions.hpp"
+#include "mesh/deformed_positions.hpp"
 #include "cutting/sweep_triangle.hpp"
 #include "mesh/connectivity.hpp"
 

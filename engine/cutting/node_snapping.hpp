@@ -16,7 +16,7 @@
 // exactly the snapped point, up to rounding.
 #pragma once
 
-#include "cutting/deformed_positions.hpp"
+#include "mesh/deformed_positions.hpp"
 #include "cutting/sweep_triangle.hpp"
 #include "topology/edit_result.hpp"
 

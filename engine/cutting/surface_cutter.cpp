@@ -5,12 +5,14 @@
 #include <limits>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 #include "core/error.hpp"
 #include "core/petsc_util.hpp"
 #include "cutting/cut_thresholds.hpp"
 #include "cutting/incision_star.hpp"
 #include "cutting/swept_intersections.hpp"
+#include "mesh/deformed_positions.hpp"
 #include "topology/collapse_edge.hpp"
 #include "topology/dissect.hpp"
 #include "topology/flip_edge.hpp"
@@ -46,9 +48,9 @@ const double crease_cosine = std::cos(45.0 * std::acos(-1.0) / 180);
 
 }  // namespace
 
-SurfaceCutter::SurfaceCutter(Mesh& mesh, Model* model, SurfaceCutterOptions options)
+SurfaceCutter::SurfaceCutter(Mesh& mesh, DisplacementSource displacement, SurfaceCutterOptions options)
     : mesh_(mesh),
-      model_(model),
+      body_displacement_(std::move(displacement)),
       options_(options),
       watch_(
           mesh.connectivity(), incision_vertices_,
@@ -57,7 +59,6 @@ SurfaceCutter::SurfaceCutter(Mesh& mesh, Model* model, SurfaceCutterOptions opti
   if (mesh.cell_dim() != 2 || mesh.space_dim() != 3)
     throw std::invalid_argument("SurfaceCutter: the mesh must be a surface (triangles in 3D), got cell_dim " +
                                 std::to_string(mesh.cell_dim()) + " in " + std::to_string(mesh.space_dim()) + "D");
-  if (model && &model->body().mesh() != &mesh) throw std::invalid_argument("SurfaceCutter: the model's body is on another mesh");
   // §5.4: thresholds as fractions of the mean edge length.
   const CutThresholds thresholds =
       resolved_thresholds("SurfaceCutter", mesh, {options.eps_edge, options.eps_entry, options.eps_exit});
@@ -80,11 +81,7 @@ Point3 SurfaceCutter::reference(VertexId v) const {
 
 Point3 SurfaceCutter::deformed(VertexId v) const {
   if (const auto found = moved_.find(v); found != moved_.end()) return found->second;
-  Point3 x = reference(v);
-  const std::size_t at = 3 * static_cast<std::size_t>(v);
-  if (at + 2 < displacement_.size())
-    for (int d = 0; d < 3; ++d) x[d] += displacement_[at + d];
-  return x;
+  return deformed_point(mesh_, displacement_, v);
 }
 
 void SurfaceCutter::carry_normal(const VertexEvent& event) {
@@ -363,12 +360,12 @@ PlanarCutReport SurfaceCutter::move(std::span<const double> segment) {
   report.triangles_before = mesh_.n_cells();
   displacement_.clear();
   moved_.clear();
-  if (model_) {
-    ReadView view(model_->displacement());
-    displacement_.assign(view.span().begin(), view.span().end());
+  if (body_displacement_) {
+    const DisplacementRead u = body_displacement_();
+    displacement_.assign(u.values.begin(), u.values.end());
   }
   // Deformed positions or the mesh may have changed since the grid was built.
-  rebuild_grid_ = rebuild_grid_ || model_ || grid_revision_ != mesh_.connectivity().revision();
+  rebuild_grid_ = rebuild_grid_ || body_displacement_ || grid_revision_ != mesh_.connectivity().revision();
   touched_.clear();
   refused_.clear();
   {

@@ -55,11 +55,11 @@
 #include <unordered_set>
 #include <vector>
 
+#include "cutting/cut_body.hpp"
 #include "cutting/delaunay_cutter.hpp"
 #include "cutting/incision_star.hpp"
 #include "cutting/sweep_triangle.hpp"
 #include "cutting/triangle_grid.hpp"
-#include "solve/model.hpp"
 
 namespace snede {
 
@@ -73,10 +73,10 @@ struct SurfaceCutterOptions {
 
 class SurfaceCutter {
  public:
-  // Cuts `mesh` (triangles in 3D). With a model (whose body is on this mesh) the scalpel moves
-  // in deformed coordinates. Throws std::invalid_argument for another kind of mesh, or
-  // negative or non-finite thresholds.
-  SurfaceCutter(Mesh& mesh, Model* model, SurfaceCutterOptions options);
+  // Cuts `mesh` (triangles in 3D). With the displacement of a body on this mesh the scalpel
+  // moves in deformed coordinates X + u; without (an unset source), in the mesh's own. Throws
+  // std::invalid_argument for another kind of mesh, or negative or non-finite thresholds.
+  SurfaceCutter(Mesh& mesh, DisplacementSource displacement, SurfaceCutterOptions options);
 
   // Moves the scalpel to `segment` (6 numbers: its two ends, deformed coordinates); the first
   // move after construction or lift() places it, entering where it pierces the surface.
@@ -234,7 +234,7 @@ class SurfaceCutter {
   void forget(VertexId v);
 
   Mesh& mesh_;
-  Model* model_;
+  DisplacementSource body_displacement_;
   SurfaceCutterOptions options_;
   std::vector<Incision> incisions_;
   std::optional<Segment> scalpel_;

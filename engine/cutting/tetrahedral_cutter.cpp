@@ -4,6 +4,7 @@
 #include <cmath>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 #include "core/error.hpp"
 #include "core/petsc_util.hpp"
@@ -36,13 +37,11 @@ void CutReport::add(const CutReport& o) {
   seconds += o.seconds;
 }
 
-TetrahedralCutter::TetrahedralCutter(Mesh& mesh, Model* model, CutterOptions options)
-    : mesh_(mesh), model_(model), options_(options), pieces_(mesh.connectivity()) {
+TetrahedralCutter::TetrahedralCutter(Mesh& mesh, CutBody body, CutterOptions options)
+    : mesh_(mesh), body_(std::move(body)), options_(options), pieces_(mesh.connectivity()) {
   if (mesh.cell_dim() != 3 || mesh.space_dim() != 3)
     throw std::invalid_argument("TetrahedralCutter: the mesh must be tetrahedral (3D cells in 3D), got cell_dim " +
                                 std::to_string(mesh.cell_dim()) + " in " + std::to_string(mesh.space_dim()) + "D");
-  if (model && &model->body().mesh() != &mesh)
-    throw std::invalid_argument("TetrahedralCutter: the model's body is on another mesh");
   const DegeneracyOptions& d = options.degeneracy;
   if (!(d.min_aspect_ratio > 0 && d.min_aspect_ratio < 1))
     throw std::invalid_argument("TetrahedralCutter: min_aspect_ratio must be in (0, 1), got " + std::to_string(d.min_aspect_ratio));
@@ -54,18 +53,23 @@ TetrahedralCutter::TetrahedralCutter(Mesh& mesh, Model* model, CutterOptions opt
 TetrahedralCutter::~TetrahedralCutter() { mesh_.connectivity().remove_watcher(this); }
 
 DeformedPositions TetrahedralCutter::cut_positions() const {
-  return DeformedPositions(mesh_, cut_configuration_.empty() ? nullptr : cut_configuration_.data());
+  return DeformedPositions(mesh_, cut_configuration_);
+}
+
+std::vector<double> TetrahedralCutter::displacement_now() const {
+  const DisplacementRead u = body_.displacement();
+  return {u.values.begin(), u.values.end()};
 }
 
 bool TetrahedralCutter::constrained(VertexId v) const {
-  return model_ && model_->constraints().constrained_components(v) > 0;
+  return body_.is_support && body_.is_support(v);
 }
 
 CutReport TetrahedralCutter::cut_triangle(std::span<const double> corners) {
   const SweepTriangle sweep(corners);  // validates before anything changes
-  if (!cut_configuration_.empty() || !model_) return cut(sweep);
+  if (!cut_configuration_.empty() || !body_.displacement) return cut(sweep);
   // A sweep triangle given alone (not by a move of the placed scalpel) meets the body as it is.
-  cut_configuration_ = vec_values(model_->displacement());
+  cut_configuration_ = displacement_now();
   try {
     CutReport report = cut(sweep);
     cut_configuration_.clear();
@@ -130,9 +134,9 @@ std::vector<VertexId> TetrahedralCutter::snap(const FaceSelection& selection, Cu
     }
     const auto plane = selection.plane.find(v);
     if (plane == selection.plane.end()) continue;  // a vertex of a face selected by an earlier sweep
-    std::optional<ReadView> u;  // read again for every vertex: each snap moves the one before
-    if (model_) u.emplace(model_->displacement());
-    const DeformedPositions now(mesh_, u ? u->span().data() : nullptr);
+    // u read again for every vertex: each snap moves the one before.
+    const DisplacementRead u = body_.displacement ? body_.displacement() : DisplacementRead{};
+    const DeformedPositions now(mesh_, u.values);
     const EditResult result = snap_to_sweep(mesh_, cut_positions(), v, plane->second, &now);
     if (result.done) {
       ++report.vertices_snapped;
@@ -216,22 +220,14 @@ void TetrahedralCutter::count_pieces(CutReport& report) {
     for (ElementId e : c.element_ids()) ++report.piece_elements[pieces_.label(e)];
     std::sort(report.piece_elements.rbegin(), report.piece_elements.rend());
   }
-  if (!separated || !model_) return;  // a bare mesh has no supports to be free of
-  // Held as a static solve requires it (PieceHolding, the solver's own check): a piece with
-  // one fixed vertex left on it still turns about that vertex.
-  for (const LoosePiece& piece : PieceHolding(mesh_).loose_pieces(model_->constraints())) {
+  if (!separated || !body_.free_pieces) return;  // a bare mesh has no supports to be free of
+  for (ElementId cell : body_.free_pieces()) {
     ++report.free_pieces;
-    if (!options_.fix_free_pieces) continue;
-    // §3.3: fixed on one face, where it is now, so that the static problem stays well posed.
-    const Simplex face = c.element(piece.first_cell).simplex.subn(0);
-    std::vector<VertexId> vertices(face.vertices().begin(), face.vertices().end());
-    std::vector<double> values;
-    {
-      const ReadView u(model_->displacement());
-      for (VertexId v : vertices)
-        for (int k = 0; k < 3; ++k) values.push_back(u.span()[3 * static_cast<std::size_t>(v) + k]);
-    }
-    model_->fix(vertices, values);
+    if (!options_.fix_free_pieces || !body_.hold_free_piece) continue;
+    // §3.3: held on one face, so that the static problem stays well posed.
+    const Simplex face = c.element(cell).simplex.subn(0);
+    const std::vector<VertexId> vertices(face.vertices().begin(), face.vertices().end());
+    body_.hold_free_piece(vertices);
     ++report.pieces_fixed;
   }
 }
@@ -246,7 +242,7 @@ CutReport TetrahedralCutter::move(std::span<const double> scalpel) {
   if (now[0] == now[3] && now[1] == now[4] && now[2] == now[5])
     throw std::invalid_argument("TetrahedralCutter.move: the scalpel's two ends coincide (a segment of zero length)");
   CutReport report;
-  if (!scalpel_ && model_) cut_configuration_ = vec_values(model_->displacement());
+  if (!scalpel_ && body_.displacement) cut_configuration_ = displacement_now();
   if (scalpel_) {
     const std::array<double, 6>& was = *scalpel_;
     // The quadrilateral p0 p1 q1 q0 swept from (p0, p1) to (q0, q1), as two triangles.

@@ -22,10 +22,10 @@
 #include <unordered_set>
 #include <vector>
 
-#include "cutting/deformed_positions.hpp"
+#include "cutting/cut_body.hpp"
 #include "cutting/face_selection.hpp"
+#include "mesh/deformed_positions.hpp"
 #include "mesh/piece_tracker.hpp"
-#include "solve/model.hpp"
 #include "topology/degeneracy_removal.hpp"
 
 namespace snede {
@@ -75,10 +75,11 @@ struct CutReport {
 
 class TetrahedralCutter : public ConnectivityWatcher {
  public:
-  // Cuts `mesh` (tetrahedral). With a model (whose body is on this mesh) the scalpel acts on
-  // the deformed body X + u and free pieces can be fixed; without one, on the mesh as it is.
-  // Throws std::invalid_argument for a mesh that is not tetrahedral or bad thresholds.
-  TetrahedralCutter(Mesh& mesh, Model* model, CutterOptions options);
+  // Cuts `mesh` (tetrahedral). With a simulated body on this mesh the scalpel acts on the
+  // deformed body X + u, supports are not snapped and free pieces are held by `body`; with an
+  // empty one, on the mesh as it is. Throws std::invalid_argument for a mesh that is not
+  // tetrahedral or bad thresholds.
+  TetrahedralCutter(Mesh& mesh, CutBody body, CutterOptions options);
   ~TetrahedralCutter() override;
   TetrahedralCutter(const TetrahedralCutter&) = delete;
   TetrahedralCutter& operator=(const TetrahedralCutter&) = delete;
@@ -117,12 +118,14 @@ class TetrahedralCutter : public ConnectivityWatcher {
   // largest piece); true if any.
   bool remove_fragments(CutReport& report);
   bool constrained(VertexId v) const;
+  // A copy of the body's displacement as it is now.
+  std::vector<double> displacement_now() const;
   // Where the scalpel meets the body: X + u with u the displacement the incision was begun in
-  // (see cut_configuration_), or X without a model.
+  // (see cut_configuration_), or X for a bare mesh.
   DeformedPositions cut_positions() const;
 
   Mesh& mesh_;
-  Model* model_;
+  CutBody body_;
   CutterOptions options_;
   FaceSelector selector_;
   std::unordered_set<VertexId> placed_;          // vertices already snapped or on the incision

@@ -72,26 +72,17 @@ bool outside_box(const Point& x, const Point& p0, const Point& p1, const Point& 
 
 }  // namespace
 
-Point deformed_point(const Mesh& mesh, std::span<const double> u, VertexId v) {
-  const auto X = mesh.point(v);
-  const int d = mesh.dim();
-  const std::size_t i = static_cast<std::size_t>(v) * d;
-  Point x{0, 0, 0};
-  for (int k = 0; k < d; ++k) x[k] = X[k] + u[i + k];
-  return x;
-}
-
 std::optional<Point> reference_position(const Mesh& mesh, std::span<const double> u, const Point& x) {
   const Connectivity& c = mesh.connectivity();
   const int d = mesh.dim();
+  const DeformedPositions deformed(mesh, u);
   double best = -1e-12;  // the most interior containing element wins (x on a face: either)
   std::optional<Point> found;
   std::array<double, 4> lambda{};
   for (ElementId e = 0; e < c.element_capacity(); ++e) {
     if (!c.is_element(e)) continue;
     const Simplex& t = c.element(e).simplex;
-    const Point p0 = deformed_point(mesh, u, t.vertex(0)), p1 = deformed_point(mesh, u, t.vertex(1)),
-                p2 = deformed_point(mesh, u, t.vertex(2));
+    const Point p0 = deformed(t.vertex(0)), p1 = deformed(t.vertex(1)), p2 = deformed(t.vertex(2));
     if (d == 2 && outside_box(x, p0, p1, p2)) continue;
     if (d == 2) {
       const double area = cross2(minus(p1, p0), minus(p2, p0));
@@ -100,7 +91,7 @@ std::optional<Point> reference_position(const Mesh& mesh, std::span<const double
       lambda[2] = cross2(minus(p1, p0), minus(x, p0)) / area;
       lambda[0] = 1 - lambda[1] - lambda[2];
     } else {
-      const Point p3 = deformed_point(mesh, u, t.vertex(3));
+      const Point p3 = deformed(t.vertex(3));
       const Point e1 = minus(p1, p0), e2 = minus(p2, p0), e3 = minus(p3, p0), r = minus(x, p0);
       const double volume = triple(e1, e2, e3);
       if (volume == 0) continue;
@@ -134,13 +125,14 @@ std::vector<ShaftCrossing> shaft_crossings(const Mesh& mesh, std::span<const dou
     hi[k] = std::max(a[k], b[k]);
   }
   const Connectivity& c = mesh.connectivity();
+  const DeformedPositions deformed(mesh, u);
   // 2D: each vertex's side of the line, once (not once per edge): most edges have both ends
   // on one side and are passed over before their corners are looked at (issue 33).
   std::vector<double> side;
   if (d == 2) {
     side.resize(static_cast<std::size_t>(mesh.n_points()));
     for (VertexId v = 0; v < mesh.n_points(); ++v)
-      if (mesh.is_vertex(v)) side[v] = side_of(a, ab, deformed_point(mesh, u, v));
+      if (mesh.is_vertex(v)) side[v] = side_of(a, ab, deformed(v));
   }
   std::vector<Point> corners(d);
   std::vector<VertexId> ids(d);
@@ -153,7 +145,7 @@ std::vector<ShaftCrossing> shaft_crossings(const Mesh& mesh, std::span<const dou
       if (d == 2 && misses_line(side[face.simplex.vertex(0)], side[face.simplex.vertex(1)])) continue;
       for (int i = 0; i < d; ++i) {
         ids[i] = face.simplex.vertex(i);
-        corners[i] = deformed_point(mesh, u, ids[i]);
+        corners[i] = deformed(ids[i]);
       }
       if (boxes_miss(corners, lo, hi, d)) continue;
       const std::optional<double> t =

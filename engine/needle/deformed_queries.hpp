@@ -10,15 +10,13 @@
 #include <vector>
 
 #include "core/vec3.hpp"
+#include "mesh/deformed_positions.hpp"
 #include "mesh/mesh.hpp"
 
 namespace snede {
 
 // A point of the needle's space; in 2D the third coordinate is 0.
 using Point = Point3;
-
-// Where vertex v is in the deformed mesh: X_v + u_v. u: (n_points, dim).
-Point deformed_point(const Mesh& mesh, std::span<const double> u, VertexId v);
 
 // The reference position of the material point that sits at x in the deformed mesh (the
 // barycentric coordinates of x in the deformed element containing it, applied to the

@@ -1,6 +1,8 @@
 """snede.Mesh(points, cells): every kind of bad input is refused with a ValueError that names
 the problem and the offending index or value; inverted cells are re-oriented."""
+import math
 import re
+import sys
 
 import numpy as np
 import pytest
@@ -294,3 +296,29 @@ def test_duplicated_interior_cell_is_named_as_a_duplicate(dim):
     base = snede.meshing.box((1, 1, 1), (2, 2, 2)) if dim == 3 else snede.meshing.rectangle((1, 1), (3, 3))
     cells = np.vstack([base.cells, base.cells[5:6]])
     raises_value_error(base.points, cells, "same vertices", "5", str(len(base.cells)))
+
+
+UNIT_CELLS = {  # cell dimension: (corners, measure of the unit cell)
+    2: (np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]), 0.5),
+    3: (np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]), 1.0 / 6.0),
+}
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+@pytest.mark.parametrize("scale", [1e-310, 1e-200, 1e-150, 1e-100, 1.0, 1e100, 1e150, 1e200, 1e300])
+def test_a_mesh_is_accepted_where_its_measures_are_doubles_and_refused_with_the_reason_elsewhere(scale, dim):
+    corners, unit_measure = UNIT_CELLS[dim]
+    # Independent of the engine: whether scale^dim · unit measure is a normal double, in logarithms.
+    log_measure = dim * math.log10(scale) + math.log10(unit_measure)
+    representable = math.log10(sys.float_info.min) < log_measure < math.log10(sys.float_info.max)
+    if representable:
+        mesh = snede.Mesh(scale * corners, [list(range(dim + 1))])
+        mesh.validate()
+        assert mesh.quality().volume[0] == pytest.approx(unit_measure * scale**dim, rel=1e-12)
+    else:
+        units = "smaller" if log_measure < 0 else "larger"
+        with pytest.raises(ValueError, match=f"cell 0's (area|volume) is too .* in {units} units"):
+            snede.Mesh(scale * corners, [list(range(dim + 1))])
+    flat = scale * np.array([[0.0, 0.0], [1.0, 0.0], [2.0, 0.0]])
+    with pytest.raises(ValueError, match="zero"):
+        snede.Mesh(flat, [[0, 1, 2]])

@@ -50,3 +50,13 @@ def as_dense(mat):
         cols, values = mat.getRow(i)
         result[i, cols] = values
     return result
+
+
+def sagging_sheet(young, material=snede.LinearElastic):
+    """A plane-stress sheet 1 × 0.2 m fixed at x = 0 under gravity scaled with E: the same
+    displacement whatever the units."""
+    mesh = snede.meshing.rectangle((1.0, 0.2), (10, 2))
+    body = snede.Body(mesh, material(young, 0.3), thickness=0.01, density=1.0)
+    body.fix(np.isclose(mesh.points[:, 0], 0.0))
+    body.add_gravity((0.0, -9.81 * young / 1e5))  # loads scaled with E: the same displacement
+    return body

@@ -1,5 +1,6 @@
 """Adversarial tests of named groups (issue 34; python/snede/mesh_groups.py) through random,
-seeded sequences of mesh edits, the cutters, bad input, edge cases and bodies.
+seeded sequences of mesh edits, bad input and edge cases (the cutters' groups:
+cutting/test_cutters_keep_groups.py; bodies loaded by groups: fem/test_group_loads.py).
 
 The invariants a group keeps: a boundary group's measure (area, length in 2D) is unchanged by
 edits that keep the boundary's geometry (refinement, splits, insertions, dissection, collapses of
@@ -13,59 +14,7 @@ import numpy as np
 import pytest
 
 import snede
-
-
-# -- measures ----------------------------------------------------------------------------------
-def simplex_measure(corners):
-    """(n, k, d) corners → (n,) measures of the simplices (k − 1 dimensional) in d-space."""
-    corners = np.asarray(corners, dtype=float)
-    if len(corners) == 0:
-        return np.zeros(0)
-    edges = corners[:, 1:] - corners[:, :1]
-    gram = np.einsum("nid,njd->nij", edges, edges)
-    k = corners.shape[1] - 1
-    return np.sqrt(np.maximum(np.linalg.det(gram), 0.0)) / float(np.prod(np.arange(1, k + 1)))
-
-
-def face_measure(mesh, faces):
-    return simplex_measure(mesh.points[np.asarray(faces, dtype=np.int64).reshape(-1, mesh.cell_dim)]).sum()
-
-
-def cell_measure(mesh, rows):
-    return simplex_measure(mesh.points[mesh.cells[np.asarray(rows, dtype=np.int64)]]).sum()
-
-
-def boundary_keys(mesh):
-    return {tuple(f) for f in np.sort(mesh.boundary_faces(), axis=1).tolist()}
-
-
-# -- invariant checks --------------------------------------------------------------------------
-def check(mesh, partition, face_expect, cell_expect, incision_expect=None, rel=1e-12):
-    """Every invariant named in the module docstring; ``partition`` names cell groups that cover
-    the cells once; ``face_expect`` / ``cell_expect`` map names to expected measures (None: not
-    checked this time)."""
-    cells, faces = mesh.cell_groups, mesh.boundary_groups
-    keys = boundary_keys(mesh)
-    live = np.flatnonzero(mesh.live_vertices)
-    for name, group in faces.items():
-        assert group.ndim == 2 and group.shape[1] == mesh.cell_dim, name
-        missing = {tuple(f) for f in np.sort(group, axis=1).tolist()} - keys
-        assert not missing, f"boundary group {name!r} holds non-boundary faces {sorted(missing)[:3]}"
-        assert np.all(np.isin(mesh.group_vertices(name), live)), name
-    for name, rows in cells.items():
-        assert rows.ndim == 1 and (len(rows) == 0 or (rows.min() >= 0 and rows.max() < mesh.n_cells)), name
-        assert np.all(np.isin(mesh.group_vertices(name), live)), name
-    if partition:
-        together = np.concatenate([cells[name] for name in partition])
-        assert len(together) == mesh.n_cells == len(np.unique(together)), "cell groups no longer partition the mesh"
-    for name, expected in face_expect.items():
-        if expected is not None:
-            assert face_measure(mesh, faces[name]) == pytest.approx(expected, rel=rel, abs=1e-14), name
-    for name, expected in cell_expect.items():
-        if expected is not None:
-            assert cell_measure(mesh, cells[name]) == pytest.approx(expected, rel=rel, abs=1e-14), name
-    if incision_expect is not None:
-        assert face_measure(mesh, faces["incision"]) == pytest.approx(incision_expect, rel=rel, abs=1e-14)
+from mesh_group_checks import boundary_keys, cell_measure, check, face_measure, interior_on_plane, label_partition
 
 
 def edges_of(mesh):
@@ -76,26 +25,6 @@ def edges_of(mesh):
 
 def boundary_vertices(mesh):
     return np.unique(mesh.boundary_faces())
-
-
-def interior_on_plane(mesh, axis, value, extra=None):
-    """Interior faces lying on the plane x[axis] = value (optionally further restricted)."""
-    def inside(x):
-        keep = np.isclose(x[:, axis], value, atol=1e-12)
-        return keep if extra is None else keep & extra(x)
-    return mesh.faces_where(inside)
-
-
-def label_partition(mesh, rng, n_groups=3):
-    """Cell groups "g0".."g{n-1}" partitioning the cells by a random split of the centroid's
-    first coordinate, and returns their names."""
-    centroid = mesh.points[mesh.cells].mean(axis=1)
-    cuts = np.sort(rng.uniform(centroid[:, 0].min(), centroid[:, 0].max(), n_groups - 1))
-    which = np.searchsorted(cuts, centroid[:, 0])
-    names = [f"g{k}" for k in range(n_groups)]
-    for k, name in enumerate(names):
-        mesh.add_cell_group(name, which == k)
-    return names
 
 
 # -- random edit sequences ---------------------------------------------------------------------
@@ -369,58 +298,6 @@ def test_dissection_of_a_box_forms_incision_of_twice_the_area_and_survives_refin
     check(mesh, partition, {"top": 1.0, "bottom": 1.0}, {}, 2 * dissected + 2 * face_measure(mesh, more))
 
 
-# -- cutters -----------------------------------------------------------------------------------
-def test_tetrahedral_cutter_opens_an_incision_and_keeps_the_user_groups():
-    mesh = snede.meshing.box((1.0, 1.0, 1.0), (6, 6, 6))
-    mesh.add_boundary_group("bottom", mesh.faces_where(lambda x: np.isclose(x[:, 2], 0.0), interior=False))
-    mesh.add_boundary_group("back", mesh.faces_where(lambda x: np.isclose(x[:, 1], 1.0), interior=False))
-    partition = label_partition(mesh, np.random.default_rng(11), 2)
-    volumes = {name: cell_measure(mesh, mesh.cell_groups[name]) for name in partition}
-    cutter = snede.TetrahedralCutter(mesh)
-    # The scalpel enters through y = 0 and stops at y = 0.6, cutting the plane x = 0.43.
-    report = cutter.cut([np.array([[0.43, y, -1.0], [0.43, y, 2.0]]) for y in (-0.5, 0.2, 0.6)])
-    assert report.faces_dissected > 0
-    incision = mesh.boundary_groups["incision"]
-    assert len(incision) > 0
-    # The cutter's own incision faces and the group are the same faces.
-    assert {tuple(f) for f in np.sort(incision, axis=1).tolist()} == \
-        {tuple(f) for f in np.sort(cutter.incision_faces(), axis=1).tolist()}
-    check(mesh, partition, {"bottom": 1.0, "back": 1.0}, {})
-    # Snapping moves vertices onto the plane: the total volume stays, each group's up to the
-    # slabs the snaps moved (a cell keeps its group by its centroid's old place).
-    assert cell_measure(mesh, np.arange(mesh.n_cells)) == pytest.approx(1.0, rel=1e-12)
-    for name in partition:
-        assert cell_measure(mesh, mesh.cell_groups[name]) == pytest.approx(volumes[name], abs=2.0 / 6)
-    assert np.all(np.abs(mesh.points[np.unique(incision), 0] - 0.43) < 1e-12)
-
-
-def test_delaunay_cutter_opens_an_incision_and_keeps_the_user_groups():
-    mesh = snede.meshing.rectangle((1.0, 1.0), (8, 8))
-    mesh.add_boundary_group("bottom", mesh.faces_where(lambda x: np.isclose(x[:, 1], 0.0), interior=False))
-    mesh.add_boundary_group("left", mesh.faces_where(lambda x: np.isclose(x[:, 0], 0.0), interior=False))
-    partition = label_partition(mesh, np.random.default_rng(12), 2)
-    cutter = snede.DelaunayCutter(mesh)
-    for y in np.linspace(1.2, 0.45, 40):  # enters through y = 1 and stops inside
-        cutter.move([0.43, y])
-    incision = mesh.boundary_groups["incision"]
-    assert len(incision) > 0
-    length = face_measure(mesh, incision)
-    assert length > 2 * 0.4  # both lips, about 0.55 long each
-    check(mesh, partition, {"bottom": 1.0, "left": 1.0}, {})
-    assert cell_measure(mesh, np.arange(mesh.n_cells)) == pytest.approx(1.0, rel=1e-12)
-
-
-def test_tetrahedral_cutter_on_a_curved_body_puts_only_the_lips_in_incision():
-    mesh = snede.meshing.ellipsoid(h=0.012, seed=1)
-    mesh.add_boundary_group("skin", mesh.boundary_faces())
-    cutter = snede.TetrahedralCutter(mesh)
-    report = cutter.cut([np.array([[0.005, y, -0.1], [0.005, y, 0.1]]) for y in (-0.06, 0.0, 0.01)])
-    assert report.faces_dissected > 0
-    keys = lambda faces: {tuple(f) for f in np.sort(faces, axis=1).tolist()}  # noqa: E731
-    assert keys(mesh.boundary_groups["incision"]) == keys(cutter.incision_faces())
-    assert keys(mesh.boundary_groups["skin"]) == keys(mesh.boundary_faces()) - keys(cutter.incision_faces())
-
-
 def test_a_moved_boundary_vertex_keeps_its_faces_in_their_group():
     sheet = snede.meshing.rectangle((1.0, 1.0), (4, 4))
     sheet.add_boundary_group("bottom", sheet.faces_where(lambda x: np.isclose(x[:, 1], 0.0), interior=False))
@@ -587,51 +464,3 @@ def test_meshes_without_groups_and_copies_have_none():
     sheet.add_cell_group("a", [0])
     assert snede.meshing.lifted(sheet, lambda x, y: np.c_[x, y, np.zeros(len(x))]).cell_groups == {}
     assert snede.Mesh(mesh.points, mesh.cells).cell_groups == {}
-
-
-# -- bodies ------------------------------------------------------------------------------------
-@pytest.mark.parametrize("formulation", ["p1", "smoothed"])
-def test_a_box_body_is_held_and_loaded_by_groups_after_refinement(formulation):
-    mesh = snede.meshing.box((1.0, 0.25, 0.25), (4, 1, 1))
-    mesh.add_boundary_group("clamped", mesh.faces_where(lambda x: np.isclose(x[:, 0], 0.0), interior=False))
-    mesh.add_boundary_group("loaded", mesh.faces_where(lambda x: np.isclose(x[:, 0], 1.0), interior=False))
-    mesh.refine_around((1.0, 0.125, 0.125), 0.1)
-    body = snede.Body(mesh, snede.LinearElastic(1e6, 0.3), formulation=formulation)
-    body.fix("clamped")
-    body.add_traction("loaded", (0.0, 0.0, -160.0))  # 160 Pa on 0.0625 m²: 10 N
-    np.testing.assert_allclose(body.external_forces().sum(axis=0), (0.0, 0.0, -10.0), atol=1e-12)
-    result = snede.StaticSolver(body, "cg", rtol=1e-8).solve()
-    assert result.converged
-    clamped = mesh.group_vertices("clamped")
-    assert len(clamped) >= 4 and np.all(body.displacement[clamped] == 0)
-    assert body.displacement[mesh.group_vertices("loaded"), 2].max() < 0
-
-
-@pytest.mark.parametrize("formulation", ["p1", "smoothed"])
-def test_a_plane_stress_sheet_is_loaded_by_length_times_thickness(formulation):
-    sheet = snede.meshing.rectangle((2.0, 0.5), (8, 2))
-    sheet.add_boundary_group("left", sheet.faces_where(lambda x: np.isclose(x[:, 0], 0.0), interior=False))
-    sheet.add_boundary_group("right", sheet.faces_where(lambda x: np.isclose(x[:, 0], 2.0), interior=False))
-    sheet.refine_uniform(1)
-    body = snede.Body(sheet, snede.LinearElastic(1e6, 0.3), thickness=0.01, formulation=formulation)
-    body.fix("left")
-    body.add_traction("right", (3000.0, -1000.0))  # on 0.5 m × 0.01 m: (15, −5) N
-    np.testing.assert_allclose(body.external_forces().sum(axis=0), (15.0, -5.0), atol=1e-12)
-    result = snede.StaticSolver(body, "cg", rtol=1e-8).solve()
-    assert result.converged
-    assert np.all(body.displacement[sheet.group_vertices("left")] == 0)
-    right = sheet.group_vertices("right")
-    assert np.sum(body.external_forces()[right] * body.displacement[right]) > 0  # the load does work
-
-
-def test_a_body_is_loaded_by_its_group_after_a_dissection():
-    mesh = snede.meshing.box((1.0, 1.0, 1.0), (4, 4, 4))
-    mesh.add_boundary_group("bottom", mesh.faces_where(lambda x: np.isclose(x[:, 2], 0.0), interior=False))
-    body = snede.Body(mesh, snede.LinearElastic(1e6, 0.3), formulation="smoothed")
-    mesh.dissect(interior_on_plane(mesh, 0, 0.5, lambda x: x[:, 2] > 0.5 - 1e-9))
-    body.fix("bottom")
-    body.add_traction("incision", (0.0, 0.0, -1.0))
-    total = face_measure(mesh, mesh.boundary_groups["incision"])
-    assert total == pytest.approx(1.0, rel=1e-12)  # both lips of the 0.5 m² cut
-    np.testing.assert_allclose(body.external_forces().sum(axis=0), (0.0, 0.0, -total), atol=1e-12)
-    assert snede.StaticSolver(body, "cg", rtol=1e-8).solve().converged

@@ -11,7 +11,8 @@ import textwrap
 
 import pytest
 
-from test_interrupts import needs_sigint
+import snede
+from interrupts import needs_sigint
 
 ERROR = "python -m snede: error: "
 MPI_ROOT = {"OMPI_ALLOW_RUN_AS_ROOT": "1", "OMPI_ALLOW_RUN_AS_ROOT_CONFIRM": "1",
@@ -138,3 +139,37 @@ def test_every_error_is_one_line_with_one_prefix(tmp_path, args, fragment):
     # message of up to seven lines) and "error:".
     line = the_one_line(run_cli(*args, "--out", str(tmp_path)) if args[0] == "run" else run_cli(*args))
     assert line.startswith(ERROR) and fragment in line, line
+
+
+DELETED_FOLDER_SCRIPT = """
+import shutil
+import sys
+from pathlib import Path
+
+import snede
+from snede.output import SeriesWriter
+
+out = Path(sys.argv[1])
+mesh = snede.meshing.rectangle((1.0, 1.0), (2, 2))
+body = snede.Body(mesh, snede.LinearElastic(1e4, 0.3), thickness=0.01)
+writer = SeriesWriter(out / "series")
+writer.write(body, 0.0)
+shutil.rmtree(out)  # the output folder goes away mid-run
+writer.write(body, 1.0)
+print("NOT REACHED")
+"""
+
+
+def test_an_output_folder_deleted_mid_run_stops_the_command_line_with_one_line(tmp_path):
+    # Item 8: the writer's failure is a snede.FileError (an OSError) naming the file; the
+    # command line prints it on one line and exits 2 instead of showing a traceback.
+    script = tmp_path / "deleting.py"
+    script.write_text(DELETED_FOLDER_SCRIPT)
+    out = tmp_path / "out"
+    result = subprocess.run([sys.executable, "-m", "snede", "run", str(script), str(out)], capture_output=True,
+                            text=True, timeout=120)
+    assert result.returncode == 2, (result.stdout, result.stderr)
+    assert "NOT REACHED" not in result.stdout and "Traceback" not in result.stderr
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("python -m snede: error: cannot open") and "series.h5" in lines[0], lines
+    assert issubclass(snede.FileError, OSError)
