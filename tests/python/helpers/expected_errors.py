@@ -1,5 +1,4 @@
-"""The one check of an error message the mesh tests share (tests/python/hardening has its own
-``value_error``, out of reach of these folders' imports)."""
+"""The one check of an error message that tests share."""
 import pytest
 
 
