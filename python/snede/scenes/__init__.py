@@ -1,73 +1,8 @@
-"""Built-in scenes for ``python -m snede run``: each module has ``build(options) -> Scene``."""
-from __future__ import annotations
-
-from dataclasses import dataclass, field
-from typing import Callable
-
-import snede
-
-MATERIAL_NAMES = ("linear", "stvk", "neohookean", "veronda")
-
-
-@dataclass
-class Scene:
-    name: str
-    description: str
-    body: "snede.Body"
-    default_method: str
-    probe_name: str  # what `probe` measures, with its unit
-    probe: Callable[["snede.Body"], float]
-    analytic: float | None = None  # the probe's analytic value, where one exists
-    damping: float = 20.0  # η for dynamic relaxation (1/s)
-    plot_scale: float = 1.0  # displacement exaggeration in the picture (stated in its title)
-    details: dict = field(default_factory=dict)
-    default_rtol: float = 1e-6
-    # A scene that is not one static solve (the needle insertion) runs itself:
-    # evolve(method, rtol, writer, folder, progress) -> summary entries (see run_scene.solve_once).
-    evolve: Callable | None = None
-    decorate: Callable | None = None  # decorate(ax): marks on the 2D picture
-    picture: Callable | None = None  # picture() -> more keyword arguments of plotting.plot_body, after the run
-    # fixed(points) -> (n_points,) bool: the vertices the scene holds (of the mesh after the
-    # run), marked on the picture; the scene's loads are drawn from the body.
-    fixed: Callable | None = None
-    # Keyword arguments of the scene's static solver (snede.StaticSolver: preconditioner,
-    # petsc_options, max_iterations); petsc_options and max_iterations also reach dynamic relaxation.
-    solver_options: dict = field(default_factory=dict)
-
-
-def material(name: str, young: float, poisson: float, gamma: float = 8.0):
-    """A material by its command-line name."""
-    makers = {
-        "linear": lambda: snede.LinearElastic(young, poisson),
-        "stvk": lambda: snede.StVenantKirchhoff(young, poisson),
-        "neohookean": lambda: snede.NeoHookean(young, poisson),
-        "veronda": lambda: snede.VerondaWestmann(young, poisson, gamma),
-    }
-    if name not in makers:
-        raise ValueError(f"unknown material {name!r}: choose one of {', '.join(MATERIAL_NAMES)}")
-    return makers[name]()
-
-
-def briefly(result) -> str:
-    """The start of ``str(result)``, for a line of a scene's progress: converged or not,
-    PETSc's reason, iterations and the time."""
-    state = "converged" if result.converged else "NOT converged"
-    return f"{state} ({result.reason}) after {result.iterations} iterations, {result.seconds:.2f} s"
-
-
-def solve_entries(results) -> dict:
-    """Summary entries (those of ``run_scene.solve_once``) of a scene that solves many times:
-    converged only if every solve did, with the first failure's reason (else the last solve's);
-    iterations, solve seconds and MFLOP summed; the last residual norm."""
-    failed = [r for r in results if not r.converged]
-    return {
-        "converged": not failed, "reason": (failed[0] if failed else results[-1]).reason,
-        "iterations": sum(r.iterations for r in results),
-        "linear_iterations": sum(r.linear_iterations for r in results),
-        "residual_norm": results[-1].residual_norm,
-        "seconds": sum(r.seconds for r in results), "mflop": sum(r.flops for r in results) / 1e6,
-        "solves": len(results),
-    }
+"""Built-in scenes for ``python -m snede run``: each module has ``build(options) -> Scene`` and
+``builders()`` names them. ``Scene`` and the helpers the scene modules share are in
+``snede.scenes.scene`` (re-exported here): the modules import them from there, not from this
+package, which imports the modules."""
+from snede.scenes.scene import MATERIAL_NAMES, Scene, briefly, material, solve_entries  # noqa: F401
 
 
 def builders() -> dict:

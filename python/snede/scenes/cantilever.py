@@ -3,7 +3,7 @@ Beam theory gives the tip deflection y = 4F/(Ed) (l/h)³ = 8.64 mm (Table 3.1)."
 import numpy as np
 
 import snede
-from snede.scenes import Scene, material
+from snede.scenes.scene import Scene, material
 
 LENGTH, HEIGHT, DEPTH, YOUNG, LOAD = 1.2, 0.2, 0.3, 1e6, 3.0
 VIEW = (20.0, 30.0, 0.0, "y")  # the picture's camera: y up, the beam bending down across the picture

@@ -17,7 +17,7 @@ import numpy as np
 
 import snede
 from snede.plotting import HIGHLIGHT, animate, draw_3d
-from snede.scenes import Scene, briefly, material, solve_entries
+from snede.scenes.scene import Scene, briefly, material, solve_entries
 from snede.scenes.incision import incision_cells, lips_gap
 
 LENGTH, WIDTH, HEIGHT = 0.2, 0.05, 0.05

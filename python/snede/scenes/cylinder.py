@@ -5,7 +5,7 @@ from pathlib import Path
 import numpy as np
 
 import snede
-from snede.scenes import Scene, material
+from snede.scenes.scene import Scene, material
 
 MESHES = Path(__file__).resolve().parents[3] / "meshes"
 OPTIONS = ("mesh_size", "formulation")  # the scene options it uses (the command line refuses the others)

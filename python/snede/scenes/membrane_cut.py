@@ -28,7 +28,7 @@ import snede
 from snede.output import SeriesWriter
 from snede.planar_cutting import PlanarCutReport, sample_path
 from snede.plotting import animate, draw_3d, highlighted, outline_edges, save_3d
-from snede.scenes import Scene, briefly, material, solve_entries
+from snede.scenes.scene import Scene, briefly, material, solve_entries
 from snede.scenes.incision import incision_cells, lips_gap
 
 DIVISIONS = 14  # the bell's n × n squares: 2n² = 392 triangles, Figure 5.19

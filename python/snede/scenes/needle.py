@@ -12,7 +12,7 @@ import numpy as np
 
 import snede
 from snede.plotting import animate, draw_2d
-from snede.scenes import Scene, material
+from snede.scenes.scene import Scene, material
 from snede.scenes.needle_slab import DEPTH, DIRECTION, ENTRY, POISSON, YOUNG, h, held, needle_for, slab_body
 
 OPTIONS = ("divisions", "speed", "formulation")  # the scene options it uses (the command line refuses the others)

@@ -26,7 +26,7 @@ import numpy as np
 import snede
 from snede.needle_forces import liver_profile, liver_young
 from snede.plotting import _figure, animate, draw_3d, save_3d
-from snede.scenes import Scene, material
+from snede.scenes.scene import Scene, material
 
 SIZE, DEPTH, RADIUS = 0.1, 0.07, 1e-3
 # Liver's shear modulus (snede.needle_forces); ν = 0.4 stays below the ratio at which linear

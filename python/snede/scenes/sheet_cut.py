@@ -19,7 +19,7 @@ import numpy as np
 import snede
 from snede.planar_cutting import PlanarCutReport, sample_path
 from snede.plotting import HIGHLIGHT, animate, draw_2d
-from snede.scenes import Scene, briefly, material, solve_entries
+from snede.scenes.scene import Scene, briefly, material, solve_entries
 from snede.scenes.incision import incision_cells, lips_gap
 
 LENGTH, HEIGHT, THICKNESS = 0.1, 0.06, 0.001

@@ -6,7 +6,7 @@ import numpy as np
 
 import snede
 from snede.plotting import LOAD
-from snede.scenes import Scene, material
+from snede.scenes.scene import Scene, material
 
 SIZE, THICKNESS, DEPTH, TOTAL_FORCE = 0.1, 0.01, 0.07, 0.2
 PLOT_SCALE = 20.0  # the slab moves half a millimetre: exaggerated in the picture
