@@ -31,9 +31,9 @@
 #include <unordered_map>
 #include <vector>
 
-#include "mesh/deformed_positions.hpp"
 #include "cutting/sweep_triangle.hpp"
 #include "mesh/connectivity.hpp"
+#include "mesh/deformed_positions.hpp"
 
 namespace snede {
 

@@ -16,8 +16,8 @@
 // exactly the snapped point, up to rounding.
 #pragma once
 
-#include "mesh/deformed_positions.hpp"
 #include "cutting/sweep_triangle.hpp"
+#include "mesh/deformed_positions.hpp"
 #include "topology/edit_result.hpp"
 
 namespace snede {
