@@ -15,8 +15,8 @@ from pathlib import Path
 import numpy as np
 
 import snede
-from studies.experiments.common import (Column, markdown_table, options_prefix, parse_arguments, pyplot, run_solve,
-                                        write_csv)
+from studies.experiments.common import (Column, PageTemplate, markdown_table, options_prefix, parse_arguments, pyplot,
+                                        run_solve, write_csv)
 
 LENGTH, HEIGHT, DEPTH, YOUNG, LOAD = 1.2, 0.2, 0.3, 1e6, 3.0
 SHEAR_COEFFICIENT = 5 / 6  # Timoshenko's κ for a rectangular section
@@ -236,92 +236,59 @@ def sign_change_divisions(table) -> int:
 
 
 def describe(table, nonlinear, quick: bool, minutes: float) -> str:
+    """cantilever.md: studies/templates/cantilever.md filled with the run's tables and verdicts."""
+    template = PageTemplate("cantilever")
     compared = [row for row in table if row["thesis_avg_error_pct"] is not None]
     falling = all(a["avg_error_pct"] > b["avg_error_pct"] for a, b in zip(table, table[1:]))
     below = all(row["all_below_analytic"] for row in table)
-    lines = [
-        "# §3.3 cantilever: Table 3.1 and geometric nonlinearity", "",
-        "Regenerate with `.venv/bin/python -m studies.experiments.cantilever"
-        + (" --quick`" if quick else "`") + " (this file, `cantilever.csv`, `cantilever.png`)."
-        + (" **Quick run: reduced sizes.**" if quick else
-           " Full run: the five Table 3.1 meshes, and the nonlinear part on "
-           + " and ".join(dict.fromkeys(row["elements"] for row in nonlinear))
-           + f" only: on the 2-core machine Veronda-Westmann at the largest load already takes minutes on the"
-           f" finer of these (this whole run: {minutes:.1f} min)."), "",
-        f"Beam l × h × d = {LENGTH} × {HEIGHT} × {DEPTH} m, E = {YOUNG:g} Pa, ν = 0, fixed at x = 0, "
-        f"{LOAD:g} N along −y split equally over the tip nodes (x = l). Meshes: `snede.meshing.box`, n × n/4 × n/4 "
-        f"cubes of 6 tetrahedra (Kuhn split). Beam theory: y = 4F/(Ed)(l/h)³ = {beam_deflection():.3e} m; with "
-        f"shear deformation (Timoshenko, κ = 5/6) {timoshenko_deflection():.4e} m. Error per tip node "
-        "|y − (−u_y)|/y; linear CG with ‖r‖ < 1e-8‖f_ext‖ (criterion (6.8)).", "",
-        "## Table 3.1", "", markdown_table(table, TABLE_COLUMNS),
-        "![tip error against element size](cantilever.png)", "",
-        "**Agrees with the thesis:** " + ("the error falls with every refinement" if falling else
-                                          "the error does NOT fall with every refinement")
-        + (" and every FEM tip deflection is below the analytic one (the FEM is stiffer), as the thesis states; "
-           if below else "; but some FEM tip deflection exceeds the analytic one, unlike the thesis; ")
-        + ("maximum and average errors stay within one point of each other (the tip face barely deforms)."
-           if all(row["max_error_pct"] - row["avg_error_pct"] < 1 for row in table) else
-           "maximum and average errors differ by more than a point on some mesh."), ""]
+    close = all(row["max_error_pct"] - row["avg_error_pct"] < 1 for row in table)
+    differs = ""
     if compared:
-        ratio_errors = np.mean([row["avg_error_pct"] / row["thesis_avg_error_pct"] for row in compared])
-        ratio_iterations = np.mean([row["iterations"] / row["thesis_iterations"] for row in compared])
-        lines += [
-            f"**Differs:** the errors are smaller than the thesis's (on average {ratio_errors:.2f} × its value over "
-            f"{len(compared)} meshes) and CG needs fewer iterations ({ratio_iterations:.2f} × on average). The "
-            "thesis does not say how its procedural beam was split into tetrahedra; a different split of the "
-            "same cubes gives a different stiffness, so this is the likely cause (not verified). Its node count "
-            "8181 for 48 × 12 × 12 cannot be a grid of 49 × 13 × 13 = 8281 points (probably a typo).", "",
-            "**Beyond the thesis:** beam theory without shear is not the FEM's limit. Shear adds "
-            f"{100 * (timoshenko_deflection() / beam_deflection() - 1):.1f} % to the deflection, so against the "
-            "shear-corrected value the errors are larger (column 'vs. shear beam'), and against the Euler-Bernoulli "
-            f"value they would change sign on meshes finer than about n = {sign_change_divisions(table)} "
-            "(n × n/4 × n/4, "
-            "extrapolating the finest mesh's error at the rate h²).", ""]
-    lines += ["## Nonlinear materials at larger loads", "",
-              "Same beam and ν = 0, truncated Newton (PETSc `newtonls` with CG inside) until ‖r‖ < 1e-8‖f_ext‖ "
-              "(6.8) with the `cp` line search (the default energy backtracking stops at DIVERGED_LINE_SEARCH "
-              "around ‖r‖ ≈ 1e-6‖f‖, where energy differences reach round-off). 'ratio' is the tip deflection over "
-              "the linear (ν = 0) one on the same mesh; 'elastica ratio' is the same ratio for the exact "
-              "large-deflection beam (inextensible elastica against Euler-Bernoulli, computed by shooting); "
-              "'ratio to small-strain equivalent' divides by the linear solid the material reduces to at small "
-              "strain.", "",
-              markdown_table(nonlinear, NONLINEAR_COLUMNS)]
+        differs = template.snippet(
+            "differs", n_compared=len(compared),
+            ratio_errors=np.mean([row["avg_error_pct"] / row["thesis_avg_error_pct"] for row in compared]),
+            ratio_iterations=np.mean([row["iterations"] / row["thesis_iterations"] for row in compared]),
+            shear_pct=100 * (timoshenko_deflection() / beam_deflection() - 1), sign_change=sign_change_divisions(table))
     small = [row for row in nonlinear if row["load"] == min(r["load"] for r in nonlinear)]
     large = [row for row in nonlinear if row["load"] == max(r["load"] for r in nonlinear)]
     classic = [row for row in large if not row["material"].startswith("Veronda") and row["converged"]]
     veronda_small = [row for row in small if row["material"].startswith("Veronda")]
+
     def by_mesh(rows):
         meshes = dict.fromkeys(row["elements"] for row in rows)
         return "; ".join(f"{mesh}: " + ", ".join(f"{row['ratio_to_linear']:.3f}" for row in rows
                                                   if row["elements"] == mesh) for mesh in meshes)
 
-    lines += [
-        "**Geometric nonlinearity:** at the smallest load St. Venant-Kirchhoff and neo-Hookean agree with the "
-        "linear model (ratios " + by_mesh([row for row in small if not row["material"].startswith("Veronda")]) + ")"
-        + (f"; at {large[0]['load']:g} N the beam deflects less than the linear prediction (ratios "
-           + by_mesh(classic)
-           + f"; elastica {large[0]['elastica_ratio']:.3f}), as the bent beam's tip swings back in x and the "
-           "load's lever arm shortens. "
-           + ("The FEM ratio moves towards the elastica's as the mesh is refined, but neither"
-              if len({row["n"] for row in classic}) > 1
-              and classic[-1]["ratio_to_linear"] < classic[0]["ratio_to_linear"]
-              else "Neither")
-           + " deflection is mesh-converged at this load, so the ratio still depends on the mesh."
-           if classic else "."), ""]
+    large_load = template.snippet("no_large_load")
+    if classic:
+        refined = (len({row["n"] for row in classic}) > 1
+                   and classic[-1]["ratio_to_linear"] < classic[0]["ratio_to_linear"])
+        large_load = template.snippet("large_load", load=large[0]["load"], ratios=by_mesh(classic),
+                                      elastica=large[0]["elastica_ratio"],
+                                      refined=template.snippet("moves_towards_elastica" if refined else "neither"))
+    veronda = ""
     if veronda_small:
         young, poisson = veronda_small_strain_constants()
-        lines += [
-            "**Veronda-Westmann is not the ν = 0 beam even at small load** (ratio "
-            + ", ".join(f"{row['ratio_to_linear']:.3f} on {row['elements']}" for row in veronda_small)
-            + f" at {veronda_small[0]['load']:g} N): its exponential term adds 2μ(2γ − 1) to λ (§4.3.4 notes the "
-            f"small-strain inconsistency), so with γ = {VERONDA_GAMMA:g} and ν = 0 it behaves like a linear solid "
-            f"with E' = {young / YOUNG:.2f}E and ν' = {poisson:.3f}: stiffer and nearly incompressible, so these P1 "
-            "tetrahedra also lock. Against that equivalent linear solid the ratio is "
-            + ", ".join(f"{row['ratio_to_equivalent_linear']:.3f}" for row in veronda_small) + ".", ""]
+        veronda = template.snippet(
+            "veronda", ratios=", ".join(f"{row['ratio_to_linear']:.3f} on {row['elements']}" for row in veronda_small),
+            load=veronda_small[0]["load"], gamma=VERONDA_GAMMA, young_ratio=young / YOUNG, poisson=poisson,
+            equivalent_ratios=", ".join(f"{row['ratio_to_equivalent_linear']:.3f}" for row in veronda_small))
     failed = [row for row in nonlinear if not row["converged"]]
-    lines += ["**Did not converge:** " + ("; ".join(f"{row['material']} at {row['load']:g} N on {row['elements']}: "
-                                                     f"{row['reason']}" for row in failed) if failed else "none") + "."]
-    return "\n".join(lines) + "\n"
+    return template.page(
+        quick_flag=" --quick" if quick else "",
+        run=template.snippet("quick_run") if quick else template.snippet(
+            "full_run", nonlinear_meshes=" and ".join(dict.fromkeys(row["elements"] for row in nonlinear)),
+            minutes=minutes),
+        length=LENGTH, height=HEIGHT, depth=DEPTH, young=YOUNG, load=LOAD, beam=beam_deflection(),
+        timoshenko=timoshenko_deflection(), table=markdown_table(table, TABLE_COLUMNS),
+        falls=template.snippet("falls" if falling else "does_not_fall"),
+        below=template.snippet("below" if below else "not_below"),
+        spread=template.snippet("close_spread" if close else "wide_spread"), differs=differs,
+        nonlinear_table=markdown_table(nonlinear, NONLINEAR_COLUMNS),
+        small_ratios=by_mesh([row for row in small if not row["material"].startswith("Veronda")]),
+        large=large_load, veronda=veronda,
+        failed="; ".join(f"{row['material']} at {row['load']:g} N on {row['elements']}: {row['reason']}"
+                         for row in failed) if failed else template.snippet("none"))
 
 
 def main(argv=None) -> dict:

@@ -1,6 +1,6 @@
-"""Small helpers shared by the experiments: their command line, results tables written as
-markdown and CSV, PETSc options prefixes that never repeat, and solve outcomes that always
-end with a verdict."""
+"""Small helpers shared by the experiments: their command line, results pages written from
+templates, results tables written as markdown and CSV, PETSc options prefixes that never
+repeat, and solve outcomes that always end with a verdict."""
 from __future__ import annotations
 
 import argparse
@@ -15,6 +15,7 @@ from typing import Callable, Sequence
 
 _REPOSITORY = Path(__file__).resolve().parents[2]
 RESULTS_DIR = (_REPOSITORY if (_REPOSITORY / "pyproject.toml").exists() else Path.cwd()) / "docs" / "results"
+TEMPLATES = Path(__file__).resolve().parents[1] / "templates"
 
 
 def parse_arguments(description: str, argv: Sequence[str] | None = None,
@@ -30,6 +31,42 @@ def parse_arguments(description: str, argv: Sequence[str] | None = None,
     arguments, _ = parser.parse_known_args(argv)
     arguments.out.mkdir(parents=True, exist_ok=True)
     return arguments
+
+
+_SNIPPET_HEADER = re.compile(r"\n<!-- snippet ([A-Za-z0-9_]+) -->\n")
+_LONE_PLACEHOLDER = re.compile(r"^\{([A-Za-z0-9_]+)\}\n(?:\n|\Z)", re.M)
+
+
+class PageTemplate:
+    """The prose of a results page, in ``studies/templates/<name>.md``: the page, then its
+    snippets (sentences and paragraphs that only some runs print), each after a line
+    ``<!-- snippet NAME -->``. The generator computes the values, picks the snippets and fills
+    them in.
+
+    Page and snippets are ``str.format`` strings: ``{name}`` or ``{name:.2f}`` takes the value
+    of that name, ``{{`` and ``}}`` are braces. A snippet ends at the next snippet's line, less
+    the line breaks before it; the page ends with one line break. A text value goes in without
+    its last line break (a markdown table's), and a paragraph that is a placeholder alone goes,
+    with the blank line after it, when its value is the empty string (a paragraph some runs
+    leave out)."""
+
+    def __init__(self, name: str):
+        self.path = TEMPLATES / f"{name}.md"
+        page, *rest = _SNIPPET_HEADER.split(self.path.read_text())
+        self.text = page.rstrip("\n") + "\n"
+        self.snippets = {name: text.rstrip("\n") for name, text in zip(rest[::2], rest[1::2])}
+
+    def snippet(self, name: str, **values) -> str:
+        return _fill(self.snippets[name], values)
+
+    def page(self, **values) -> str:
+        return _fill(self.text, values)
+
+
+def _fill(text: str, values: dict) -> str:
+    values = {key: value.removesuffix("\n") if isinstance(value, str) else value for key, value in values.items()}
+    text = _LONE_PLACEHOLDER.sub(lambda match: "" if values.get(match[1]) == "" else match[0], text)
+    return text.format_map(values)
 
 
 @dataclass(frozen=True)
