@@ -34,7 +34,8 @@ def parse_arguments(description: str, argv: Sequence[str] | None = None,
 
 
 _SNIPPET_HEADER = re.compile(r"\n<!-- snippet ([A-Za-z0-9_]+) -->\n")
-_LONE_PLACEHOLDER = re.compile(r"^\{([A-Za-z0-9_]+)\}\n(?:\n|\Z)", re.M)
+# A placeholder alone in a paragraph, with the blank line after it (or before it, at the end).
+_LONE_PLACEHOLDER = re.compile(r"^\{([A-Za-z0-9_]+)\}\n\n|\n\n\{([A-Za-z0-9_]+)\}\n\Z", re.M)
 
 
 class PageTemplate:
@@ -65,7 +66,8 @@ class PageTemplate:
 
 def _fill(text: str, values: dict) -> str:
     values = {key: value.removesuffix("\n") if isinstance(value, str) else value for key, value in values.items()}
-    text = _LONE_PLACEHOLDER.sub(lambda match: "" if values.get(match[1]) == "" else match[0], text)
+    text = _LONE_PLACEHOLDER.sub(lambda match: "\n" * bool(match[2]) if values.get(match[1] or match[2]) == "" else match[0],
+                                 text)
     return text.format_map(values)
 
 

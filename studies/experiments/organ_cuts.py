@@ -3,21 +3,8 @@ exactly what it spans, with and without the body relaxing between the scalpel's 
 
     .venv/bin/python -m studies.experiments.organ_cuts [--quick] [--out DIR] [--cuts N]
 
-Shapes: gmsh-made solids (an ellipsoid, a torus, two lumpy organ-like solids) and SOFA's
-public liver surfaces tetrahedralised by gmsh (``studies/benchmarks/organ_meshes.py``). Each cut is a
-straight blade, long enough to span the body, in a random direction, swept in a random plane
-in 12 moves, either across the whole body or stopping inside it. The body is neo-Hookean
-(E = 5 kPa, ν = 0.45, 1000 kg/m³) under gravity, held on a patch of its top; "relaxed" cuts
-run a Newton solve after every move, so the lips open between moves.
-
-The independent count: the cells of the mesh before the cut, where the body was when the
-scalpel was placed, joined across their shared faces except where the segment between the two
-cells' centroids crosses the swept region of the plane; the flood fill's components are the
-pieces the cut should leave. Blades whose expected pieces include one smaller than 50 mean
-cells (the plane grazing a lobe, which the mesh cannot resolve), or whose count changes when
-the sweep ends two edge lengths earlier or later (a partial cut ending just across a section: the
-tetrahedra the scalpel is still in are cut with its next move), are drawn again. A fragment is
-a piece of the cut body smaller than 50 mean cells: every piece the cut should leave is bigger. ``validate()`` runs after every move.
+The shapes, the blades and the independent count of the pieces a cut should leave are described
+on the page (studies/templates/organ_cuts.md).
 
 Writes organ_cuts.md and organ_cuts.csv (one row per cut).
 """
@@ -34,7 +21,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 import snede
-from studies.experiments.common import _REPOSITORY, Column, markdown_table, parse_arguments, write_csv
+from studies.experiments.common import _REPOSITORY, Column, PageTemplate, markdown_table, parse_arguments, write_csv
 
 E, NU, DENSITY, GRAVITY = 5e3, 0.45, 1000.0, 9.81
 MOVES = 12
@@ -269,56 +256,30 @@ def summary(rows: list[dict]) -> list[dict]:
 
 
 def describe(rows: list[dict], quick: bool, minutes: float) -> str:
+    """organ_cuts.md: studies/templates/organ_cuts.md filled with this run's rows."""
+    template = PageTemplate("organ_cuts")
     total = summary(rows)
-    wrong = sum(r["wrong"] for r in rows)
-    fragments = sum(r["fragments"] for r in rows)
     failures = [r for r in rows if r["wrong"] or r["fragments"] or r["invalid"]]
-    text = [
-        "# Random cuts through real and organ-like shapes (issue 32)\n",
-        f"Regenerate with `.venv/bin/python -m studies.experiments.organ_cuts{' --quick' if quick else ''}`"
-        f" (this file and `organ_cuts.csv`, one row per cut); this run took {minutes:.1f} min on the 2-core "
-        "development machine.\n",
-        (__doc__.split("\n\n", 2)[2].split("Writes")[0]).strip() + "\n",
-        f"**{len(rows)} cuts on {len(total) // 2} shapes: {wrong} wrong piece counts, {fragments} fragments.**\n",
-        markdown_table(total, COLUMNS),
-        "A move here sweeps a twelfth of the body's section: those that dissect the most faces (30–70) took "
-        "5–13 ms when 36 of these cuts were timed again on a quiet machine; the larger maxima above came from the "
-        "shared machine's load during this run. 'fragments removed' counts the pieces of "
-        "at most 10 mean elements the cutter removed (flat tetrahedra between two cut faces); 'largest volume "
-        "change' includes the snapping's changes of the elements' volumes. 'solves failed' counts Newton solves "
-        "after a move (12 per relaxed cut) that did not converge. Until 2026-11-27 there were 70 of them in "
-        "the 600 relaxed cuts: a vertex snapped onto the sweep in the configuration where the scalpel was "
-        "placed left an element of the body as it hung by then nearly flat (J = 1.8e-13 on the torus, not "
-        "inverted), its neo-Hookean stress was not finite, and every later solve of that cut failed from the "
-        "same state. Snaps that would shrink an element of the current body below a thousandth of its volume "
-        "are now refused (node_snapping.cpp).\n",
-        "A smallest piece just above the fragment threshold (50 mean cells) can come out just below it: the "
-        "cut's snapping and fragment removal change the pieces' volumes by a few per cent, and a piece of 53 "
-        "mean cells by the flood fill then counts as a fragment.\n",
-    ]
-    if failures:
-        text.append("Cuts that went wrong:\n")
-        text.append(markdown_table(failures[:20], [Column(k, k) for k in
-                                                    ("shape", "relaxed", "full", "expected", "big pieces", "fragments", "invalid")]))
-    return "\n".join(text)
+    columns = [Column(k, k) for k in ("shape", "relaxed", "full", "expected", "big pieces", "fragments", "invalid")]
+    return template.page(
+        quick_flag=" --quick" if quick else "", minutes=minutes, moves=MOVES, resolved_cells=RESOLVED_CELLS,
+        n_cuts=len(rows), n_shapes=len(total) // 2, wrong=sum(r["wrong"] for r in rows),
+        fragments=sum(r["fragments"] for r in rows), table=markdown_table(total, COLUMNS),
+        failures=template.snippet("failures", table=markdown_table(failures[:20], columns)) if failures else "")
 
 
 def section_for_cutting(folder) -> str:
     """The section of cutting.md on real organ meshes: the summary of ``organ_cuts.csv`` in
     ``folder`` (written by this experiment), or how to make it."""
-    heading = "## Real organ meshes: random cuts with and without relaxation (issue 32)\n\n"
+    template = PageTemplate("organ_cuts")
     path = folder / "organ_cuts.csv"
     if not path.exists():
-        return heading + "Run `.venv/bin/python -m studies.experiments.organ_cuts` for this section.\n"
+        return template.snippet("cutting_section_missing") + "\n"
     with open(path, newline="") as stream:
         rows = [{key: _parsed(value) for key, value in row.items()} for row in csv.DictReader(stream)]
-    wrong, fragments = sum(r["wrong"] for r in rows), sum(r["fragments"] for r in rows)
-    return (heading + f"From [organ_cuts.md](organ_cuts.md) (its method and the failures in detail): {len(rows)} random "
-            f"straight blades swept in {MOVES} moves through gmsh-made shapes and SOFA's livers, half of them with a "
-            f"Newton solve after every move, gave {wrong} piece counts different from an independent flood fill of "
-            f"the uncut mesh and {fragments} fragments. The thesis reports no such count; its Figure 3.17 shows the "
-            "effect of relaxing between moves that made the lips open away from the next sweep.\n\n"
-            + markdown_table(summary(rows), COLUMNS))
+    return template.snippet("cutting_section", n_cuts=len(rows), moves=MOVES, wrong=sum(r["wrong"] for r in rows),
+                            fragments=sum(r["fragments"] for r in rows),
+                            table=markdown_table(summary(rows), COLUMNS)) + "\n"
 
 
 def _parsed(value: str):
