@@ -19,7 +19,8 @@ import numpy as np
 import snede
 from studies.experiments.cantilever import (DEPTH, HEIGHT, LENGTH, YOUNG, cantilever_body, timoshenko_deflection,
                                             tip_deflections)
-from studies.experiments.common import Column, markdown_table, options_prefix, parse_arguments, run_solve, write_csv
+from studies.experiments.common import (Column, PageTemplate, markdown_table, options_prefix, parse_arguments, run_solve,
+                                        write_csv)
 from studies.experiments.tradeoff import MESHES, critical_damping_estimate, cylinder_body, tip_sag
 
 LOCKING_RATIO = 0.9  # below this fraction of beam theory's deflection, call the mesh locked
@@ -273,143 +274,103 @@ def _outcomes(rows) -> str:
                      for r in rows)
 
 
-def findings(rows) -> list[str]:
-    """The bullet points of the markdown, each computed from the rows it summarises."""
+def findings(rows, template: PageTemplate) -> list[str]:
+    """The bullet points of the markdown (snippets of ``template``), each filled from the rows it
+    summarises."""
     def pick(case_start, **match):
         return [r for r in rows if r["case"].startswith(case_start) and all(r[k] == v for k, v in match.items())]
 
+    snippet = template.snippet
     bullets = []
     locking = pick("ν")
     locked = [r for r in locking if r["note"].startswith("locks")]
     linear_cg = [r for r in locking if r["material"] == "LinearElastic"]
     stiffest = [r for r in linear_cg if r["poisson"] == max(r["poisson"] for r in linear_cg)]
-    refinement = ("Refining the mesh recovers little: " + " → ".join(f"{r['ratio']:.0%} ({r['setting']})"
-                                                                       for r in stiffest) + ". "
-                  if len(stiffest) > 1 else "")
     if locking:
-        bullets.append(
-            "**Locking (ν → ½).** " + ("P1 tetrahedra lock: " + "; ".join(
-                f"{r['setting']} {r['material']}: {r['ratio']:.0%}" for r in locked)
-                + " of the beam-theory deflection" if locked else "No locking below the threshold")
-            + f" (threshold {LOCKING_RATIO:.0%}; reference: the same mesh's ν = 0 deflection scaled by Timoshenko's "
-            "ν dependence, which beam theory makes tiny). " + refinement + "The experiment warns "
-            "(snede.LockingWarning, with the measured fraction) for each locked run. Linear CG's iterations "
-            "grow with λ/μ: "
-            + ", ".join(f"{r['iterations']} ({r['setting']})" for r in linear_cg) + ".")
+        bullets.append(snippet(
+            "locking",
+            locks=snippet("locked", runs="; ".join(f"{r['setting']} {r['material']}: {r['ratio']:.0%}" for r in locked))
+            if locked else snippet("not_locked"),
+            threshold=LOCKING_RATIO,
+            refinement=snippet("refinement", ratios=" → ".join(f"{r['ratio']:.0%} ({r['setting']})" for r in stiffest))
+            if len(stiffest) > 1 else "",
+            iterations=", ".join(f"{r['iterations']} ({r['setting']})" for r in linear_cg)))
     scaled = pick("E (cantilever")
     if scaled:
-        worst_linear = max(abs(r["ratio"] - 1) for r in scaled if r["material"] == "LinearElastic")
         neo = [r for r in scaled if r["material"] == "NeoHookean"]
         stalled = [r for r in neo if r["reason"] == "DIVERGED_LINE_SEARCH"]
-        bullets.append(
-            f"**E, load ∝ E.** The linear cantilever is scale invariant (largest relative change {worst_linear:.1e}). "
-            "Neo-Hookean Newton at rtol 1e-8: " + _outcomes(neo) + "."
-            + (" Where it stops with DIVERGED_LINE_SEARCH its deflection differs from the E = 1e6 one by only "
-               + ", ".join(f"{abs(r['ratio'] - 1):.0e}" for r in stalled)
-               + " (relative): the default energy backtracking stalls at round-off near rtol = 1e-8, and whether "
-               "it gets there varies from case to case; use rtol ≥ 1e-6 or `-static_snes_linesearch_type cp` for "
-               "tighter solves." if stalled else ""))
+        bullets.append(snippet(
+            "scaled", worst=max(abs(r["ratio"] - 1) for r in scaled if r["material"] == "LinearElastic"),
+            outcomes=_outcomes(neo),
+            stalled=snippet("line_search_stalls", changes=", ".join(f"{abs(r['ratio'] - 1):.0e}" for r in stalled))
+            if stalled else ""))
     cylinder = pick("E (cylinder")
     if cylinder:
         stuck = [r for r in cylinder if r["solver"] == "ncg" and not r["converged"] and r["iterations"] == 0]
-        bullets.append(
-            "**E, cylinder under gravity.** " + _outcomes(cylinder) + ". The softest cylinders hang many times "
-            "their length (column note)."
-            + (" Nonlinear CG fails at its first iteration there: its first secant step (scaled by the tangent at "
-               "rest) inverts elements (at E = 100 Pa on the 1125-cell cylinder the full step inverts 223 cells, "
-               "checked separately) and the line search does not recover." if stuck else
-               " From rest, nonlinear CG's first secant step is far too long for the softest material (at "
-               "E = 100 Pa the full step inverts 223 cells of the 1125-cell cylinder, checked separately); the rows "
-               "above show whether its line search recovers."))
+        bullets.append(snippet("cylinder", outcomes=_outcomes(cylinder),
+                               ncg=snippet("ncg_stuck" if stuck else "ncg_first_step")))
     veronda = pick("Veronda-Westmann γ (cylinder")
     if veronda:
         newton = [r for r in veronda if r["solver"] == "newton"]
-        cfl_rows = [r for r in veronda if r["solver"] == "dynamic CFL"]
         critical_rows = [r for r in veronda if r["solver"] == "dynamic 0.9 × critical"]
-        bullets.append(
-            "**Veronda-Westmann γ.** Larger γ stiffens the cylinder (sag "
-            + " → ".join(f"{r['value']:.3g} m" for r in newton) + ") and costs Newton more iterations ("
-            + " → ".join(str(r["iterations"]) for r in newton) + "). Dynamic relaxation with the default CFL "
-            "step: " + _outcomes(cfl_rows) + "; with 0.9 × the searched critical step: " + _outcomes(critical_rows)
-            + " (" + "; ".join(f"{r['setting']}: {r['note']}" for r in critical_rows) + "). The CFL estimate "
-            "(2.61) uses the wave speed of (λ, μ), but at small strain Veronda-Westmann acts like "
-            "λ + 2μ(2γ − 1) (§4.3.4), so from γ ≈ 8 on — the thesis's own setting — the default step is above "
-            "the stable one and the run diverges; `DynamicRelaxation.critical_time_step()` finds a stable one.")
+        bullets.append(snippet(
+            "veronda", sags=" → ".join(f"{r['value']:.3g} m" for r in newton),
+            iterations=" → ".join(str(r["iterations"]) for r in newton),
+            cfl=_outcomes([r for r in veronda if r["solver"] == "dynamic CFL"]), critical=_outcomes(critical_rows),
+            notes="; ".join(f"{r['setting']}: {r['note']}" for r in critical_rows)))
     far = pick("Veronda-Westmann γ (cantilever")
     if far:
-        domain = [r for r in far if r["reason"] == "DIVERGED_FUNCTION_DOMAIN"]
-        bullets.append("**Veronda-Westmann, cantilever far stretched.** " + _outcomes(far) + "."
-                       + (" DIVERGED_FUNCTION_DOMAIN is what snede reports when the function evaluation at a "
-                          "Newton iterate hits an exponential overflow or an inverted element: the solve stops "
-                          "with a named reason instead of raising snede.DomainError."
-                          if domain else ""))
+        domain = any(r["reason"] == "DIVERGED_FUNCTION_DOMAIN" for r in far)
+        bullets.append(snippet("far", outcomes=_outcomes(far), domain=snippet("function_domain") if domain else ""))
     slivers = pick("aspect")
     if slivers:
         static_rows = [r for r in slivers if r["solver"] == "cg"]
         dynamic_rows = [r for r in slivers if r["solver"] == "dynamic"]
         spread = max(abs(r["ratio"] - 1) for r in static_rows)
-        bullets.append(
-            "**Slivers.** With one node moved until the smallest aspect ratio is "
-            + ", ".join(f"{r['min_aspect_ratio']:.0e}" for r in static_rows)
-            + ", linear CG's tip deflection is " + ", ".join(f"{r['ratio']:.3f}" for r in static_rows)
-            + " × the unmoved mesh's (moving the node also distorts its other cells"
-            + ("; the change is small" if spread < 0.02 else "; on this coarse mesh that changes the answer")
-            + "), with " + ", ".join(str(r["iterations"]) for r in static_rows)
-            + " iterations against " + str(static_rows[0]["iterations"]) + " at the mildest setting: as §4.5.6 "
-            "finds for linear CG, a sliver costs the static solvers little, while the explicit step follows the "
-            "smallest element (" + ", ".join(r["note"] for r in dynamic_rows) + ") and dynamic relaxation ends "
-            + ", ".join(r["reason"] if not r["converged"] else "converged" for r in dynamic_rows) + ".")
+        bullets.append(snippet(
+            "slivers", aspects=", ".join(f"{r['min_aspect_ratio']:.0e}" for r in static_rows),
+            ratios=", ".join(f"{r['ratio']:.3f}" for r in static_rows),
+            change=snippet("small_change" if spread < 0.02 else "changes_answer"),
+            iterations=", ".join(str(r["iterations"]) for r in static_rows), first=static_rows[0]["iterations"],
+            notes=", ".join(r["note"] for r in dynamic_rows),
+            ends=", ".join(r["reason"] if not r["converged"] else "converged" for r in dynamic_rows)))
     steps = pick("time step")
     if steps:
-        bullets.append("**Time step.** " + "; ".join(
-            f"{r['material']}, {r['setting'].split(' (')[0]}: "
-            + (f"converged, {r['ratio']:.4f} × static" if r["converged"] else r["reason"]) for r in steps)
-            + ". The critical step is §4.4.1's search (an undamped run from rest within a flop budget); "
-            + ("with damping, a step above it still settled in: " + ", ".join(
-                f"{r['material']} at {r['factor']:g} ×" for r in steps if r["factor"] > 1 and r["converged"])
-               if any(r["factor"] > 1 and r["converged"] for r in steps) else "no step above it settled")
-            + (". Below it, some runs did not settle: " + ", ".join(
-                f"{r['material']} at {r['factor']:g} ×" for r in steps if r["factor"] <= 1 and not r["converged"])
-               if any(r["factor"] <= 1 and not r["converged"] for r in steps) else "") + ".")
+        above = [r for r in steps if r["factor"] > 1 and r["converged"]]
+        below = [r for r in steps if r["factor"] <= 1 and not r["converged"]]
+        bullets.append(snippet(
+            "time_step",
+            runs="; ".join(f"{r['material']}, {r['setting'].split(' (')[0]}: "
+                           + (snippet("settled", ratio=r["ratio"]) if r["converged"] else r["reason"]) for r in steps),
+            above=snippet("settled_above", runs=", ".join(f"{r['material']} at {r['factor']:g} ×" for r in above))
+            if above else snippet("none_settled_above"),
+            below=snippet("unsettled_below", runs=", ".join(f"{r['material']} at {r['factor']:g} ×" for r in below))
+            if below else ""))
     compression = pick("compression")
     if compression:
         through = [r for r in compression if r["converged"] and r["inverted_elements"]]
         neo_failed = [r for r in compression if r["material"] == "NeoHookean" and not r["converged"]]
-        bullets.append(
-            "**Inversion.** St. Venant-Kirchhoff converged to states with inverted cells (allowed for it, flagged "
-            "in the note): " + (", ".join(f"{r['setting']} {r['solver']}" for r in through) or "none")
-            + ". Neo-Hookean never converged to an inverted state"
-            + (("; it failed with a named reason in " + _outcomes(neo_failed)) if neo_failed else "")
-            + f". Above about {EULER_BUCKLING_STRESS:.2f}·E (Euler's estimate π²E/48 for this block as a column "
-            "clamped at its base) the pressed block also buckles sideways under the dead load and bends over: "
-            "top displacements beyond the height without inverted cells are such post-buckled states, and "
-            "different solvers can find different ones.")
-    return ["* " + bullet for bullet in bullets]
+        bullets.append(snippet(
+            "inversion", through=", ".join(f"{r['setting']} {r['solver']}" for r in through) or snippet("none"),
+            neo_failed=snippet("neo_failed", outcomes=_outcomes(neo_failed)) if neo_failed else "",
+            buckling=EULER_BUCKLING_STRESS))
+    return bullets
 
 
 def describe(rows, quick: bool, minutes: float) -> str:
+    """extremes.md: studies/templates/extremes.md filled with the findings and a table per case."""
+    template = PageTemplate("extremes")
     by_case = {}
     for entry in rows:
         by_case.setdefault(entry["case"], []).append(entry)
     failed = [r for r in rows if not r["converged"]]
-    lines = [
-        "# Extremes: where the solvers and elements break, and how they say so", "",
-        "Regenerate with `.venv/bin/python -m studies.experiments.extremes" + (" --quick`" if quick else "`")
-        + " (this file and `extremes.csv`)."
-        + (" **Quick run: reduced sizes.**" if quick else
-           " Meshes are kept small (cantilever 16 × 4 × 4, and 32 × 8 × 8 for locking; the 1125-cell cylinder; "
-           f"a 4 × 4 × 4 cube) to keep the whole run to a few minutes on the 2-core machine (this run: "
-           f"{minutes:.1f} min)."), "",
-        f"{len(rows)} runs: {len(rows) - len(failed)} converged, {len(failed)} ended with a named reason "
-        "(PETSc's or snede's converged reason, or the exception's class and message). Iteration caps (static "
-        "500–50 000, dynamic steps 20 000–30 000) turn stalls into DIVERGED_ITS / DIVERGED_MAX_IT. Static runs "
-        "use criterion (6.9) from rest; 'seconds' is the solve's own time. The thesis has no such table; where "
-        "it speaks about the same effect (§4.5.6 on short edges, §4.4.1 on the critical step) the findings are "
-        "compared.", "", "## Findings", ""]
-    lines += findings(rows)
-    for case, case_rows in by_case.items():
-        lines += ["", f"## {case}", "", markdown_table(case_rows, COLUMNS)]
-    return "\n".join(lines) + "\n"
+    return template.page(
+        quick_flag=" --quick" if quick else "",
+        run=template.snippet("quick_run") if quick else template.snippet("full_run", minutes=minutes),
+        n_runs=len(rows), n_converged=len(rows) - len(failed), n_failed=len(failed),
+        findings="\n".join(findings(rows, template)),
+        cases="\n\n".join(template.snippet("case", case=case, table=markdown_table(case_rows, COLUMNS))
+                           for case, case_rows in by_case.items()))
 
 
 def main(argv=None) -> list[dict]:
