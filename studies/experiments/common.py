@@ -57,7 +57,7 @@ class PageTemplate:
         self.text = page.rstrip("\n") + "\n"
         self.snippets = {name: text.rstrip("\n") for name, text in zip(rest[::2], rest[1::2])}
 
-    def snippet(self, name: str, **values) -> str:
+    def snippet(self, name: str, /, **values) -> str:
         return _fill(self.snippets[name], values)
 
     def page(self, **values) -> str:

@@ -21,8 +21,8 @@ import numpy as np
 
 import snede
 from studies.experiments.cantilever import LENGTH, YOUNG, cantilever_body, tip_deflections
-from studies.experiments.common import (Column, markdown_table, options_prefix, parse_arguments, pyplot, run_solve,
-                                        write_csv)
+from studies.experiments.common import (Column, PageTemplate, markdown_table, options_prefix, parse_arguments, pyplot,
+                                        run_solve, write_csv)
 
 MESHES = Path(__file__).resolve().parents[2] / "meshes"
 TARGETS_PCT = (1.0, 5.0, 20.0)
@@ -267,7 +267,7 @@ def median_time_ratio(rows: list[dict], slow: str, fast: str) -> float:
     return float(np.median(ratios)) if ratios else float("nan")
 
 
-def tolerance_sentence(rows: list[dict], tolerances) -> str:
+def tolerance_sentence(rows: list[dict], tolerances, template: PageTemplate) -> str:
     """§6.8.2 compared: the change rtol = 0.01 causes in each static run's tip deflection
     (against the tightest rtol, same mesh and solver) next to that run's total error."""
     tightest = min(tolerances)
@@ -279,29 +279,21 @@ def tolerance_sentence(rows: list[dict], tolerances) -> str:
                            and r["solver"] == row["solver"] and r["rtol"] == tightest)
             changes.append((100 * abs(row["tip_deflection"] / partner["tip_deflection"] - 1), row))
     if not changes:
-        return "* §6.8.2 (Table 6.1): rtol = 0.01 is not in this grid."
+        return template.snippet("tolerance_not_in_grid")
     change, worst = max(changes, key=lambda pair: pair[0] / pair[1]["error_pct"])
     share = change / worst["error_pct"]
-    verdict = ("agrees: the mesh, not the tolerance, decides the accuracy" if share < 0.2 else
-               "only partly agrees: there the tolerance is a sizeable part of the error")
-    return ("* §6.8.2 (Table 6.1) finds that modest tolerances already make displacement errors small. Here "
-            f"rtol = 0.01 changes a static solver's tip deflection (against rtol {tightest:g}) by at most "
-            f"{max(c for c, _ in changes):.2g} %; relative to the run's own total error the largest effect is "
-            f"{worst['solver']} on the {worst['scene']} mesh {worst['mesh']}: {change:.2g} % of "
-            f"{worst['error_pct']:.2g} %"
-            f" ({verdict}). Dynamic relaxation needs a tighter rtol for the same effect (its residual falls before "
-            "the slow lowest mode has settled).")
+    return template.snippet("tolerance", tightest=tightest, largest=max(c for c, _ in changes), solver=worst["solver"],
+                            scene=worst["scene"], mesh=worst["mesh"], change=change, error=worst["error_pct"],
+                            verdict=template.snippet("mesh_decides" if share < 0.2 else "tolerance_matters"))
 
 
-def unreached_sentence(picks: list[dict]) -> str:
+def unreached_sentence(picks: list[dict], template: PageTemplate) -> str:
     missed = [pick for pick in picks if pick["error_pct"] is None]
     if not missed:
-        return "* Every target error is reached in this grid."
-    return ("* Not reached in this grid: " + ", ".join(f"{p['target_pct']:g} % on the {p['scene']} (best "
-                                                       f"{p['best_error_pct']:.2g} %)" for p in missed)
-            + ". P1 tetrahedra in bending converge slowly (order in the reference table), so 1 % needs meshes "
-              "well beyond 10⁵ tetrahedra here, which is why the references are extrapolated; the smoothed "
-              "formulation bends more accurately on the same mesh.")
+        return template.snippet("all_reached")
+    return template.snippet("unreached", missed=", ".join(
+        template.snippet("missed_target", target=p["target_pct"], scene=p["scene"], best=p["best_error_pct"])
+        for p in missed))
 
 
 def plot(all_rows: list[dict], scene_names, path: Path) -> None:
@@ -350,25 +342,9 @@ REFERENCE_COLUMNS = [
 
 
 def describe(scene_list, references, rows, picks, tolerances, quick: bool, minutes: float) -> str:
-    lines = [
-        "# Accuracy against time: mesh size × formulation × tolerance × solver", "",
-        "Regenerate with `.venv/bin/python -m studies.experiments.tradeoff" + (" --quick`" if quick else "`")
-        + " (this file, `tradeoff.csv` with every run, `tradeoff.png`)."
-        + (" **Quick run: reduced sizes.**" if quick else
-           f" Sizes are chosen to keep the full run under ten minutes on the 2-core development machine (this run: "
-           f"{minutes:.1f} min, the cylinder's finest reference mesh about a third of it); timings were taken while "
-           "other work shared the machine, so treat them as ±30 %."), "",
-        "**What is compared.** The tip deflection: the mean over the nodes of the free end face (x = max) of −u_y "
-        "(cantilever) or −u_z (cylinder), defined on every mesh. Its error is measured against a reference "
-        "extrapolated (Richardson, value = limit − C h², a fitted order as a check) from three fine meshes solved "
-        "at a tight tolerance, so it includes each run's discretization error, not only its solver error. Wall "
-        "time is the solve's own (`SolveResult.seconds`), from rest, without mesh generation. Every solver stops at "
-        "criterion (6.9) (the default: ‖r‖ ≤ rtol·√(‖f_ext‖² + ‖f_react‖²)); dynamic relaxation uses the CFL "
-        "time step and η = 2√λ₁ with λ₁ estimated by the Rayleigh quotient of the reference solution "
-        "(§4.1; an optimistic choice a user would have to tune). Hollow markers in the figure: not converged. "
-        "The formulation (issue 35, docs/results/locking.md) is \"p1\" unless the mesh's label names "
-        "\"smoothed\" (strains averaged over edge and vertex patches); the reference is p1's, extrapolated, "
-        "which both converge to.", ""]
+    """tradeoff.md: studies/templates/tradeoff.md filled with the references, the picks, each
+    scene's frontier and the comparisons with the thesis."""
+    template = PageTemplate("tradeoff")
     reference_rows = []
     for scene in scene_list:
         ref = references[scene.name]
@@ -379,58 +355,39 @@ def describe(scene_list, references, rows, picks, tolerances, quick: bool, minut
             "finest_error_pct": 100 * abs(ref["values"][-1] / ref["limit"] - 1),
             "fitted_shift_pct": 100 * (ref["limit_fitted"] / ref["limit"] - 1), "damping": ref["damping"],
             "seconds": ref["seconds"]})
-    lines += ["## Reference", "",
-              "; ".join(f"{s.name}: {s.material}, solved by {s.reference_settings}" for s in scene_list) + ".", "",
-              markdown_table(reference_rows, REFERENCE_COLUMNS),
-              "The reference is the p = 2 extrapolation of the two finest meshes; the last two columns check it: "
-              "the order fitted to all three meshes, and how far the limit moves with that order. Errors well "
-              "below that shift (and below the finest mesh's own error, if the extrapolation is doubted) are not "
-              "resolved by this reference.", "",
-              "## Knobs to pick", "", markdown_table(picks, PICK_COLUMNS),
-              "The fastest converged run of the grid within each target. These picks optimise the tip "
-              "deflection, a global quantity dominated by the lowest mode, which the iterative solvers resolve "
-              "first: that is why very loose tolerances (even 0.3) appear. Local quantities (stresses at the "
-              "support, displacements next to a point load) were not measured and will need tighter tolerances. "
-              "The η of dynamic relaxation comes from the reference (cylinder: about 30 1/s, against 21 1/s in "
-              "the thesis's Table 4.4 for its own mesh).", "", "![error against wall time](tradeoff.png)", ""]
+    sections = []
     for scene in scene_list:
         scene_rows = [row for row in rows if row["scene"] == scene.name]
-        frontier = sorted((row for row in scene_rows if row["pareto"]), key=lambda r: r["seconds"])
         failed = [row for row in scene_rows if not row["converged"]]
-        lines += [f"## {scene.name}: Pareto frontier", "",
-                  f"{len(scene_rows)} runs: meshes {', '.join(c.label for c in scene.meshes)}; solvers "
-                  f"{', '.join(scene.solvers)}; rtol {', '.join(f'{t:g}' for t in tolerances)}. Not converged: "
-                  + ("; ".join(f"{r['mesh']} {r['solver']} rtol {r['rtol']:g}: {r['reason']}" for r in failed)
-                     if failed else "none") + ".", "", markdown_table(frontier, RUN_COLUMNS),
-                  "Change of the tip deflection caused by the tolerance alone (median over meshes, % of the value at "
-                  f"rtol {min(tolerances):g}, same mesh and solver):", "",
-                  markdown_table(tolerance_effect(scene_rows, tolerances),
-                                 [Column("rtol", "rtol", "{:g}")] + [Column(s, s, "{:.3g}") for s in scene.solvers])]
+        sections.append(template.snippet(
+            "scene", name=scene.name, n_runs=len(scene_rows), meshes=", ".join(c.label for c in scene.meshes),
+            solvers=", ".join(scene.solvers), tolerances=", ".join(f"{t:g}" for t in tolerances),
+            failed="; ".join(f"{r['mesh']} {r['solver']} rtol {r['rtol']:g}: {r['reason']}" for r in failed)
+            if failed else template.snippet("none"),
+            frontier_table=markdown_table(sorted((row for row in scene_rows if row["pareto"]),
+                                                 key=lambda r: r["seconds"]), RUN_COLUMNS),
+            tightest=min(tolerances),
+            tolerance_table=markdown_table(tolerance_effect(scene_rows, tolerances),
+                                           [Column("rtol", "rtol", "{:g}")]
+                                           + [Column(s, s, "{:.3g}") for s in scene.solvers])))
     cantilever_rows = [row for row in rows if row["scene"] == "cantilever"]
     cylinder_rows = [row for row in rows if row["scene"] == "cylinder"]
     linear_ratio = time_to_accuracy_ratio(cantilever_rows, "dynamic", "cg")
     nonlinear_ratio = time_to_accuracy_ratio(cylinder_rows, "dynamic", "ncg")
     newton_ratio = time_to_accuracy_ratio(cylinder_rows, "ncg", "newton")
-    lines += [
-        "## Against the thesis", "",
-        "Chapter 4 compares solvers by the time to reach an energy error; here the comparable measure is the "
-        "time to bring the tip deflection within 1 % of the same mesh's converged value (fastest run of each "
-        "solver in the grid that does so; median over meshes; the tolerance grid is coarse, so these ratios "
-        "are rough).", "",
-        f"* §4.5.4 finds linear CG 5–10 × faster than dynamic relaxation. Here dynamic relaxation takes "
-        f"{linear_ratio:.1f} × CG's time on the cantilever "
-        + ("(agrees)." if 4 <= linear_ratio <= 12 else "(differs).")
-        + f" At equal rtol instead the median ratio is {median_time_ratio(cantilever_rows, 'dynamic', 'cg'):.1f}, "
-          "but equal rtol leaves dynamic relaxation with the larger error.",
-        f"* §4.5.5 finds nonlinear CG as fast as dynamic relaxation with optimal parameters. On the cylinder dynamic "
-        f"relaxation takes {nonlinear_ratio:.1f} × nonlinear CG's time "
-        + ("(roughly agrees)." if 0.5 <= nonlinear_ratio <= 2 else
-           "(differs: nonlinear CG is faster here)." if nonlinear_ratio > 2 else "(differs: dynamic is faster here).")
-        + f" Truncated Newton, which chapter 4 does not benchmark, takes {1 / newton_ratio:.2f} × nonlinear CG's "
-          "time.",
-        tolerance_sentence(rows, tolerances),
-        unreached_sentence(picks), ""]
-    return "\n".join(lines) + "\n"
+    return template.page(
+        quick_flag=" --quick" if quick else "",
+        run=template.snippet("quick_run") if quick else template.snippet("full_run", minutes=minutes),
+        settings="; ".join(template.snippet("reference_settings", scene=s.name, material=s.material,
+                                            settings=s.reference_settings) for s in scene_list),
+        reference_table=markdown_table(reference_rows, REFERENCE_COLUMNS), picks_table=markdown_table(picks, PICK_COLUMNS),
+        scenes="\n\n".join(sections), linear_ratio=linear_ratio,
+        linear_verdict=template.snippet("agrees" if 4 <= linear_ratio <= 12 else "differs"),
+        equal_rtol_ratio=median_time_ratio(cantilever_rows, "dynamic", "cg"), nonlinear_ratio=nonlinear_ratio,
+        nonlinear_verdict=template.snippet("roughly_agrees" if 0.5 <= nonlinear_ratio <= 2 else
+                                           "ncg_faster" if nonlinear_ratio > 2 else "dynamic_faster"),
+        newton_share=1 / newton_ratio, tolerance=tolerance_sentence(rows, tolerances, template),
+        unreached=unreached_sentence(picks, template))
 
 
 def main(argv=None) -> dict:
