@@ -17,7 +17,7 @@ import numpy as np
 import snede
 from snede import PETSc
 from studies.experiments.common import (
-    Column, best_seconds, markdown_table, options_prefix, parse_arguments, pyplot, write_csv,
+    Column, PageTemplate, best_seconds, markdown_table, options_prefix, parse_arguments, pyplot, write_csv,
 )
 
 YOUNG, POISSON = 1e6, 0.25  # §3.3
@@ -373,84 +373,42 @@ def total_seconds(row) -> float:
 
 
 def describe(products, assemblies, cube, quick: bool, divisions) -> str:
+    """performance.md: studies/templates/performance.md filled with the three tables and the
+    numbers the comparisons quote."""
+    template = PageTemplate("performance")
     largest = max(row["tetrahedra"] for row in products)
     at_largest = {row["format"]: row for row in products if row["tetrahedra"] == largest}
+    shell, aij = at_largest["shell"], at_largest["AIJ"]
     shell_cg = cube[0]
     gamg = next(row for row in cube if row["preconditioner"].startswith("GAMG"))
     jacobi = next(row for row in cube if row["operator"] == "AIJ" and row["preconditioner"] == "jacobi")
     aij_plain = next(row for row in cube if row["operator"] == "AIJ" and row["preconditioner"] == "none")
     repay = [row["products_to_repay_aij"] for row in assemblies]
-    call_growth = assemblies[-1]["element_stiffness_call_us"] / assemblies[0]["element_stiffness_call_us"]
-    lines = [
-        "# Matrix-free tangent against assembled matrices", "",
-        "Regenerate with `.venv/bin/python -m studies.experiments.performance" + (" --quick`" if quick else "`")
-        + " (this file, `performance.csv`, `performance.png`)."
-        + (" **Quick run: small boxes only.**" if quick else
-           f" Full run: Kuhn boxes of 6n³ tetrahedra, n = {', '.join(map(str, divisions))} (up to {largest} "
-           "tetrahedra); under a minute on the 2-core machine, one core used."), "",
-        f"Linear elasticity, E = {YOUNG:g} Pa, ν = {POISSON} (§3.3), on `snede.meshing.box` (unit cube, n³ cubes of "
-        "six tetrahedra). 'shell' is the engine's MatShell (`body._model.tangent_mat`, the tangent applied "
-        "element by element, §2.3); AIJ and BAIJ (block size 3) are PETSc's assembled formats, filled from "
-        "element matrices with one MatSetValues(Blocked) per element (petsc4py's RCV loop, in C) after an "
-        "exact preallocation from the node graph. Times are the best of several products on one core. "
-        "Matrix bytes are values plus column indices plus row pointers, computed from `MatGetInfo`'s nonzeros "
-        "(its 'memory' field is 0 for these formats in PETSc 3.18). The shell's own data is the kernels' "
-        f"reference data, {REFERENCE_BYTES_PER_TET} "
-        "bytes per tetrahedron (Z⁻¹, |τ| and the vertex ids, streamed in blocks of four elements); the mesh (connectivity and coordinates, `Mesh.memory_bytes`) is "
-        "needed by both approaches and shown separately.", "",
-        "## Time per product and memory", "", markdown_table(products, PRODUCT_COLUMNS),
-        "![time per product and memory](performance.png)", "",
-        "## Assembly cost", "",
-        "Element matrices come from a vectorised numpy construction of BᵀDB (checked against "
-        "`Body.element_stiffness` on a sample of elements, last column). The public per-element call "
-        "`Body.element_stiffness(row, u)` is timed on a sample and extrapolated to all cells: its cost per call "
-        f"grows {call_growth:.0f}× from the smallest to the largest box, because it rebuilds `mesh.cell_ids` (an "
-        "O(n_cells) array) on every call, so a Python loop over it is quadratic in the mesh size. "
-        "'shell products ≙ AIJ assembly' is how many matrix-free products cost as much as building the AIJ "
-        "matrix (element matrices + node graph + preallocation + insertion + assembly).", "",
-        markdown_table(assemblies, ASSEMBLY_COLUMNS),
-        "## CG on the §3.3 cube", "",
-        f"{shell_cg['tetrahedra']} tetrahedra, {shell_cg['nodes']} nodes "
-        "(`snede.meshing.box((1, 1, 1), (11, 11, 11))`), "
-        f"fixed at x = 0, the face x = 1 pulled outwards from its centre with {DILATION:g} N/m × distance per node; "
-        f"CG until ‖r‖ ≤ {CG_RTOL:g}‖f_ext‖ (unpreconditioned residual) from zero. The first row is snede's "
-        "StaticSolver (KSPCG on the shell); the others are petsc4py KSPCG on the shell or on the assembled "
-        "P K P + (I − P) (fixed rows and columns replaced by the identity, the operator the shell applies).", "",
-        markdown_table(cube, CG_COLUMNS),
-        "## Where this agrees with the thesis and where not", "",
-        f"- **Iterations (§3.3: 100–300, 55 iterations/s on a Pentium III):** unpreconditioned CG on the shell "
-        f"takes {shell_cg['iterations']} iterations at {shell_cg['iterations_per_second']:.0f} iterations/s "
-        + ("(inside the thesis's range of iterations" if THESIS_ITERATIONS[0] <= shell_cg["iterations"]
-           <= THESIS_ITERATIONS[1] else "(outside the thesis's range of iterations")
-        + f"; {shell_cg['iterations_per_second'] / THESIS_ITERATIONS_PER_SECOND:.0f}× its rate). The thesis does "
-        "not give the load's size or exact shape, so the iteration count is comparable only roughly.",
-        f"- **Preconditioning (§4.6 expects it to help, with assembled matrices):** Jacobi takes "
-        f"{jacobi['iterations']} iterations, GAMG {gamg['iterations']} (plus {gamg['setup_seconds']:.3f} s setup and "
-        f"{gamg['assembly_seconds']:.3f} s assembly). One solve from scratch, assembly included: shell "
-        f"{shell_cg['solve_seconds']:.3f} s, AIJ without preconditioner {total_seconds(aij_plain):.3f} s, AIJ with "
-        f"Jacobi {total_seconds(jacobi):.3f} s, GAMG {total_seconds(gamg):.3f} s. Jacobi barely helps on this "
-        "uniform mesh, whose stiffness diagonal varies little (§4.6 makes the same point for the lumped mass of "
-        "uniform meshes).",
-        f"- **Matrix-free against assembled (§2.3, §4.6):** at {largest} tetrahedra an AIJ product takes "
-        f"{1e3 * at_largest['AIJ']['seconds_per_product']:.3g} ms, BAIJ "
-        f"{1e3 * at_largest['BAIJ']['seconds_per_product']:.3g} ms, the shell "
-        f"{1e3 * at_largest['shell']['seconds_per_product']:.3g} ms; AIJ needs "
-        f"{at_largest['AIJ']['bytes'] / largest:.0f} bytes per tetrahedron against the shell's "
-        f"{REFERENCE_BYTES_PER_TET} (+ {at_largest['shell']['mesh_bytes'] / largest:.0f} for the mesh, which both "
-        f"need). The shell spends {at_largest['shell']['flops_per_product'] / largest:.0f} counted flops per "
-        "tetrahedron (the thesis's Table 4.3: 129 for the linear force) at about "
-        f"{at_largest['shell']['mflop_per_s'] / 1e3:.1f} GFLOP/s, while AIJ does 2 flops per stored nonzero and "
-        f"streams its {at_largest['AIJ']['bytes'] / 1e6:.0f} MB at "
-        f"{at_largest['AIJ']['bytes'] / at_largest['AIJ']['seconds_per_product'] / 1e9:.1f} GB/s (relaxation.md "
-        "measures the STREAM triad); building AIJ costs as much as "
-        f"{min(repay):.0f}–{max(repay):.0f} shell products. The thesis argues for matrix-free evaluation "
-        "because meshes change (every cut would force a reassembly) and because nonlinear tangents change "
-        "every iteration; it does not measure assembled products, so this table has no thesis counterpart.",
-        f"- **Products agree:** ‖Ax − Jx‖/‖Jx‖ ≤ {max(row['relative_difference'] for row in products):.1e} for "
-        "every size and format, and CG on the assembled matrix without preconditioner ends within "
-        f"{aij_plain['solution_difference']:.1e} of the shell's solution after "
-        f"{aij_plain['iterations']} iterations (the shell: {shell_cg['iterations']}).", ""]
-    return "\n".join(lines) + "\n"
+    in_range = THESIS_ITERATIONS[0] <= shell_cg["iterations"] <= THESIS_ITERATIONS[1]
+    return template.page(
+        quick_flag=" --quick" if quick else "",
+        run=template.snippet("quick_run") if quick else template.snippet(
+            "full_run", divisions=", ".join(map(str, divisions)), largest=largest),
+        young=YOUNG, poisson=POISSON, reference_bytes=REFERENCE_BYTES_PER_TET,
+        product_table=markdown_table(products, PRODUCT_COLUMNS),
+        call_growth=assemblies[-1]["element_stiffness_call_us"] / assemblies[0]["element_stiffness_call_us"],
+        assembly_table=markdown_table(assemblies, ASSEMBLY_COLUMNS),
+        tetrahedra=shell_cg["tetrahedra"], nodes=shell_cg["nodes"], dilation=DILATION, rtol=CG_RTOL,
+        cg_table=markdown_table(cube, CG_COLUMNS),
+        iterations=shell_cg["iterations"], iterations_per_second=shell_cg["iterations_per_second"],
+        iterations_range=template.snippet("inside_range" if in_range else "outside_range"),
+        rate_ratio=shell_cg["iterations_per_second"] / THESIS_ITERATIONS_PER_SECOND,
+        jacobi_iterations=jacobi["iterations"], gamg_iterations=gamg["iterations"],
+        gamg_setup=gamg["setup_seconds"], gamg_assembly=gamg["assembly_seconds"],
+        shell_seconds=shell_cg["solve_seconds"], aij_seconds=total_seconds(aij_plain),
+        jacobi_seconds=total_seconds(jacobi), gamg_seconds=total_seconds(gamg),
+        largest=largest, aij_ms=1e3 * aij["seconds_per_product"], baij_ms=1e3 * at_largest["BAIJ"]["seconds_per_product"],
+        shell_ms=1e3 * shell["seconds_per_product"], aij_bytes_per_tet=aij["bytes"] / largest,
+        mesh_bytes_per_tet=shell["mesh_bytes"] / largest, flops_per_tet=shell["flops_per_product"] / largest,
+        gflops=shell["mflop_per_s"] / 1e3, aij_mb=aij["bytes"] / 1e6,
+        aij_gb_per_s=aij["bytes"] / aij["seconds_per_product"] / 1e9, repay_min=min(repay), repay_max=max(repay),
+        largest_difference=max(row["relative_difference"] for row in products),
+        solution_difference=aij_plain["solution_difference"], aij_iterations=aij_plain["iterations"])
 
 
 def main(argv=None) -> dict:
