@@ -1,4 +1,5 @@
 #include "bindings.hpp"
+#include "record_binding.hpp"
 #include "cutting/tetrahedral_cutter.hpp"
 #include "solve/cut_model_adapter.hpp"
 
@@ -23,29 +24,23 @@ std::unique_ptr<TetrahedralCutter> make_cutter(Mesh& mesh, Model* model, bool sn
 }  // namespace
 
 void bind_cutting(py::module_& m) {
-  py::class_<CutReport>(m, "CutReport")
-      .def(py::init<>())
-      .def("add", &CutReport::add, py::arg("other"))
-      .def_readwrite("sweeps", &CutReport::sweeps)
-      .def_readwrite("faces_selected", &CutReport::faces_selected)
-      .def_readwrite("faces_dissected", &CutReport::faces_dissected)
-      .def_readwrite("vertices_split", &CutReport::vertices_split)
-      .def_readwrite("vertices_snapped", &CutReport::vertices_snapped)
-      .def_readwrite("snaps_refused", &CutReport::snaps_refused)
-      .def_readwrite("degenerate_found", &CutReport::degenerate_found)
-      .def_readwrite("degenerate_shapes", &CutReport::degenerate_shapes)
-      .def_readwrite("edges_collapsed", &CutReport::edges_collapsed)
-      .def_readwrite("edges_split", &CutReport::edges_split)
-      .def_readwrite("faces_split", &CutReport::faces_split)
-      .def_readwrite("elements_cut_free", &CutReport::elements_cut_free)
-      .def_readwrite("components", &CutReport::components)
-      .def_readwrite("free_pieces", &CutReport::free_pieces)
-      .def_readwrite("pieces_fixed", &CutReport::pieces_fixed)
-      .def_readwrite("fragments_removed", &CutReport::fragments_removed)
-      .def_readwrite("fragment_elements", &CutReport::fragment_elements)
-      .def_readwrite("piece_elements", &CutReport::piece_elements)
-      .def_readwrite("piece_search", &CutReport::piece_search)
-      .def_readwrite("seconds", &CutReport::seconds);
+  bind_record<CutReport>(
+      m, "CutReport",
+      "What one ``move`` or ``cut_triangle`` did.\n\n"
+      "``faces_dissected`` counts selected faces the dissection opened; a face whose vertices' stars do not\n"
+      "split yet (Figure 7.7) stays joined and is cut again with the next sweep. ``degenerate_found`` counts\n"
+      "the flat elements (aspect ratio below the threshold) around the cut before removal,\n"
+      "``degenerate_shapes`` them as (needles, spindles, slivers, caps); ``elements_cut_free`` the\n"
+      "incollapsible ones that were cut free and removed. ``components`` is the number of pieces of the body\n"
+      "afterwards. On a sweep that separates a piece, ``free_pieces`` counts the pieces with no constraint\n"
+      "and ``pieces_fixed`` those of them fixed on one face (``fix_free_pieces``). ``fragments_removed``\n"
+      "counts the separated pieces no bigger than ``max_fragment_elements`` mean elements that were removed,\n"
+      "``fragment_elements`` the elements they had; ``piece_elements`` the elements of each piece, largest\n"
+      "first, after a sweep that separated one (empty otherwise). ``piece_search`` is the number of elements\n"
+      "the local search for separated pieces visited (it stays near the cut unless a piece separates).\n"
+      "``a + b``: both reports together (counts and times add up; ``components`` is ``b``'s unless it swept\n"
+      "nothing), as ``move`` combines its halves.")
+      .def("__str__", [](const CutReport& r) { return summary(r); });
 
   py::class_<TetrahedralCutter>(m, "TetrahedralCutter")
       .def(py::init(&make_cutter), py::arg("mesh"), py::arg("model"), py::arg("snap"), py::arg("remove_degeneracies"),

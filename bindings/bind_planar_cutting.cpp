@@ -1,4 +1,5 @@
 #include "bindings.hpp"
+#include "record_binding.hpp"
 #include "cutting/delaunay_cutter.hpp"
 #include "solve/cut_model_adapter.hpp"
 
@@ -6,23 +7,15 @@ namespace snede::bindings {
 
 void bind_planar_cutting(py::module_& m) {
   py::register_exception<IncisionLost>(m, "IncisionLost", PyExc_RuntimeError);
-  py::class_<PlanarCutReport>(m, "PlanarCutReport")
-      .def(py::init<>())
-      .def("add", &PlanarCutReport::add, py::arg("later"))
-      .def_readwrite("moves", &PlanarCutReport::moves)
-      .def_readwrite("flips", &PlanarCutReport::flips)
-      .def_readwrite("nodes_removed", &PlanarCutReport::nodes_removed)
-      .def_readwrite("nodes_inserted", &PlanarCutReport::nodes_inserted)
-      .def_readwrite("incision_splits", &PlanarCutReport::incision_splits)
-      .def_readwrite("edges_contracted", &PlanarCutReport::edges_contracted)
-      .def_readwrite("entries", &PlanarCutReport::entries)
-      .def_readwrite("exits", &PlanarCutReport::exits)
-      .def_readwrite("branches", &PlanarCutReport::branches)
-      .def_readwrite("annihilations", &PlanarCutReport::annihilations)
-      .def_readwrite("stuck", &PlanarCutReport::stuck)
-      .def_readwrite("triangles_before", &PlanarCutReport::triangles_before)
-      .def_readwrite("triangles_after", &PlanarCutReport::triangles_after)
-      .def_readwrite("seconds", &PlanarCutReport::seconds);
+  bind_record<PlanarCutReport>(
+      m, "PlanarCutReport",
+      "What one ``move`` (or a whole ``cut``) did: edge ``flips``, ``nodes_removed`` near the active node,\n"
+      "``nodes_inserted`` (entry, exit and incision splits), ``incision_splits`` (Figure 5.5),\n"
+      "``edges_contracted`` after exits (Figure 5.7), ``entries``, ``exits``, on surfaces ``branches``\n"
+      "(Figure 5.14) and ``annihilations`` (incisions meeting, Figure 5.13), moves that left the active node\n"
+      "short of the scalpel (``stuck``), the triangle counts before and after, and the time in ``seconds``.\n"
+      "``a + b``: counts and times add, ``triangles_after`` is ``b``'s.")
+      .def("__str__", [](const PlanarCutReport& r) { return summary(r); });
 
   py::class_<DelaunayCutter>(m, "DelaunayCutter")
       .def(py::init([](Mesh& mesh, Model* model, double eps_edge, double eps_entry, double eps_exit, double angle) {

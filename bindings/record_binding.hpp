@@ -6,17 +6,31 @@
 
 #include <pybind11/stl.h>
 
+#include <array>
 #include <string>
 #include <type_traits>
+#include <utility>
+#include <vector>
 
 #include "bindings.hpp"
 
 namespace snede::bindings {
 
+template <class T>
+constexpr bool is_sequence = false;
+template <class T, class Allocator>
+constexpr bool is_sequence<std::vector<T, Allocator>> = true;
+template <class T, std::size_t N>
+constexpr bool is_sequence<std::array<T, N>> = true;
+
+// The fields by name, as Python reads them (sequences as tuples).
 template <class Record>
 py::dict record_fields(const Record& record) {
   py::dict values;
-  Record::visit_fields([&](const char* name, auto member) { values[name] = py::cast(record.*member); });
+  Record::visit_fields([&](const char* name, auto member) {
+    py::object value = py::cast(record.*member);
+    values[name] = py::isinstance<py::list>(value) ? py::tuple(value) : value;
+  });
   return values;
 }
 
@@ -50,7 +64,17 @@ template <class Record>
 py::class_<Record> bind_record(py::module_& m, const char* type_name, const char* doc) {
   py::class_<Record> cls(m, type_name, doc);
   cls.def(py::init([type_name](const py::kwargs& values) { return record_from<Record>(type_name, values); }));
-  Record::visit_fields([&](const char* name, auto member) { cls.def_readwrite(name, member); });
+  Record::visit_fields([&](const char* name, auto member) {
+    using Field = std::remove_reference_t<decltype(std::declval<Record&>().*member)>;
+    if constexpr (is_sequence<Field>) {
+      // A record is a value: its sequences read as tuples, so changing one cannot go unseen.
+      cls.def_property(
+          name, [member](const Record& record) { return py::tuple(py::cast(record.*member)); },
+          [member](Record& record, const Field& value) { record.*member = value; });
+    } else {
+      cls.def_readwrite(name, member);
+    }
+  });
   cls.def("__repr__", [type_name](const Record& record) {
     std::string text = std::string(type_name) + "(";
     const char* separator = "";

@@ -70,23 +70,6 @@ double angle_at(const Point& w, const Point& a, const Point& b) {
 
 }  // namespace
 
-void PlanarCutReport::add(const PlanarCutReport& later) {
-  if (moves == 0) triangles_before = later.triangles_before;
-  moves += later.moves;
-  flips += later.flips;
-  nodes_removed += later.nodes_removed;
-  nodes_inserted += later.nodes_inserted;
-  incision_splits += later.incision_splits;
-  edges_contracted += later.edges_contracted;
-  entries += later.entries;
-  exits += later.exits;
-  branches += later.branches;
-  annihilations += later.annihilations;
-  stuck += later.stuck;
-  triangles_after = later.triangles_after;
-  seconds += later.seconds;
-}
-
 DelaunayCutter::DelaunayCutter(Mesh& mesh, DisplacementSource displacement, DelaunayCutterOptions options)
     : mesh_(mesh),
       displacement_(std::move(displacement)),

@@ -41,6 +41,7 @@
 
 #include "cutting/cut_body.hpp"
 #include "cutting/incision_star.hpp"
+#include "cutting/planar_cut_report.hpp"
 
 namespace snede {
 
@@ -53,27 +54,6 @@ struct DelaunayCutterOptions {
   // > 0 (radians): an interior neighbour of the active node is removed when every angle
   // facing their edge is below this, instead of the distance ε_edge (scale free, §5.5).
   double short_edge_angle = 0;
-};
-
-// What one move (or several, added up) did to the mesh.
-struct PlanarCutReport {
-  int moves = 0;
-  int flips = 0;
-  int nodes_removed = 0;
-  int nodes_inserted = 0;
-  int incision_splits = 0;   // Figure 5.5: each inserts a node on both lips
-  int edges_contracted = 0;  // short edges left by an exit (Figure 5.7)
-  int entries = 0;
-  int exits = 0;
-  int branches = 0;          // surfaces: an incision branching at a fold (Figure 5.14)
-  int annihilations = 0;     // surfaces: incisions meeting and ending together (Figure 5.13)
-  int stuck = 0;             // moves that left the active node short of the scalpel
-  std::size_t triangles_before = 0;
-  std::size_t triangles_after = 0;
-  double seconds = 0;
-
-  // Accumulates a later report: counts and times add, triangles_after is the later one's.
-  void add(const PlanarCutReport& later);
 };
 
 class DelaunayCutter {

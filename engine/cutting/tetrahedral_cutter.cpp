@@ -14,29 +14,6 @@
 
 namespace snede {
 
-void CutReport::add(const CutReport& o) {
-  sweeps += o.sweeps;
-  faces_selected += o.faces_selected;
-  faces_dissected += o.faces_dissected;
-  vertices_split += o.vertices_split;
-  vertices_snapped += o.vertices_snapped;
-  snaps_refused += o.snaps_refused;
-  degenerate_found += o.degenerate_found;
-  for (int k = 0; k < 4; ++k) degenerate_shapes[k] += o.degenerate_shapes[k];
-  edges_collapsed += o.edges_collapsed;
-  edges_split += o.edges_split;
-  faces_split += o.faces_split;
-  elements_cut_free += o.elements_cut_free;
-  if (o.sweeps > 0 || sweeps == 0) components = o.components;  // the later count, unless it swept nothing
-  if (!o.piece_elements.empty()) piece_elements = o.piece_elements;
-  free_pieces += o.free_pieces;
-  pieces_fixed += o.pieces_fixed;
-  fragments_removed += o.fragments_removed;
-  fragment_elements += o.fragment_elements;
-  piece_search += o.piece_search;
-  seconds += o.seconds;
-}
-
 TetrahedralCutter::TetrahedralCutter(Mesh& mesh, CutBody body, CutterOptions options)
     : mesh_(mesh), body_(std::move(body)), options_(options), pieces_(mesh.connectivity()) {
   if (mesh.cell_dim() != 3 || mesh.space_dim() != 3)

@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "cutting/cut_body.hpp"
+#include "cutting/cut_report.hpp"
 #include "cutting/face_selection.hpp"
 #include "mesh/deformed_positions.hpp"
 #include "mesh/piece_tracker.hpp"
@@ -41,36 +42,6 @@ struct CutterOptions {
   // artefact of that approximation (flat tetrahedra between two cut faces), not a part of the
   // body the scalpel meant to separate.
   int max_fragment_elements = 10;
-};
-
-struct CutReport {
-  int sweeps = 0;              // sweep triangles processed
-  int faces_selected = 0;
-  int faces_dissected = 0;     // selected faces the dissection opened (others stay joined, Figure 7.7)
-  int vertices_split = 0;      // vertex copies the dissection made
-  int vertices_snapped = 0;
-  int snaps_refused = 0;
-  int degenerate_found = 0;
-  std::array<int, 4> degenerate_shapes{};  // needles, spindles, slivers, caps among them
-  int edges_collapsed = 0;
-  int edges_split = 0;
-  int faces_split = 0;         // cap removals: a vertex inserted in a face
-  int elements_cut_free = 0;
-  int components = 0;          // pieces of the body after the cut
-  int free_pieces = 0;         // after a sweep that separated a piece: pieces not held (fewer constrained
-                               // displacement components than their 6 rigid motions)
-  int pieces_fixed = 0;        // of those, fixed on one face (fix_free_pieces)
-  int fragments_removed = 0;   // separated pieces of at most max_fragment_elements (by volume), removed
-  int fragment_elements = 0;   // the elements they had
-  // After a sweep that separated a piece: the elements of each piece, largest first (the
-  // latest such sweep's when reports are added).
-  std::vector<std::size_t> piece_elements;
-  std::size_t piece_search = 0;  // elements the local search for separated pieces visited
-  double seconds = 0;
-
-  // Accumulates a later report: counts and times add up; components is the later report's
-  // unless that one swept nothing.
-  void add(const CutReport& other);
 };
 
 class TetrahedralCutter : public ConnectivityWatcher {

@@ -10,80 +10,12 @@ continues from where it was.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, fields
 
 import numpy as np
 
 from snede import _checks, _snede
+from snede._snede import CutReport
 from snede.mesh import Mesh
-
-
-@dataclass(frozen=True)
-class CutReport:
-    """What one ``move`` or ``cut_triangle`` did.
-
-    ``faces_dissected`` counts selected faces the dissection opened; a face whose vertices'
-    stars do not split yet (Figure 7.7) stays joined and is cut again with the next sweep.
-    ``degenerate_found`` counts the flat elements (aspect ratio below the threshold) around the
-    cut before removal, ``degenerate_shapes`` them as (needles, spindles, slivers, caps);
-    ``elements_cut_free`` the incollapsible ones that were cut free and removed. ``components``
-    is the number of pieces of the body afterwards. On a sweep that separates a piece,
-    ``free_pieces`` counts the pieces with no constraint and ``pieces_fixed`` those of them
-    fixed on one face (``fix_free_pieces``). ``fragments_removed`` counts the separated pieces
-    no bigger than ``max_fragment_elements`` mean elements that were removed,
-    ``fragment_elements`` the elements they had; ``piece_elements`` the elements of each piece,
-    largest first, after a sweep that separated one (empty otherwise). ``piece_search`` is the number of elements the
-    local search for separated pieces visited (it stays near the cut unless a piece separates)."""
-
-    sweeps: int = 0
-    faces_selected: int = 0
-    faces_dissected: int = 0
-    vertices_split: int = 0
-    vertices_snapped: int = 0
-    snaps_refused: int = 0
-    degenerate_found: int = 0
-    degenerate_shapes: tuple = (0, 0, 0, 0)
-    edges_collapsed: int = 0
-    edges_split: int = 0
-    faces_split: int = 0
-    elements_cut_free: int = 0
-    components: int = 0
-    free_pieces: int = 0
-    pieces_fixed: int = 0
-    fragments_removed: int = 0
-    fragment_elements: int = 0
-    piece_elements: tuple = ()
-    piece_search: int = 0
-    seconds: float = 0.0
-
-    @classmethod
-    def _from_engine(cls, r) -> "CutReport":
-        values = {f.name: getattr(r, f.name) for f in fields(cls)}
-        values["degenerate_shapes"] = tuple(values["degenerate_shapes"])
-        values["piece_elements"] = tuple(values["piece_elements"])
-        return cls(**values)
-
-    def __add__(self, other: "CutReport") -> "CutReport":
-        """Both reports together (counts and times add up; ``components`` is ``other``'s
-        unless it swept nothing), combined by the engine as ``move`` combines its halves."""
-        return CutReport._from_engine(engine_sum(self, other, _snede.CutReport))
-
-    def __str__(self) -> str:
-        return (f"{self.faces_dissected} faces dissected ({self.vertices_snapped} vertices snapped, "
-                f"{self.snaps_refused} refused), {self.degenerate_found} degenerate: {self.edges_collapsed} collapses, "
-                f"{self.edges_split} splits, {self.elements_cut_free} cut free, {self.fragments_removed} fragments removed; "
-                f"{self.components} pieces "
-                f"in {self.seconds * 1e3:.2f} ms")
-
-
-def engine_sum(earlier, later, engine_report):
-    """The engine's sum of two report dataclasses (its ``add``), as an ``engine_report``."""
-    total, other = engine_report(), engine_report()
-    for f in fields(earlier):
-        setattr(total, f.name, getattr(earlier, f.name))
-        setattr(other, f.name, getattr(later, f.name))
-    total.add(other)
-    return total
 
 
 def body_and_mesh(body_or_mesh, cutter: str):
@@ -162,10 +94,10 @@ class TetrahedralCutter:
                                               _checks.count(max_fragment_elements, "max_fragment_elements", 0))
 
     def cut_triangle(self, corners) -> CutReport:
-        return CutReport._from_engine(self._impl.cut_triangle(_points(corners, (3, 3), "corners")))
+        return self._impl.cut_triangle(_points(corners, (3, 3), "corners"))
 
     def move(self, scalpel) -> CutReport:
-        return CutReport._from_engine(self._impl.move(_points(scalpel, (2, 3), "scalpel")))
+        return self._impl.move(_points(scalpel, (2, 3), "scalpel"))
 
     def cut(self, path, progress=None) -> CutReport:
         """Move the scalpel through ``path``, an (n, 2, 3) sequence of scalpel positions; the

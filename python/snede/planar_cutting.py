@@ -9,12 +9,12 @@ configuration; the body keeps its state, so a stretched sheet opens as it is cut
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, fields
 
 import numpy as np
 
 from snede import _snede
-from snede.cutting import body_and_mesh, engine_sum, move_along
+from snede._snede import PlanarCutReport
+from snede.cutting import body_and_mesh, move_along
 
 #: Raised by a Delaunay cutter's ``move`` (a RuntimeError) when edits others made to the mesh
 #: since its last move — a collapse, a dissection, a removal — took an incision's active node
@@ -22,49 +22,6 @@ from snede.cutting import body_and_mesh, engine_sum, move_along
 #: happened to it. Edits that leave a tip (a collapse into a neighbour, splits, bisection,
 #: flips) are followed instead, and the cut goes on.
 IncisionLost = _snede.IncisionLost
-
-
-@dataclass(frozen=True)
-class PlanarCutReport:
-    """What one ``move`` (or a whole ``cut``) did: edge ``flips``, ``nodes_removed`` near the
-    active node, ``nodes_inserted`` (entry, exit and incision splits), ``incision_splits``
-    (Figure 5.5), ``edges_contracted`` after exits (Figure 5.7), ``entries``, ``exits``, on
-    surfaces ``branches`` (Figure 5.14) and ``annihilations`` (incisions meeting, Figure
-    5.13), moves that left the active node short of the scalpel (``stuck``), the triangle
-    counts before and after, and the time in ``seconds``."""
-
-    moves: int = 0
-    flips: int = 0
-    nodes_removed: int = 0
-    nodes_inserted: int = 0
-    incision_splits: int = 0
-    edges_contracted: int = 0
-    entries: int = 0
-    exits: int = 0
-    branches: int = 0
-    annihilations: int = 0
-    stuck: int = 0
-    triangles_before: int = 0
-    triangles_after: int = 0
-    seconds: float = 0.0
-
-    @classmethod
-    def _from_engine(cls, r) -> "PlanarCutReport":
-        return cls(**{f.name: getattr(r, f.name) for f in fields(cls)})
-
-    def __add__(self, later: "PlanarCutReport") -> "PlanarCutReport":
-        return PlanarCutReport._from_engine(engine_sum(self, later, _snede.PlanarCutReport))
-
-    def _surface_events(self) -> str:
-        if not (self.branches or self.annihilations):
-            return ""
-        return f", {self.branches} branches, {self.annihilations} annihilations"
-
-    def __str__(self) -> str:
-        return (f"{self.moves} moves: {self.flips} flips, {self.nodes_removed} nodes removed, {self.nodes_inserted} "
-                f"inserted ({self.incision_splits} incision splits), {self.entries} entries, {self.exits} exits"
-                f"{self._surface_events()}; "
-                f"{self.triangles_before} → {self.triangles_after} triangles in {self.seconds * 1e3:.2f} ms")
 
 
 def _threshold(value, name: str) -> float:
@@ -164,7 +121,7 @@ class DelaunayCutter(IncisionCutter):
                                            _threshold(eps_entry, "eps_entry"), _threshold(eps_exit, "eps_exit"), angle)
 
     def move(self, point) -> PlanarCutReport:
-        return PlanarCutReport._from_engine(self._impl.move(_point(point)))
+        return self._impl.move(_point(point))
 
     def cut(self, path, step: float | None = None, progress=None) -> PlanarCutReport:
         """Move along the polyline ``path`` ((n, 2)), sampled every ``step`` (default

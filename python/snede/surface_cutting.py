@@ -67,7 +67,7 @@ class SurfaceCutter(IncisionCutter):
         segment = _points(segment, (2, 3), "segment")
         if np.array_equal(segment[0], segment[1]):
             raise ValueError(f"segment: the scalpel's two ends coincide: {segment.tolist()}")
-        return PlanarCutReport._from_engine(self._impl.move(segment))
+        return self._impl.move(segment)
 
     def cut(self, segments, progress=None) -> PlanarCutReport:
         """Move the scalpel through ``segments`` ((n, 2, 3), n >= 2; the first places it);

@@ -28,7 +28,7 @@ def test_a_solve_returns_the_record_with_its_fields():
 def test_keyword_construction_defaults_and_unknown_names():
     record = snede.SolveResult(converged=True, reason="CONVERGED_RTOL", iterations=3, residual_history=[2.0, 1.0])
     assert (record.converged, record.reason, record.iterations, record.energy) == (True, "CONVERGED_RTOL", 3, 0.0)
-    assert record.residual_history == [2.0, 1.0]
+    assert record.residual_history == (2.0, 1.0)
     with pytest.raises(TypeError, match="unexpected keyword argument 'iteration'"):
         snede.SolveResult(iteration=3)
     with pytest.raises(TypeError, match="iterations cannot be 'three'"):
@@ -64,3 +64,19 @@ def test_needle_step_report_is_the_engines_record():
     assert (report.rearrangements, report.slipped, report.stuck, report.converged) == (2, 1, 0, True)
     assert pickle.loads(pickle.dumps(report)) == report
     assert repr(report).startswith("NeedleStepReport(rearrangements=2, solver_iterations=0,")
+
+
+def test_cut_reports_add_as_the_engine_adds_them_and_read_sequences_as_tuples():
+    first = snede.CutReport(sweeps=2, faces_dissected=3, degenerate_shapes=[1, 0, 2, 0], components=1, seconds=0.5)
+    later = snede.CutReport(sweeps=1, faces_dissected=4, degenerate_shapes=[0, 1, 0, 1], components=2,
+                            piece_elements=[40, 2], seconds=0.25)
+    total = first + later
+    assert (total.sweeps, total.faces_dissected, total.components, total.seconds) == (3, 7, 2, 0.75)
+    assert total.degenerate_shapes == (1, 1, 2, 1) and total.piece_elements == (40, 2)
+    assert first == snede.CutReport(sweeps=2, faces_dissected=3, degenerate_shapes=(1, 0, 2, 0), components=1,
+                                    seconds=0.5)
+    assert str(total).startswith("7 faces dissected (0 vertices snapped, 0 refused)")
+    planar = snede.PlanarCutReport(moves=1, triangles_before=10, triangles_after=12) + \
+        snede.PlanarCutReport(moves=2, branches=1, triangles_before=12, triangles_after=15)
+    assert (planar.moves, planar.triangles_before, planar.triangles_after) == (3, 10, 15)
+    assert str(planar).endswith("1 branches, 0 annihilations; 10 → 15 triangles in 0.00 ms")
