@@ -24,7 +24,8 @@ import numpy as np
 
 import snede
 from snede import PETSc
-from studies.experiments.common import Column, markdown_table, options_prefix, parse_arguments, pyplot, write_csv
+from studies.experiments.common import (Column, PageTemplate, markdown_table, options_prefix, parse_arguments, pyplot,
+                                        write_csv)
 
 MESHES = Path(__file__).resolve().parents[2] / "meshes"
 GRAVITY, DENSITY, YOUNG, POISSON, VERONDA_GAMMA = 9.8, 1000.0, 1e4, 0.3, 8.0
@@ -666,73 +667,34 @@ def lookup(rows, **keys) -> dict | None:
 
 
 def describe(results: dict, quick: bool) -> str:
+    """relaxation.md: studies/templates/relaxation.md filled with the tables and the findings."""
+    template = PageTemplate("relaxation")
     convergence, damping, rates, peak = results["convergence"], results["damping"], results["rates"], results["peak"]
     short_edge, cp_rows = results["short_edge"], results["cp_damping"]
-    peak_a = max(row["mflops"] for row in peak if row["in_cache"])
     triad = lookup(peak, kernel="PETSc VecWAXPY triad")
-    lines = [
-        "# Chapter 4: static against dynamic relaxation", "",
-        "Regenerate with `.venv/bin/python -m studies.experiments.relaxation" + (" --quick`" if quick else "`")
-        + " (this file, `relaxation.csv`, `relaxation_curves.csv`, `relaxation_*.png`)."
-        + (" **Quick run: small mesh, two materials, few damping values.**" if quick else
-           " Full run: both Table 4.2 cylinders (`meshes/cylinder_small.msh`, 1125 tetrahedra; "
-           "`meshes/cylinder_large.msh`, 8724), the four materials plus St. Venant-Kirchhoff at E = 2e4 "
-           "(Figure 4.13) on the small one; on the large one the four materials with the small mesh's η*, "
-           "Polak-Ribière only and every second iteration recorded, to keep the run at about 5 minutes on the "
-           "2-core machine. Our meshes have 1125 and 8724 tetrahedra where the thesis's had 1230 and 9300."), "",
-        "Setup (Table 4.1): g = 9.8 m/s², ρ = 1000 kg/m³, E = 1e4 Pa, ν = 0.3, γ = 8; fixed at x = min, "
-        "gravity along −z, from rest. Energy error (e,e)_K = ½ eᵀK(û)e against the §4.2 reference û (nonlinear CG "
-        "to 1e-2, then truncated Newton to ‖r‖ ≤ 1e-10‖f‖, 1e-12 for linear). Every run stops at "
-        f"‖r‖ ≤ {results['rtol']:g}·√(‖f_ext‖² + ‖f_react‖²) (criterion (6.9)). 'Target' is "
-        f"(e,e)_K ≤ {TARGET_REDUCTION:g}·(e₀,e₀)_K, e₀ = −û. MFLOP are PETSc's logged flops (the kernels' counted "
-        "flops plus PETSc's vector operations); seconds are wall-clock on one core; the recording monitor's own "
-        "cost is subtracted. Nonlinear CG line searches: 'secant' is §4.4.2's secant whose first slope comes from a "
-        "tangent action (`snede_secant`), 'Newton' the Newton line search (`snede_newton`), 'scale-dep. secant' "
-        f"PETSc's `cp` with first trial step α₋₁ = {CP_DAMPING:g} (the thesis's value); PRP = Polak-Ribière, "
-        "FR = Fletcher-Reeves. Dynamic relaxation: SS22 with lumped mass, C = ηM, Δt = the empirical critical "
-        "step of §4.4.1 (undamped, no blow-up within 50 MFLOP and 200 steps, from the CFL estimate in 15 % steps).",
-        ""]
-    lines += ["## Table 4.4: damping", "",
-              "η* minimises the steps to the target over the grid "
-              + ", ".join(f"{eta:g}" for eta in results["eta_grid"]) + " s⁻¹, refined by ±1 s⁻¹ around the best. "
-              "For comparison, §4.1's analysis applied to the problem linearised at the solution: λ₁ and λ_n are the "
-              "smallest and largest eigenvalues of M⁻¹K(û) on the free dofs (dense, from tangent actions); 2√λ₁ is "
-              "the damping that leaves no mode overdamped, 2/√λ_n the SS22 stability limit (– where K(û) is not "
-              "positive definite).", "", markdown_table(damping, DAMPING_COLUMNS)]
     eta_ratio = [row["eta_best"] / row["thesis_eta"] for row in damping]
     steps = [row["critical_step_ms"] for row in damping if row["case"] in THESIS_TABLE_4_4]
-    lines += [f"η*/thesis: {min(eta_ratio):.2f}–{max(eta_ratio):.2f}. Critical steps on the small mesh "
-              f"{min(steps):.2f}–{max(steps):.2f} ms (thesis: 'approximately {THESIS_CRITICAL_STEP_MS:g} ms').", ""]
-    lines += ["## Convergence (Figures 4.7, 4.9–4.13)", "", markdown_table(convergence, CONVERGENCE_COLUMNS)]
-    for name in dict.fromkeys(row["case"] for row in convergence):
-        lines.append(f"![{name}]({figure_name(name)})")
-    lines += ["", "## Table 4.5: machine-dependent performance", "",
-              "Machine peak measured two ways: (a) the thesis's baseline, a repeated vector add; peak (a) is its "
-              f"best rate, reached in cache: {peak_a:.0f} MFLOP/s (the thesis's 1024-double add also ran in the "
-              "Pentium III's 16 KB L1; at 1024 entries numpy and petsc4py are bound by Python's call overhead); "
-              "(b) a STREAM triad on vectors far larger than the caches, PETSc VecWAXPY: "
-              f"{triad['mflops']:.0f} MFLOP/s, {triad['gbytes_per_s']:.1f} GB/s. The thesis's peak was "
-              f"{THESIS_PEAK_MFLOPS:g} MFLOP/s (Pentium III, 1 GHz). The element kernels work on data that fits "
-              "in cache on these meshes, so they can exceed the memory-bound triad (b) but not the in-cache add (a).",
-              "",
-              markdown_table(peak, PEAK_COLUMNS),
-              "Rates of unmonitored runs to the same tolerance (the whole run, not the first second):", "",
-              markdown_table(rates, RATE_COLUMNS)]
-    lines += ["## Figure 4.15: one short edge", "",
-              f"Vertex {short_edge[0]['vertex']} (interior, near the middle) moved towards its neighbour "
-              f"{short_edge[0]['neighbour']} so that their edge becomes r times its length; neo-Hookean except the "
-              "linear CG row (linear material); dynamic relaxation at the neo-Hookean η* of the unmodified mesh "
-              "with each mesh's own critical step.", "", markdown_table(short_edge, SHORT_EDGE_COLUMNS),
-              "![short edge](relaxation_short_edge.png)", ""]
-    if cp_rows:
-        lines += ["## The scale-dependent secant's first step", "", markdown_table(cp_rows, CP_COLUMNS)]
-    lines += ["## Where this agrees with the thesis and where not", ""] + findings(results) + [""]
-    return "\n".join(lines) + "\n"
+    return template.page(
+        quick_flag=" --quick" if quick else "", run=template.snippet("quick_run" if quick else "full_run"),
+        rtol=results["rtol"], target=TARGET_REDUCTION, cp_damping=CP_DAMPING,
+        eta_grid=", ".join(f"{eta:g}" for eta in results["eta_grid"]), damping_table=markdown_table(damping, DAMPING_COLUMNS),
+        eta_ratio_min=min(eta_ratio), eta_ratio_max=max(eta_ratio), step_min=min(steps), step_max=max(steps),
+        thesis_step=THESIS_CRITICAL_STEP_MS, convergence_table=markdown_table(convergence, CONVERGENCE_COLUMNS),
+        figures="\n".join(template.snippet("figure", name=name, file=figure_name(name))
+                          for name in dict.fromkeys(row["case"] for row in convergence)),
+        peak_a=max(row["mflops"] for row in peak if row["in_cache"]), triad_mflops=triad["mflops"],
+        triad_gbytes=triad["gbytes_per_s"], thesis_peak=THESIS_PEAK_MFLOPS, peak_table=markdown_table(peak, PEAK_COLUMNS),
+        rates_table=markdown_table(rates, RATE_COLUMNS), vertex=short_edge[0]["vertex"],
+        neighbour=short_edge[0]["neighbour"], short_edge_table=markdown_table(short_edge, SHORT_EDGE_COLUMNS),
+        cp_section=template.snippet("cp_section", table=markdown_table(cp_rows, CP_COLUMNS)) if cp_rows else "",
+        findings="\n".join(findings(results, template)))
 
 
-def findings(results: dict) -> list[str]:
-    """Statements computed from the tables, each comparing with a claim of chapter 4."""
+def findings(results: dict, template: PageTemplate) -> list[str]:
+    """Statements computed from the tables (snippets of ``template``), each comparing with a
+    claim of chapter 4."""
     convergence, damping, rates = results["convergence"], results["damping"], results["rates"]
+    snippet = template.snippet
     out = []
 
     def cost(case, mesh, method, key="mflop_to_target"):
@@ -744,27 +706,22 @@ def findings(results: dict) -> list[str]:
         return f"dynamic η={eta:.3g}"
 
     for row in damping:
-        row_eta = row["eta_best"]
-        verdict = "close to" if abs(row_eta / row["thesis_eta"] - 1) <= 0.25 else "differs from"
-        modal = (f"; §4.1's 2√λ₁ at û is {row['eta_modal']:.1f} s⁻¹" if row["eta_modal"] else
-                 "; K(û) is not positive definite (inverted elements), so §4.1 gives no η")
-        out.append(f"- **η\\* for {row['case']}**: {row_eta:g} s⁻¹, {verdict} the thesis's {row['thesis_eta']:g} s⁻¹"
-                   f"{modal}. The empirical critical step {row['critical_step_ms']:.3f} ms is "
-                   f"{row['critical_step_ms'] / row['stability_limit_ms']:.2f}× the limit 2/√λ_n at û.")
+        out.append(snippet(
+            "damping", case=row["case"], eta=row["eta_best"], thesis_eta=row["thesis_eta"],
+            verdict=snippet("close_to" if abs(row["eta_best"] / row["thesis_eta"] - 1) <= 0.25 else "differs_from"),
+            modal=snippet("modal_eta", eta=row["eta_modal"]) if row["eta_modal"] else snippet("no_modal_eta"),
+            step=row["critical_step_ms"], limit_ratio=row["critical_step_ms"] / row["stability_limit_ms"]))
     if lookup(convergence, case="LinearElastic", mesh="small", method="linear CG"):
         dyn = dynamic_label("LinearElastic", "small")
         flop_ratio = ratio(cost("LinearElastic", "small", dyn), cost("LinearElastic", "small", "linear CG"))
-        second_ratio = ratio(cost("LinearElastic", "small", dyn, "seconds_to_target"),
-                             cost("LinearElastic", "small", "linear CG", "seconds_to_target"))
-        at_thesis = (cost("LinearElastic", "small", "linear CG", "seconds_to_1e-4_J"),
-                     cost("LinearElastic", "small", dyn, "seconds_to_1e-4_J"))
         if flop_ratio:
-            verdict = "agrees with" if 5 <= flop_ratio <= 10 else "differs from"
-            out.append(f"- **Linear (Figure 4.10)**: dynamic relaxation at η* needs {flop_ratio:.1f}× the MFLOP "
-                       f"({second_ratio:.1f}× the seconds) of linear CG to reach the target; this {verdict} the "
-                       "thesis's factor 5 to 10. An energy error below 1e-4 J takes "
-                       f"{at_thesis[0]:.4f} s with CG and {at_thesis[1]:.4f} s dynamically (thesis: 0.10 s and "
-                       "0.89 s on its Pentium III).")
+            out.append(snippet(
+                "linear", flop_ratio=flop_ratio,
+                second_ratio=ratio(cost("LinearElastic", "small", dyn, "seconds_to_target"),
+                                   cost("LinearElastic", "small", "linear CG", "seconds_to_target")),
+                verdict=snippet("agrees_with" if 5 <= flop_ratio <= 10 else "differs_from"),
+                cg_seconds=cost("LinearElastic", "small", "linear CG", "seconds_to_1e-4_J"),
+                dynamic_seconds=cost("LinearElastic", "small", dyn, "seconds_to_1e-4_J")))
     for case in dict.fromkeys(row["case"] for row in convergence):
         for mesh in dict.fromkeys(row["mesh"] for row in convergence if row["case"] == case):
             if case == "LinearElastic":
@@ -776,11 +733,9 @@ def findings(results: dict) -> list[str]:
             reached = {k: v for k, v in statics.items() if v is not None}
             if dyn and secant:
                 best = min(reached, key=reached.get)
-                out.append(f"- **{case}, {mesh} mesh**: NCG (secant, PRP) needs {secant / dyn:.2f}× the MFLOP of "
-                           f"dynamic relaxation at η*; the cheapest static variant ({best}) "
-                           f"{reached[best] / dyn:.2f}×. Thesis: "
-                           + ("dynamic relaxation slightly ahead (Figure 4.12)." if case == "StVenantKirchhoff"
-                              else "nonlinear CG 'as quick as' dynamic relaxation."))
+                out.append(snippet("nonlinear", case=case, mesh=mesh, secant_ratio=secant / dyn, best=best,
+                                   best_ratio=reached[best] / dyn,
+                                   thesis=snippet("dynamic_ahead" if case == "StVenantKirchhoff" else "as_quick")))
     cheapest, dearest, fr_ratios = [], [], {}
     for case, mesh in dict.fromkeys((row["case"], row["mesh"]) for row in convergence):
         costs = {ls: cost(case, mesh, f"NCG {ls} PRP") for ls in ("secant", "Newton", "scale-dep. secant")}
@@ -792,20 +747,17 @@ def findings(results: dict) -> list[str]:
             if pr and fr:
                 fr_ratios.setdefault(f"{case} ({mesh})", []).append(fr / pr)
     if cheapest:
-        out.append("- **Line searches (Figure 4.7)**, MFLOP to the target with PRP: cheapest "
-                   + ", ".join(f"{ls} in {cheapest.count(ls)}" for ls in dict.fromkeys(cheapest))
-                   + f" of {len(cheapest)} cases; dearest "
-                   + ", ".join(f"{ls} in {dearest.count(ls)}" for ls in dict.fromkeys(dearest))
-                   + ". Thesis: the scale-dependent secant is fastest, the Newton line search slowest.")
+        def counts(found):
+            return ", ".join(snippet("count", line_search=ls, count=found.count(ls)) for ls in dict.fromkeys(found))
+
+        out.append(snippet("line_searches", cheapest=counts(cheapest), n_cases=len(cheapest), dearest=counts(dearest)))
     if fr_ratios:
         spans = {name: (min(r), max(r)) for name, r in fr_ratios.items()}
         similar = [name for name, (low, high) in spans.items() if 0.5 <= low and high <= 1.5]
         different = [name for name in spans if name not in similar]
-        out.append("- **Fletcher-Reeves against Polak-Ribière** (FR/PRP MFLOP to the target, over the three line "
-                   "searches): " + "; ".join(f"{name} {low:.2f}–{high:.2f}" for name, (low, high) in spans.items())
-                   + ". Thesis: 'no difference in performance'"
-                   + (f"; that holds within a factor 1.5 except for {', '.join(different)}." if different
-                      else "; that holds within a factor 1.5 everywhere."))
+        out.append(snippet(
+            "fletcher_reeves", spans="; ".join(f"{name} {low:.2f}–{high:.2f}" for name, (low, high) in spans.items()),
+            holds=snippet("holds_except", names=", ".join(different)) if different else snippet("holds_everywhere")))
     for case in dict.fromkeys(row["case"] for row in convergence if row["mesh"] == "large"):
         growth = {}
         for method in ("NCG secant PRP", "dynamic"):
@@ -815,16 +767,12 @@ def findings(results: dict) -> list[str]:
                          "iterations_to_target")
             growth[method] = ratio(large, small)
         if all(growth.values()):
-            out.append(f"- **Mesh size, {case} (Figure 4.9)**: from the small to the large mesh the iterations to "
-                       f"the target grow {growth['NCG secant PRP']:.2f}× for NCG and {growth['dynamic']:.2f}× for "
-                       "dynamic relaxation. Thesis: 'static and dynamic are slowed down by the same amount'.")
-    plateau = [row for row in convergence if row["iterations_to_target"] is None]
-    for row in plateau:
-        out.append(f"- **{row['case']}, {row['mesh']} mesh, {row['method']}** never reached the target: it ended "
-                   f"({row['reason']}) with (e,e)_K = {row['final_error']:.1e} J and Π(u) − Π(û) = "
-                   f"{row['final_energy_difference']:.1e} J" + (", a different equilibrium of lower energy than "
-                                                                "the reference" if row["final_energy_difference"] < 0
-                                                                else "") + ".")
+            out.append(snippet("mesh_size", case=case, ncg=growth["NCG secant PRP"], dynamic=growth["dynamic"]))
+    for row in convergence:
+        if row["iterations_to_target"] is None:
+            out.append(snippet("plateau", case=row["case"], mesh=row["mesh"], method=row["method"],
+                               reason=row["reason"], error=row["final_error"], energy=row["final_energy_difference"],
+                               lower=snippet("lower_equilibrium") if row["final_energy_difference"] < 0 else ""))
     pct = [row["pct_peak"] for row in rates]
     speedups = [row["iterations_per_second"] / row["thesis_iterations_per_second"] for row in rates
                 if row["thesis_iterations_per_second"]]
@@ -832,13 +780,10 @@ def findings(results: dict) -> list[str]:
                   > per_iteration(rates, c, "dynamic")
                   for c in ("StVenantKirchhoff", "NeoHookean", "VerondaWestmann")
                   if lookup(rates, case=c, mesh="small", method="NCG Newton"))
-    out.append(f"- **Table 4.5**: the runs reach {min(pct):.0f}–{max(pct):.0f} % of peak (a) (thesis: 50–90 % of "
-               "its vector-add peak); MFLOP per iteration "
-               + ("are ordered Newton line search > secant > dynamic for every nonlinear material, as in the thesis"
-                  if ordered else "are not ordered Newton > secant > dynamic for every material as in the thesis")
-               + f". Iterations per second are {min(speedups):.0f}–{max(speedups):.0f}× the thesis's (this machine's "
-               "core against a 1 GHz Pentium III).")
-    out += short_edge_findings(results["short_edge"])
+    out.append(snippet("table_4_5", pct_min=min(pct), pct_max=max(pct),
+                       order=snippet("ordered" if ordered else "not_ordered"),
+                       speed_min=min(speedups), speed_max=max(speedups)))
+    out += short_edge_findings(results["short_edge"], template)
     return out
 
 
@@ -846,7 +791,7 @@ def per_iteration(rates, case: str, method: str) -> float:
     return lookup(rates, case=case, mesh="small", method=method)["mflop_per_iteration"]
 
 
-def short_edge_findings(rows) -> list[str]:
+def short_edge_findings(rows, template: PageTemplate) -> list[str]:
     out = []
     methods = list(dict.fromkeys(row["method"] for row in rows))
     original = {row["method"]: row for row in rows if row["ratio"] == 1.0}
@@ -856,28 +801,17 @@ def short_edge_findings(rows) -> list[str]:
         a, b = original.get(method), shortest.get(method)
         if a and b:
             if b["iterations_to_target"] is None:
-                growth.append(f"{method}: did not reach the target ({b['reason']})")
+                growth.append(template.snippet("not_reached", method=method, reason=b["reason"]))
             else:
                 growth.append(f"{method}: {ratio(b['mflop_to_target'], a['mflop_to_target']):.2f}×")
     if growth:
-        out.append(f"- **Short edge (Figure 4.15)**, MFLOP to the target at r = {min(r['ratio'] for r in rows):g} "
-                   "relative to the unmodified mesh: " + "; ".join(growth) + ". Thesis: negligible for linear CG, "
-                   "severe for dynamic relaxation (critical step ∝ shortest edge), noticeable but smaller for "
-                   "nonlinear CG, and the scale-dependent secant failed to converge.")
+        out.append(template.snippet("short_edge", r=min(r["ratio"] for r in rows), growth="; ".join(growth)))
     line_search_failures = sorted({row["ratio"] for row in rows if row["reason"] == "DIVERGED_LINE_SEARCH"})
     if line_search_failures:
-        ratios = ", ".join(format(r, "g") for r in line_search_failures)
-        out.append(f"  Nonlinear CG's line search fails (DIVERGED_LINE_SEARCH) at r = {ratios}: a trial step that "
-                   "inverts an element makes `snede_secant`/`snede_newton` give up instead of shortening the step "
-                   "(on the r = 0.01 mesh the first step α = g/g′ along the gravity residual inverts one flattened "
-                   "element, half of it would not). This is an engine limitation, not the thesis's finding for "
-                   "nonlinear CG.")
+        out.append(template.snippet("line_search_fails", ratios=", ".join(format(r, "g") for r in line_search_failures)))
     reduced = [row for row in rows if row.get("step_reductions")]
     if reduced:
-        ratios = ", ".join(format(row["ratio"], "g") for row in reduced)
-        out.append("  The §4.4.1 critical step (undamped, from rest) was too large for the damped run on the meshes "
-                   f"with r = {ratios} (inverted elements once the body sags); the runs above use it lowered by 15 % "
-                   "until they converged (column 'Δt used').")
+        out.append(template.snippet("step_lowered", ratios=", ".join(format(row["ratio"], "g") for row in reduced)))
     return out
 
 
