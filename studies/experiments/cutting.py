@@ -34,7 +34,8 @@ import numpy as np
 
 import snede
 from studies.experiments import organ_cuts
-from studies.experiments.common import Column, markdown_table, options_prefix, parse_arguments, pyplot, write_csv
+from studies.experiments.common import (Column, PageTemplate, markdown_table, options_prefix, parse_arguments, pyplot,
+                                        write_csv)
 
 DIVISIONS = 8  # 8 × 8 × 8 cubes of 6 tetrahedra: 3072 tetrahedra, 729 nodes (§3.3)
 YOUNG, POISSON = 1e4, 0.25  # Pa; ν = 1/4 as in §3.3 (E only scales the displacement)
@@ -505,36 +506,14 @@ CYLINDER_COLUMNS = [
     Column("components", "pieces"), Column("small_pieces", "pieces < 20 elements")]
 
 
-def comparison_table(cube) -> str:
+def comparison_table(cube, template: PageTemplate) -> str:
     by = {row["variant"]: row for row in cube}
-    snapped, thesis_like = by["snapped, no removal"], by["removal at 0.01"]
-    strongest = by["removal at 0.1"]
-    lines = ["| quantity | thesis (§3.3, Figures 3.14–3.16) | snede |", "|---|---|---|"]
-    entries = [
-        ("mesh", f"{THESIS['elements']} elements, {THESIS['nodes']} nodes",
-         f"{snapped['elements']} elements, {cube_nodes()} nodes"),
-        ("faces dissected", THESIS["faces_dissected"], snapped["faces_dissected"]),
-        ("repositionings that failed", f"{THESIS['failed_repositionings']} (spikes in Figure 3.14)",
-         f"{snapped['snaps_refused']} snaps refused"),
-        ("degenerate elements (aspect < 0.01) after the cut", THESIS["degenerate"],
-         f"{snapped['below_0.01']} (min aspect {snapped['min_aspect']:.4f}); {snapped['below_0.05']} below 0.05, "
-         f"{snapped['below_0.1']} below 0.1"),
-        ("CG iterations after the cut, no removal", THESIS["iterations_degenerate"], snapped["cg_after"]),
-        ("edge collapses at 0.01 / 0.99π", THESIS["collapses"],
-         f"{thesis_like['edges_collapsed']} (at 0.1: {strongest['edges_collapsed']})"),
-        ("incollapsible elements cut free", THESIS["incollapsible"],
-         f"{thesis_like['elements_cut_free']} (at 0.1: {strongest['elements_cut_free']})"),
-        ("elements / nodes after removal", f"{THESIS['elements_after']} / {THESIS['nodes_after']}",
-         f"{thesis_like['elements']} / {thesis_like['nodes']} (at 0.1: {strongest['elements']} / "
-         f"{strongest['nodes']})"),
-        ("CG iterations after the cut, with removal", THESIS["iterations_removed"],
-         f"{thesis_like['cg_after']} (at 0.1: {strongest['cg_after']})"),
-        ("time of the removal", f"{THESIS['removal_seconds']} s (Pentium III, 1 GHz)",
-         f"{_ms(thesis_like['removal_seconds'])} (at 0.1: {_ms(strongest['removal_seconds'])}); whole cut "
-         f"{thesis_like['cut_seconds'] * 1e3:.1f} ms"),
-    ]
-    lines += [f"| {a} | {b} | {c} |" for a, b, c in entries]
-    return "\n".join(lines) + "\n"
+    thesis_like = by["removal at 0.01"]
+    return template.snippet("comparison", thesis=THESIS, snapped=by["snapped, no removal"], at_001=thesis_like,
+                            at_01=by["removal at 0.1"], nodes=cube_nodes(),
+                            removal_001=_ms(thesis_like["removal_seconds"]),
+                            removal_01=_ms(by["removal at 0.1"]["removal_seconds"]),
+                            cut_ms=thesis_like["cut_seconds"] * 1e3)
 
 
 def _ms(seconds) -> str:
@@ -561,235 +540,130 @@ def engine_version() -> str:
 
 
 def describe(cube, scan, steps, cylinder, fresh, quick: bool, minutes: float) -> str:
+    """cutting.md (without its organ section): studies/templates/cutting.md filled with the tables
+    and the summaries of (a)–(d)."""
+    template = PageTemplate("cutting")
     other = [row for row in cube if row["cut"] != "diagonal"]
     cube_all, cube = cube, [row for row in cube if row["cut"] == "diagonal"]
-    by = {row["variant"]: row for row in cube}
-    snapped, jagged = by["snapped, no removal"], by["jagged (no snapping)"]
-    removal = [row for row in cube if row["remove"]]
-    zero_scan = sum(row["below_0.01"] == 0 for row in scan)
-    lines = [
-        "# §3.3 cutting: the diagonal cut in the cube, steps, pie-like cuts, element quality", "",
-        "Regenerate with `.venv/bin/python -m studies.experiments.cutting" + (" --quick`" if quick else "`")
-        + " (this file, `cutting.csv`, `cutting_quality.png`, `cutting_scan.png`, `cutting_incision.png`)"
-        + (". **Quick run: reduced variants and sizes.**" if quick else f"; this run took {minutes:.1f} min on the "
-           "2-core development machine") + f", with snede at {engine_version()}. The numbers depend on the "
-        "cutter's details (face selection, snapping rules), which were still changing when this was written.", "",
-        "The cutter is `snede.TetrahedralCutter` (§3.2: face selection by closest nodes, node snapping in the "
-        "deformed body, dissection §7.3, degeneracy removal by shape, free pieces fixed). Unlike the thesis's "
-        "prototype, snede's node snapping refuses any move that would make an element of the vertex's star flat or "
-        "inverted (exact predicates, in the reference and the deformed configuration); this is the main reason "
-        "the numbers below differ from the thesis's.", "",
-        "## (a) The large diagonal cut in the cube (Figures 3.5, 3.14–3.16)", "",
-        f"`snede.meshing.box((1, 1, 1), (8, 8, 8))`: {snapped['elements']} tetrahedra and {cube_nodes()} nodes as in the "
-        f"thesis (6 tetrahedra per cube, Kuhn split). Linear elastic, E = {YOUNG:g} Pa, ν = {POISSON}; back face "
-        f"z = 0 fixed; an outward traction of {TRACTION:g} Pa on the four side faces (x = 0, 1 and y = 0, 1), "
-        "lumped onto their nodes (a third of each boundary face's force per corner) and lumped again after the cut "
-        "so that the vertex copies on the sides carry their share. Linear CG with ‖r‖ < 1e-3‖f‖ (criterion (6.8)): "
-        f"{snapped['cg_before']} iterations from zero before the cut; 'CG after cut' continues from the state before "
-        "the cut, as the thesis's counts do.", "",
-        f"The cut: a straight blade along the front face's diagonal (from (0, 1, 1) to (1, 0, 1), {2 * HALF_BLADE} "
-        f"long so that it spans the dilated face) moved straight back along −z from z = {START} (outside) to "
-        f"z = {FRONT - DEPTH:g} (65 % of the depth) in **one move**, i.e. one swept quadrilateral processed as two "
-        "sweep triangles, in deformed coordinates: the vertical diagonal plane x + y = 1 (where the deformed body "
-        f"is). It dissects {snapped['faces_dissected']} faces, against the thesis's 108. The thesis does not give "
-        "its cut's plane; its Figure 3.14 shows a large diagonal cut, and the scan below shows how strongly the "
-        "counts depend on the orientation. Cut times are medians of "
-        f"{1 if quick else REPEATS} cuts; 'removal' is the difference from the snapped cut without removal.", "",
-        markdown_table(cube_all, CUBE_COLUMNS),
-        "Next to the thesis (the diagonal cut):", "", comparison_table(cube),
-        "![incisions](cutting_incision.png)", "",
-        cube_summary(cube, scan), "", other_cut_summary(other), "",
-        "### The angle of the cut", "",
-        "The thesis notes that in generated cubes the frequency of degeneracies correlates strongly with the angle "
-        "of the cut (the mesh has six orientations of tetrahedra). One-move cuts, each dissecting about a hundred "
-        "faces: the blade at 45° (the diagonal), 30° and 15° to the x axis in the front face, its sweep tilted by 0°, "
-        "15° or 30° from −z, through the face's centre or shifted by 0.3 element; each cut without removal and with "
-        "removal at 0.01 and at 0.1 (three separate runs). CG iterations after the cut against the smallest aspect "
-        "ratio the cut left:", "",
-        markdown_table(scan, SCAN_COLUMNS),
-        "![CG iterations against the worst element](cutting_scan.png)", "",
-        scan_summary(scan), "",
-        "## (b) The same cut in steps, relaxed in between (Figure 3.17)", "",
-        f"The blade path of (a) divided into {steps[0]['moves'] if steps else 1}–"
-        f"{max((row['moves'] for row in steps), default=1)} "
-        f"equal moves (each move two sweep triangles; one move advances the blade {START - FRONT + DEPTH:g}/moves, i.e. "
-        f"{(START - FRONT + DEPTH) * DIVISIONS:.1f}/moves element edges). 'Relaxed': after every "
-        "move the traction is lumped again and CG relaxes the body before the next move (the thesis's interactive "
-        "loop), so the opening incision moves the material relative to the blade. 'Incision pieces' counts the "
-        "pieces of the incision surface (its faces joined through edges; one connected incision is 1); 'incision "
-        "area' is measured in the reference configuration (half the area of the incision's faces, one lip); "
-        "'of one move' divides it by the one-move cut of the same variant.", "",
-        markdown_table(steps, STEP_COLUMNS),
-        steps_summary(steps), "",
-        "## (c) Pie-like cuts in an unstructured cylinder (Figure 3.13)", "",
-        f"`snede.meshing.cylinder({CYLINDER['length']}, {CYLINDER['radius']}, h={0.012 if quick else CYLINDER['h']}, "
-        f"seed={CYLINDER['seed']})` "
-        "(gmsh Delaunay, optimised): "
-        + (f"{cylinder[0]['elements_before']} tetrahedra and {cylinder[0]['vertices_before']} vertices (the thesis's "
-           f"Delaunay tetrahedralization of a cylindrical point cloud: {THESIS_CYLINDER['elements']} and "
-           f"{THESIS_CYLINDER['vertices']}). " if cylinder else "")
-        + "Three pie-like cuts: a blade parallel to the axis, slightly longer than the cylinder, moved from the axis "
-        f"outward to 1.2 radii in {' or '.join(str(m) for m in dict.fromkeys(row['moves_per_cut'] for row in cylinder))} "
-        "moves, at angles θ, θ + 120° and θ + 240°, on the bare "
-        "mesh (no body), each cut with a new cutter (the scalpel lifted in between). The thesis's 'three large "
-        f"pie-like cuts (45 faces)' dissect 873 faces in all; we read the 45 as sweep steps, 3 × {PIE_MOVES} moves. "
-        "Its finding: edge collapses are about 5 % of the faces "
-        "dissected, with a handful of incollapsible elements, whatever the orientation.", "",
-        markdown_table(cylinder, CYLINDER_COLUMNS),
-        cylinder_summary(cylinder), "",
-        "## (d) Element quality before and after", "",
-        "![aspect ratio and dihedral angle histograms](cutting_quality.png)", "",
-        quality_summary(cube, other, fresh), "",
-        "## Cost per sweep triangle", "",
-        "The time of a sweep triangle against the mesh size (boxes of 10³–10⁶ tetrahedra, the same cut in units of "
-        "the mesh spacing) is measured by `.venv/bin/python studies/benchmarks/cutting_rates.py`; see the README's "
-        "benchmark section.", "",
-    ]
-    return "\n".join(lines) + "\n"
+    snapped = {row["variant"]: row for row in cube}["snapped, no removal"]
+    return template.page(
+        quick_flag=" --quick" if quick else "",
+        run=template.snippet("quick_run") if quick else template.snippet("full_run", minutes=minutes),
+        engine=engine_version(), elements=snapped["elements"], nodes=cube_nodes(), young=YOUNG, poisson=POISSON,
+        traction=TRACTION, cg_before=snapped["cg_before"], blade_length=2 * HALF_BLADE, start=START,
+        stop=FRONT - DEPTH, faces=snapped["faces_dissected"], repeats=1 if quick else REPEATS,
+        cube_table=markdown_table(cube_all, CUBE_COLUMNS), comparison=comparison_table(cube, template),
+        cube_summary=cube_summary(cube, scan, template), other_summary=other_cut_summary(other, template),
+        scan_table=markdown_table(scan, SCAN_COLUMNS), scan_summary=scan_summary(scan, template),
+        fewest_moves=steps[0]["moves"] if steps else 1, most_moves=max((row["moves"] for row in steps), default=1),
+        path=START - FRONT + DEPTH, path_edges=(START - FRONT + DEPTH) * DIVISIONS,
+        steps_table=markdown_table(steps, STEP_COLUMNS), steps_summary=steps_summary(steps, template),
+        length=CYLINDER["length"], radius=CYLINDER["radius"], h=0.012 if quick else CYLINDER["h"],
+        seed=CYLINDER["seed"],
+        cylinder_size=template.snippet("cylinder_size", elements=cylinder[0]["elements_before"],
+                                       vertices=cylinder[0]["vertices_before"],
+                                       thesis_elements=THESIS_CYLINDER["elements"],
+                                       thesis_vertices=THESIS_CYLINDER["vertices"]) if cylinder else "",
+        pie_moves=" or ".join(str(m) for m in dict.fromkeys(row["moves_per_cut"] for row in cylinder)),
+        pie_moves_per_cut=PIE_MOVES, cylinder_table=markdown_table(cylinder, CYLINDER_COLUMNS),
+        cylinder_summary=cylinder_summary(cylinder, template), quality_summary=quality_summary(cube, other, fresh, template))
 
 
-def shapes(row) -> str:
+def shapes(row, template: PageTemplate) -> str:
     names = ("needles", "spindles", "slivers", "caps")
     found = [f"{row[name]} {name}" for name in names if row[name]]
-    return ", ".join(found) if found else "none"
+    return ", ".join(found) if found else template.snippet("none")
 
 
-def cube_summary(cube, scan) -> str:
+def large_angle(row, template: PageTemplate) -> str:
+    return template.snippet("large_angle") if "0.9π" in row["variant"] else ""
+
+
+def cube_summary(cube, scan, template: PageTemplate) -> str:
+    snippet = template.snippet
     by = {row["variant"]: row for row in cube}
     snapped, jagged = by["snapped, no removal"], by["jagged (no snapping)"]
     at_001 = by["removal at 0.01"]
-    removal = [row for row in cube if row["remove"]]
-    larger = [row for row in removal if row["threshold"] != 0.01]
-    zero_scan = sum(row["below_0.01"] == 0 for row in scan)
-    text = [
-        f"**What agrees.** The cut is of the thesis's size ({snapped['faces_dissected']} faces dissected against "
-        f"108, on the same mesh) and dissection keeps the number of elements ({jagged['elements']}; the nodes grow "
-        f"from {cube_nodes()} to {snapped['nodes']} by the vertex copies). Without snapping the incision is jagged "
-        "(Figure 3.5) and every element keeps its shape (min aspect ratio "
-        f"{jagged['min_aspect']:.3f}, the mesh's own); snapping makes the incision smooth (Figure 3.14) and thins the "
-        f"elements next to it (min aspect {snapped['min_aspect']:.4f})"
-        + (f", {snapped['below_0.01']} of them below the thesis's threshold 0.01, and CG then needs "
-           f"{snapped['cg_after']} iterations after the cut against {jagged['cg_after']} after the jagged one. "
-           f"Removal at 0.01 brings that back to {at_001['cg_after']} iterations (thesis: from 2439 to 236) and "
-           f"barely changes the mesh size ({at_001['elements']} elements, {at_001['nodes']} nodes; thesis: 3034 "
-           "and 823)." if snapped["below_0.01"] else
-           f"; CG needs {snapped['cg_after']} iterations after the cut against {jagged['cg_after']} after the jagged "
-           "one."),
-        "",
-        f"**What differs.** The number of degenerate elements: {snapped['below_0.01']} below 0.01 here against the "
-        f"thesis's 143, and CG {snapped['cg_after']} iterations without removal against 2439. snede's snapping never "
-        "makes an element exactly flat or inverted (it refuses such a move, in both configurations) and moves a vertex "
-        "on an edge of the body only along that edge (a corner not at all); it refused "
-        f"{snapped['snaps_refused']} of {snapped['vertices_snapped'] + snapped['snaps_refused']} snaps here (the "
-        "thesis reports 2 failed repositionings, the spikes of Figure 3.14)"
-        + (f". In the orientation scan below {zero_scan} of {len(scan)} one-move cuts leave no element below 0.01"
-           if scan else "") + ". "
-        f"The removal at 0.01 finds {at_001['degenerate_found']} degenerate elements ({shapes(at_001)}) and makes "
-        f"{at_001['edges_collapsed']} collapses, {at_001['edges_split']} edge splits and cuts "
-        f"{at_001['elements_cut_free']} elements free (thesis: 99 collapses, 13 cut free)"
-        + (f". Without removal these elements have a very short edge (median shortest/longest edge "
-           f"{snapped['flat_edge_ratio']:.3f}) and no large dihedral angle (at most "
-           f"{snapped['flat_max_dihedral_deg']:.0f}°)"
-           + (f"; in {snapped['flat_at_crease']} of them that edge ends at a vertex on an edge of the cube (where "
-              "the diagonal meets the vertical edges x = 1, y = 0 and x = 0, y = 1): snapping moved a vertex of the "
-              "side face next to it" if snapped["flat_at_crease"] else "")
-           + ". Collapsing the short edge removes the elements around it"
-           if snapped.get("flat_edge_ratio") is not None and at_001["needles"] == at_001["degenerate_found"] > 0
-           else "")
-        + ". At larger thresholds: "
-        + "; ".join(f"{row['threshold']:g}{' with large angle 0.9π' if '0.9π' in row['variant'] else ''}: "
-                    f"{row['degenerate_found']} found ({shapes(row)}), {row['edges_collapsed']} collapses, "
-                    f"{row['edges_split']} edge splits, {row['elements_cut_free']} cut free, min aspect "
-                    f"{row['min_aspect']:.3f} after, CG {row['cg_after']}" for row in larger) + "."]
-    if all(row["degenerate_found"] == 0 for row in larger):
-        text[-1] += " Even at 0.1 this cut leaves nothing to remove; some orientations of the scan below do."
-    text += ["", f"Removal time: {_ms(at_001['removal_seconds'])} at 0.01 and "
-             f"{_ms(by['removal at 0.1']['removal_seconds'])} at 0.1 (medians of whole cuts minus the cut without "
-             f"removal; whole cut {at_001['cut_seconds'] * 1e3:.1f} ms; differences of a few ms are within the noise of "
-             "the shared machine), against the thesis's 0.7 s on a 1 GHz Pentium III for 99 collapses. The removal "
-             "only visits the elements around the dissected faces."]
-    return "\n".join(text)
+    larger = [row for row in cube if row["remove"] and row["threshold"] != 0.01]
+    rows = dict(snapped=snapped, jagged=jagged, at_001=at_001)
+    flat = ""
+    if snapped.get("flat_edge_ratio") is not None and at_001["needles"] == at_001["degenerate_found"] > 0:
+        flat = snippet("flat", edge_ratio=snapped["flat_edge_ratio"], dihedral=snapped["flat_max_dihedral_deg"],
+                       crease=snippet("crease", n=snapped["flat_at_crease"]) if snapped["flat_at_crease"] else "")
+    return snippet(
+        "cube_summary", **rows, nodes=cube_nodes(),
+        degenerate=snippet("degenerate" if snapped["below_0.01"] else "no_degenerate", **rows),
+        attempted=snapped["vertices_snapped"] + snapped["snaps_refused"],
+        scan_zero=snippet("scan_zero", zero=sum(row["below_0.01"] == 0 for row in scan), n_scan=len(scan))
+        if scan else "",
+        shapes=shapes(at_001, template), flat=flat,
+        larger="; ".join(snippet("larger_threshold", row=row, large_angle=large_angle(row, template),
+                                 shapes=shapes(row, template)) for row in larger),
+        nothing_to_remove=snippet("nothing_to_remove") if all(row["degenerate_found"] == 0 for row in larger) else "",
+        removal_001=_ms(at_001["removal_seconds"]), removal_01=_ms(by["removal at 0.1"]["removal_seconds"]),
+        cut_ms=at_001["cut_seconds"] * 1e3)
 
 
-def other_cut_summary(rows) -> str:
+def other_cut_summary(rows, template: PageTemplate) -> str:
     if not rows:
         return ""
     by = {row["variant"]: row for row in rows}
-    snapped = by["snapped, no removal"]
-    removal = [row for row in rows if row["remove"]]
-    cut = rows[0]["cut"]
-    return (f"**The {cut} cut** (same path, the blade at 15° to the x axis instead of 45°) leaves many thin elements "
-            f"but none flat: {snapped['faces_dissected']} faces dissected, "
-            f"{snapped['below_0.01']} elements below 0.01, {snapped['below_0.05']} below 0.05 and "
-            f"{snapped['below_0.1']} below 0.1 (min {snapped['min_aspect']:.4f}), CG {snapped['cg_after']} after the "
-            f"cut without removal (jagged: {by['jagged (no snapping)']['cg_after']}). With the large angle at 0.99π "
-            "(178.2°) "
-            "its thin elements have no dihedral angle that large and count as needles; at 0.9π the other shapes of "
-            "§3.2.3 appear. Removal: "
-            + "; ".join(f"at {row['threshold']:g}{' with large angle 0.9π' if '0.9π' in row['variant'] else ''}: "
-                        f"{row['degenerate_found']} found ({shapes(row)}), {row['edges_collapsed']} collapses, "
-                        f"{row['edges_split']} edge splits, {row['elements_cut_free']} cut free, {row['elements']} "
-                        f"elements and {row['nodes']} nodes after, min aspect {row['min_aspect']:.3f}, CG "
-                        f"{row['cg_after']}, removal {_ms(row['removal_seconds'])}" for row in removal) + ".")
+    return template.snippet(
+        "other_cut", cut=rows[0]["cut"], snapped=by["snapped, no removal"],
+        jagged_cg=by["jagged (no snapping)"]["cg_after"],
+        removals="; ".join(template.snippet("other_removal", row=row, large_angle=large_angle(row, template),
+                                            shapes=shapes(row, template), removal=_ms(row["removal_seconds"]))
+                           for row in rows if row["remove"]))
 
 
-def scan_summary(scan) -> str:
+def scan_summary(scan, template: PageTemplate) -> str:
     if not scan:
         return ""
+    snippet = template.snippet
     faces = [row["faces_dissected"] for row in scan]
-    most = max(scan, key=lambda row: row["below_0.1"])
     minimum = np.array([row["min_aspect"] for row in scan])
     iterations = np.array([row["cg_after_none"] for row in scan])
     rho = float(np.corrcoef(np.argsort(np.argsort(minimum)), np.argsort(np.argsort(iterations)))[0, 1])
     helped = [row for row in scan if row["collapses_0.1"] > 0]
-    text = (f"Faces dissected range over {min(faces)}–{max(faces)}; elements below 0.1 after the cut from "
-            f"{min(row['below_0.1'] for row in scan)} to {most['below_0.1']} (blade {most['angle_deg']:g}°, tilt "
-            f"{most['tilt_deg']:g}°), below 0.05 from {min(row['below_0.05'] for row in scan)} to "
-            f"{max(row['below_0.05'] for row in scan)}, below 0.01 from {min(row['below_0.01'] for row in scan)} to "
-            f"{max(row['below_0.01'] for row in scan)}: the thin elements do depend strongly on the orientation, as "
-            f"the thesis says{', but none of these cuts comes near flat' if minimum.min() > 0.01 else ''}. "
-            f"CG after the cut takes {iterations.min()}–"
-            f"{iterations.max()} iterations without removal (the uncut body {scan[0]['cg_before']} from zero); the "
-            f"rank correlation between the smallest aspect ratio and the CG count is {rho:+.2f}: ")
-    text += ("the count follows the worst element (a negative correlation: thinner, more iterations). " if rho < -0.5
-             else "no clear relation; the count follows the cut's orientation and extent, i.e. how far the solution "
-             "has to move after the cut (mean CG by tilt: " + ", ".join(
-                 f"{tilt:g}°: {np.mean([row['cg_after_none'] for row in scan if row['tilt_deg'] == tilt]):.0f}"
-                 for tilt in dict.fromkeys(row["tilt_deg"] for row in scan)) + "). ")
+    relation = snippet("follows_worst") if rho < -0.5 else snippet("no_relation", by_tilt=", ".join(
+        f"{tilt:g}°: {np.mean([row['cg_after_none'] for row in scan if row['tilt_deg'] == tilt]):.0f}"
+        for tilt in dict.fromkeys(row["tilt_deg"] for row in scan)))
+    removal = ""
     if helped:
-        best = max(helped, key=lambda row: row["cg_after_none"] - row["cg_after_0.1"])
-        text += (f"Removal at 0.1 collapses edges after {len(helped)} of the {len(scan)} cuts and changes their CG "
-                 "counts by " + ", ".join(f"{row['cg_after_0.1'] - row['cg_after_none']:+d}" for row in helped)
-                 + f"; the largest saving is on the cut with the blade at {best['angle_deg']:g}°, tilt "
-                 f"{best['tilt_deg']:g}° (min aspect {best['min_aspect']:.4f}): {best['cg_after_none']} to "
-                 f"{best['cg_after_0.1']} iterations, as in the thesis (2439 to 236), where the cut's elements were "
-                 "flatter still.")
-    return text
+        removal = snippet("removal_helped", n_helped=len(helped), n_scan=len(scan),
+                          changes=", ".join(f"{row['cg_after_0.1'] - row['cg_after_none']:+d}" for row in helped),
+                          best=max(helped, key=lambda row: row["cg_after_none"] - row["cg_after_0.1"]))
+    return snippet(
+        "scan_summary", faces_min=min(faces), faces_max=max(faces), most=max(scan, key=lambda row: row["below_0.1"]),
+        below_01_min=min(row["below_0.1"] for row in scan),
+        below_005_min=min(row["below_0.05"] for row in scan), below_005_max=max(row["below_0.05"] for row in scan),
+        below_001_min=min(row["below_0.01"] for row in scan), below_001_max=max(row["below_0.01"] for row in scan),
+        none_flat=snippet("none_flat") if minimum.min() > 0.01 else "", cg_min=iterations.min(),
+        cg_max=iterations.max(), cg_before=scan[0]["cg_before"], rho=rho, relation=relation, helped=removal)
 
 
-def joined_sentence(steps) -> str:
+def joined_sentence(steps, template: PageTemplate) -> str:
     joined = sorted({row["moves"] for row in steps if row["faces_selected"] > 0 and row["area_ratio"] < 0.5})
     none = sorted({row["moves"] for row in steps if row["faces_selected"] == 0})
-    text = ""
-    if joined:
-        text += (f"At {', '.join(map(str, joined))} moves faces are still selected but stay joined (the dissection "
-                 "opens a face only where the selected faces around its vertices close into a surface)")
+    text = template.snippet("joined", moves=", ".join(map(str, joined))) if joined else ""
     if none:
-        text += ("; at " if text else "At ") + f"{', '.join(map(str, none))} moves none is selected"
+        moves = ", ".join(map(str, none))
+        text += "; " + template.snippet("none_selected", moves=moves) if text else \
+            template.snippet("none_selected_first", moves=moves)
     return text + ". " if text else ""
 
 
-def steps_summary(steps) -> str:
+def steps_summary(steps, template: PageTemplate) -> str:
     if not steps:
         return ""
+    snippet = template.snippet
     variants = list(dict.fromkeys(row["variant"] for row in steps))
     lines = []
     for name in variants:
         rows = [row for row in steps if row["variant"] == name]
-        lines.append(f"* *{name}*: area " + ", ".join(f"{row['area_ratio']:.2f}" for row in rows)
-                     + " of the one-move cut for " + ", ".join(str(row["moves"]) for row in rows)
-                     + " moves; incision pieces " + ", ".join(str(row["incision_pieces"]) for row in rows) + ".")
-    text = "\n".join(lines) + "\n\n"
+        lines.append(snippet("step_variant", name=name, areas=", ".join(f"{row['area_ratio']:.2f}" for row in rows),
+                             moves=", ".join(str(row["moves"]) for row in rows),
+                             pieces=", ".join(str(row["incision_pieces"]) for row in rows)))
     edges = (START - FRONT + DEPTH) * DIVISIONS
 
     def failing(name):  # the first number of moves from which the incision is mostly lost
@@ -799,20 +673,13 @@ def steps_summary(steps) -> str:
 
     fails = {name: failing(name) for name in variants}
     if any(fails.values()):
-        text += ("**The incision depends on the step size, whether or not the body moves between moves.** "
-                 + ("Every variant loses it from " + f"{next(iter(fails.values()))} moves on "
-                    f"({edges / next(iter(fails.values())):.2f} element edges per move)"
-                    if len(set(fails.values())) == 1 else
-                    "; ".join(f"{name}: lost from {moves} moves on ({edges / moves:.2f} element edges per move)"
-                              for name, moves in fails.items() if moves))
-                 + ". " + joined_sentence(steps) + "The likely cause (from reading the code, not verified by changing it): a "
-                 "tetrahedron selects a face only when the crossings of the current and a few recent "
-                 "sweep triangles (the last four in engine/cutting/face_selection.hpp) mark three of its corners, so "
-                 "when the blade needs more moves than that to cross an element, its crossings are forgotten before "
-                 "it is complete. The thesis keeps the crossings of an incomplete tetrahedron for as long as the "
-                 "scalpel is in it (§3.2.1, Figure 3.4). ")
+        first = next(iter(fails.values()))
+        lost = snippet("every_variant_lost", moves=first, edges=edges / first) if len(set(fails.values())) == 1 else \
+            "; ".join(snippet("variant_lost", name=name, moves=moves, edges=edges / moves)
+                      for name, moves in fails.items() if moves)
+        sentences = [snippet("incision_lost", lost=lost, joined=joined_sentence(steps, template))]
     else:
-        text += "No variant loses its incision as the moves get smaller. "
+        sentences = [snippet("incision_kept")]
     relaxed, still = "snapped, removal at 0.01, relaxed", "snapped, removal at 0.01, not relaxed"
     pairs = []
     for row in steps:
@@ -823,85 +690,67 @@ def steps_summary(steps) -> str:
             pairs.append((row, twin))
     if pairs:
         split = [(row, twin) for row, twin in pairs if row["incision_pieces"] > twin["incision_pieces"]]
-        text += ("Where the cut works without relaxation (" + ", ".join(str(row["moves"]) for row, _ in pairs)
-                 + " moves), relaxing between moves (the Figure 3.17 setting: the incision opens and the material "
-                 "moves relative to the blade) keeps the area within "
-                 f"{max(abs(row['incision_area'] / twin['incision_area'] - 1) for row, twin in pairs):.0%} of the "
-                 "unrelaxed cut's; the incision "
-                 + ("stays one connected surface" if not split else
-                    "gains pieces: " + ", ".join(f"{row['incision_pieces']} pieces ({row['incision_piece_faces']} "
-                                                 f"faces) at {row['moves']} moves" for row, _ in split)
-                    + ", the disconnection of Figure 3.17 on a small scale")
-                 + ". snede's scalpel is given in deformed coordinates and each sweep re-reads the deformed mesh, so "
-                 "the body's motion between moves is followed; the thesis's stored crossings were not. The jagged cut "
-                 "with relaxation dissects more faces than in one move (area ratio up to "
-                 f"{max(row['area_ratio'] for row in steps if row['variant'].startswith('jagged')):.2f}): the "
-                 "opening lips move into the blade's later sweeps.")
-    return text
+        sentences.append(snippet(
+            "relaxed_moves", moves=", ".join(str(row["moves"]) for row, _ in pairs),
+            area_change=max(abs(row["incision_area"] / twin["incision_area"] - 1) for row, twin in pairs),
+            pieces=snippet("gains_pieces", pieces=", ".join(
+                snippet("pieces_at", pieces=row["incision_pieces"], faces=row["incision_piece_faces"], moves=row["moves"])
+                for row, _ in split)) if split else snippet("one_surface"),
+            jagged_ratio=max(row["area_ratio"] for row in steps if row["variant"].startswith("jagged"))))
+    return "\n".join(lines) + "\n\n" + " ".join(sentences)
 
 
-def cylinder_summary(cylinder) -> str:
+def cylinder_summary(cylinder, template: PageTemplate) -> str:
     if not cylinder:
         return ""
+    snippet = template.snippet
     working = [row for row in cylinder if row["faces_dissected"] >= 50]
     failed = list(dict.fromkeys((row["moves_per_cut"], row["offset_rad"], row["faces_per_cut"])
                                 for row in cylinder if row["faces_dissected"] < 50))
 
-    def shares(setting):
-        rows = [row for row in working if row["removal"] == setting]
-        return ", ".join(f"{row['collapse_share']:.1%} ({row['edges_collapsed']}/{row['faces_dissected']}, "
-                         f"{row['elements_cut_free']} cut free; θ = {row['offset_rad']:.1f}, {row['moves_per_cut']} "
-                         f"move{'s' if row['moves_per_cut'] > 1 else ''})" for row in rows)
+    def moves(n):
+        return snippet("moves" if n > 1 else "one_move", n=n)
 
-    text = (f"Edge collapses as a share of the faces dissected, at the thesis's threshold 0.01: {shares('0.01')}; at "
-            f"0.1: {shares('0.1')}. The thesis finds about 5 % at 0.01 with a handful of incollapsible elements; "
-            "with snede's guarded snapping that share is reached only at a ten times larger threshold. The three "
-            "directions give counts of the same size (columns 'per cut'), as the thesis says for the unstructured "
-            "mesh. ")
+    def shares(setting):
+        return ", ".join(snippet("share", row=row, moves=moves(row["moves_per_cut"]))
+                         for row in working if row["removal"] == setting)
+
+    sentences = [snippet("cylinder_shares", shares_001=shares("0.01"), shares_01=shares("0.1"))]
     if working:
-        text += (f"Faces dissected per cut: {min(min(map(int, row['faces_per_cut'].split('/'))) for row in working)}–"
-                 f"{max(max(map(int, row['faces_per_cut'].split('/'))) for row in working)} "
-                 f"(thesis: 873 for three cuts in a mesh of 4020 elements, about 290 per cut; its cuts were larger "
-                 "than ours or counted both lips, it does not say). ")
+        sentences.append(snippet(
+            "faces_per_cut", low=min(min(map(int, row["faces_per_cut"].split("/"))) for row in working),
+            high=max(max(map(int, row["faces_per_cut"].split("/"))) for row in working)))
     if failed:
-        text += ("**With small moves the cuts fail:** "
-                 + "; ".join(f"{moves} moves per cut (θ = {offset:.1f}): {faces} faces dissected"
-                             for moves, offset, faces in failed)
-                 + f". {failed[0][0]} moves of 1.2 radii are {1.2 * CYLINDER['radius'] / failed[0][0] / CYLINDER['h']:.2f} "
-                 "target edge lengths per move, too short for the face selection (see (b)); the vertices are "
-                 "snapped all the same, which is why removal still finds and collapses elements there. ")
+        sentences.append(snippet(
+            "small_moves_fail", failed="; ".join(snippet("failed_cut", moves=m, offset=offset, faces=faces)
+                                                 for m, offset, faces in failed),
+            moves=failed[0][0], edges=1.2 * CYLINDER["radius"] / failed[0][0] / CYLINDER["h"]))
     small = [row for row in cylinder if row["small_pieces"] > 0]
     if small:
         worst = max(small, key=lambda row: row["small_pieces"])
-        text += (f"**Free fragments:** {len(small)} of {len(cylinder)} runs leave small free pieces besides the body "
-                 f"(up to {worst['small_pieces']} pieces of fewer than 20 elements, {worst['small_piece_elements']} "
-                 f"elements in all, with {worst['moves_per_cut']} move{'s' if worst['moves_per_cut'] > 1 else ''} per "
-                 "cut): tetrahedra all of whose faces were dissected. A single pie cut on this mesh shows them when it "
-                 "is made as two sweep triangles (one move) with snapping, not as one large sweep triangle and not "
-                 "without snapping; its fragments lie within about an element of the diagonal the two triangles "
-                 "share and are bounded partly by faces off the cut plane, so the second triangle seems to select "
-                 "faces around vertices the first one had snapped onto the plane. With a body attached the cutter "
-                 "fixes each such piece on one face (§3.3).")
-    return text
+        sentences.append(snippet("free_fragments", n_small=len(small), n_runs=len(cylinder), worst=worst,
+                                 moves=moves(worst["moves_per_cut"])))
+    return " ".join(sentences)
 
 
-def quality_summary(cube, other, fresh) -> str:
+def quality_summary(cube, other, fresh, template: PageTemplate) -> str:
+    snippet = template.snippet
     q = fresh.quality()
-    text = (f"Before the cut every element of the Kuhn cube has aspect ratio {q.aspect_ratio.min():.3f}"
-            + (f"–{q.aspect_ratio.max():.3f}" if q.aspect_ratio.max() - q.aspect_ratio.min() > 1e-9 else
-               " (the six tetrahedra of a cube are congruent)")
-            + f" and largest dihedral angle {np.degrees(q.max_dihedral.max()):.0f}°. ")
+    spread = q.aspect_ratio.max() - q.aspect_ratio.min() > 1e-9
+    sentences = [snippet("quality_before", low=q.aspect_ratio.min(),
+                         spread=snippet("quality_range", high=q.aspect_ratio.max()) if spread else snippet("congruent"),
+                         dihedral=np.degrees(q.max_dihedral.max()))]
     for rows in (cube, other):
         if not rows:
             continue
         by = {row["variant"]: row for row in rows}
-        text += (f"{rows[0]['cut'].capitalize()} cut: the jagged cut leaves the elements as they were (min aspect "
-                 f"{by['jagged (no snapping)']['min_aspect']:.3f}); snapping spreads those around the cut towards "
-                 f"small aspect ratios (min {by['snapped, no removal']['min_aspect']:.4f}, largest dihedral angle "
-                 f"{by['snapped, no removal']['max_dihedral_deg']:.1f}°); after removal the smallest aspect ratio is "
-                 + ", ".join(f"{row['min_aspect']:.3f} at {row['threshold']:g}" for row in rows
-                             if row["remove"] and "0.9π" not in row["variant"]) + ". ")
-    return text
+        sentences.append(snippet(
+            "quality_after", cut=rows[0]["cut"].capitalize(), jagged_min=by["jagged (no snapping)"]["min_aspect"],
+            snapped_min=by["snapped, no removal"]["min_aspect"],
+            snapped_dihedral=by["snapped, no removal"]["max_dihedral_deg"],
+            after=", ".join(snippet("aspect_at", min_aspect=row["min_aspect"], threshold=row["threshold"])
+                            for row in rows if row["remove"] and "0.9π" not in row["variant"])))
+    return " ".join(sentences)
 
 
 def main(argv=None) -> dict:
