@@ -9,7 +9,7 @@
 // the tangent action and for the element stiffness matrices of for_each_element_stiffness
 // (what an assembled preconditioner's rebuild starts with; the visitor only reads them), then ns per tetrahedron
 // for the linear tangent and for MatMult on the BAIJ(3) matrix assembled from the same
-// element stiffness matrices. The state is the one benchmarks/fem_throughput.py uses: a
+// element stiffness matrices. The state is the one studies/benchmarks/fem_throughput.py uses: a
 // 0.1 m cube, u = 1e-4·N(0, 1) per component, d = N(0, 1).
 #include <petscmat.h>
 
