@@ -76,7 +76,7 @@ NeedleInsertion::NeedleInsertion(Model& model, Bisection* bisection, const Point
   const Mesh& mesh = model_.body().mesh();
   // The needle's loop changes the mesh at nearly every update (refinement at the tip), so "mg"
   // takes grid levels, which are rebuilt cheaply, unless told otherwise: on the cube of
-  // benchmarks/needle3d_rates.py --haptic (neo-Hookean) 22.3 updates/s against 12.9 with the
+  // studies/benchmarks/needle3d_rates.py --haptic (neo-Hookean) 22.3 updates/s against 12.9 with the
   // bisection levels, the same for the linear material. The bisection's hierarchy stays
   // available (-<prefix>mg_coarsening bisection).
   const OptionList& given = solver_options.petsc_options;
