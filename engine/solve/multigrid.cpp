@@ -98,7 +98,7 @@ void GalerkinMultigrid::configure_levels(PC pc, std::vector<Mat> interpolations,
     // stalled after the third move through the liver). The estimate costs a few products.
     // The finest level's matrix is the assembled tangent, with a vertex's components in a
     // block: Jacobi by those blocks couples them as elasticity does. On the livers' cut loops
-    // (benchmarks/interactive_cut.py) it took 13.7 CG iterations per Newton step against 15.6
+    // (studies/benchmarks/interactive_cut.py) it took 13.7 CG iterations per Newton step against 15.6
     // (20k and 60k tetrahedra) and 6–8 % less time; on the bisected blocks 3 % more at most.
     set_chebyshev_jacobi_smoother(smoother, options, 0.0, l == n - 1);
   }
