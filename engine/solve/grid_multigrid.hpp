@@ -25,7 +25,7 @@ class GridMultigrid final : public GalerkinMultigrid {
   // Throws std::invalid_argument for a non-positive width.
   explicit GridMultigrid(Model& fine, double grid_width = default_grid_width);
   // 4 spacings is 3 mean edge lengths on a uniform mesh, the fastest of 2, 3 and 4 in
-  // benchmarks/interactive_cut.py on the block and the liver; on a mesh refined along a needle's
+  // studies/benchmarks/interactive_cut.py on the block and the liver; on a mesh refined along a needle's
   // shaft, 3 mean edge lengths made a coarse level larger than the fine one (needle3d_rates.py).
   static constexpr double default_grid_width = 4.0;
   // Throws std::invalid_argument naming mg_grid_width unless `grid_width` is finite and ≥ 1.
