@@ -33,7 +33,7 @@ class MembranePositivePart {
   static constexpr int n = 9;  // 3 corners × 3 components
   // Eigenvalues are raised to at least this fraction of the element's largest: a slack element
   // has none across the sheet, and a singular coarse operator made mg fail on a sheet loaded
-  // across its plane before it was stretched (benchmarks/membrane_preconditioners.py: with 1e-4
+  // across its plane before it was stretched (studies/benchmarks/membrane_preconditioners.py: with 1e-4
   // it converged at 128 and 512 triangles, with 0 at 512 only). Measured 0, 1e-4, 1e-3, 1e-2,
   // 1e-1: 1e-4 took the fewest iterations on the taut and the sagging sheets and the
   // membrane-cut scene (574 Newton iterations against 615 with 0 and 851 with 1e-3).
