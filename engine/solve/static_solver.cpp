@@ -58,7 +58,7 @@ constexpr PetscInt newton_finish_steps = 10;
 // ‖F‖ changed by less than this fraction over a Newton iteration: a stalled line search.
 constexpr double newton_stall = 1e-6;
 
-// "auto": multigrid where it pays. On the cantilever block (benchmarks/static_solve_scaling.py
+// "auto": multigrid where it pays. On the cantilever block (studies/benchmarks/static_solve_scaling.py
 // and docs/results/interactive.md) mg and no preconditioner cost the same at about 650 cells,
 // mg is 1.3× faster at 1 500, 2–3× at 5 000–40 000. Membranes (docs/results/interactive.md):
 // 1.3–5× faster from 1 000 triangles on sheets and organ skins (a slack sheet loaded across its
