@@ -35,7 +35,7 @@ class AggregationMultigrid final : public GalerkinMultigrid {
   // aggregate_width: the first level's grid cells, in mean edge lengths.
   explicit AggregationMultigrid(Model& fine, int max_levels = 0, bool smooth_first_level = false,
                                 double aggregate_width = default_aggregate_width);
-  // On a structured tetrahedral mesh about 3 vertices per direction (benchmarks/interactive_cut.py
+  // On a structured tetrahedral mesh about 3 vertices per direction (studies/benchmarks/interactive_cut.py
   // measured widths 2 to 4; see docs/results/interactive.md).
   static constexpr double default_aggregate_width = 2.5;
   ~AggregationMultigrid() override;
