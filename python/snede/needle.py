@@ -111,7 +111,7 @@ class NeedleInsertion:
       Inexact Newton (``petsc_options={"snes_ksp_ew": None}`` or ``-needle_snes_ksp_ew``,
       Eisenstat–Walker: early steps solve their linear systems loosely) pays in the haptic
       loop: 12–16 % less time with one solve per update at 22k–34k neo-Hookean tetrahedra
-      (``benchmarks/needle3d_rates.py --thesis-size``), but 8 % more when every update is
+      (``studies/benchmarks/needle3d_rates.py --thesis-size``), but 8 % more when every update is
       settled (the ``needle3d`` scene: more Newton steps, each with a new preconditioner).
     * ``max_rearrangements``: per update; reaching it is reported, not hidden.
     * ``solves_per_update``: None (default) relaxes and rearranges until no node changes state
