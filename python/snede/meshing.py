@@ -134,7 +134,7 @@ def ellipsoid(radii=(0.06, 0.04, 0.03), h=0.01, seed: int | None = None) -> Mesh
 
 def hollow_sphere(inner=0.5, outer=1.0, h=0.1, seed: int | None = None) -> Mesh:
     """Unstructured tetrahedra (gmsh, edge length ``h``) of the shell inner ≤ |x| ≤ outer centred
-    at the origin: the pressurised sphere of Lamé's analytic solution (benchmarks/locking.py)."""
+    at the origin: the pressurised sphere of Lamé's analytic solution (studies/benchmarks/locking.py)."""
     _positive(inner=inner, outer=outer, h=h)
     if not inner < outer:
         raise ValueError(f"inner radius must be below the outer one, got inner={inner}, outer={outer}")
