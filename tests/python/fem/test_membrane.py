@@ -382,7 +382,7 @@ def pretensioned_sheet(divisions: int) -> snede.Body:
 
 
 # GAMG is left out: on this sheet its Newton stops with DIVERGED_LINE_SEARCH (reported, not
-# hidden; benchmarks/membrane_preconditioners.py).
+# hidden; studies/benchmarks/membrane_preconditioners.py).
 @pytest.mark.parametrize("preconditioner", ["jacobi", "mg"])
 def test_jacobi_and_multigrid_solve_a_membrane_to_the_unpreconditioned_answer(preconditioner):
     reference = pretensioned_sheet(12)
