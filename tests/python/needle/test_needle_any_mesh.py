@@ -51,7 +51,7 @@ def test_the_surface_depth_is_zero_from_inside_and_a_line_that_misses_is_refused
 @pytest.mark.parametrize("coarsening", [None, "bisection"])
 def test_the_needle_takes_grid_levels_unless_told_otherwise(coarsening):
     # Its refinement changes the mesh at nearly every update: grid levels are rebuilt more
-    # cheaply than bisection levels (benchmarks/needle3d_rates.py --haptic).
+    # cheaply than bisection levels (studies/benchmarks/needle3d_rates.py --haptic).
     mesh = snede.meshing.box((0.1, 0.1, 0.1), (2, 2, 2))
     mesh.refine_uniform(3)
     body = snede.Body(mesh, snede.LinearElastic(34e3, 0.34))
