@@ -1,7 +1,7 @@
 """The surface cutter on coarse closed surfaces (issue 32 item 4): where the cut crosses a crease
 the incision puts a node on the scalpel's path, on the crease (§5.3.1), so that its active node
 goes on instead of sticking, and its cut edges stay on the surface instead of becoming chords
-through the body. The scalpels and counts are those of benchmarks/surface_incisions.py."""
+through the body. The scalpels and counts are those of studies/benchmarks/surface_incisions.py."""
 import sys
 from pathlib import Path
 
