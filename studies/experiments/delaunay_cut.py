@@ -43,7 +43,7 @@ from pathlib import Path
 import numpy as np
 
 import snede
-from studies.experiments.common import Column, markdown_table, parse_arguments, pyplot, write_csv
+from studies.experiments.common import Column, PageTemplate, markdown_table, parse_arguments, pyplot, write_csv
 from snede.planar_cutting import PlanarCutReport, sample_path
 from snede.subdivision_cutting import SubdivisionCutter
 
@@ -643,192 +643,93 @@ def random_table(rows) -> list[dict]:
     return table
 
 
-def figure_summary(rows, thesis: dict) -> str:
+def figure_summary(rows, thesis: dict, template: PageTemplate) -> str:
     by = {row["cut"]: row for row in rows}
-    sub, d3, d8 = by["subdivision"], by["delaunay h̄/3"], by["delaunay h̄/8"]
-    parts = []
-    compared = [(name, by[name]["added"], value) for name, value in thesis.items()]
-    parts.append("Triangles added, snede against the thesis: " + "; ".join(
-        f"{name} {ours:+d} (thesis {theirs:+d}, {'the same' if ours == theirs else f'{ours - theirs:+d}'})"
-        for name, ours, theirs in compared) + ".")
+    sub = by["subdivision"]
+    compared = "; ".join(template.snippet("thesis_added", name=name, ours=by[name]["added"], theirs=value,
+                                          difference=template.snippet("the_same") if by[name]["added"] == value
+                                          else f"{by[name]['added'] - value:+d}")
+                         for name, value in thesis.items())
+    split = ""
     if sub.get("sliced") is not None:
-        parts.append(f"Subdivision split {sub['split_inside']} interior edges and {sub['split_on_sides']} edges on the "
-                     f"sides: 2 × {sub['split_inside']} + {sub['split_on_sides']} = "
-                     f"{2 * sub['split_inside'] + sub['split_on_sides']} triangles, i.e. {sub['sliced']:.0f} sliced "
-                     f"triangles each made three (the thesis's +{thesis['subdivision']} is "
-                     f"{thesis['subdivision'] // 2} sliced triangles).")
-    parts.append(f"Smallest angle: subdivision {sub['min_angle']:.1f}°, Delaunay h̄/3 {d3['min_angle']:.1f}°, h̄/8 "
-                 f"{d8['min_angle']:.1f}°; largest angle {sub['max_angle']:.1f}°, {d3['max_angle']:.1f}°, "
-                 f"{d8['max_angle']:.1f}°; triangles with an angle below 20°: {sub['below_20']}, {d3['below_20']}, "
-                 f"{d8['below_20']} (of {sub['triangles']}, {d3['triangles']}, {d8['triangles']}).")
-    parts.append(f"The path is {sub['path_length_h']:.1f} h̄ long inside the square (h̄ = {sub['h_bar']:.4f}); the "
-                 f"incision lies at most {d3['incision_to_path_max']:.2f} h̄ (h̄/3) and {d8['incision_to_path_max']:.2f} "
-                 f"h̄ (h̄/8) from it, the path at most {d3['path_to_incision_max']:.2f} and "
-                 f"{d8['path_to_incision_max']:.2f} h̄ from the incision (subdivision: "
-                 f"{sub['incision_to_path_max']:.3f} and {sub['path_to_incision_max']:.3f} h̄; its incision is made of "
-                 "chords of the path inside each sliced triangle).")
-    return " ".join(parts)
+        split = template.snippet("sliced", sub=sub, total=2 * sub["split_inside"] + sub["split_on_sides"],
+                                 thesis_added=thesis["subdivision"], thesis_sliced=thesis["subdivision"] // 2)
+    return template.snippet("figure_summary", compared=compared, split=split, sub=sub, d3=by["delaunay h̄/3"],
+                            d8=by["delaunay h̄/8"])
 
 
 def describe(results, quick: bool, minutes: float, triangle_version) -> str:
+    """delaunay_cut.md: studies/templates/delaunay_cut.md filled with the tables and summaries."""
     from studies.experiments.cutting import engine_version
 
+    template = PageTemplate("delaunay_cut")
     small, large = results["figure_5_16"], results["figure_5_8"]
     references, variants, random, eps = results["reference"], results["variants"], results["random"], results["eps"]
     by_small = {row["cut"]: row for row in small}
     by_large = {row["cut"]: row for row in large}
-    lines = [
-        "# §5.2 and §5.4 cutting in 2D: the Delaunay cut against subdivision (Figures 5.8, 5.16, 5.17)", "",
-        "Regenerate with `.venv/bin/python -m studies.experiments.delaunay_cut" + (" --quick`" if quick else "`")
-        + " (this file, `delaunay_cut.csv`, `delaunay_cut_meshes.png`, `delaunay_cut_722.png`, "
-        "`delaunay_cut_angles.png`, `delaunay_cut_scan.png`)"
-        + (f", with snede at {engine_version()}. **Quick run: fewer paths and variants.** " if quick else
-           f"; this run took {minutes:.1f} min on the 2-core development machine, with snede at {engine_version()}. ")
-        + (f"The reference remeshings use the `triangle` package {triangle_version} (Shewchuk's Triangle), which is "
-           "not a dependency of snede (`pip install triangle` to reproduce them; without it the experiment runs and "
-           "leaves them out)." if triangle_version else
-           "**The `triangle` package was not installed for this run, so the constrained-Delaunay reference columns "
-           "are left out** (`pip install triangle` adds them)."), "",
-        "## Setup", "",
-        "§5.4 cuts \"uniform meshes on a square grid\" with a mouse-driven point scalpel; Figure 5.17's peaks at "
-        "45° and 90° say that the grid's squares are split into two right isosceles triangles. "
-        f"`snede.meshing.rectangle((1, 1), ({N_SMALL}, {N_SMALL}))` has the 50 triangles of Figure 5.16 and "
-        f"`rectangle((1, 1), ({N_LARGE}, {N_LARGE}))` the 722 of Figure 5.8 (h̄, the mean edge length, is "
-        f"{by_small['subdivision']['h_bar']:.4f} and {by_large['subdivision']['h_bar']:.4f}). The thresholds are the "
-        "thesis's: ε_edge = h̄/3 (Figures 5.8, 5.16) or h̄/8 (Figure 5.16), ε_entry = ε_exit = h̄/6. "
-        "`snede.DelaunayCutter.cut` moves the scalpel along the path in steps of ε_edge (the thesis's mouse samples "
-        "are not known); `snede.SubdivisionCutter` splits every edge the path crosses (each sliced triangle becomes "
-        "three, Figure 5.2).", "",
-        "**The paths are ours.** The thesis draws its paths (dotted in Figures 5.8 and 5.16) but does not give "
-        "them. For Figure 5.16 we use an S: in from the left at y = 0.83, a half-circle turn at x = 0.75 down to "
-        "y = 0.5, another at x = 0.25 down to y = 0.17, out at the right. We chose the S shape before counting, "
-        "with its turns first at x = 0.2 and 0.8, on grid lines, where the subdivision cutter then lost a crossing "
-        "(fixed since; last section); the turns were moved to 0.25 and 0.75, which changed the Delaunay counts too. "
-        "Subdivision adds "
-        f"{by_small['subdivision']['added']:+d} triangles against the thesis's +62: the path is about as long in "
-        "triangles as the thesis's. (f) shows how much every count moves when the S is shifted by a fraction of an "
-        "element. For Figure 5.8 we use a curve with two hairpin turns and two hooks of about an element's radius "
-        "(the thesis remarks that strongly curved stretches are cut short), "
-        f"{by_large['subdivision']['path_length_h']:.0f} h̄ long inside the square; the thesis's path length is "
-        "unknown, so only the kind of result, not the count, can be compared.", "",
-        "Columns: 'added' is triangles after − before; 'min/max angle' the smallest and largest angle of any "
-        "triangle; '< 20°' and '> 120°' count triangles with an angle below 20° or above 120°; 'path → incision' is "
-        "the distance from points of the path inside the square (every h̄/50) to the nearest incision edge, "
-        "'incision → path' from points along the incision edges (the boundary edges not on the square's sides, both "
-        "lips) to the path, both in h̄; 'exit offset' the distance from where the path leaves the square to the "
-        "incision's end on the side; 'made by' says what the shortest edge of the triangle with the smallest angle "
-        "joins (an incision vertex and a vertex not on the incision: 'old vertex next to the incision'; two vertices "
-        "on the square's sides: 'short side edge') and 'where' whether that triangle lies within h̄ of where the "
-        "path enters or leaves.", "",
-        "## (a) Figure 5.16: the 50-triangle mesh", "",
-        markdown_table(small, CUT_COLUMNS),
-        figure_summary(small, THESIS), "",
-        "![the cuts of Figure 5.16](delaunay_cut_meshes.png)", "",
-        "Dotted: the path; red: the incision (both lips); orange: the triangle with the smallest angle.", "",
-        "## (b) Figure 5.8: the 722-triangle mesh", "",
-        markdown_table(large, CUT_COLUMNS),
-        large_summary(large), "",
-        "![the cuts of Figure 5.8](delaunay_cut_722.png)", "",
-        "## (c) Figure 5.17: smallest and largest angles", "",
-        "![angle histograms](delaunay_cut_angles.png)", "",
-        histogram_summary(results), "",
-        "## (d) How closely the incision follows the path", "",
-        distance_summary(small, large, variants), "",
-        "## (e) Reference: the cut domain remeshed", "",
-        reference_intro(triangle_version),
-        markdown_table(references, REFERENCE_COLUMNS) if references else "",
-        reference_summary(references, small + large) if references else "", "",
-        "## (f) Sensitivity", "",
-        "### The S path shifted", "",
-        "The S of (a) with its three passes at other heights (first number triple) and its turns at other x "
-        "(pair); 'distance' is the larger of the two path–incision distances (a Hausdorff distance), in h̄.", "",
-        markdown_table(variant_table(variants), VARIANT_COLUMNS),
-        variant_summary(variants), "",
-        "### Random paths", "",
-        f"{len([r for r in random if r['cut'] == 'subdivision']) // 2} paths per mesh, each in at the left, through "
-        "two random points, out at the right (seeded; the kind of path the cutter tests use). 'exits > ε_exit off' "
-        "counts cuts whose incision ends farther than ε_exit = h̄/6 from where the path leaves.", "",
-        markdown_table(random_table(random), RANDOM_COLUMNS),
-        random_summary(random), "",
-        "### ε_edge", "",
-        "The S path (50 triangles) and the Figure 5.8 path (722 triangles) cut with ε_edge from h̄/8 to h̄ "
-        "(ε_entry = ε_exit = h̄/6 throughout). The thesis: above h̄/2 a cut *reduces* the number of triangles.", "",
-        markdown_table([{**row, "eps": f"{row['path']}, h̄/{1 / row['eps_edge_h']:g}"} for row in eps], SCAN_COLUMNS),
-        eps_summary(eps), "",
-        "![ε_edge scan and random paths](delaunay_cut_scan.png)", "",
-        "## Smallest angles: where they come from", "",
-        worst_summary(results),
-        fixes_summary(results), "",
-    ]
-    return "\n".join(lines) + "\n"
+    return template.page(
+        quick_flag=" --quick" if quick else "",
+        run=template.snippet("quick_run", engine=engine_version()) if quick else
+        template.snippet("full_run", minutes=minutes, engine=engine_version()),
+        triangle=template.snippet("triangle", version=triangle_version) if triangle_version else
+        template.snippet("no_triangle"),
+        n_small=N_SMALL, n_large=N_LARGE, h_small=by_small["subdivision"]["h_bar"],
+        h_large=by_large["subdivision"]["h_bar"], sub_added=by_small["subdivision"]["added"],
+        path_length=by_large["subdivision"]["path_length_h"],
+        small_table=markdown_table(small, CUT_COLUMNS), figure_summary=figure_summary(small, THESIS, template),
+        large_table=markdown_table(large, CUT_COLUMNS), large_summary=large_summary(large, template),
+        histogram_summary=histogram_summary(results, template),
+        distance_summary=distance_summary(small, large, variants, template),
+        reference_intro=reference_intro(triangle_version, template),
+        reference_table=markdown_table(references, REFERENCE_COLUMNS) if references else "",
+        reference_summary=reference_summary(references, small + large, template) if references else "",
+        variant_table=markdown_table(variant_table(variants), VARIANT_COLUMNS),
+        variant_summary=variant_summary(variants, template),
+        n_random=len([r for r in random if r["cut"] == "subdivision"]) // 2,
+        random_table=markdown_table(random_table(random), RANDOM_COLUMNS), random_summary=random_summary(random, template),
+        eps_table=markdown_table([{**row, "eps": f"{row['path']}, h̄/{1 / row['eps_edge_h']:g}"} for row in eps],
+                                 SCAN_COLUMNS),
+        eps_summary=eps_summary(eps, template), worst_summary=worst_summary(results, template),
+        fixes_summary=fixes_summary(results, template))
 
 
-def large_summary(rows) -> str:
+def large_summary(rows, template: PageTemplate) -> str:
     by = {row["cut"]: row for row in rows}
     sub, d3, d8 = by["subdivision"], by["delaunay h̄/3"], by["delaunay h̄/8"]
-    return (f"The Delaunay cut at h̄/3 adds {d3['added']:+d} triangles (thesis: +57 for its own path), h̄/8 "
-            f"{d8['added']:+d}, subdivision {sub['added']:+d}; per h̄ of path: {d3['added'] / d3['path_length_h']:.2f}, "
-            f"{d8['added'] / d8['path_length_h']:.2f} and {sub['added'] / sub['path_length_h']:.2f}. Smallest angle "
-            f"{d3['min_angle']:.1f}° (h̄/3), {d8['min_angle']:.1f}° (h̄/8), {sub['min_angle']:.1f}° (subdivision); "
-            f"largest {d3['max_angle']:.1f}°, {d8['max_angle']:.1f}°, {sub['max_angle']:.1f}°. The thesis says "
-            "of Figure 5.8 that the tight turns are cut short; here the incision lies up to "
-            f"{d3['incision_to_path_max']:.2f} h̄ (h̄/3) from the path and the path up to "
-            f"{d3['path_to_incision_max']:.2f} h̄ from the incision, against {sub['path_to_incision_max']:.3f} h̄ for "
-            "subdivision.")
+    return template.snippet("large_summary", sub=sub, d3=d3, d8=d8, d3_per_h=d3["added"] / d3["path_length_h"],
+                            d8_per_h=d8["added"] / d8["path_length_h"], sub_per_h=sub["added"] / sub["path_length_h"])
 
 
-def histogram_summary(results) -> str:
+def histogram_summary(results, template: PageTemplate) -> str:
     def grid_shaped(points, cells) -> int:  # triangles with angles 45°, 45°, 90°
         return int(np.all(np.abs(np.sort(triangle_angles(points, cells), axis=1) - [45, 45, 90]) < 1e-6, axis=1).sum())
 
-    text = [f"{title}: triangles still of the grid's shape (the peaks at 45° and 90°): "
-            + ", ".join(f"{name} {grid_shaped(*mesh)} of {len(mesh[1])}" for name, mesh in group.items()) + "."
-            for title, group in results["angle_meshes"].items()]
+    sentences = [template.snippet("grid_shapes", title=title, counts=", ".join(
+        template.snippet("grid_shaped", name=name, n=grid_shaped(*mesh), total=len(mesh[1]))
+        for name, mesh in group.items())) for title, group in results["angle_meshes"].items()]
     small = {row["cut"]: row for row in results["figure_5_16"]}
     sub, d3 = small["subdivision"], small["delaunay h̄/3"]
-    verdict = ("agrees with Figure 5.17: the Delaunay cut has fewer extreme angles than subdivision"
-               if d3["below_20"] < sub["below_20"] and d3["above_120"] <= sub["above_120"] else
-               "does not show Figure 5.17's clear advantage of the Delaunay cut everywhere")
-    return (" ".join(text) + f" On the 50-triangle cut the comparison {verdict} (angles below 20°: "
-            f"{sub['below_20']} subdivision, {d3['below_20']} Delaunay h̄/3; above 120°: {sub['above_120']} and "
-            f"{d3['above_120']}; smallest {sub['min_angle']:.1f}° and {d3['min_angle']:.1f}°). The histograms use a "
-            "log scale; the reference column shows Triangle's quality remeshing of the Delaunay h̄/3 cut's domain "
-            "where available.")
+    fewer = d3["below_20"] < sub["below_20"] and d3["above_120"] <= sub["above_120"]
+    sentences.append(template.snippet("histogram_verdict", sub=sub, d3=d3,
+                                      verdict=template.snippet("fewer_extremes" if fewer else "not_everywhere")))
+    return " ".join(sentences)
 
 
-def distance_summary(small, large, variants) -> str:
+def distance_summary(small, large, variants, template: PageTemplate) -> str:
     s = {row["cut"]: row for row in small}
     table = variant_table(variants)
     closer = sum(row["d3_hausdorff"] < row["d8_hausdorff"] for row in table)
-    return (f"The thesis says the subdivision cut follows the path more closely, and that in Figure 5.16 the h̄/3 "
-            f"cut matches the path better than the h̄/8 cut. Path–incision distance (the larger of both ways, in h̄) on "
-            f"the S: subdivision {s['subdivision']['hausdorff']:.3f}, h̄/3 {s['delaunay h̄/3']['hausdorff']:.2f}, h̄/8 "
-            f"{s['delaunay h̄/8']['hausdorff']:.2f}. Subdivision's incision consists of chords of the path within "
-            "single triangles, so it stays within a small fraction of h̄; the Delaunay cut's incision is a chain of "
-            "chords between incision nodes on the path, which only an incision split (where the cut edges fail the "
-            "empty-circle test) shortens, with no new node within ε_edge/2 of an opposite old node (last section), "
-            "so a curved stretch between two splits is replaced by one chord. "
-            + (f"Over the {len(table)} shifted S paths (f) the h̄/3 cut is closer to its path than the h̄/8 cut on "
-               f"{closer}" + ("; the thesis's remark on Figure 5.16 holds for some paths, not as a rule." if closer else
-                              ": on our paths the thesis's remark does not hold; the h̄/8 cut, with more incision "
-                              "nodes, always follows the path at least as closely.") if table else ""))
+    shifted = template.snippet("shifted", n=len(table), closer=closer,
+                               remark=template.snippet("remark_sometimes" if closer else "remark_never")) if table else ""
+    return template.snippet("distance_summary", sub=s["subdivision"]["hausdorff"], d3=s["delaunay h̄/3"]["hausdorff"],
+                            d8=s["delaunay h̄/8"]["hausdorff"], shifted=shifted)
 
 
-def reference_intro(version) -> str:
-    if not version:
-        return ("Left out: the `triangle` package is not installed. With it, each cut domain's boundary (the "
-                "square's sides and both lips) is remeshed by Triangle.\n")
-    return ("Each cut's domain remeshed from scratch by Triangle, from its boundary alone: the square's sides and the "
-            "incision, with the cut's own boundary vertices (the two lips' coinciding vertices become one interior "
-            "segment; separating the lips again changes no angle). 'CDT' is the constrained Delaunay triangulation of "
-            "those vertices without Steiner points (`-p`). "
-            "'quality' adds interior Steiner points until every angle is at least 30° where the boundary allows it, "
-            "never splitting a side or the incision (`-pq30YY`). "
-            "Neither keeps the cut's interior vertices, so both replace the whole mesh, which an interactive "
-            "cutter on a deforming body cannot do; they bound what a local method can achieve.\n")
+def reference_intro(version, template: PageTemplate) -> str:
+    return template.snippet("reference_intro" if version else "reference_missing")
 
 
-def reference_summary(references, cuts) -> str:
+def reference_summary(references, cuts, template: PageTemplate) -> str:
     by_cut = {(row["grid"], row["cut"]): row for row in cuts}
     lines = []
     for grid_name in dict.fromkeys(row["grid"] for row in references):
@@ -840,24 +741,19 @@ def reference_summary(references, cuts) -> str:
             cut_row_ = by_cut.get((grid_name, name))
             if not (quality and cdt and cut_row_):
                 continue
-            lines.append(f"{grid_name}, {name}: the cut has {cut_row_['triangles']} triangles with smallest angle "
-                         f"{cut_row_['min_angle']:.1f}°; on its boundary the CDT needs {cdt['triangles']} "
-                         f"(smallest angle {cdt['min_angle']:.1f}°) and the quality mesh {quality['triangles']} "
-                         f"(smallest {quality['min_angle']:.1f}°, largest {quality['max_angle']:.1f}°).")
+            lines.append(template.snippet("reference_line", grid=grid_name, name=name, cut=cut_row_, cdt=cdt,
+                                          quality=quality))
+    if not lines:
+        return ""
     quality = [row for row in references if row["remesh"].startswith("quality")]
     short = [row for row in quality if row["min_angle"] < 30]
     pinned = [row for row in short if row["worst_boundary_corners"] >= 2]
-    return ("* " + "\n* ".join(lines) + "\n\n"
-            + (f"The quality remeshing stays below 30° on {len(short)} of {len(quality)} domains; in {len(pinned)} of "
-               "them the worst triangle has two or three corners on the boundary, which Triangle may not refine "
-               "under -YY (short side or incision edges next to long ones, kinks of the incision). "
-               if short else "The quality remeshing reaches 30° on every domain. ")
-            + "Triangle's quality mesh is a good reference, not a proven optimum: its smallest angle is what a "
-            "fresh mesher gets on the same boundary. Every triangulation of the boundary vertices alone has as many "
-            "triangles as the CDT, the fewest possible without interior vertices.") if lines else ""
+    return template.snippet("reference_summary", lines="\n".join(lines), quality=template.snippet(
+        "below_30", n_short=len(short), n_quality=len(quality), n_pinned=len(pinned)) if short else
+        template.snippet("reaches_30"))
 
 
-def variant_summary(variants) -> str:
+def variant_summary(variants, template: PageTemplate) -> str:
     table = variant_table(variants)
     if not table:
         return ""
@@ -867,51 +763,44 @@ def variant_summary(variants) -> str:
     m3 = [row["d3_min"] for row in table]
     m8 = [row["d8_min"] for row in table]
     ms = [row["sub_min"] for row in table]
-    return (f"Over the {len(table)} S paths subdivision adds {min(subs):+d} to {max(subs):+d} triangles (thesis: +62), "
-            f"the Delaunay cut at h̄/3 {min(d3):+d} to {max(d3):+d} (thesis: +10) and at h̄/8 {min(d8):+d} to "
-            f"{max(d8):+d} (thesis: +12). The smallest angle after the h̄/3 cut ranges from {min(m3):.1f}° to "
-            f"{max(m3):.1f}°, after the h̄/8 cut from {min(m8):.1f}° to {max(m8):.1f}°, after subdivision from "
-            f"{min(ms):.1f}° to {max(ms):.1f}°. Subdivision's count depends only on which edges the path "
-            "crosses, the Delaunay cut's on where its nodes fall: shifts of a fraction of an element move the h̄/3 "
-            f"count over {min(d3):+d} … {max(d3):+d} around the thesis's +10. The h̄/8 cut adds {min(d8) / 12:.1f} to "
-            f"{max(d8) / 12:.1f} times the thesis's +12, and more than the h̄/3 cut on {sum(b > a for a, b in zip(d3, d8))} "
-            f"of {len(table)} paths (thesis: +12 against +10). With ε_edge = h̄/8 old vertices farther than h̄/8 from "
-            "the active node survive next to the incision, and the cut keeps more short edges.")
+    return template.snippet(
+        "variant_summary", n=len(table), sub_min=min(subs), sub_max=max(subs), d3_min=min(d3), d3_max=max(d3),
+        d8_min=min(d8), d8_max=max(d8), m3_min=min(m3), m3_max=max(m3), m8_min=min(m8), m8_max=max(m8),
+        ms_min=min(ms), ms_max=max(ms), d8_low=min(d8) / 12, d8_high=max(d8) / 12,
+        more=sum(b > a for a, b in zip(d3, d8)))
 
 
-def random_summary(random) -> str:
+def random_summary(random, template: PageTemplate) -> str:
     table = random_table(random)
-    parts = []
+    pairs = []
     for grid_name in dict.fromkeys(row["grid"] for row in random):
         runs = {}
         for row in random:
             if row["grid"] == grid_name:
                 runs.setdefault(row["path"], {})[row["cut"]] = row
-        fewer = sum(r["delaunay h̄/3"]["added"] < r["subdivision"]["added"] for r in runs.values())
-        better = sum(r["delaunay h̄/3"]["min_angle"] > r["subdivision"]["min_angle"] for r in runs.values())
-        better8 = sum(r["delaunay h̄/8"]["min_angle"] > r["subdivision"]["min_angle"] for r in runs.values())
-        parts.append(f"on the {grid_name} grid the h̄/3 cut adds fewer triangles than subdivision on {fewer} of "
-                     f"{len(runs)} paths and has the larger smallest angle on {better} (h̄/8: {better8})")
+        pairs.append(template.snippet(
+            "paired", grid=grid_name, n=len(runs),
+            fewer=sum(r["delaunay h̄/3"]["added"] < r["subdivision"]["added"] for r in runs.values()),
+            better=sum(r["delaunay h̄/3"]["min_angle"] > r["subdivision"]["min_angle"] for r in runs.values()),
+            better8=sum(r["delaunay h̄/8"]["min_angle"] > r["subdivision"]["min_angle"] for r in runs.values())))
     late = sum(row["exit_late"] or 0 for row in table)
-    return ("Paired by path: " + "; ".join(parts) + ". "
-            + (f"{late} Delaunay cuts end their incision farther than ε_exit from where the path leaves."
-               if late else "Every Delaunay incision ends within ε_exit of where the path leaves."))
+    return template.snippet("random_summary", pairs="; ".join(pairs),
+                            exits=template.snippet("late_exits", n=late) if late else template.snippet("exits_within"))
 
 
-def eps_summary(eps) -> str:
+def eps_summary(eps, template: PageTemplate) -> str:
     parts = []
     for path_name in dict.fromkeys(row["path"] for row in eps):
         rows = [row for row in eps if row["path"] == path_name]
         parts.append(f"{path_name}: " + ", ".join(f"h̄/{1 / row['eps_edge_h']:g} {row['added']:+d}" for row in rows))
     above = [row for row in eps if row["eps_edge_h"] > 0.5]
     reduced = [row for row in above if row["added"] < 0]
-    return ("Triangles added — " + "; ".join(parts) + ". "
-            + (f"Above h̄/2 the cut reduces the mesh in {len(reduced)} of {len(above)} cuts, as the thesis says "
-               "(more nodes are removed in front of the scalpel than inserted behind it)." if above else "")
-            + " The smallest angle is lowest at " + " and ".join(
-                f"h̄/{1 / min((r for r in eps if r['path'] == name), key=lambda r: r['min_angle'])['eps_edge_h']:g} "
-                f"({name})" for name in dict.fromkeys(row["path"] for row in eps))
-            + ": a smaller ε_edge lets more old vertices survive next to the incision.")
+    return template.snippet(
+        "eps_summary", added="; ".join(parts),
+        reduced=template.snippet("reduces", n_reduced=len(reduced), n_above=len(above)) if above else "",
+        lowest=" and ".join(
+            f"h̄/{1 / min((r for r in eps if r['path'] == name), key=lambda r: r['min_angle'])['eps_edge_h']:g} "
+            f"({name})" for name in dict.fromkeys(row["path"] for row in eps)))
 
 
 WORST_COLUMNS = [Column("kind", "shortest edge of the worst triangle joins"), Column("where", "where")] + [
@@ -949,7 +838,8 @@ def worst_table(rows) -> list[dict]:
     return table
 
 
-def worst_summary(results) -> str:
+def worst_summary(results, template: PageTemplate) -> str:
+    snippet = template.snippet
     rows = [row for part in ("figure_5_16", "figure_5_8", "variants", "random") for row in results[part]
             if row["cut"].startswith("delaunay")]  # the ε_edge scan left out
     by = {f: [row for row in rows if row["cut"] == f"delaunay h̄/{f}"] for f in FRACTIONS}
@@ -960,37 +850,19 @@ def worst_summary(results) -> str:
     exit_edges = [row["worst_edge"] for row in by[8] if (row["worst_kind"], row["worst_where"])
                   == ("short incision edge", "exit")]
     low = {f: min(row["min_angle"] for row in by[f]) for f in FRACTIONS}
-    return "\n".join([
-        f"The triangle with the smallest angle of each of the {len(rows)} Delaunay cuts of (a), (b) and (f) (the "
-        "ε_edge scan left out), by what its shortest edge joins and whether it lies within h̄ of where the path "
-        "enters or leaves; 'shortest edge' is the shortest of those edges in units of ε_edge.", "",
-        markdown_table(worst_table(rows), WORST_COLUMNS),
-        "An old vertex next to the incision gives the worst triangle of "
-        + " and ".join(f"{len(old[f])} of {len(by[f])} cuts at h̄/{f}" for f in FRACTIONS)
-        + ", its incision vertex made by an incision split in " + " and ".join(str(len(split[f])) for f in FRACTIONS)
-        + " of them. `split_incision` puts the new nodes where the line through the opposite nodes o1, o2 crosses "
-        "the path (on the chord from the incision's last node to the active node where it misses the path), and "
-        "where one would fall within ε_edge/2 of o1 or o2 it removes that node instead "
-        "(or, next to a boundary or incision node, does not split). In these worst triangles the edge from the "
-        f"split's node to the old vertex is {'at least' if min(shortest.values()) >= 0.5 - 1e-6 else 'not always'} "
-        "ε_edge/2 long (shortest " + ", ".join(f"{shortest[f]:.2f} ε_edge at h̄/{f}" for f in FRACTIONS) + "). The "
-        "bound scales with ε_edge, h̄/6 at h̄/3 but h̄/16 at h̄/8"
-        + (f": the h̄/8 cuts keep the smaller angles (lowest {low[8]:.1f}° against {low[3]:.1f}°). " if low[8] < low[3]
-           else f" (lowest angles {low[3]:.1f}° at h̄/3, {low[8]:.1f}° at h̄/8). ")
-        + f"Short side edges ({side[3]} cuts at h̄/3, {side[8]} at h̄/8) are left where the path enters or leaves "
-        "farther than ε_entry = ε_exit = h̄/6 from a side vertex: the new side node's edge to that vertex, as short "
-        "as h̄/6, stays, as the thesis's thresholds have it."
-        + (f" At h̄/8, {len(exit_edges)} cuts have a short incision edge at the exit, {min(exit_edges):.2f} to "
-           f"{max(exit_edges):.2f} h̄ long; the exit contracts only edges shorter than ε_edge (Figure 5.7)."
-           if exit_edges else ""), "",
-    ])
+    return snippet(
+        "worst_summary", n_cuts=len(rows), table=markdown_table(worst_table(rows), WORST_COLUMNS),
+        old=" and ".join(snippet("cuts_at", n=len(old[f]), total=len(by[f]), f=f) for f in FRACTIONS),
+        split=" and ".join(str(len(split[f])) for f in FRACTIONS),
+        bound=snippet("at_least" if min(shortest.values()) >= 0.5 - 1e-6 else "not_always"),
+        shortest=", ".join(snippet("edge_at", edge=shortest[f], f=f) for f in FRACTIONS),
+        lowest=snippet("h8_smaller" if low[8] < low[3] else "lowest_angles", low3=low[3], low8=low[8]),
+        side3=side[3], side8=side[8],
+        exit=snippet("exit_edges", n=len(exit_edges), low=min(exit_edges), high=max(exit_edges)) if exit_edges else "")
 
 
-def fixes_summary(results) -> str:
+def fixes_summary(results, template: PageTemplate) -> str:
     regression = {row["path"]: row for row in results["regression"]}
-    split, exit_ = regression["S split case"], regression["straight exit case"]
-    first = regression["first S (turns at x = 0.2, 0.8)"]
-    short = next(row for path, row in regression.items() if "2⁻⁵⁵" in path)
     now = [next(row for row in results[part] if row["cut"] == "delaunay h̄/3")
            for part in ("figure_5_16", "figure_5_8")]
     thresholds = [{"threshold": name, "added": f"{added[0]:+d}, {added[1]:+d}", "angle": f"{angle[0]}, {angle[1]}",
@@ -998,45 +870,14 @@ def fixes_summary(results) -> str:
     thresholds.append({"threshold": "ε_edge/2, this run", "added": ", ".join(f"{row['added']:+d}" for row in now),
                        "angle": ", ".join(f"{row['min_angle']:.1f}" for row in now),
                        "distance": ", ".join(f"{row['hausdorff']:.2f}" for row in now)})
-    return "\n".join([
-        "For the record, three faults found by this experiment's first run have been fixed (before: commit "
-        f"{BEFORE_FIXES}, after: {AFTER_FIXES}; the numbers in this paragraph were measured on each). "
-        "`split_incision` no longer makes an incision node within ε_edge/2 of an opposite node o1 or o2 but removes "
-        "that interior node instead (next to a boundary or incision node it does not split): the smallest angle of "
-        "the S split case below went from 1.1° (a shortest edge of 0.018 h̄) to 15.6°, while its path–incision "
-        f"distance grew from 1.13 h̄ (the first run, whose engine cut as {BEFORE_FIXES} does) to 1.57 h̄. `advance` "
-        "exits through the boundary edge of the active node's star that the way crosses, not whichever of two "
-        "collinear side edges rounding made invert first: the straight exit case, whose incision ended at the "
-        "midpoint (1, 0.7) of the neighbouring side edge, 0.47 h̄ off, now ends at the side vertex (1, 0.6). "
-        "`SubdivisionCutter` no longer drops an edge crossing a rounding error behind the start of a move, which "
-        "left the straight path through (0.2 − 2⁻⁵⁵, 0.5) in one piece with 10 nodes inserted, and the first S, "
-        "whose turns lie on the grid lines, in one piece with +62 triangles (now 11 nodes and +64, two pieces "
-        "each).", "",
-        "Then, as §5.2.2 has it, the new incision nodes went on the scalpel's path instead of the chord (before: "
-        f"commit {BEFORE_PATH_NODES}, after: {AFTER_PATH_NODES}): each lip's copy of the node is moved to where the "
-        "line o1 o2 crosses the active node's trail, with its own side's barycentric coordinates (so a body's "
-        "fields follow each lip). At h̄/3 the path–incision distance fell from 0.71 to 0.29 h̄ on the S of (a) and "
-        "from 0.98 to 0.37 h̄ on the Figure 5.8 path, the smallest angles rose from 8.7° to 24.5° and from 15.7° "
-        "to 17.2°, and the cuts add +10 and +45 triangles instead of +6 and +21.", "",
-        "The removal threshold was chosen from full runs with three thresholds (the S of (a) and the Figure 5.8 "
-        "path, both at h̄/3; measured once, with the nodes still on the chord, and not regenerated; the last row is "
-        "this run, with the nodes on the path): ε_edge/2 removed the slivers without moving the incision farther "
-        "from these two paths, ε_edge gave larger angles still but moved it farther.", "",
-        markdown_table(thresholds, THRESHOLD_COLUMNS),
-        "### Regression cases", "",
-        "The faults' reproducers on the 50-triangle grid, as this run cuts them; 'closest vertices' is the smallest "
-        "distance between two distinct vertices (the tests in tests/python/cutting require more than ε_edge/4 = "
-        "0.083 h̄ at h̄/3).", "",
-        markdown_table([{**row, "exit_end": f"({row['exit_end_x']:.4g}, {row['exit_end_y']:.4g})"}
-                        for row in results["regression"]], REGRESSION_COLUMNS),
-        f"The S split case's smallest angle is {split['min_angle']:.1f}° and its closest vertices "
-        f"{split['closest']:.3f} h̄ apart; its incision lies up to {split['hausdorff']:.2f} h̄ from the path. The "
-        f"straight exit case's incision ends at ({exit_['exit_end_x']:.4g}, {exit_['exit_end_y']:.4g}), "
-        f"{exit_['exit_offset']:.3f} h̄ from where the path leaves; its smallest angle is {exit_['min_angle']:.1f}° "
-        f"(worst triangle: {exit_['worst_kind']}, at the {exit_['worst_where']}). Subdivision: the path through "
-        f"(0.2 − 2⁻⁵⁵, 0.5) inserts {short['nodes_inserted']} nodes and leaves {short['components']} pieces, the "
-        f"first S adds {first['added']:+d} triangles and leaves {first['components']} pieces.",
-    ])
+    return template.snippet(
+        "fixes_summary", before_fixes=BEFORE_FIXES, after_fixes=AFTER_FIXES, before_path=BEFORE_PATH_NODES,
+        after_path=AFTER_PATH_NODES, thresholds_table=markdown_table(thresholds, THRESHOLD_COLUMNS),
+        regression_table=markdown_table([{**row, "exit_end": f"({row['exit_end_x']:.4g}, {row['exit_end_y']:.4g})"}
+                                         for row in results["regression"]], REGRESSION_COLUMNS),
+        split=regression["S split case"], exit=regression["straight exit case"],
+        first=regression["first S (turns at x = 0.2, 0.8)"],
+        short=next(row for path, row in regression.items() if "2⁻⁵⁵" in path))
 
 
 # --- main ----------------------------------------------------------------------------------
