@@ -1,7 +1,7 @@
 #include "bindings.hpp"
 #include "core/rank_agreement.hpp"
 #include "mesh/distributed_mesh.hpp"
-#include "solve/distributed_relaxation.hpp"
+#include "solve/dynamic_relaxation.hpp"
 #include "solve/distributed_static.hpp"
 
 #include <pybind11/stl.h>
@@ -40,7 +40,7 @@ void bind_distributed(py::module_& m) {
       },
       py::arg("comm"), py::arg("caller"), py::arg("inputs"));
 
-  py::class_<DistributedStatic>(m, "DistributedStatic")
+  py::class_<DistributedStatic, Problem>(m, "DistributedStatic")
       .def(py::init([](DistributedMesh& part, const py::handle& material, double density, double thickness,
                        std::vector<std::int64_t> fixed, std::vector<double> fixed_values, std::vector<std::int64_t> loaded,
                        std::vector<double> forces, std::vector<double> gravity) {
@@ -59,14 +59,8 @@ void bind_distributed(py::module_& m) {
             s.set_displacement(std::span<const double>(serial.data(), static_cast<std::size_t>(serial.size())));
           },
           py::arg("serial_displacement"))
-      .def("energy", &DistributedStatic::energy)
+      .def("energy", [](DistributedStatic& s) { return s.energy(); })
       .def("local_displacement", [](DistributedStatic& s) { return to_array(s.local_displacement(), 1); });
-
-  py::class_<DistributedRelaxation>(m, "DistributedRelaxation")
-      .def(py::init<DistributedStatic&, double, double, const std::string&>(), py::arg("problem"), py::arg("damping"),
-           py::arg("dt"), py::arg("prefix"), py::keep_alive<1, 2>())
-      .def("run", &DistributedRelaxation::run, py::arg("rtol"), py::arg("max_steps"))
-      .def_property_readonly("dt", &DistributedRelaxation::time_step);
 }
 
 }  // namespace snede::bindings

@@ -4,6 +4,7 @@
 #include "petsc4py_interop.hpp"
 #include "record_binding.hpp"
 #include "solve/model.hpp"
+#include "solve/problem.hpp"
 #include "solve/solve_result.hpp"
 #include "solve/static_solver.hpp"
 #include "solve/tangent_assembly.hpp"
@@ -126,6 +127,8 @@ void bind_solve(py::module_& m) {
       .def_property_readonly("tangent_mat", [](const Model& s) { return to_petsc4py(s.tangent()); })
       .def("tangent_operator", &tangent_operator_at, py::arg("u"))
       .def("assemble_tangent", &assembled_tangent_at, py::arg("u"), py::arg("format"));
+
+  py::class_<Problem>(m, "Problem", "A static problem on a communicator, which the solvers drive (problem.hpp).");
 
   const StaticOptions defaults;
   py::class_<StaticOptions>(m, "StaticOptions",

@@ -15,7 +15,7 @@
 #include "core/rank_agreement.hpp"
 #include "core/petsc_util.hpp"
 #include "mesh/element_quality.hpp"
-#include "solve/dynamic_relaxation.hpp"
+#include "fem/stable_time_step.hpp"
 #include "solve/failed_solve.hpp"
 #include "solve/static_solver.hpp"
 #include "solve/stopping.hpp"
@@ -64,7 +64,8 @@ bool require_same_inputs_everywhere(MPI_Comm comm, const Material& material, dou
 PetscErrorCode residual_callback(SNES snes, Vec u, Vec F, void* context) {
   return petsc_callback("snede distributed residual", [&] {
     // Every rank agrees on the verdict, so line searches shorten the same step everywhere.
-    if (!static_cast<DistributedStatic*>(context)->residual(u, F)) SNEDE_PETSC(SNESSetFunctionDomainError(snes));
+    if (!static_cast<DistributedStatic*>(context)->residual(u, F).admissible())
+      SNEDE_PETSC(SNESSetFunctionDomainError(snes));
   });
 }
 
@@ -238,7 +239,7 @@ void DistributedStatic::add_to_global(const std::vector<double>& local, Vec glob
   SNEDE_PETSC(VecScatterEnd(scatter_, local_vec_, global, ADD_VALUES, SCATTER_REVERSE));
 }
 
-bool DistributedStatic::residual(Vec u, Vec F) {
+ResidualCheck DistributedStatic::residual(Vec u, Vec F) {
   // F = P(−f_int(u) − f_ext) + (I − P)(u − ū); the fixed rows' −f_int − f_ext are the reactions.
   to_local(u, u_local_);
   EvaluationReport report;
@@ -268,13 +269,48 @@ bool DistributedStatic::residual(Vec u, Vec F) {
   MPI_Allreduce(MPI_IN_PLACE, sums, 3, MPI_DOUBLE, MPI_SUM, part_.comm);
   last_reaction_norm_ = std::sqrt(sums[2]);
   last_failure_ = sums[1] > 0 ? "DIVERGED_NONFINITE_STATE" : sums[0] > 0 ? "DIVERGED_INVERTED_ELEMENTS" : "";
+  const ResidualCheck check{sums[1] == 0, sums[0] > 0};
   // A failure on any rank makes the residual NaN everywhere: no solver can call it converged.
-  const bool admissible = last_failure_.empty();
-  if (!admissible)
+  if (!check.admissible())
     for (std::size_t k = 0; k < owned_rows_.size(); ++k) r[owned_rows_[k] - start] = std::numeric_limits<double>::quiet_NaN();
   SNEDE_PETSC(VecRestoreArrayRead(u, &x));
   SNEDE_PETSC(VecRestoreArray(F, &r));
-  return admissible;
+  return check;
+}
+
+std::string DistributedStatic::inadmissible(Vec u) {
+  VecHandle scratch;
+  SNEDE_PETSC(VecDuplicate(u, scratch.out()));
+  const double reaction_norm = last_reaction_norm_;  // the caller's latest residual's
+  residual(u, scratch);
+  last_reaction_norm_ = reaction_norm;
+  return last_failure_;
+}
+
+void DistributedStatic::enforce_constraints(Vec u) {
+  PetscInt start = 0, end = 0;
+  SNEDE_PETSC(VecGetOwnershipRange(u, &start, &end));
+  PetscScalar* x = nullptr;
+  SNEDE_PETSC(VecGetArray(u, &x));
+  for (std::size_t k = 0; k < owned_rows_.size(); ++k)
+    if (const auto dof = static_cast<std::size_t>(owned_local_dof_[k]); fixed_local_[dof])
+      x[owned_rows_[k] - start] = fixed_value_local_[dof];
+  SNEDE_PETSC(VecRestoreArray(u, &x));
+}
+
+bool DistributedStatic::every_dof_prescribed() const {
+  std::int64_t fixed = 0;
+  for (std::size_t k = 0; k < owned_rows_.size(); ++k) fixed += fixed_local_[static_cast<std::size_t>(owned_local_dof_[k])];
+  std::int64_t total = 0;
+  MPI_Allreduce(&fixed, &total, 1, MPI_INT64_T, MPI_SUM, part_.comm);
+  return total == n_global_dofs();
+}
+
+double DistributedStatic::flops_per_residual() const {
+  double local = static_cast<double>(body_.flops_per_element().force) * static_cast<double>(part_.local->n_cells());
+  double total = 0;
+  MPI_Allreduce(&local, &total, 1, MPI_DOUBLE, MPI_SUM, part_.comm);
+  return total;
 }
 
 double DistributedStatic::external_force_norm() {
@@ -419,7 +455,7 @@ SolveResult DistributedStatic::solve(const std::string& method, const std::strin
   stopping_external_norm_ = external_force_norm();
   const double start = wall_seconds();
   SolveResult result;
-  const bool admissible_start = residual(u_, work_);
+  const bool admissible_start = residual(u_, work_).admissible();
   result.initial_residual_norm = vec_norm(work_);
   stopping_reaction_norm_.reset();
   if (method == "cg") stopping_reaction_norm_ = last_reaction_norm_;
@@ -437,7 +473,7 @@ SolveResult DistributedStatic::solve(const std::string& method, const std::strin
   // An inverted element or a non-finite state is never converged, and a rule is checked on
   // the final state (the factor allows CG's recursive residual to differ by round-off). The
   // relative tests stay PETSc's verdict: preconditioned CG measures another norm.
-  const bool admissible = residual(u_, work_);
+  const bool admissible = residual(u_, work_).admissible();
   result.residual_norm = vec_norm(work_);
   result.tolerance = at_equilibrium ? equilibrium_tolerance
                      : stopping_    ? stopping_tolerance()
@@ -519,16 +555,16 @@ void DistributedStatic::run_petsc(const std::string& method, const std::string& 
   }
 }
 
-double DistributedStatic::energy() {
-  to_local(u_, u_local_);
+double DistributedStatic::energy(Vec u) {
+  to_local(u, u_local_);
   EvaluationReport report;
   double local = body_.energy(u_local_, report);
   PetscInt start = 0, end = 0;
-  SNEDE_PETSC(VecGetOwnershipRange(u_, &start, &end));
+  SNEDE_PETSC(VecGetOwnershipRange(u, &start, &end));
   const PetscScalar* x = nullptr;
-  SNEDE_PETSC(VecGetArrayRead(u_, &x));
+  SNEDE_PETSC(VecGetArrayRead(u, &x));
   for (std::size_t k = 0; k < owned_rows_.size(); ++k) local -= load_owned_[k] * x[owned_rows_[k] - start];
-  SNEDE_PETSC(VecRestoreArrayRead(u_, &x));
+  SNEDE_PETSC(VecRestoreArrayRead(u, &x));
   double total = 0;
   MPI_Allreduce(&local, &total, 1, MPI_DOUBLE, MPI_SUM, part_.comm);
   return total;

@@ -5,8 +5,8 @@
 // the ghosts' contributions into their owners (a VecScatter, forward then reverse with
 // ADD_VALUES); energies are summed over the ranks. The tangent is a matrix-free MatShell on the
 // communicator, so PETSc's SNES and KSP run unchanged on any number of ranks; GAMG gets an
-// assembled MPIAIJ copy (distributed_assembly.hpp), and dynamic relaxation drives the same
-// residual through a TS (distributed_relaxation.hpp).
+// assembled MPIAIJ copy (distributed_assembly.hpp). It is a Problem (problem.hpp), which the
+// one DynamicRelaxation drives on any number of ranks.
 //
 // Constraints and loads are given by the serial mesh's vertex ids, the same on every rank:
 // fixed vertices (all components), their displacements, nodal forces, and gravity. A fixed dof's
@@ -24,6 +24,7 @@
 #include "fem/elastic_body.hpp"
 #include "mesh/distributed_mesh.hpp"
 #include "solve/distributed_assembly.hpp"
+#include "solve/problem.hpp"
 #include "solve/solve_result.hpp"
 #include "solve/stopping.hpp"
 
@@ -37,7 +38,7 @@ struct DistributedConditions {
   std::vector<double> gravity;         // dim components (m/s²), or empty for none
 };
 
-class DistributedStatic {
+class DistributedStatic final : public Problem {
  public:
   // Collective. Throws std::invalid_argument (the same on every rank) for conditions of the
   // wrong size, ids outside the serial mesh, or arguments that differ between the ranks
@@ -45,7 +46,7 @@ class DistributedStatic {
   // by each cell's corners, as serially) and the lumped masses of dynamic relaxation.
   DistributedStatic(DistributedMesh& part, Material material, double density, double thickness,
                     const DistributedConditions& conditions);
-  ~DistributedStatic();
+  ~DistributedStatic() override;
   DistributedStatic(const DistributedStatic&) = delete;
   DistributedStatic& operator=(const DistributedStatic&) = delete;
 
@@ -69,29 +70,35 @@ class DistributedStatic {
   double stopping_tolerance() const {
     return stopping_->tolerance(stopping_external_norm_, stopping_reaction_norm_.value_or(last_reaction_norm_));
   }
-  // Π(u) = Π_int(u) − f_extᵀu over the whole body (collective).
-  double energy();
+  // Π(u) = Π_int(u) − f_extᵀu over the whole body (collective), at the state or at u.
+  double energy() { return energy(u_); }
+  double energy(Vec u) override;
   // The displacement of this rank's vertices (owned and ghosts), (n_local_vertices, dim).
   std::vector<double> local_displacement();
 
-  // What the solvers (SNES callbacks, DistributedRelaxation) use. All collective.
-  // F = P(−f_int(u) − f_ext) + (I − P)(u − ū). Returns false when an element on some rank is
+  // What the solvers (SNES callbacks, DynamicRelaxation) use. All collective.
+  // F = P(−f_int(u) − f_ext) + (I − P)(u − ū). Not admissible when an element on some rank is
   // inverted (for a material that forbids it) or not finite; F is then NaN on every rank.
-  bool residual(Vec u, Vec F);
+  ResidualCheck residual(Vec u, Vec F) override;
   // ‖reactions‖ (the residual −f_int − f_ext on the fixed dofs) from the latest residual().
-  double last_reaction_norm() const { return last_reaction_norm_; }
+  double last_reaction_norm() const override { return last_reaction_norm_; }
+  std::string inadmissible(Vec u) override;
   // Why the latest residual() failed ("DIVERGED_INVERTED_ELEMENTS", "DIVERGED_NONFINITE_STATE"),
   // or empty.
   const std::string& last_failure() const { return last_failure_; }
-  double external_force_norm();
+  double external_force_norm() override;
   // (6.9)'s force scale E·H² (E·t·H in 2D), H the whole body's diameter.
-  double force_scale();
+  double force_scale() override;
   // 1/m per owned dof from the lumped masses (§2.5) summed over the ranks, 0 without mass.
-  void inverse_lumped_mass(Vec out);
+  void inverse_lumped_mass(Vec out) override;
   // (2.61) on the whole mesh: the smallest over the ranks.
-  double cfl_time_step();
+  double cfl_time_step() override;
+  double flops_per_residual() const override;
   // The fixed owned rows of `v` set to zero (a motion the constraints allow).
-  void zero_fixed_rows(Vec v) { set_fixed_rows(v, nullptr, 0.0); }
+  void project_onto_allowed_motions(Vec v) override { set_fixed_rows(v, nullptr, 0.0); }
+  // The fixed owned rows of `u` set to their prescribed displacements.
+  void enforce_constraints(Vec u) override;
+  bool every_dof_prescribed() const override;
   void linearize_at(Vec u);
   void tangent_mult(Vec d, Vec out);
   void tangent_diagonal(Vec diagonal);
@@ -100,10 +107,11 @@ class DistributedStatic {
   Mat assembled_tangent();
   void assemble_tangent();
 
-  Vec state() const { return u_; }
-  MPI_Comm comm() const { return part_.comm; }
+  Vec state() const override { return u_; }
+  MPI_Comm comm() const override { return part_.comm; }
+  int dim() const override { return dim_; }
   const Material& material() const { return body_.material(); }
-  std::int64_t n_global_dofs() const { return part_.n_global_vertices * dim_; }
+  std::int64_t n_global_dofs() const override { return part_.n_global_vertices * dim_; }
 
  private:
   // SNES (or its KSP, for "cg") from the current state; its reason and iteration counts.

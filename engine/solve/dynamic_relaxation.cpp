@@ -9,22 +9,14 @@
 #include "core/error.hpp"
 #include "core/interrupt.hpp"
 #include "core/norms.hpp"
+#include "core/rank_agreement.hpp"
 #include "core/petsc_util.hpp"
-#include "mesh/element_quality.hpp"
+#include "solve/model_problem.hpp"
 
 namespace snede {
 namespace {
 
 // ---- Helpers of DynamicRelaxation -------------------------------------------------------
-
-void project_onto_allowed_motions(const Model& model, Vec v) {
-  PetscScalar* data = nullptr;
-  PetscInt n = 0;
-  SNEDE_PETSC(VecGetLocalSize(v, &n));
-  SNEDE_PETSC(VecGetArray(v, &data));
-  model.constraints().project({data, static_cast<std::size_t>(n)});
-  SNEDE_PETSC(VecRestoreArray(v, &data));
-}
 
 // Restores TS max steps (the user's cap, -<prefix>ts_max_steps) however a solve ends.
 class MaxStepsGuard {
@@ -37,16 +29,6 @@ class MaxStepsGuard {
   PetscInt cap_;
 };
 
-// Modulus of the dilatational wave: λ + 2μ in 3D, E/(1 − ν²) = 4μ(λ+μ)/(λ+2μ) in plane stress.
-// Veronda-Westmann's small-strain stiffness has λ' = λ + 2μ(2γ − 1) (§4.3.4, see
-// veronda_westmann.hpp): with λ alone its default step was up to 3× too large at γ = 50.
-double dilatational_modulus(const Material& material, int dim) {
-  Lame lame = std::visit([](const auto& m) { return m.lame; }, material);
-  if (const auto* vw = std::get_if<VerondaWestmann>(&material)) lame.lambda += 2 * lame.mu * (2 * vw->gamma - 1);
-  // The ratio first: μ(λ + μ) underflows for E = 1e-200 Pa and overflows for E = 1e160 Pa.
-  return dim == 3 ? lame.lambda + 2 * lame.mu : 4 * lame.mu * ((lame.lambda + lame.mu) / (lame.lambda + 2 * lame.mu));
-}
-
 }  // namespace
 
 std::string blow_up_failure(Vec u) {
@@ -55,40 +37,38 @@ std::string blow_up_failure(Vec u) {
   return norm > 1e15 ? "DIVERGED_BLOW_UP" : "";
 }
 
-// h: with the shortest edge (the h of the text around (2.61)) the estimate exceeded the
-// stability limit 2/√λ_max(M⁻¹K) by 1.4–1.8× on structured boxes and gmsh cylinders, so the
-// default step would blow up. The inscribed diameter is the element length in 1D and gave
-// 0.3–0.98 of the limit on the same meshes (2D and 3D, ν from 0 to 0.49).
-// A membrane (§5.3) carries in-plane waves only: each triangle is measured in its own plane,
-// and its waves travel at the plane-stress speed.
-double cfl_time_step(const Mesh& mesh, const Material& material, double density) {
-  double size = std::numeric_limits<double>::infinity();
-  for (ElementId e : mesh.cell_ids()) {
-    const std::vector<double> corners = mesh.corners(e);
-    const ElementQuality quality = mesh.is_surface() ? element_quality(2, flattened_triangle(corners))
-                                                     : element_quality(mesh.dim(), corners);
-    size = std::min(size, quality.inscribed_diameter);
-  }
-  const double wave_speed = std::sqrt(dilatational_modulus(material, mesh.cell_dim()) / density);
-  return 2 / std::sqrt(3.0) * size / wave_speed;  // (2.61)
-}
-
 // ---- DynamicRelaxation --------------------------------------------------------------------
 
 DynamicRelaxation::DynamicRelaxation(Model& model, double damping_eta, double dt, const std::string& options_prefix,
                                      const OptionList& petsc_options)
-    : model_(model), option_database_(options_prefix, petsc_options) {
+    : DynamicRelaxation(std::make_unique<ModelProblem>(model), nullptr, damping_eta, dt, options_prefix,
+                        petsc_options) {}
+
+DynamicRelaxation::DynamicRelaxation(Problem& problem, double damping_eta, double dt,
+                                     const std::string& options_prefix, const OptionList& petsc_options)
+    : DynamicRelaxation(nullptr, &problem, damping_eta, dt, options_prefix, petsc_options) {}
+
+DynamicRelaxation::DynamicRelaxation(std::unique_ptr<Problem> owned, Problem* problem, double damping_eta, double dt,
+                                     const std::string& options_prefix, const OptionList& petsc_options)
+    : owned_problem_(std::move(owned)),
+      problem_(problem ? *problem : *owned_problem_),
+      option_database_(options_prefix, petsc_options) {
+  RankAgreement("DynamicRelaxation")
+      .input("damping", damping_eta)
+      .input("dt", dt)
+      .input("options_prefix", options_prefix)
+      .require(problem_.comm());
   require_valid_damping(damping_eta);
   require(dt == 0 || positive_finite(dt), "dt", "positive and finite (or 0 for the CFL estimate)", dt);
   try {
-    generation_ = model_.generation();
-    Vec u = model_.displacement();
+    generation_ = problem_.generation();
+    Vec u = problem_.state();
     SNEDE_PETSC(VecDuplicate(u, velocity_.out()));
     SNEDE_PETSC(VecZeroEntries(velocity_));
-    model_.add_carried_field(velocity_.slot());  // follows cuts and refinements like the state
+    problem_.add_carried_field(velocity_.slot());  // follows cuts and refinements like the state
     SNEDE_PETSC(VecDuplicate(u, inverse_mass_.out()));
     SNEDE_PETSC(VecDuplicate(u, residual_.out()));
-    SNEDE_PETSC(TSCreate(PETSC_COMM_SELF, ts_.out()));
+    SNEDE_PETSC(TSCreate(problem_.comm(), ts_.out()));
     option_database_.use_for(ts_);
     TSAdapt adapt = nullptr;
     SNEDE_PETSC(TSGetAdapt(ts_, &adapt));
@@ -97,25 +77,22 @@ DynamicRelaxation::DynamicRelaxation(Model& model, double damping_eta, double dt
     SNEDE_PETSC(TSGetSNES(ts_, &snes));
     option_database_.use_for(snes);
     const double default_dt = dt > 0 ? dt : cfl_time_step();
+    require(positive_finite(default_dt), "the CFL time step", "positive and finite (is the mesh empty?)", default_dt);
     set_up_ss22(ts_, {options_prefix, damping_eta, default_dt, this, acceleration_callback, post_step_callback, u,
                       velocity_});
     option_database_.mark_read_options_used();
     follows_cfl_ = dt == 0 && time_step() == default_dt;
   } catch (...) {
-    model_.remove_carried_field(velocity_.slot());  // the handles release the PETSc objects
+    problem_.remove_carried_field(velocity_.slot());  // the handles release the PETSc objects
     throw;
   }
 }
 
 DynamicRelaxation::~DynamicRelaxation() {
-  model_.remove_carried_field(velocity_.slot());
+  problem_.remove_carried_field(velocity_.slot());
   TSSetApplicationContext(ts_, nullptr);  // a petsc4py handle may outlive this solver
   TSSetRHSFunction(ts_, nullptr,
                    [](TS, PetscReal, Vec, Vec, void*) { return orphaned_callback_error("DynamicRelaxation"); }, nullptr);
-}
-
-double DynamicRelaxation::cfl_time_step() const {
-  return snede::cfl_time_step(model_.body().mesh(), model_.body().material(), model_.body().density());
 }
 
 double DynamicRelaxation::time_step() const {
@@ -143,43 +120,37 @@ void DynamicRelaxation::set_velocity(std::span<const double> values) {
 }
 
 void DynamicRelaxation::reissue_sizes_if_mesh_changed() {
-  if (generation_ == model_.generation()) return;
+  if (generation_ == problem_.generation()) return;
   // The mesh changed size (a cut or a refinement): the model has carried the velocity over
   // like the displacement (a copy moves with its original, a midpoint with its edge); the
   // same TS takes the new vectors, so a user's handle and options survive.
   inverse_mass_.reset();
   residual_.reset();
-  Vec u = model_.displacement();
+  Vec u = problem_.state();
   SNEDE_PETSC(VecDuplicate(u, inverse_mass_.out()));
   SNEDE_PETSC(VecDuplicate(u, residual_.out()));
   SNEDE_PETSC(TSReset(ts_));
   SNEDE_PETSC(TS2SetSolution(ts_, u, velocity_));
-  generation_ = model_.generation();
+  generation_ = problem_.generation();
   if (follows_cfl_) SNEDE_PETSC(TSSetTimeStep(ts_, cfl_time_step()));
 }
 
 void DynamicRelaxation::prepare_state() {
   // Constraints may have been set between calls: put u on them and let v move only along them.
-  model_.enforce_constraints(model_.displacement());
-  project_onto_allowed_motions(model_, velocity_);
-  update_inverse_mass();
-}
-
-void DynamicRelaxation::update_inverse_mass() {
+  problem_.enforce_constraints(problem_.state());
+  problem_.project_onto_allowed_motions(velocity_);
   // Lumped masses (§2.5), recomputed per call since elements may change without a size change.
-  const std::vector<double> mass = model_.body().lumped_mass();
-  std::vector<double> inverse(mass.size() * model_.dim());
-  for (std::size_t v = 0; v < mass.size(); ++v)
-    for (int k = 0; k < model_.dim(); ++k) inverse[v * model_.dim() + k] = mass[v] > 0 ? 1 / mass[v] : 0.0;
-  set_vec_values(inverse_mass_, inverse);
+  problem_.inverse_lumped_mass(inverse_mass_);
 }
 
 SolveResult DynamicRelaxation::step(int n) {
+  RankAgreement("DynamicRelaxation.step").input("n", n).require(problem_.comm());
   require(n >= 0, "the number of steps", "≥ 0", n);
   return advance(n, Mode::steps, 0);
 }
 
 SolveResult DynamicRelaxation::run(double rtol, int max_steps) {
+  RankAgreement("DynamicRelaxation.run").input("rtol", rtol).input("max_steps", max_steps).require(problem_.comm());
   require(positive_finite(rtol), "rtol", "positive and finite", rtol);
   require(max_steps >= 0, "max_steps", "≥ 0", max_steps);
   return advance(max_steps, Mode::relaxation, rtol);
@@ -197,14 +168,14 @@ SolveResult DynamicRelaxation::advance(PetscInt n_steps, Mode mode, double rtol)
   mode_ = mode;
   stopping_.criterion = StoppingCriterion::with_reactions;
   stopping_.rtol = rtol;
-  stopping_.force_scale = model_.force_scale();
-  stopping_.n_dofs = static_cast<double>(model_.n_dofs());
-  external_norm_ = euclidean_norm(model_.external_forces());
+  stopping_.force_scale = problem_.force_scale();
+  stopping_.n_dofs = static_cast<double>(problem_.n_global_dofs());
+  external_norm_ = problem_.external_force_norm();
   history_.clear();
   failure_.clear();
   converged_ = false;
 
-  Vec u = model_.displacement();
+  Vec u = problem_.state();
   bool already_converged = false;
   if (mode == Mode::relaxation) {
     already_converged = converged_at(u);
@@ -214,16 +185,15 @@ SolveResult DynamicRelaxation::advance(PetscInt n_steps, Mode mode, double rtol)
   if (mode == Mode::steps) result.initial_residual_norm = history_.empty() ? 0 : history_.front();
 
   // The verdict is checked on the final state.
-  EvaluationReport report;
-  model_.residual(u, residual_, report);
+  const ResidualCheck check = problem_.residual(u, residual_);
   result.residual_norm = vec_norm(residual_);
-  result.tolerance = tolerance(model_.last_reaction_norm());
+  result.tolerance = tolerance(problem_.last_reaction_norm());
   std::string why;
   if (!failure_.empty()) {
     result.reason = failure_;
-  } else if (!report.domain_errors.empty() || !std::isfinite(result.residual_norm)) {
+  } else if (!check.finite || !std::isfinite(result.residual_norm)) {
     result.reason = "DIVERGED_NONFINITE_STATE";
-  } else if (!model_.admissible(u, &why)) {
+  } else if (!(why = problem_.inadmissible(u)).empty()) {
     result.reason = why;
   } else if (mode == Mode::relaxation) {
     result.converged = already_converged || converged_;
@@ -234,8 +204,7 @@ SolveResult DynamicRelaxation::advance(PetscInt n_steps, Mode mode, double rtol)
     result.converged = true;
     result.reason = TSConvergedReasons[reason];
   }
-  EvaluationReport energy_report;
-  result.energy = model_.potential_energy(u, energy_report);
+  result.energy = problem_.energy(u);
   result.residual_history = history_;
   result.seconds = wall_seconds() - start;
   result.flops = logged_flops() - start_flops;
@@ -259,15 +228,14 @@ PetscInt DynamicRelaxation::take_steps(PetscInt n_steps) {
 }
 
 bool DynamicRelaxation::converged_at(Vec u) {
-  EvaluationReport report;
-  model_.residual(u, residual_, report);
+  const ResidualCheck check = problem_.residual(u, residual_);
   checked_residual_norm_ = vec_norm(residual_);
-  return report.domain_errors.empty() && checked_residual_norm_ <= tolerance(model_.last_reaction_norm()) &&
-         model_.admissible(u);
+  return check.finite && checked_residual_norm_ <= tolerance(problem_.last_reaction_norm()) &&
+         problem_.inadmissible(u).empty();
 }
 
 void DynamicRelaxation::after_step() {
-  Vec u = model_.displacement();
+  Vec u = problem_.state();
   if (mode_ != Mode::stability_trial) history_.push_back(last_residual_norm_);
   if (failure_.empty()) failure_ = blow_up_failure(u);
   if (!failure_.empty()) {
@@ -287,16 +255,15 @@ double DynamicRelaxation::critical_time_step(double flop_budget, double initial,
           initial);
   require(reduction > 0 && reduction < 1, "reduction", "in (0, 1)", reduction);
   require(min_steps >= 1, "min_steps", "≥ 1", min_steps);
-  if (model_.constraints().n_constrained_components() == static_cast<std::size_t>(model_.n_dofs()))
+  if (problem_.every_dof_prescribed())
     throw std::invalid_argument("every displacement is prescribed: nothing can vibrate, no step is critical");
   reissue_sizes_if_mesh_changed();
   prepare_state();
-  const double flops_per_step = static_cast<double>(model_.body().flops_per_element().force) *
-                                static_cast<double>(model_.body().mesh().n_cells());
+  const double flops_per_step = problem_.flops_per_residual();
   const auto trial_steps = static_cast<PetscInt>(std::max<double>(min_steps, std::ceil(flop_budget / flops_per_step)));
 
   // Everything a trial changes, restored after each trial and at the end.
-  Vec u = model_.displacement();
+  Vec u = problem_.state();
   const std::vector<double> u0 = vec_values(u), v0 = vec_values(velocity_);
   const double dt0 = time_step(), damping0 = damping();
   PetscReal t0 = 0;
@@ -350,18 +317,16 @@ double DynamicRelaxation::critical_time_step(double flop_budget, double initial,
 PetscErrorCode DynamicRelaxation::acceleration_callback(TS, PetscReal, Vec u, Vec a, void* context) {
   return petsc_callback("snede dynamic relaxation force", [&] {
     auto* self = &callback_owner<DynamicRelaxation>(context, "DynamicRelaxation");
-    Model& model = self->model_;
-    EvaluationReport report;
-    model.residual(u, a, report);  // F(u) = P∇Π(u) on u's constraints
+    Problem& problem = self->problem_;
+    const ResidualCheck check = problem.residual(u, a);  // F(u) = P∇Π(u) on u's constraints
     self->last_residual_norm_ = vec_norm(a);
-    self->last_tolerance_ = self->tolerance(model.last_reaction_norm());
-    const bool inverted = !report.inverted.empty() && forbids_inversion(model.body().material());
+    self->last_tolerance_ = self->tolerance(problem.last_reaction_norm());
     if (self->failure_.empty()) {
-      if (!report.domain_errors.empty()) self->failure_ = "DIVERGED_NONFINITE_STATE";
-      else if (inverted && self->mode_ != Mode::stability_trial) self->failure_ = "DIVERGED_INVERTED_ELEMENTS";
+      if (!check.finite) self->failure_ = "DIVERGED_NONFINITE_STATE";
+      else if (check.inverted && self->mode_ != Mode::stability_trial) self->failure_ = "DIVERGED_INVERTED_ELEMENTS";
     }
     // a = −M⁻¹ P ∇Π(u): the net force on the allowed motions over the lumped mass.
-    project_onto_allowed_motions(model, a);
+    problem.project_onto_allowed_motions(a);
     SNEDE_PETSC(VecPointwiseMult(a, self->inverse_mass_, a));
     SNEDE_PETSC(VecScale(a, -1.0));
   });

@@ -10,17 +10,23 @@
 // -dynamic_ts_ss22_damping apply; TSSetFromOptions runs after snede's defaults. The TS reads
 // its own options database (core/solver_options.hpp): the constructor's petsc_options, then
 // the command line over them.
+//
+// It drives any Problem (problem.hpp): a serial Model, whose mesh may be cut or refined between
+// calls, or a DistributedStatic on its communicator, with the same steps on any number of ranks.
 #pragma once
 
 #include <petscts.h>
 
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <string>
 #include <vector>
 
 #include "core/solver_options.hpp"
+#include "fem/stable_time_step.hpp"
 #include "solve/model.hpp"
+#include "solve/problem.hpp"
 #include "solve/solve_result.hpp"
 #include "solve/stopping.hpp"
 #include "solve/ts_ss22.hpp"
@@ -31,11 +37,6 @@ namespace snede {
 // motion has left behind, else empty.
 std::string blow_up_failure(Vec u);
 
-// (2.61): Δt = (2/√3) h/c, c = √((λ+2μ)/ρ) (plane stress: √(E/((1−ν²)ρ))), h the smallest
-// element size, taken as the diameter of the smallest inscribed sphere (circle); ∞ without cells.
-// A membrane's triangles are measured in their own planes, with the plane-stress speed.
-double cfl_time_step(const Mesh& mesh, const Material& material, double density);
-
 class DynamicRelaxation {
  public:
   // damping_eta: η ≥ 0 (1/s). dt: the time step (s), or 0 for the CFL estimate (2.61), which
@@ -43,6 +44,10 @@ class DynamicRelaxation {
   // without the prefix.
   DynamicRelaxation(Model& model, double damping_eta, double dt = 0, const std::string& options_prefix = "dynamic_",
                     const OptionList& petsc_options = {});
+  // Collective on problem.comm(); the problem must outlive the solver. Throws
+  // std::invalid_argument (the same on every rank) for arguments that differ between the ranks.
+  DynamicRelaxation(Problem& problem, double damping_eta, double dt = 0,
+                    const std::string& options_prefix = "dynamic_", const OptionList& petsc_options = {});
   ~DynamicRelaxation();
   DynamicRelaxation(const DynamicRelaxation&) = delete;
   DynamicRelaxation& operator=(const DynamicRelaxation&) = delete;
@@ -53,8 +58,8 @@ class DynamicRelaxation {
   // Steps until ‖F(u)‖ ≤ rtol·√(‖f_ext‖² + ‖f_react‖²) (6.9), or max_steps ("DIVERGED_MAX_IT").
   SolveResult run(double rtol, int max_steps);
 
-  // (2.61) on the model's mesh (the free function cfl_time_step).
-  double cfl_time_step() const;
+  // (2.61) on the problem's mesh.
+  double cfl_time_step() const { return problem_.cfl_time_step(); }
   // §4.4.1: a step is stable if an undamped run from the current state does not blow up
   // within flop_budget flops (force kernel flops × elements per step), and at least
   // min_steps steps: on large meshes 50 MFLOP alone buys too few steps (31 on 8724
@@ -72,9 +77,13 @@ class DynamicRelaxation {
   std::vector<double> velocity();
   void set_velocity(std::span<const double> values);
   TS ts() const { return ts_; }
-  Model& model() { return model_; }
+  Problem& problem() { return problem_; }
 
  private:
+  // The problem given, or else the one owned.
+  DynamicRelaxation(std::unique_ptr<Problem> owned, Problem* problem, double damping_eta, double dt,
+                    const std::string& options_prefix, const OptionList& petsc_options);
+
   enum class Mode { steps, relaxation, stability_trial };
   SolveResult advance(PetscInt n_steps, Mode mode, double rtol);
   // TSSolve for up to n_steps more steps (within the user's cap, except in a stability
@@ -82,7 +91,6 @@ class DynamicRelaxation {
   PetscInt take_steps(PetscInt n_steps);
   void reissue_sizes_if_mesh_changed();
   void prepare_state();
-  void update_inverse_mass();
   // (6.9) threshold for the current relaxation; 0 outside one.
   double tolerance(double reaction_norm) const;
   // Evaluates F(u): within the tolerance, finite and admissible?
@@ -92,7 +100,8 @@ class DynamicRelaxation {
   static PetscErrorCode acceleration_callback(TS ts, PetscReal t, Vec u, Vec a, void* context);
   static PetscErrorCode post_step_callback(TS ts);
 
-  Model& model_;
+  std::unique_ptr<Problem> owned_problem_;  // the serial model's, when made from a Model
+  Problem& problem_;
   SolverOptions option_database_;  // read by the PETSc objects below
   TsHandle ts_;
   VecHandle velocity_;

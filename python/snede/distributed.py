@@ -21,6 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from snede import _checks, _snede
+from snede._petsc import option_list
 from snede.mesh import Mesh
 from snede._snede import SolveResult
 
@@ -191,21 +192,21 @@ class DistributedStatic:
 class DistributedRelaxation:
     """Dynamic relaxation (§2.5) of a :class:`DistributedStatic` problem: the damped motion
     M ü + η M u̇ = −F(u) with lumped masses, integrated by snede's central-difference TS
-    (snede_ss22) on all ranks; ``run(rtol, max_steps)`` stops at criterion (6.9)
+    (snede_ss22) on all ranks — the serial DynamicRelaxation's engine, on the problem's
+    communicator; ``run(rtol, max_steps)`` stops at criterion (6.9)
     ‖F(u)‖ ≤ rtol·√(‖f_ext‖² + ‖f_react‖²). ``dt`` None takes the CFL estimate (2.61) of the
     whole mesh. Options under ``options_prefix`` (``drelax_``): ``-drelax_ts_monitor`` and so
-    on. Collective."""
+    on, or ``petsc_options`` (without the prefix) for this solver only. Collective."""
 
     def __init__(self, problem: DistributedStatic, damping: float, dt: float | None = None, *,
-                 options_prefix: str = "drelax_"):
+                 options_prefix: str = "drelax_", petsc_options: dict | None = None):
         def checked():
             if dt is not None and not (np.isfinite(dt) and dt > 0):
                 raise ValueError(f"dt must be positive and finite (or None for the CFL estimate), got {dt}")
-            return float(damping), float(dt or 0.0), str(options_prefix)
+            return float(damping), float(dt or 0.0), str(options_prefix), option_list(petsc_options)
 
         self.problem = problem
-        arguments = agreed(problem.part.comm, checked)
-        self._impl = _snede.DistributedRelaxation(problem._impl, *arguments)
+        self._impl = _snede.DynamicRelaxation(problem._impl, *agreed(problem.part.comm, checked))
 
     @property
     def dt(self) -> float:

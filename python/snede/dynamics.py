@@ -56,11 +56,8 @@ class DynamicRelaxation(RunsOnRanks):
         self._distributed = None
         comm = getattr(body, "comm", None) if comm is None else comm
         if comm is not None:
-            if petsc_options:
-                raise NotImplementedError(f"petsc_options on MPI ranks (comm): give -{options_prefix}ts_* "
-                                          "options on the command line")
             self._distributed = DistributedBody(body, comm)
-            self._settings = (damping, dt, options_prefix)
+            self._settings = (damping, dt, options_prefix, petsc_options)
             self._start_relaxation()
             self._impl = None
             return
@@ -68,9 +65,10 @@ class DynamicRelaxation(RunsOnRanks):
                                               option_list(petsc_options))
 
     def _start_relaxation(self) -> None:
-        damping, dt, prefix = self._settings
+        damping, dt, prefix, petsc_options = self._settings
         self._problem = self._distributed.problem()
-        self._relaxation = DistributedRelaxation(self._problem, damping, dt, options_prefix=prefix)
+        self._relaxation = DistributedRelaxation(self._problem, damping, dt, options_prefix=prefix,
+                                                 petsc_options=petsc_options)
 
     def step(self, n: int = 1) -> SolveResult:
         """Take ``n`` time steps. ``converged`` is False only on divergence (blow-up, NaN,

@@ -110,6 +110,18 @@ def test_dynamic_relaxation_reports_a_blow_up_on_every_rank():
     assert set(COMM.allgather(result.reason)) == {"DIVERGED_BLOW_UP"}
 
 
+def test_dynamic_relaxation_reads_its_own_petsc_options_on_every_rank():
+    """petsc_options reach the distributed TS as the serial one's (one engine since issue 36):
+    a step given as -ts_dt for this solver only, and a damping option, taken on every rank."""
+    problem = linear_cantilever_problem(COMM)
+    cfl = snede.DistributedRelaxation(problem, damping=1.5).dt
+    halved = snede.DistributedRelaxation(problem, damping=1.5, options_prefix="halved_",
+                                         petsc_options={"ts_dt": 0.5 * cfl, "ts_ss22_damping": 3.0})
+    assert COMM.allgather(halved.dt) == [0.5 * cfl] * COMM.size
+    assert halved._impl.damping == 3.0
+    assert snede.DistributedRelaxation(problem, damping=1.5, options_prefix="halved_").dt == cfl
+
+
 def test_dynamic_relaxation_refuses_bad_parameters_everywhere():
     problem = linear_cantilever_problem(COMM)
     with pytest.raises(ValueError, match="dt must be positive"):

@@ -158,7 +158,7 @@ def test_solver_arguments_that_differ_between_ranks_raise_everywhere():
         problem.solve("cg", rtol=1e-8 * (1 + COMM.rank))
     with pytest.raises(ValueError, match=r"the ranks were given different inputs \(method: rank 1"):
         problem.solve("cg" if COMM.rank == 0 else "bicg")
-    with pytest.raises(ValueError, match=r"DistributedRelaxation: the ranks were given different inputs \(damping:"):
+    with pytest.raises(ValueError, match=r"DynamicRelaxation: the ranks were given different inputs \(damping:"):
         snede.DistributedRelaxation(problem, damping=1.0 + COMM.rank)
     with pytest.raises(ValueError, match=f"rank {COMM.size - 1}: dt must be positive"):
         snede.DistributedRelaxation(problem, damping=1.0, dt=-1.0 if COMM.rank == COMM.size - 1 else None)

@@ -1,0 +1,57 @@
+#include "solve/model_problem.hpp"
+
+#include <vector>
+
+#include "core/norms.hpp"
+#include "core/petsc_util.hpp"
+#include "fem/stable_time_step.hpp"
+
+namespace snede {
+
+ResidualCheck ModelProblem::residual(Vec u, Vec F) {
+  EvaluationReport report;
+  model_.residual(u, F, report);
+  return {report.domain_errors.empty(), !report.inverted.empty() && forbids_inversion(model_.body().material())};
+}
+
+std::string ModelProblem::inadmissible(Vec u) {
+  std::string why;
+  return model_.admissible(u, &why) ? std::string() : why;
+}
+
+double ModelProblem::energy(Vec u) {
+  EvaluationReport report;
+  return model_.potential_energy(u, report);
+}
+
+double ModelProblem::external_force_norm() { return euclidean_norm(model_.external_forces()); }
+
+void ModelProblem::project_onto_allowed_motions(Vec v) {
+  WriteView values(v);
+  model_.constraints().project(values.span());
+}
+
+bool ModelProblem::every_dof_prescribed() const {
+  return model_.constraints().n_constrained_components() == static_cast<std::size_t>(model_.n_dofs());
+}
+
+void ModelProblem::inverse_lumped_mass(Vec out) {
+  const std::vector<double> mass = model_.body().lumped_mass();
+  const int dim = model_.dim();
+  std::vector<double> inverse(mass.size() * dim);
+  for (std::size_t v = 0; v < mass.size(); ++v)
+    for (int k = 0; k < dim; ++k) inverse[v * dim + k] = mass[v] > 0 ? 1 / mass[v] : 0.0;
+  set_vec_values(out, inverse);
+}
+
+double ModelProblem::cfl_time_step() {
+  const ElasticBody& body = model_.body();
+  return snede::cfl_time_step(body.mesh(), body.material(), body.density());
+}
+
+double ModelProblem::flops_per_residual() const {
+  return static_cast<double>(model_.body().flops_per_element().force) *
+         static_cast<double>(model_.body().mesh().n_cells());
+}
+
+}  // namespace snede

@@ -1,0 +1,67 @@
+// What a solver needs of a static problem, whatever communicator it lives on (issue 36): the
+// state, the residual F(u) = P∇Π(u) + (I − P)(u − ū) and the energy, the lumped masses, the
+// constraints' projection, and the scales of the stopping rule (6.9). The serial Model is the
+// one-rank problem (ModelProblem); DistributedStatic is the problem over a distributed mesh.
+// A solver written against Problem runs unchanged on 1 or N ranks, as PETSc's tutorials run
+// the same code on any number of processes. Every member is collective on comm().
+#pragma once
+
+#include <petscvec.h>
+
+#include <cstdint>
+#include <string>
+
+namespace snede {
+
+// What an evaluation of F found wrong with the state.
+struct ResidualCheck {
+  bool finite = true;     // every element's forces were finite
+  bool inverted = false;  // an element is inverted and the material forbids it
+  bool admissible() const { return finite && !inverted; }
+};
+
+class Problem {
+ public:
+  virtual ~Problem() = default;
+
+  virtual MPI_Comm comm() const = 0;
+  virtual int dim() const = 0;
+  // The displacement, solved in place (block size dim; the rows this rank owns).
+  virtual Vec state() const = 0;
+
+  // F(u) (6.7): the net force on the allowed motions, u − ū on the prescribed ones.
+  virtual ResidualCheck residual(Vec u, Vec F) = 0;
+  // ‖reactions‖ from the latest residual().
+  virtual double last_reaction_norm() const = 0;
+  // Why `u` cannot be a result ("DIVERGED_INVERTED_ELEMENTS", …), or empty.
+  virtual std::string inadmissible(Vec u) = 0;
+  // Π(u) = Π_int(u) − f_extᵀu.
+  virtual double energy(Vec u) = 0;
+
+  // The scales of (6.9): ‖f_ext‖, the force scale E·H² (E·t·H in 2D), and the dofs.
+  virtual double external_force_norm() = 0;
+  virtual double force_scale() = 0;
+  virtual std::int64_t n_global_dofs() const = 0;
+
+  // Puts u on the constraints (prescribed values, sliding lines).
+  virtual void enforce_constraints(Vec u) = 0;
+  // v onto the motions the constraints allow.
+  virtual void project_onto_allowed_motions(Vec v) = 0;
+  virtual bool every_dof_prescribed() const = 0;
+
+  // 1/m per dof from the lumped masses (§2.5), 0 for a vertex without mass.
+  virtual void inverse_lumped_mass(Vec out) = 0;
+  // (2.61) on the whole mesh.
+  virtual double cfl_time_step() = 0;
+  // Floating-point operations of one residual's element loop (a step's cost, §4.4.1).
+  virtual double flops_per_residual() const = 0;
+
+  // A mesh that changes (cuts, refinement) reissues the unknowns: the count changes with
+  // every reissue, and the fields registered here are carried over like the state. A
+  // problem whose mesh does not change keeps 0 and carries nothing.
+  virtual std::uint64_t generation() const { return 0; }
+  virtual void add_carried_field(Vec* /*field*/) {}
+  virtual void remove_carried_field(Vec* /*field*/) {}
+};
+
+}  // namespace snede
