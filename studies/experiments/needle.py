@@ -32,7 +32,7 @@ from pathlib import Path
 import numpy as np
 
 import snede
-from studies.experiments.common import options_prefix, parse_arguments, pyplot, write_csv
+from studies.experiments.common import PageTemplate, options_prefix, parse_arguments, pyplot, write_csv
 from snede.scenes.needle_slab import DEPTH, ENTRY, SIZE, YOUNG, h, needle_for, slab_body
 
 ROUND_TOLERANCE = 1e-8  # ε_round of (6.9), §6.8.1
@@ -428,29 +428,15 @@ def table_6_5_line(row: dict) -> str:
             f"{'yes' if row['converged'] else row['reason']} |")
 
 
-TABLE_6_5_HEADER = ["| ε | h_ref | speed [h_ref/update] | updates | cells | CPU [s] | rearrangements | rate [Hz] | "
-                    "rate ratio | CG mean | CG max | converged |", "|---|---|---|---|---|---|---|---|---|---|---|---|"]
-
-
 def table_6_5_section(rows: list[dict], command: str) -> list[str]:
-    """The results page's Table 6.5 section (written by this module and by
+    """The results page's Table 6.5 section, as lines (written by this module and by
     studies/benchmarks/needle_rates.py --markdown)."""
-    lines = ["## Table 6.5: timings (h_start = h3)", "",
-             f"The thesis's haptic loop (§6.7: `needle_for(slab_body(3), h_ref, rtol=ε, solves_per_update=1)`, one solve "
-             "and one rearrangement per update, pending rearrangements carried into the next update, at 70 mm updates "
-             "in place until no node changes state), linear CG without a preconditioner (the default below 1000 "
-             "cells). CPU time: `time.process_time()` around `NeedleInsertion.insert`; rate = rearrangements (solves) "
-             "per CPU second, as the thesis's 'updates [Hz]'. Thesis (Pentium III 1 GHz) in parentheses; 'rate "
-             f"ratio' = our rate / the thesis's. Goals (issue 33): ≥ {UPDATE_RATE_GOAL:g}× in every row at ε = "
-             f"{ISSUE_TOLERANCE:g}, ≥ {H7_RATE_GOAL_HZ:g} Hz at h7. ε = {THESIS_CG_TOLERANCE:g} is the ε whose CG "
-             "counts are the thesis's: over the 12 rows the geometric mean of our mean CG iterations over the "
-             "thesis's is 1.06 there (2.40 at 0.01, 1.53 at 0.02, 0.68 at 0.05; `studies/benchmarks/needle_rates.py --scan`). "
-             "No single ε matches every row: our counts fall faster with the speed than the thesis's (at 0.03 "
-             "from 2.4–2.5× the thesis's at 3 h_ref/update to 0.26–0.38× at 0.01). The thesis does not state its ε. "
-             f"This section: `{command}`.", ""]
-    lines += TABLE_6_5_HEADER + [table_6_5_line(row) for row in rows]
-    lines += ["", rate_note(rows), "", "![update rates](needle_rates.png)", ""]
-    return lines
+    template = PageTemplate("needle")
+    text = template.snippet("table_6_5", rate_goal=UPDATE_RATE_GOAL, issue_rtol=ISSUE_TOLERANCE,
+                            h7_goal=H7_RATE_GOAL_HZ, thesis_cg_rtol=THESIS_CG_TOLERANCE, command=command,
+                            t65_table="\n".join([template.snippet("t65_header")] + [table_6_5_line(row) for row in rows]),
+                            rate_note=rate_note(rows, template))
+    return text.split("\n") + [""]
 
 
 def replace_table_6_5(page: str, section: list[str]) -> str:
@@ -714,190 +700,116 @@ def geometric_mean(values) -> float | None:
 
 
 def describe(settings: Settings, quick: bool, minutes: float, results: dict) -> str:
+    """needle.md: studies/templates/needle.md filled with the tables and notes of §6.8."""
+    template = PageTemplate("needle")
+    snippet = template.snippet
     t61, mesh_rows, insertion, t66, nonlinear = (results[k] for k in ("table_6_1", "tables_6_2_6_3", "insertion",
                                                                       "table_6_6", "figure_6_12"))
-    profile = snede.FrictionProfile.figure_6_4()
     reference = results["reference"]
-    lines = [
-        "# §6.8 needle insertion: Tables 6.1–6.6, Figures 6.10 and 6.12", "",
-        "Regenerate with `.venv/bin/python -m studies.experiments.needle`" + (" --quick" if quick else "")
-        + f" (this file, `needle.csv`, `needle_errors.png`, `needle_rates.png`, `needle_nonlinear*.png`; "
-        f"this run: {minutes:.1f} min on the shared 2-core machine, 1-minute load average "
-        f"{results['load_average'][0]:.1f} at the start and {results['load_average'][1]:.1f} at the end)."
-        + (" **Quick run: smaller meshes than the thesis; thesis numbers are shown only where the set-up matches.**"
-           if quick else ""), "",
-        "## Set-up", "",
-        f"The §6.8.1 slab of `snede.scenes.needle_slab`: 0.1 × 0.1 m, 0.01 m thick, plane stress, E = 34 kPa, "
-        f"ν = 0.34, fixed at x = 0.1 m; meshes `slab_body(k)`: right triangles with legs h_k = 0.1·2^-k m.",
-        "",
-        "* **Friction profile: a stand-in.** The thesis's Figure 6.4 gives the shape of DiMaio and Salcudean's "
-        "measured distribution but no numbers; we use `FrictionProfile.figure_6_4()` (40 N/m at the tip, a bulge of "
-        f"60 N/m at 2 mm, 20 N/m of shaft friction from 10 mm on; {profile.integral(0, DEPTH):.2f} N over 70 mm). "
-        "Displacements, and so absolute errors in mm, therefore differ from the thesis's: compare trends and "
-        "orders of magnitude, not digits. Our static line load gives at most "
-        f"{reference['max_displacement_mm']:.2f} mm of displacement.",
-        "* **Element sizes.** `slab_body(h_start)` has legs h_start (longest edge √2·h_start). Refining to h_ref "
-        "follows §6.5's refine-around and the needle engine: bisect until the cells containing the point have "
-        "longest edge ≤ h_ref (legs h_ref/√2), at points every h_ref/4 along the line. So a refined region is half a "
-        "bisection level finer than a start mesh of the same index.",
-        f"* **Reference (\"uniform h{settings.fine}\")**: `slab_body({settings.fine})` bisected once uniformly, "
-        f"every cell with longest edge h{settings.fine} ({reference['nodes']} nodes, {reference['cells']} cells), "
-        f"solved with ε = {REFERENCE_TOLERANCE:g}. Every other mesh here (longest edges ≥ h{settings.fine}) is nested in "
-        "it.",
-        "* **Comparing meshes.** Displacements are compared at the vertices of the reference mesh: a coarser solution "
-        "is evaluated there by barycentric interpolation in the coarse cell containing the vertex "
-        "(matplotlib.tri trapezoid-map point location + `LinearTriInterpolator`, i.e. the coarse P1 field itself). "
-        "'mean' and 'max' are the mean and maximum of |u − u_ref| over those vertices (area-uniform sampling), in mm.",
-        f"* **Solves.** Linear CG (`snede.StaticSolver(body, \"cg\", preconditioner=\"none\", rtol=ε, round_tolerance={ROUND_TOLERANCE:g})`, "
-        f"stopping criterion (6.9)). Insertions: `needle_for(slab_body(h_start), h_ref, rtol={WORKING_TOLERANCE:g}, "
-        f"round_tolerance={ROUND_TOLERANCE:g})` (static friction threshold 2 × dynamic).",
-        f"* **Working tolerance ε = {WORKING_TOLERANCE:g}** for Table 6.2 and the insertions of Table 6.4 and "
-        "Figure 6.12: the thesis does not say which ε its Tables 6.2 and 6.5 used; ε = 0.01 reproduces its Table 6.2 "
-        "CG counts best (ε = 0.001 needs about twice as many iterations on h3/h6) and costs about 0.01 mm of error "
-        f"(Table 6.1). Table 6.5 is timed at ε = {ISSUE_TOLERANCE:g} and at ε = {THESIS_CG_TOLERANCE:g}, where the "
-        "insertions' CG counts are the thesis's (see there).", "",
-    ]
+    values = dict(
+        quick_flag=" --quick" if quick else "", minutes=minutes, load_start=results["load_average"][0],
+        load_end=results["load_average"][1], quick_note=snippet("quick_note") if quick else "",
+        profile_force=snede.FrictionProfile.figure_6_4().integral(0, DEPTH),
+        max_displacement=reference["max_displacement_mm"], fine=settings.fine, reference_nodes=reference["nodes"],
+        reference_cells=reference["cells"], reference_rtol=REFERENCE_TOLERANCE, round_tolerance=ROUND_TOLERANCE,
+        working_rtol=WORKING_TOLERANCE, issue_rtol=ISSUE_TOLERANCE, thesis_cg_rtol=THESIS_CG_TOLERANCE,
+        h_start=settings.h_start, h_ref=settings.h_ref)
 
     # Table 6.1
     thesis61 = settings.tolerance_level == 7
-    lines += [f"## Table 6.1: error against relaxation tolerance (h_start = h_ref = h{settings.tolerance_level})", "",
-              f"Same mesh ({t61[0]['nodes']} nodes), solved from zero at each ε, compared with ε = "
-              f"{REFERENCE_TOLERANCE:g} ({t61[0]['reference_iterations']} CG iterations). Thesis values in "
-              "parentheses" + ("" if thesis61 else " are for h7 and not shown in a quick run") + ".", "",
-              "| ε | CG iterations | mean error [mm] | thesis mean | ratio | max error [mm] | thesis max | ratio |",
-              "|---|---|---|---|---|---|---|---|"]
-    for row in t61:
-        lines.append(f"| {row['rtol']:g} | {row['iterations']} | {row['mean_error_mm']:.2g} | "
-                     f"{cell(row['thesis_mean_error_mm'], None, '{:g}') if thesis61 else '–'} | "
-                     f"{cell(ratio(row['mean_error_mm'], row['thesis_mean_error_mm']), None) if thesis61 else '–'} | "
-                     f"{row['max_error_mm']:.2g} | "
-                     f"{cell(row['thesis_max_error_mm'], None, '{:g}') if thesis61 else '–'} | "
-                     f"{cell(ratio(row['max_error_mm'], row['thesis_max_error_mm']), None) if thesis61 else '–'} |")
+    rows61 = [f"| {row['rtol']:g} | {row['iterations']} | {row['mean_error_mm']:.2g} | "
+              f"{cell(row['thesis_mean_error_mm'], None, '{:g}') if thesis61 else '–'} | "
+              f"{cell(ratio(row['mean_error_mm'], row['thesis_mean_error_mm']), None) if thesis61 else '–'} | "
+              f"{row['max_error_mm']:.2g} | "
+              f"{cell(row['thesis_max_error_mm'], None, '{:g}') if thesis61 else '–'} | "
+              f"{cell(ratio(row['max_error_mm'], row['thesis_max_error_mm']), None) if thesis61 else '–'} |"
+              for row in t61]
     means = [row["mean_error_mm"] for row in t61]
-    falls = all(b < a for a, b in zip(means, means[1:]))
-    lines += ["", f"**Agrees:** modest tolerances already give small errors; the error "
-              + ("falls at every step" if falls else "falls overall (not at every step)")
-              + f" as ε tightens, from {means[0]:.2g} mm at ε = {t61[0]['rtol']:g} to {means[-1]:.2g} mm at ε = "
-              f"{t61[-1]['rtol']:g} (least-squares slope {slope(t61):.2f} on log-log axes: "
-              + ("about in proportion to ε" if 0.8 <= slope(t61) <= 1.25 else
-                 "slower than in proportion to ε" if slope(t61) < 0.8 else "faster than in proportion to ε")
-              + "). Our errors are smaller than the thesis's by the ratios shown; our load, and so our displacements, "
-              "differ from its (see the set-up), and the thesis does not give its displacements. At ε = 0.01 it is "
-              f"{t61[3]['mean_error_mm']:.2g} mm mean, far below the 1 mm accuracy goal of §6.8.", ""]
+    values.update(
+        tolerance_level=settings.tolerance_level, t61_nodes=t61[0]["nodes"],
+        t61_reference_iterations=t61[0]["reference_iterations"],
+        t61_not_shown="" if thesis61 else snippet("t61_not_shown"), t61_table="\n".join([snippet("t61_header")] + rows61),
+        t61_falls=snippet("falls_every_step" if all(b < a for a, b in zip(means, means[1:])) else "falls_overall"),
+        mean_first=means[0], rtol_first=t61[0]["rtol"], mean_last=means[-1], rtol_last=t61[-1]["rtol"],
+        slope=slope(t61), proportion=snippet("in_proportion" if 0.8 <= slope(t61) <= 1.25 else
+                                             "slower_than_proportion" if slope(t61) < 0.8 else
+                                             "faster_than_proportion"),
+        mean_at_001=t61[3]["mean_error_mm"])
 
     # Tables 6.2 and 6.3
     thesis = settings.fine == 7
-    diagonal = [r for r in mesh_rows if r["h_start"] == r["h_ref"]]
-    lines += [f"## Table 6.2: CG iterations (ε = {WORKING_TOLERANCE:g}), h_start × h_ref", "",
-              "Ours, thesis in parentheses" + ("" if thesis else " (not shown: quick run)") + ".", "",
-              grid_table(mesh_rows, settings, "iterations", "thesis_iterations", "{:.0f}")]
+    t62_ratio = t63_ratio = ""
     if thesis:
         r62 = [ratio(r["iterations"], r["thesis_iterations"]) for r in mesh_rows]
-        lines += [f"Ratio ours/thesis: geometric mean {geometric_mean(r62):.2f}, range "
-                  f"{min(x for x in r62 if x):.2f}–{max(x for x in r62 if x):.2f}. ", ""]
-    lines += ["**Agrees:** fewer iterations on coarser meshes: iterations grow with h_ref along every row and with "
-              "h_start down every column" + (" (with the exceptions visible above)" if not monotone_iterations(mesh_rows)
-                                             else "") + ".", ""]
-    lines += [f"## Table 6.3: displacement error [mm] against uniform h{settings.fine}", "",
-              f"Solutions with ε = {REFERENCE_TOLERANCE:g} (pure discretisation error; at ε = {WORKING_TOLERANCE:g} "
-              "the numbers change by at most "
-              f"{max(abs(r['mean_error_at_working_rtol_mm'] - r['mean_error_mm']) for r in mesh_rows):.3f} mm "
-              "(mean) and "
-              f"{max(abs(r['max_error_at_working_rtol_mm'] - r['max_error_mm']) for r in mesh_rows):.3f} mm (max), "
-              "see needle.csv). Thesis in parentheses.", "",
-              "Mean error [mm]:", "", grid_table(mesh_rows, settings, "mean_error_mm", "thesis_mean_error_mm", "{:.3f}"),
-              "Maximum error [mm]:", "", grid_table(mesh_rows, settings, "max_error_mm", "thesis_max_error_mm", "{:.3f}")]
-    if thesis:
+        t62_ratio = snippet("t62_ratio", mean=geometric_mean(r62), low=min(x for x in r62 if x),
+                            high=max(x for x in r62 if x))
         rm = [ratio(r["mean_error_mm"], r["thesis_mean_error_mm"]) for r in mesh_rows if r["thesis_mean_error_mm"]]
         rx = [ratio(r["max_error_mm"], r["thesis_max_error_mm"]) for r in mesh_rows if r["thesis_max_error_mm"]]
-        lines += [f"Ratio ours/thesis (entries where the thesis is non-zero): mean errors geometric mean "
-                  f"{geometric_mean(rm):.2f}, max errors {geometric_mean(rx):.2f}.", ""]
+        t63_ratio = snippet("t63_ratio", mean=geometric_mean(rm), max=geometric_mean(rx))
     pair = next((r for r in mesh_rows if (r["h_start"], r["h_ref"]) == (settings.h_start, settings.h_ref)), None)
-    lines += ["**Agrees:** refining either h_start or h_ref lowers the error; a fine h_ref on a coarse start mesh "
-              "buys most of the accuracy of a uniformly fine mesh for a fraction of its nodes"
-              + (f" (h{pair['h_start']}/h{pair['h_ref']}: {pair['nodes']} nodes, mean {pair['mean_error_mm']:.3f} / "
-                 f"max {pair['max_error_mm']:.3f} mm; thesis 0.10 / 0.29 mm)" if pair else "") + ". "
-              "Errors are largest where the load varies (the entry point and the tip bulge) and at the corners of "
-              "the fixed side (Figure 6.10).", ""]
-    lines += monotone_notes(mesh_rows, settings)
-    lines += ["## Figure 6.10: displacement-error fields", "",
-              f"|u − u_ref| at the reference vertices for (h_start, h_ref) = "
-              + " and ".join(f"(h{a}, h{b})" for a, b in settings.figure_pairs)
-              + ", same colour scale, the coarse mesh drawn over it.", "", "![Figure 6.10](needle_errors.png)", ""]
+    values.update(
+        t62_not_shown="" if thesis else snippet("t62_not_shown"),
+        t62_table=grid_table(mesh_rows, settings, "iterations", "thesis_iterations", "{:.0f}"), t62_ratio=t62_ratio,
+        t62_exceptions="" if monotone_iterations(mesh_rows) else snippet("t62_exceptions"),
+        change_mean=max(abs(r["mean_error_at_working_rtol_mm"] - r["mean_error_mm"]) for r in mesh_rows),
+        change_max=max(abs(r["max_error_at_working_rtol_mm"] - r["max_error_mm"]) for r in mesh_rows),
+        t63_mean=grid_table(mesh_rows, settings, "mean_error_mm", "thesis_mean_error_mm", "{:.3f}"),
+        t63_max=grid_table(mesh_rows, settings, "max_error_mm", "thesis_max_error_mm", "{:.3f}"), t63_ratio=t63_ratio,
+        t63_pair=snippet("t63_pair", pair=pair) if pair else "", monotone=monotone_notes(mesh_rows, settings, template),
+        figure_pairs=" and ".join(f"(h{a}, h{b})" for a, b in settings.figure_pairs))
 
     # Tables 6.4 and 6.5
     errors = [r for r in insertion if "mean_error_mm" in r]
     reference_run = next(r for r in insertion if r["reference"])
-    lines += [f"## Table 6.4: error against insertion speed (h_start = h{settings.h_start}, h_ref = h{settings.h_ref})",
-              "",
-              f"Automated insertion to 70 mm, advancing speed × h_ref per update (each update relaxes and rearranges "
-              f"until no needle node changes state), compared with the slow insertion at {settings.reference_speed:g} "
-              f"h_ref per update ({reference_run['updates']} updates, {reference_run['rearrangements']} "
-              f"rearrangements, {reference_run['cpu_seconds']:.1f} s)"
-              + (" — the thesis's reference speed" if settings.reference_speed == THESIS_TABLE_6_4_REFERENCE_SPEED
-                 else "") + f", on the uniform h{settings.fine} vertices.", "",
-              "| speed [h_ref/update] | mean error [mm] | thesis mean | ratio | max error [mm] | thesis max | ratio |",
-              "|---|---|---|---|---|---|---|"]
+    rows64 = []
     for row in errors:
         tm, tx = row.get("thesis_mean_error_mm"), row.get("thesis_max_error_mm")
-        lines.append(f"| {row['speed']:g} | {row['mean_error_mm']:.3f} | {cell(tm, None, '{:g}') if tm else '–'} | "
-                     f"{cell(ratio(row['mean_error_mm'], tm), None) if tm else '–'} | {row['max_error_mm']:.3f} | "
-                     f"{cell(tx, None, '{:g}') if tx else '–'} | "
-                     f"{cell(ratio(row['max_error_mm'], tx), None) if tx else '–'} |")
-    if pair:
-        lines += ["", f"Discretisation error at this resolution (Table 6.3, static load): mean {pair['mean_error_mm']:.3f}, "
-                  f"max {pair['max_error_mm']:.3f} mm (thesis: {THESIS_TABLE_6_4_DISCRETISATION[0]} / "
-                  f"{THESIS_TABLE_6_4_DISCRETISATION[1]} mm)."]
-    lines += ["", speed_note(errors, pair), ""]
-
-    lines += table_6_5_section(results["table_6_5"], "python -m studies.experiments.needle"
-                               + (" --quick" if quick else ""))
+        rows64.append(f"| {row['speed']:g} | {row['mean_error_mm']:.3f} | {cell(tm, None, '{:g}') if tm else '–'} | "
+                      f"{cell(ratio(row['mean_error_mm'], tm), None) if tm else '–'} | {row['max_error_mm']:.3f} | "
+                      f"{cell(tx, None, '{:g}') if tx else '–'} | "
+                      f"{cell(ratio(row['max_error_mm'], tx), None) if tx else '–'} |")
+    values.update(
+        reference_speed=settings.reference_speed, reference_updates=reference_run["updates"],
+        reference_rearrangements=reference_run["rearrangements"], reference_cpu=reference_run["cpu_seconds"],
+        thesis_reference_speed=snippet("thesis_reference_speed")
+        if settings.reference_speed == THESIS_TABLE_6_4_REFERENCE_SPEED else "",
+        t64_table="\n".join([snippet("t64_header")] + rows64),
+        t64_discretisation=snippet("t64_discretisation", pair=pair, thesis_mean=THESIS_TABLE_6_4_DISCRETISATION[0],
+                                   thesis_max=THESIS_TABLE_6_4_DISCRETISATION[1]) if pair else "",
+        speed_note=speed_note(errors, pair, template),
+        table_6_5="\n".join(table_6_5_section(results["table_6_5"], "python -m studies.experiments.needle"
+                                              + (" --quick" if quick else ""))))
 
     # Table 6.6
-    lines += [f"## Table 6.6: conformance error (h_start = h{settings.h_start}, h_ref = h{settings.h_ref})", "",
-              f"The static load along a line tilted {TILT_DEGREES:g}° from the entry point (0, 0.05) over 70 mm, so the "
-              "'needle' does not follow mesh edges. Loaded nodes: of every edge the line crosses, the end closest to "
-              "the line (the needle's rule, §6.4), plus nodes on it; forces as for the straight line, along the line, "
-              "from the nodes' positions projected onto it. 'With relocation': the loaded nodes are first projected "
-              "orthogonally onto the line with `mesh.snap_vertex` (which refuses a move that would flatten or invert a "
-              f"cell; such nodes stay). Reference: uniform h{settings.fine} with relocation, ε = {REFERENCE_TOLERANCE:g}; "
-              f"errors at its vertices.", "",
-              "| comparison | mean error [mm] | thesis mean | max error [mm] | thesis max |", "|---|---|---|---|---|"]
-    for row in t66:
-        lines.append(f"| {row['label']} | {row['mean_error_mm']:.3f} | "
-                     f"{cell(row['thesis_mean_error_mm'], None, '{:g}') if row['thesis_mean_error_mm'] else '–'} | "
-                     f"{row['max_error_mm']:.3f} | "
-                     f"{cell(row['thesis_max_error_mm'], None, '{:g}') if row['thesis_max_error_mm'] else '–'} |")
-    lines += ["", "Nodes: " + t66[0]["details"].rstrip("; ") + ".", "",
-              conformance_note(t66, reference["max_displacement_mm"]), ""]
+    values.update(
+        tilt=TILT_DEGREES,
+        t66_table="\n".join([snippet("t66_header")] + [
+            f"| {row['label']} | {row['mean_error_mm']:.3f} | "
+            f"{cell(row['thesis_mean_error_mm'], None, '{:g}') if row['thesis_mean_error_mm'] else '–'} | "
+            f"{row['max_error_mm']:.3f} | "
+            f"{cell(row['thesis_max_error_mm'], None, '{:g}') if row['thesis_max_error_mm'] else '–'} |" for row in t66]),
+        t66_nodes=t66[0]["details"].rstrip("; "),
+        conformance=conformance_note(t66, reference["max_displacement_mm"], template))
 
     # Figure 6.12
-    lines += [f"## Figure 6.12: nonlinearity (sideways insertion, slab fixed at the bottom, ν = 0)", "",
-              f"`slab_body({settings.h_start}, material, fixed=\"bottom\")`, needle from (0, 0.05) along +x to 70 mm, "
-              f"h_ref = h{settings.h_ref}, {settings.nonlinear_speed:g} h_ref per update"
-              + (" (the thesis's speed)" if settings.nonlinear_speed == 0.01 else " (coarser than the thesis's 0.01)")
-              + "; linear CG for `LinearElastic(34e3, 0)`, truncated Newton for `NeoHookean(34e3, 0)`. "
-              "**Tip's reference location**: the reference position of the material point under the deformed tip, "
-              "found by locating the tip in the deformed mesh and mapping its barycentric coordinates back to the "
-              "reference cell; as a check, the reference position of the needle node furthest along the shaft.", "",
-              "| friction ×| material | updates | rearrangements | CPU [s] | CG mean / max | max |u| [mm] | "
-              "tip's reference location [mm] | furthest needle node, reference [mm] | converged |",
-              "|---|---|---|---|---|---|---|---|---|---|"]
+    rows612 = []
     for row in nonlinear:
         exact = ("–" if row["tip_reference_x"] is None
                  else f"({row['tip_reference_x'] * MM:.2f}, {row['tip_reference_y'] * MM:.2f})")
-        lines.append(f"| {row['scale']:g} | {row['material']} | {row['updates']} | {row['rearrangements']} | "
-                     f"{row['cpu_seconds']:.1f} | {row['mean_iterations']:.1f} / {row['max_iterations']} | "
-                     f"{row['max_displacement_mm']:.1f} | {exact} | ({row['tip_node_reference_x'] * MM:.2f}, "
-                     f"{row['tip_node_reference_y'] * MM:.2f}) | {'yes' if row['converged'] else row['reason']} |")
-    lines += ["", nonlinear_note(nonlinear), ""]
-    for scale in settings.nonlinear_scales:
-        lines += [f"![Figure 6.12, friction ×{scale:g}]({nonlinear_png(scale)})", ""]
-    failed = ([f"insertion h{r['h_ref']} at {r['speed']:g} (ε = {r['rtol']:g}): {r['reason']}"
-               for r in insertion + results["table_6_5"] if not r["converged"]]
-              + [f"Figure 6.12 {r['material']} ×{r['scale']:g}: {r['reason']}" for r in nonlinear if not r["converged"]])
-    lines += ["**Did not converge:** " + ("; ".join(failed) if failed else "none") + "."]
-    return "\n".join(lines) + "\n"
+        rows612.append(f"| {row['scale']:g} | {row['material']} | {row['updates']} | {row['rearrangements']} | "
+                       f"{row['cpu_seconds']:.1f} | {row['mean_iterations']:.1f} / {row['max_iterations']} | "
+                       f"{row['max_displacement_mm']:.1f} | {exact} | ({row['tip_node_reference_x'] * MM:.2f}, "
+                       f"{row['tip_node_reference_y'] * MM:.2f}) | {'yes' if row['converged'] else row['reason']} |")
+    failed = ([snippet("failed_insertion", row=r) for r in insertion + results["table_6_5"] if not r["converged"]]
+              + [snippet("failed_nonlinear", row=r) for r in nonlinear if not r["converged"]])
+    values.update(
+        nonlinear_speed=settings.nonlinear_speed,
+        nonlinear_speed_note=snippet("thesis_speed" if settings.nonlinear_speed == 0.01 else "coarser_speed"),
+        nonlinear_table="\n".join([snippet("nonlinear_header")] + rows612), nonlinear_note=nonlinear_note(nonlinear, template),
+        nonlinear_images="\n\n".join(snippet("nonlinear_image", scale=scale, file=nonlinear_png(scale))
+                                      for scale in settings.nonlinear_scales),
+        failed="; ".join(failed) if failed else snippet("none"))
+    return template.page(**values)
 
 
 def slope(rows) -> float:
@@ -911,164 +823,97 @@ def monotone_iterations(rows) -> bool:
         all(by[(a, b)] <= by[(a2, b)] for (a, b) in by for (a2, b2) in by if b2 == b and a2 > a)
 
 
-def monotone_notes(rows, settings) -> list[str]:
+def monotone_notes(rows, settings, template: PageTemplate) -> str:
     by = {(r["h_start"], r["h_ref"]): r["mean_error_mm"] for r in rows}
     rises = [(f"h{a}/h{b} → h{a}/h{b + 1}", by[(a, b + 1)] - by[(a, b)]) for (a, b) in by
              if (a, b + 1) in by and by[(a, b + 1)] > by[(a, b)]]
     rises += [(f"h{a}/h{b} → h{a + 1}/h{b}", by[(a + 1, b)] - by[(a, b)]) for (a, b) in by
               if (a + 1, b) in by and by[(a + 1, b)] > by[(a, b)]]
-    lines = []
-    if rises:
-        lines += ["**Not monotone everywhere:** the mean error rises, by at most "
-                  f"{max(d for _, d in rises):.4f} mm, for " + ", ".join(name for name, _ in rises)
-                  + ": refining only along the line cannot remove the error of the coarse far field, and moves "
-                  "the load's discretisation slightly.", ""]
-    else:
-        lines += ["The mean error falls with every refinement step of either h (no exceptions).", ""]
+    paragraphs = [template.snippet("not_monotone", largest=max(d for _, d in rises),
+                                   steps=", ".join(name for name, _ in rises)) if rises else
+                  template.snippet("monotone")]
     first, last = settings.refs[0], settings.refs[-1]
     gains = [(a, by[(a, b)], by[(a, last)]) for a in settings.starts for b in (max(first, a + 1),)
              if (a, b) in by and (a, last) in by and b < last]
     if gains:
-        lines += ["**Differs:** past h_ref = h_start + 1 the *mean* error hardly moves in our runs ("
-                  + "; ".join(f"h{a}: {x:.3f} → {y:.3f} mm" for a, x, y in gains)
-                  + f", from the first tabulated h_ref finer than h_start to h{last}), while the thesis's keeps falling with "
-                  "h_ref (e.g. h3: "
-                  "0.13 → 0.08 mm); the far field of the coarse start mesh dominates ours. The *maximum* error, "
-                  "which sits near the line, does fall with h_ref in both.", ""]
-    return lines
+        paragraphs.append(template.snippet("mean_flat", last=last,
+                                           gains="; ".join(f"h{a}: {x:.3f} → {y:.3f} mm" for a, x, y in gains)))
+    return "\n\n".join(paragraphs)
 
 
-def speed_note(errors, pair) -> str:
+def speed_note(errors, pair, template: PageTemplate) -> str:
     if not errors:
         return ""
-    fastest, slowest = errors[0], errors[-1]
-    worst = max(errors, key=lambda r: r["mean_error_mm"])
-    text = (f"**Trend:** the error of the fastest insertion ({fastest['speed']:g} h_ref/update) is "
-            f"{fastest['mean_error_mm']:.3f} mm mean / {fastest['max_error_mm']:.3f} mm max; the slowest "
-            f"({slowest['speed']:g}) {slowest['mean_error_mm']:.3f} / {slowest['max_error_mm']:.3f} mm; the largest "
-            f"mean error is at {worst['speed']:g}. ")
     monotone = all(b["mean_error_mm"] <= a["mean_error_mm"] for a, b in zip(errors, errors[1:]))
-    text += ("The error falls monotonically with speed here. " if monotone else
-             "As in the thesis (\"no clear trend\"), the error does not fall monotonically with speed (our "
-             "reading: stick-slip is path dependent, and where each node last stuck depends on the step). ")
+    sentences = [template.snippet("trend", fastest=errors[0], slowest=errors[-1],
+                                  worst=max(errors, key=lambda r: r["mean_error_mm"])),
+                 template.snippet("falls_with_speed" if monotone else "no_clear_trend")]
     if pair:
         below = [r for r in errors if r["speed"] < 1.0]
         if below:
-            ratio_to_disc = max(r["mean_error_mm"] for r in below) / pair["mean_error_mm"]
-            text += (f"Below 1 h_ref per update the mean error is at most {ratio_to_disc:.1f}× the static "
-                     "discretisation error at this resolution (thesis: \"the same order of magnitude\").")
-    return text
+            sentences.append(template.snippet("below_one",
+                                              ratio=max(r["mean_error_mm"] for r in below) / pair["mean_error_mm"]))
+    return " ".join(sentences)
 
 
-def rate_note(rows) -> str:
+def rate_note(rows, template: PageTemplate) -> str:
+    snippet = template.snippet
     texts = []
     for rtol in sorted({r["rtol"] for r in rows}):
         timed = [r for r in rows if r["rtol"] == rtol and r.get("rate_ratio")]
         if not timed:
             continue
         ratios = [r["rate_ratio"] for r in timed]
-        worst = min(timed, key=lambda r: r["rate_ratio"])
-        best = max(timed, key=lambda r: r["rate_ratio"])
         h7 = [r["update_rate_hz"] for r in rows if r["rtol"] == rtol and r["h_ref"] == 7]
         per_solve = [1e6 * r["cpu_seconds"] / r["rearrangements"] for r in timed]
-        text = (f"**ε = {rtol:g}: {min(ratios):.1f}× to {max(ratios):.1f}× the thesis's rate (geometric mean "
-                f"{geometric_mean(ratios):.1f}×)"
-                + (f"; the ≥ {UPDATE_RATE_GOAL:g}× goal is " + ("met" if min(ratios) >= UPDATE_RATE_GOAL else "not met")
-                   if rtol == ISSUE_TOLERANCE else "")
-                + (f"; h7 at {min(h7):.0f}–{max(h7):.0f} Hz (goal ≥ {H7_RATE_GOAL_HZ:g} Hz"
-                   + (", met)" if min(h7) >= H7_RATE_GOAL_HZ else ", not met everywhere)") if h7 else "")
-                + f".** Smallest ratio: h{worst['h_ref']} at {worst['speed']:g} h_ref/update, largest: "
-                f"h{best['h_ref']} at {best['speed']:g}. CG iterations per solve: {cg_ratio(timed):.2f}× the "
-                f"thesis's (geometric mean); CPU per solve {min(per_solve):.0f}–{max(per_solve):.0f} µs.")
-        texts.append(text)
+        texts.append(snippet(
+            "rate", rtol=rtol, low=min(ratios), high=max(ratios), mean=geometric_mean(ratios),
+            goal=snippet("rate_goal", goal=UPDATE_RATE_GOAL,
+                         met=snippet("met" if min(ratios) >= UPDATE_RATE_GOAL else "not_met"))
+            if rtol == ISSUE_TOLERANCE else "",
+            h7=snippet("h7_rates", low=min(h7), high=max(h7), goal=H7_RATE_GOAL_HZ,
+                       met=snippet("h7_met" if min(h7) >= H7_RATE_GOAL_HZ else "h7_not_met")) if h7 else "",
+            worst=min(timed, key=lambda r: r["rate_ratio"]), best=max(timed, key=lambda r: r["rate_ratio"]),
+            cg=cg_ratio(timed), cpu_low=min(per_solve), cpu_high=max(per_solve)))
     if not texts:
-        return "No thesis numbers for this set-up (quick run)."
-    texts.append("Where the time goes (`studies/benchmarks/needle_rates.py` prints it from PETSc's event log; `perf` on the "
-                 "C++ build): at ε = 1e-3 the solver, 20–40 unpreconditioned CG iterations per solve of about 3 µs "
-                 "each on 750–1300 triangles, the matrix-free tangent product half of that and the rest PETSc's "
-                 "vector operations (the reference BLAS's ddot), the constraint projections around each product and "
-                 "the convergence test; at ε = 0.03, below 4 iterations per solve at the slow speeds, the 25–35 µs "
-                 "per update outside the solver: point location for the refinement at the tip (in the deformed "
-                 "mesh, then in the bisection hierarchy), the residual at the start of each solve and again at its "
-                 "end (the check of (6.9) on the final state, which the rearrangement now reuses), the interception "
-                 "scan and the rearrangement. 50× at ε = 1e-3 leaves 28–43 µs per solve in the slowest rows (0.03 and "
-                 "0.01 h_ref/update), less than their 22–35 tangent products alone take: it needs fewer iterations, "
-                 "not cheaper ones. "
-                 "Measured and not taken: ICC (`-needle_pc_type icc`, 11–15 iterations) and a Cholesky "
-                 "factorisation (`cholesky`, 1 iteration) cost more per solve than they save (h6, ε = 1e-3: 145–260 "
-                 "and 175–520 µs per solve against 125–175 without a preconditioner; Jacobi 165–330), because the "
-                 "system changes at 45–100 % of the updates (refinement at the tip changes the mesh, stick-slip the "
-                 "constraints) and each change is a new factorisation; the linear predictor (`extrapolate=True`) "
-                 "saves iterations in the slow rows but adds rearrangements in the fast ones. As in the thesis, "
-                 "slower insertion needs fewer CG iterations per solve (more coherence between solutions) and "
-                 "reaches higher update rates.")
+        return snippet("no_thesis_rates")
+    texts.append(snippet("time_goes"))
     return " ".join(texts)
 
 
-def conformance_note(rows, straight_max_mm: float) -> str:
+def conformance_note(rows, straight_max_mm: float, template: PageTemplate) -> str:
     by = {r["comparison"]: r for r in rows}
     a, w, wo = by["relocation_vs_none"], by["with_relocation"], by["without_relocation"]
     smaller = a["mean_error_mm"] < min(w["mean_error_mm"], wo["mean_error_mm"])
-    return ((f"**{'Agrees' if smaller else 'Differs'}:** the difference relocation makes ({a['mean_error_mm']:.3f} mm "
-             f"mean, {a['max_error_mm']:.3f} max) is {'smaller' if smaller else 'not smaller'} than the discretisation "
-             f"error ({w['mean_error_mm']:.3f} with, {wo['mean_error_mm']:.3f} without relocation)")
-            + (", as in the thesis: not relocating nodes costs little accuracy." if smaller else ".")
-            + f" The reference's own conformance error (h-fine with vs. without relocation) is "
-              f"{by['reference_relocation_vs_none']['mean_error_mm']:.3f} mm mean: the reference is good to about that. "
-              f"The tilted load bends the slab (up to {a['reference_max_displacement_mm']:.1f} mm of displacement, "
-              f"against {straight_max_mm:.1f} mm for the straight line), so its discretisation error on the coarse "
-              "start mesh is larger than the straight line's in Table 6.3; the thesis found the two about equal.")
+    return template.snippet(
+        "conformance", verdict=template.snippet("relocation_smaller" if smaller else "relocation_not_smaller",
+                                                a=a, w=w, wo=wo),
+        reference=by["reference_relocation_vs_none"]["mean_error_mm"], tilted=a["reference_max_displacement_mm"],
+        straight=straight_max_mm)
 
 
-# Why snede's Figure 6.12 distance is smaller than the thesis's (issue 33; docs/results/needle.md).
-FIGURE_6_12_EXPLANATION = (
-    "**Why, and not a snede mistake.** (1) The units hold: the profile is a force per length across the slab's "
-    "10 mm (§6.3.1: t = t̃/d) and the slab's stiffness has that thickness (`Body(thickness=0.01)`); the static line "
-    "load's 4.6 mm (Tables 6.1–6.3) is of the size a hand estimate gives (1.6 N on a 0.1 × 0.01 m section of "
-    "E = 34 kPa: a strain of 5 % over the 30–100 mm to the fixed side, 1.5–5 mm). (2) The materials are the thesis's: linear elasticity (2.22) and, at ν = 0, neo-Hookean "
-    "S = μ(I − C⁻¹) (6.4), which the engine's plane-stress closed form gives at λ = 0 (C₃₃ = 1). (3) The "
-    "deformation is a shear parallel to the fixed bottom, and in simple shear neo-Hookean's shear stress is μγ, "
-    "the linear one's: the two differ only in second order (normal stresses and rotation, γ²·h). The friction "
-    "thresholds prescribe forces, equal for both materials, so the tip's material point moves alike along x; the "
-    "distance grows with the load and levels off near 2 mm once the slab's left part is dragged off the shaft. "
-    "(4) The load is what the thesis does not give: Figure 6.4 has no numbers, so `figure_6_4()` is a stand-in. "
-    "Its refined mesh gives a hint: 625 triangles at the end, between snede's ×1 (about 760) and ×5 (about 600) "
-    "meshes, where snede's distance is 0.2–2 mm. A load, or a measure (the text says 'the final location of "
-    "needle tip', the caption 'the tip reference locations'), that gives 8 mm cannot be read from the thesis; "
-    "nothing to fix in snede.")
-
-
-def nonlinear_note(rows) -> str:
-    text = []
+def nonlinear_note(rows, template: PageTemplate) -> str:
+    snippet = template.snippet
+    distances = []
     for scale in sorted({r["scale"] for r in rows}):
         pair = [r for r in rows if r["scale"] == scale]
         distance = pair[0]["tip_reference_distance_mm"]
-        node = pair[0]["tip_node_distance_mm"]
-        largest = max(r["max_displacement_mm"] for r in pair)
-        text.append(f"friction ×{scale:g} (max |u| {largest:.0f} mm): "
-                    + (f"{distance:.1f} mm" if distance is not None else "not found")
-                    + f" (furthest needle nodes: {node:.1f} mm)")
-    distances = [r["tip_reference_distance_mm"] for r in rows if r["tip_reference_distance_mm"] is not None]
-    largest = max(distances, default=float("nan"))
-    lines = ["**Distance between the tips' reference locations, linear vs. neo-Hookean (thesis ≈ "
-             f"{THESIS_TIP_DISTANCE_MM:g} mm):** " + "; ".join(text) + "."]
-    lines.append(("**Differs:** " if largest < 0.5 * THESIS_TIP_DISTANCE_MM else "")
-                 + f"at most {largest:.1f} mm here"
-                 + ((", well short of the thesis's ≈ 8 mm"
-                     + (", even when the profile is scaled up until the slab's top is dragged several centimetres. "
-                        if len({r["scale"] for r in rows}) > 1 else ". "))
-                    if largest < 0.5 * THESIS_TIP_DISTANCE_MM else ". ")
-                 + FIGURE_6_12_EXPLANATION)
-    lines.append(" ".join(f"{r['material']} ×{r['scale']:g}: the shaft's material points lie at reference y = "
-                          f"{r['shaft_reference_y_min_mm']:.1f}–{r['shaft_reference_y_max_mm']:.1f} mm, the tip's "
-                          "material point at x = " + (f"{r['tip_reference_x'] * MM:.1f} mm"
-                                                      if r["tip_reference_x"] is not None else "–") + "."
-                          for r in rows)
-                 + " The tip's material point lies short of x = 70 mm because friction dragged the material along +x "
-                 "before the tip reached it (at large scales the slab's left side is dragged so far that only the end "
-                 "of the shaft is inside it); the spread in y is how far the shaft's material trajectory bends away "
-                 "from the straight line y = 50 mm in the reference configuration.")
-    return "\n\n".join(lines)
+        distances.append(snippet("scale_distance", scale=scale, largest=max(r["max_displacement_mm"] for r in pair),
+                                 distance=f"{distance:.1f} mm" if distance is not None else snippet("not_found"),
+                                 node=pair[0]["tip_node_distance_mm"]))
+    largest = max((r["tip_reference_distance_mm"] for r in rows if r["tip_reference_distance_mm"] is not None),
+                  default=float("nan"))
+    if largest < 0.5 * THESIS_TIP_DISTANCE_MM:
+        verdict = snippet("distance_short", largest=largest, why=snippet("why"),
+                          scaled=snippet("even_scaled") if len({r["scale"] for r in rows}) > 1 else ".")
+    else:
+        verdict = snippet("distance_close", largest=largest, why=snippet("why"))
+    shafts = " ".join(snippet("shaft_row", material=r["material"], scale=r["scale"],
+                              y_min=r["shaft_reference_y_min_mm"], y_max=r["shaft_reference_y_max_mm"],
+                              x=f"{r['tip_reference_x'] * MM:.1f} mm" if r["tip_reference_x"] is not None else "–")
+                      for r in rows)
+    return "\n\n".join([snippet("distances", thesis=THESIS_TIP_DISTANCE_MM, distances="; ".join(distances)), verdict,
+                         snippet("shaft_summary", rows=shafts)])
 
 
 def nonlinear_png(scale: float) -> str:
