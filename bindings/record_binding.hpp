@@ -6,7 +6,9 @@
 
 #include <pybind11/stl.h>
 
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <string>
 #include <type_traits>
 #include <utility>
@@ -15,6 +17,17 @@
 #include "bindings.hpp"
 
 namespace snede::bindings {
+
+// A record equals itself field by field, NaN included (as a dataclass holding the same float
+// objects does): a DIVERGED_NONFINITE_STATE result carries a NaN residual norm.
+inline bool same_value(double a, double b) { return a == b || (std::isnan(a) && std::isnan(b)); }
+inline bool same_value(const std::vector<double>& a, const std::vector<double>& b) {
+  return a.size() == b.size() && std::equal(a.begin(), a.end(), b.begin(), [](double x, double y) { return same_value(x, y); });
+}
+template <class T>
+bool same_value(const T& a, const T& b) {
+  return a == b;
+}
 
 template <class T>
 constexpr bool is_sequence = false;
@@ -86,16 +99,22 @@ py::class_<Record> bind_record(py::module_& m, const char* type_name, const char
   });
   cls.def(
       "__eq__",
-      [](const Record& a, const py::object& other) {
-        if (!py::isinstance<Record>(other)) return false;
+      [](const Record& a, const py::object& other) -> py::object {
+        if (!py::isinstance<Record>(other)) return py::reinterpret_borrow<py::object>(Py_NotImplemented);
         const Record& b = other.cast<const Record&>();
         bool same = true;
-        Record::visit_fields([&](const char*, auto member) { same = same && a.*member == b.*member; });
-        return same;
+        Record::visit_fields([&](const char*, auto member) { same = same && same_value(a.*member, b.*member); });
+        return py::bool_(same);
       },
       py::is_operator());
-  cls.def(py::pickle([](const Record& record) { return record_fields(record); },
-                     [type_name](const py::dict& values) { return record_from<Record>(type_name, values); }));
+  // Pickling and copying rebuild the record from its type and fields, under every pickle
+  // protocol (pybind11's own pickling needs protocol 2 and aborted the process below it).
+  if (!py::hasattr(m, "_record_from_fields"))
+    m.def("_record_from_fields", [](const py::object& type, const py::dict& values) { return type(**values); });
+  cls.def("__reduce__", [m](const py::object& self) {
+    return py::make_tuple(m.attr("_record_from_fields"),
+                          py::make_tuple(py::type::of(self), record_fields(self.cast<const Record&>())));
+  });
   if constexpr (requires(Record& a, const Record& b) { a.add(b); }) {
     cls.def("__add__", [](const Record& a, const Record& b) {
       Record sum = a;

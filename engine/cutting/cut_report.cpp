@@ -1,6 +1,6 @@
 #include "cutting/cut_report.hpp"
 
-#include <cstdio>
+#include "core/formatted.hpp"
 
 namespace snede {
 
@@ -28,13 +28,11 @@ void CutReport::add(const CutReport& o) {
 }
 
 std::string summary(const CutReport& r) {
-  char line[320];
-  std::snprintf(line, sizeof line,
-                "%d faces dissected (%d vertices snapped, %d refused), %d degenerate: %d collapses, %d splits, "
-                "%d cut free, %d fragments removed; %d pieces in %.2f ms",
-                r.faces_dissected, r.vertices_snapped, r.snaps_refused, r.degenerate_found, r.edges_collapsed,
-                r.edges_split, r.elements_cut_free, r.fragments_removed, r.components, r.seconds * 1e3);
-  return line;
+  return formatted(
+      "%d faces dissected (%d vertices snapped, %d refused), %d degenerate: %d collapses, %d splits, %d cut free, "
+      "%d fragments removed; %d pieces in %.2f ms",
+      r.faces_dissected, r.vertices_snapped, r.snaps_refused, r.degenerate_found, r.edges_collapsed, r.edges_split,
+      r.elements_cut_free, r.fragments_removed, r.components, r.seconds * 1e3);
 }
 
 }  // namespace snede

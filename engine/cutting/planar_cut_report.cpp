@@ -1,6 +1,6 @@
 #include "cutting/planar_cut_report.hpp"
 
-#include <cstdio>
+#include "core/formatted.hpp"
 
 namespace snede {
 
@@ -28,10 +28,8 @@ std::string summary(const PlanarCutReport& r) {
                      std::to_string(r.entries) + " entries, " + std::to_string(r.exits) + " exits";
   if (r.branches || r.annihilations)
     line += ", " + std::to_string(r.branches) + " branches, " + std::to_string(r.annihilations) + " annihilations";
-  char rest[96];
-  std::snprintf(rest, sizeof rest, "; %zu \u2192 %zu triangles in %.2f ms", r.triangles_before, r.triangles_after,
-                r.seconds * 1e3);
-  return line + rest;
+  return line + formatted("; %zu \u2192 %zu triangles in %.2f ms", r.triangles_before, r.triangles_after,
+                          r.seconds * 1e3);
 }
 
 }  // namespace snede

@@ -53,10 +53,13 @@ DynamicRelaxation::DynamicRelaxation(std::unique_ptr<Problem> owned, Problem* pr
     : owned_problem_(std::move(owned)),
       problem_(problem ? *problem : *owned_problem_),
       option_database_(options_prefix, petsc_options) {
+  InputDigest options_digest;
+  for (const auto& [name, value] : petsc_options) options_digest.add(name).add(value);
   RankAgreement("DynamicRelaxation")
       .input("damping", damping_eta)
       .input("dt", dt)
       .input("options_prefix", options_prefix)
+      .input("petsc_options", options_digest)
       .require(problem_.comm());
   require_valid_damping(damping_eta);
   require(dt == 0 || positive_finite(dt), "dt", "positive and finite (or 0 for the CFL estimate)", dt);

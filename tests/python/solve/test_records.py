@@ -1,12 +1,17 @@
 """The engine's report structs are Python's records (issue 36: fields spelled once, in C++):
 keyword construction, attributes, repr, equality, pickling, and the one-line summary."""
+import copy
 import pickle
+import subprocess
+import sys
 
 import numpy as np
 import pytest
 
 import snede
-from snede._snede import NeedleStepReport
+from snede._snede import NeedleOptions, NeedleStepReport
+
+RECORDS = [snede.SolveResult, NeedleStepReport, NeedleOptions, snede.CutReport, snede.PlanarCutReport]
 
 
 def a_solve():
@@ -80,3 +85,21 @@ def test_cut_reports_add_as_the_engine_adds_them_and_read_sequences_as_tuples():
         snede.PlanarCutReport(moves=2, branches=1, triangles_before=12, triangles_after=15)
     assert (planar.moves, planar.triangles_before, planar.triangles_after) == (3, 10, 15)
     assert str(planar).endswith("1 branches, 0 annihilations; 10 → 15 triangles in 0.00 ms")
+
+
+# Protocols 0 and 1 aborted the interpreter with pybind11's own pickling (it serves 2 and up),
+# so the probe runs in a subprocess.
+@pytest.mark.parametrize("protocol", [0, 1])
+@pytest.mark.parametrize("record", RECORDS, ids=lambda cls: cls.__name__)
+def test_records_pickle_under_every_protocol_without_killing_the_interpreter(record, protocol):
+    code = (f"import pickle, snede._snede as m\n"
+            f"r = m.{record.__name__}()\n"
+            f"assert pickle.loads(pickle.dumps(r, {protocol})) == r\n")
+    run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert run.returncode == 0, f"returncode {run.returncode}: {run.stderr[-400:]}"
+
+
+def test_a_record_holding_nan_equals_itself_and_its_copy():
+    result = snede.SolveResult(converged=False, reason="DIVERGED_NONFINITE_STATE", residual_norm=float("nan"))
+    assert result == result
+    assert copy.deepcopy(result) == result
