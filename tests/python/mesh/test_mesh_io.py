@@ -13,7 +13,7 @@ import pytest
 import snede
 from snede import canonical_meshes, meshing
 
-MESHES = Path(__file__).resolve().parents[2] / "meshes"
+MESHES = Path(__file__).resolve().parents[3] / "meshes"
 
 
 def signed_volumes(points, cells):
