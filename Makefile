@@ -11,7 +11,7 @@ test: setup
 	@bash tools/run_tests.sh
 
 meshes: setup
-	@.venv/bin/python -m snede.canonical_meshes
+	@.venv/bin/python tools/canonical_meshes.py
 
 benchmark: setup
 	@.venv/bin/python studies/benchmarks/connectivity_build.py

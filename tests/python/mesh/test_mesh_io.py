@@ -1,6 +1,7 @@
 """Mesh.read / Mesh.write round trips, files written by gmsh itself, and the canonical meshes
-in meshes/ (python -m snede.canonical_meshes)."""
+in meshes/ (tools/canonical_meshes.py, the tool that writes them)."""
 import contextlib
+import importlib.util
 import io
 import math
 import re
@@ -11,9 +12,21 @@ import numpy as np
 import pytest
 
 import snede
-from snede import canonical_meshes, meshing
+from snede import meshing
 
-MESHES = Path(__file__).resolve().parents[3] / "meshes"
+ROOT = Path(__file__).resolve().parents[3]
+MESHES = ROOT / "meshes"
+
+
+def load_tool(path: Path):
+    """A script of tools/ as a module (tools/ is not a package)."""
+    spec = importlib.util.spec_from_file_location(path.stem, path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+canonical_meshes = load_tool(ROOT / "tools" / "canonical_meshes.py")
 
 
 def signed_volumes(points, cells):

@@ -1,9 +1,8 @@
 """Regenerate the small canonical meshes kept in the repository's ``meshes/`` folder.
 
-    python -m snede.canonical_meshes [output-folder]
+    .venv/bin/python tools/canonical_meshes.py [output-folder]      # or: make meshes
 
-writes the meshes below (default folder: ``meshes/`` at the repository root, i.e.
-``python/snede/../../meshes``), reads each file back to check that ``Mesh.read`` returns
+writes the meshes below (default folder: ``meshes/`` at the repository root), reads each file back to check that ``Mesh.read`` returns
 exactly the points and cells that were written, and prints a table of what it wrote.
 
 The cylinders follow the two cylinders of the thesis's Table 4.2 (length 0.1 m, radius 0.03 m,
@@ -26,7 +25,7 @@ reference.
 Files are written as gmsh 2.2 ASCII (``$MeshFormat 2.2 0 8``), which gmsh itself, meshio and
 most finite-element tools read; coordinates are written with 17 significant digits, so they
 read back bit for bit. (``Mesh.write`` is not used: for ``.msh`` meshio picks its ANSYS
-writer first, see the test ``test_mesh_io.py::test_write_msh_is_a_gmsh_file``.)
+writer first, see the test ``tests/python/mesh/test_mesh_io.py::test_write_msh_is_a_gmsh_file``.)
 """
 from __future__ import annotations
 
@@ -42,7 +41,7 @@ from snede import meshing
 from snede.mesh import Mesh
 
 #: The repository's ``meshes/`` folder, found relative to this file (python/snede/../../meshes).
-MESH_DIR = Path(__file__).resolve().parent.parent.parent / "meshes"
+MESH_DIR = Path(__file__).resolve().parent.parent / "meshes"
 
 LENGTH = 0.1  #: cylinder length (m), Table 4.2
 RADIUS = 0.03  #: cylinder radius (m), Table 4.2
@@ -167,7 +166,7 @@ def format_table(rows: list[Written]) -> str:
 def main(argv: list[str] | None = None) -> int:
     argv = sys.argv[1:] if argv is None else argv
     if len(argv) > 1 or (argv and argv[0].startswith("-")):
-        print("usage: python -m snede.canonical_meshes [output-folder]", file=sys.stderr)
+        print("usage: python tools/canonical_meshes.py [output-folder]", file=sys.stderr)
         return 2
     directory = Path(argv[0]) if argv else MESH_DIR
     rows = regenerate(directory)
