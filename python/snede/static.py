@@ -84,8 +84,10 @@ class StaticSolver(RunsOnRanks):
       ``criterion``, and the result is gathered into ``body.displacement`` on every rank. The
       preconditioner is ``"gamg"`` (default), ``"jacobi"``, ``"none"``, ``"bjacobi"`` (ILU(0)
       on each rank's block), ``"sor"`` (each rank's rows) or ``"lu"`` (MUMPS);
-      ``part`` is this rank's part. None (default): the body's ``comm``, and without one the
-      serial solver.
+      ``part`` is this rank's part. ``petsc_options``, ``line_search`` and ``ncg_type`` are
+      refused there (NotImplementedError): the distributed solve reads the command line's
+      ``-<prefix>snes_*``/``-<prefix>ksp_*`` options only. None (default): the body's ``comm``,
+      and without one the serial solver.
 
     ``solve()`` first checks that every piece of the body (cells joined through faces) is held:
     a piece with fewer constrained displacement components than rigid motions (3 in 2D, 6 in 3D
@@ -126,6 +128,10 @@ class StaticSolver(RunsOnRanks):
         self._distributed = None
         comm = getattr(body, "comm", None) if comm is None else comm
         if comm is not None:
+            if options:  # the distributed solve reads PETSc's global options only
+                raise NotImplementedError(f"petsc_options, line_search and ncg_type on MPI ranks (comm): give "
+                                          f"-{options_prefix}snes_* and -{options_prefix}ksp_* options on the "
+                                          "command line, which every rank reads")
             if preconditioner not in DISTRIBUTED_PRECONDITIONERS:
                 raise NotImplementedError(f"preconditioner {preconditioner!r} on MPI ranks (comm): distributed "
                                           f"solves take {DISTRIBUTED_PRECONDITIONERS}")

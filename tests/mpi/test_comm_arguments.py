@@ -114,6 +114,10 @@ def test_what_is_not_distributed_is_refused_on_every_rank():
     solver = snede.StaticSolver(loaded_body(snede.LinearElastic(1e5, 0.3)), "cg", comm=COMM)
     with pytest.raises(NotImplementedError, match="only solve"):
         solver.ksp
+    # Options for this solver alone were dropped without a word on ranks: refused instead.
+    for options in ({"petsc_options": {"snes_max_it": 3}}, {"line_search": "bt"}, {"ncg_type": "fr"}):
+        with pytest.raises(NotImplementedError, match="on MPI ranks \\(comm\\): give -static_snes_"):
+            snede.StaticSolver(loaded_body(snede.LinearElastic(1e5, 0.3)), "ncg", comm=COMM, **options)
     assert COMM.allreduce(1) == COMM.size
 
 
