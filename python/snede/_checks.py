@@ -7,9 +7,13 @@ beyond that range reaches pybind11 as an opaque "incompatible function arguments
 and a uint64 beyond int64 wraps to a negative number on its way to int64. Every failure is a
 ``ValueError`` naming the argument, the offending value (and its position in an array) and
 the allowed range.
+
+Real numbers (lengths, tolerances) and coordinates are checked here too: finite, and in range
+or of the right shape.
 """
 from __future__ import annotations
 
+import math
 import operator
 
 import numpy as np
@@ -103,3 +107,30 @@ def size(n_points: int, n_cells: int, given: str) -> None:
     if n_points > INT32_MAX or n_cells > INT32_MAX:
         raise ValueError(f"{given} would make a mesh too large: {n_points} vertices and {n_cells} cells, but "
                          f"vertex and cell ids are 32-bit in the engine (at most 2**31 − 1 = {INT32_MAX} of each)")
+
+
+def positive(value, name: str) -> float:
+    """``value`` as a float, positive and finite; else a ValueError naming ``name`` and the value."""
+    return _real(value, name, float(value) > 0, "positive")
+
+
+def non_negative(value, name: str) -> float:
+    """``value`` as a float, at least 0 and finite; else a ValueError naming ``name`` and the value."""
+    return _real(value, name, float(value) >= 0, "non-negative")
+
+
+def _real(value, name: str, in_range: bool, kind: str) -> float:
+    if not (in_range and math.isfinite(float(value))):
+        raise ValueError(f"{name} must be {kind} and finite, got {value}")
+    return float(value)
+
+
+def coordinates(value, shape: tuple, name: str) -> np.ndarray:
+    """``value`` as a C-contiguous float64 array of ``shape`` with finite entries (a point, a
+    segment's ends, a triangle's corners); else a ValueError naming ``name``."""
+    array = np.asarray(value, dtype=np.float64)
+    if array.shape != shape:
+        raise ValueError(f"{name} must have shape {shape}, got {array.shape}")
+    if not np.all(np.isfinite(array)):
+        raise ValueError(f"{name} must be finite, got non-finite coordinates {array.tolist()}")
+    return np.ascontiguousarray(array)

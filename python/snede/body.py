@@ -10,6 +10,7 @@ import warnings
 import numpy as np
 
 from snede import _checks, _snede
+from snede._engine import engine_property
 from snede.mesh import Mesh
 
 # Above this Poisson's ratio linear tetrahedra visibly lock (docs/results/extremes.md: at
@@ -100,13 +101,8 @@ class Body:
     def dim(self) -> int:
         return self.mesh.dim
 
-    @property
-    def formulation(self) -> str:
-        return self._impl.formulation
-
-    @property
-    def density(self) -> float:
-        return self._impl.density
+    formulation = engine_property("formulation")
+    density = engine_property("density")
 
     @property
     def thickness(self) -> float | None:
@@ -238,10 +234,8 @@ class Body:
     def clear_gravity(self) -> None:
         self._model.clear_gravity()
 
-    @property
-    def has_gravity(self) -> bool:
-        """Whether gravity acts (``add_gravity`` until ``clear_gravity`` or ``clear_loads()``)."""
-        return self._model.has_gravity
+    has_gravity = engine_property("has_gravity", "Whether gravity acts (``add_gravity`` until ``clear_gravity`` or "
+                                                 "``clear_loads()``).", source="_model")
 
     def add_nodal_force(self, vertices, force, channel: str = "nodal") -> None:
         """Add a force (newtons) to load channel ``channel``: one (dim,) vector on every listed
@@ -287,13 +281,11 @@ class Body:
         else:
             self._model.clear_channel(str(channel))
 
-    @property
-    def load_channels(self) -> list[str]:
-        """Names of the nodal-force channels in use, those ``external_forces(channel)`` and
+    load_channels = engine_property(
+        "load_channels", """Names of the nodal-force channels in use, those ``external_forces(channel)`` and
         ``clear_loads(channel)`` take. Gravity is not among them: it is a body force on the
         element masses, not forces on named vertices, set by ``add_gravity`` and cleared by
-        ``clear_gravity``; ``has_gravity`` says whether it acts."""
-        return list(self._model.load_channels)
+        ``clear_gravity``; ``has_gravity`` says whether it acts.""", list, "_model")
 
     def external_forces(self, channel: str | None = None) -> np.ndarray:
         """Gravity plus every channel's nodal forces, or one channel's, (n_points, dim)."""

@@ -14,6 +14,7 @@ import math
 import numpy as np
 
 from snede import _checks, _snede
+from snede._engine import engine_property
 from snede._snede import CutReport
 from snede.mesh import Mesh
 
@@ -39,15 +40,6 @@ def move_along(move, positions, total, progress=None):
         if progress is not None:
             progress(k + 1, len(positions), report)
     return total
-
-
-def _points(value, shape: tuple, what: str) -> np.ndarray:
-    a = np.asarray(value, dtype=np.float64)
-    if a.shape != shape:
-        raise ValueError(f"{what} must have shape {shape}, got {a.shape}")
-    if not np.all(np.isfinite(a)):
-        raise ValueError(f"{what} has non-finite coordinates: {a.tolist()}")
-    return np.ascontiguousarray(a)
 
 
 class TetrahedralCutter:
@@ -94,10 +86,10 @@ class TetrahedralCutter:
                                               _checks.count(max_fragment_elements, "max_fragment_elements", 0))
 
     def cut_triangle(self, corners) -> CutReport:
-        return self._impl.cut_triangle(_points(corners, (3, 3), "corners"))
+        return self._impl.cut_triangle(_checks.coordinates(corners, (3, 3), "corners"))
 
     def move(self, scalpel) -> CutReport:
-        return self._impl.move(_points(scalpel, (2, 3), "scalpel"))
+        return self._impl.move(_checks.coordinates(scalpel, (2, 3), "scalpel"))
 
     def cut(self, path, progress=None) -> CutReport:
         """Move the scalpel through ``path``, an (n, 2, 3) sequence of scalpel positions; the
@@ -112,9 +104,7 @@ class TetrahedralCutter:
         cut is a new incision (earlier sweeps no longer count, Figure 3.2)."""
         self._impl.lift()
 
-    @property
-    def placed(self) -> bool:
-        return self._impl.placed
+    placed = engine_property("placed")
 
     def incision_faces(self) -> np.ndarray:
         """The boundary faces the cuts opened, (n, 3) vertex ids, oriented outward."""

@@ -10,6 +10,7 @@ from typing import NamedTuple
 import numpy as np
 
 from snede import _checks, _geometry, _snede
+from snede._engine import engine_property
 from snede.mesh_edits import MeshEdits, serial_only
 
 
@@ -88,57 +89,24 @@ class Mesh(MeshEdits):
         return mesh
 
     # -- properties --------------------------------------------------------------------
-    @property
-    def dim(self) -> int:
-        """Coordinate dimension (columns of ``points`` and of every nodal field)."""
-        return self._impl.dim
-
-    @property
-    def cell_dim(self) -> int:
-        """2 for triangles (in 2D or on a surface), 3 for tetrahedra."""
-        return self._impl.cell_dim
-
-    @property
-    def space_dim(self) -> int:
-        return self._impl.space_dim
+    dim = engine_property("dim", "Coordinate dimension (columns of ``points`` and of every nodal field).")
+    cell_dim = engine_property("cell_dim", "2 for triangles (in 2D or on a surface), 3 for tetrahedra.")
+    space_dim = engine_property("space_dim")
 
     @property
     def is_surface(self) -> bool:
         """Triangles in 3D."""
         return self.cell_dim < self.space_dim
 
-    @property
-    def n_live_points(self) -> int:
-        """Vertices not removed (``n_points`` counts rows, removed ones included)."""
-        return self._impl.n_live_points
-
-    @property
-    def live_vertices(self) -> np.ndarray:
-        """(n_points,) bool: False for a removed vertex, whose row is kept until reused."""
-        return self._impl.live_vertices
-
-    @property
-    def n_points(self) -> int:
-        return self._impl.n_points
-
-    @property
-    def n_cells(self) -> int:
-        return self._impl.n_cells
-
-    @property
-    def n_reoriented(self) -> int:
-        """How many input cells were re-oriented to positive volume."""
-        return self._impl.n_reoriented
-
-    @property
-    def points(self) -> np.ndarray:
-        """(n_points, dim) coordinates (a copy)."""
-        return self._impl.points
-
-    @property
-    def cells(self) -> np.ndarray:
-        """(n_cells, dim + 1) vertex indices, each row positively oriented (a copy)."""
-        return self._impl.cells
+    n_live_points = engine_property("n_live_points", "Vertices not removed (``n_points`` counts rows, removed ones "
+                                                     "included).")
+    live_vertices = engine_property("live_vertices", "(n_points,) bool: False for a removed vertex, whose row is "
+                                                     "kept until reused.")
+    n_points = engine_property("n_points")
+    n_cells = engine_property("n_cells")
+    n_reoriented = engine_property("n_reoriented", "How many input cells were re-oriented to positive volume.")
+    points = engine_property("points", "(n_points, dim) coordinates (a copy).")
+    cells = engine_property("cells", "(n_cells, dim + 1) vertex indices, each row positively oriented (a copy).")
 
     @property
     def cell_ids(self) -> np.ndarray:
@@ -302,9 +270,7 @@ class Mesh(MeshEdits):
         count), as sorted vertex indices, what ``Body.fix`` and ``add_nodal_force`` take; with
         ``displacement`` ((n_points, dim)) measured on the deformed body."""
         point = self._vector(point, "point")
-        radius = float(radius)
-        if not (np.isfinite(radius) and radius >= 0):
-            raise ValueError(f"radius must be non-negative and finite, got {radius}")
+        radius = _checks.non_negative(radius, "radius")
         faces, points = self._aiming_faces(displacement)
         vertices = np.unique(faces)
         return vertices[np.linalg.norm(points[vertices] - point, axis=1) <= radius]
@@ -415,15 +381,8 @@ class Mesh(MeshEdits):
         """Bisect (§6.5 refine-around) until every cell containing ``point`` (shape (dim,))
         has edges no longer than ``h``; the refinement spreads only as far as conformity
         needs. Returns how many cells were split."""
-        point = np.asarray(point, dtype=np.float64)
-        if point.shape != (self.dim,):
-            raise ValueError(f"point must have shape ({self.dim},) for this {self.dim}-D mesh, got {point.shape}")
-        if not np.all(np.isfinite(point)):
-            raise ValueError(f"point must be finite, got {point}")
-        h = float(h)
-        if not (np.isfinite(h) and h > 0):
-            raise ValueError(f"h must be positive and finite, got {h}")
-        return self._bisection().refine_around(np.ascontiguousarray(point), h)
+        point = _checks.coordinates(point, (self.dim,), "point")
+        return self._bisection().refine_around(point, _checks.positive(h, "h"))
 
     @serial_only
     def refine_near_segment(self, a, b, h: float, radius: float = 0.0) -> int:
@@ -431,20 +390,9 @@ class Mesh(MeshEdits):
         (shape (dim,) each; a needle's shaft) has edges no longer than ``h``, as one mesh
         change. Nearness is decided on each cell's bounding ball, so cells up to one cell size
         beyond ``radius`` may be refined too. Returns how many cells were split."""
-        ends = []
-        for name, point in (("a", a), ("b", b)):
-            point = np.asarray(point, dtype=np.float64)
-            if point.shape != (self.dim,):
-                raise ValueError(f"{name} must have shape ({self.dim},) for this {self.dim}-D mesh, got {point.shape}")
-            if not np.all(np.isfinite(point)):
-                raise ValueError(f"{name} must be finite, got {point}")
-            ends.append(np.ascontiguousarray(point))
-        h, radius = float(h), float(radius)
-        if not (np.isfinite(h) and h > 0):
-            raise ValueError(f"h must be positive and finite, got {h}")
-        if not (np.isfinite(radius) and radius >= 0):
-            raise ValueError(f"radius must be non-negative and finite, got {radius}")
-        return self._bisection().refine_near_segment(ends[0], ends[1], h, radius)
+        a, b = (_checks.coordinates(end, (self.dim,), name) for end, name in ((a, "a"), (b, "b")))
+        return self._bisection().refine_near_segment(a, b, _checks.positive(h, "h"),
+                                                     _checks.non_negative(radius, "radius"))
 
     # -- files -------------------------------------------------------------------------
     @classmethod

@@ -74,8 +74,7 @@ def rectangle(size=(1.0, 1.0), divisions=(10, 10)) -> Mesh:
 
 def _positive(**values) -> None:
     for name, value in values.items():
-        if not (np.isfinite(value) and value > 0):
-            raise ValueError(f"{name} must be positive and finite, got {value}")
+        _checks.positive(value, name)
 
 
 def _gmsh_tetrahedra(name: str, add_solid, h: float, seed: int | None) -> Mesh:

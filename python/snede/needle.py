@@ -18,6 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from snede import _checks, _snede
+from snede._engine import engine_property
 from snede._petsc import option_list
 from snede._snede import NeedleStepReport
 
@@ -53,13 +54,8 @@ class FrictionProfile:
         """∫ from a to b (distances from the tip, 0 ≤ a ≤ b) of the profile (N)."""
         return self._impl.integral(float(a), float(b))
 
-    @property
-    def distances(self) -> np.ndarray:
-        return np.asarray(self._impl.distances)
-
-    @property
-    def force_per_length(self) -> np.ndarray:
-        return np.asarray(self._impl.force_per_length)
+    distances = engine_property("distances", convert=np.asarray)
+    force_per_length = engine_property("force_per_length", convert=np.asarray)
 
     def __repr__(self) -> str:
         return f"FrictionProfile(distance_from_tip={self.distances.tolist()}, force_per_length={self.force_per_length.tolist()})"
@@ -139,8 +135,8 @@ class NeedleInsertion:
         if dim == 2 and radius is not None:
             raise ValueError(f"radius is for 3D needles; in 2D the needle is a line, got radius={radius}")
         radius = 0.0 if dim == 2 else (1e-3 if radius is None else radius)
-        if dim == 3 and not (np.isfinite(radius) and radius > 0):
-            raise ValueError(f"radius must be positive and finite, got {radius}")
+        if dim == 3:
+            _checks.positive(radius, "radius")
         for name, value in (("entry", entry), ("direction", direction)):
             if np.shape(value) != (dim,):
                 raise ValueError(f"{name} must have {dim} components for this {dim}-D body, got shape {np.shape(value)}")
@@ -180,8 +176,7 @@ class NeedleInsertion:
         step shortened to land on it), then, with ``solves_per_update``, keep updating in place
         until no node changes state (as the thesis's automated insertion does).
         ``progress(done, total, step_report)`` is called after each update."""
-        if not (np.isfinite(step) and step > 0):
-            raise ValueError(f"step must be positive and finite, got {step}")
+        _checks.positive(step, "step")
         if not (np.isfinite(depth) and depth >= self.depth):
             raise ValueError(f"depth must be finite and at least the current depth {self.depth}, got {depth}")
         n_steps = int(np.ceil((depth - self.depth) / step - 1e-9))
@@ -195,85 +190,37 @@ class NeedleInsertion:
             steps.append(self.advance(0.0))
         return summarize(steps)
 
-    @property
-    def depth(self) -> float:
-        return self._impl.depth
-
-    @property
-    def tip(self) -> np.ndarray:
-        return np.asarray(self._impl.tip)
-
-    @property
-    def surface_depth(self) -> float:
-        """How far from ``entry`` the shaft's line first meets the deformed body (0 when
+    depth = engine_property("depth")
+    tip = engine_property("tip", convert=np.asarray)
+    surface_depth = engine_property(
+        "surface_depth", """How far from ``entry`` the shaft's line first meets the deformed body (0 when
         ``entry`` is inside it): ``advance(surface_depth - depth)`` brings the tip to the
-        surface in one update. Scans the mesh; ValueError if the line no longer meets the body."""
-        return self._impl.surface_depth
-
-    @property
-    def preconditioner_fills(self) -> int:
-        """How many times the needle's solver filled its preconditioner (see
-        :attr:`snede.StaticSolver.preconditioner_fills`)."""
-        return self._impl.preconditioner_fills
-
-    @property
-    def multigrid_builds(self) -> int:
-        """How many times the needle's solver made multigrid levels (see
+        surface in one update. Scans the mesh; ValueError if the line no longer meets the body.""")
+    preconditioner_fills = engine_property(
+        "preconditioner_fills", """How many times the needle's solver filled its preconditioner (see
+        :attr:`snede.StaticSolver.preconditioner_fills`).""")
+    multigrid_builds = engine_property(
+        "multigrid_builds", """How many times the needle's solver made multigrid levels (see
         :attr:`snede.StaticSolver.multigrid_builds`): after refinements, not after stick-slip
-        changes, which refill the levels it has."""
-        return self._impl.multigrid_builds
-
-    @property
-    def multigrid_source(self) -> str:
-        """What made the needle solver's ``"mg"`` levels at its last solve (see
-        :attr:`snede.StaticSolver.multigrid_source`)."""
-        return self._impl.multigrid_source
-
-    @property
-    def multigrid_unknowns(self) -> list[int]:
-        """Unknowns per level of the needle solver's ``"mg"`` levels, coarsest first."""
-        return list(self._impl.multigrid_unknowns)
-
-    @property
-    def entry(self) -> np.ndarray:
-        return np.asarray(self._impl.entry)
-
-    @property
-    def direction(self) -> np.ndarray:
-        return np.asarray(self._impl.direction)
-
-    @property
-    def needle_nodes(self) -> np.ndarray:
-        """Vertex ids of the needle nodes."""
-        return np.asarray(self._impl.needle_nodes, dtype=np.int64)
-
-    @property
-    def sticking(self) -> np.ndarray:
-        """True per needle node that sticks (False: slips)."""
-        return np.asarray(self._impl.sticking, dtype=bool)
-
-    @property
-    def d_perp(self) -> np.ndarray:
-        """Each needle node's offset from the shaft (held while the needle moves), metres."""
-        return self._impl.d_perp
-
-    @property
-    def d_needle(self) -> np.ndarray:
-        """Each needle node's position along the shaft from the entry point (deformed)."""
-        return self._impl.d_needle
-
-    @property
-    def dynamic_thresholds(self) -> np.ndarray:
-        return self._impl.dynamic_thresholds
-
-    @property
-    def static_thresholds(self) -> np.ndarray:
-        return self._impl.static_thresholds
-
-    @property
-    def friction(self) -> np.ndarray:
-        """Friction force along the shaft on each slipping node (0 for sticking ones)."""
-        return self._impl.friction
+        changes, which refill the levels it has.""")
+    multigrid_source = engine_property(
+        "multigrid_source", """What made the needle solver's ``"mg"`` levels at its last solve (see
+        :attr:`snede.StaticSolver.multigrid_source`).""")
+    multigrid_unknowns = engine_property(
+        "multigrid_unknowns", "Unknowns per level of the needle solver's ``\"mg\"`` levels, coarsest first.", list)
+    entry = engine_property("entry", convert=np.asarray)
+    direction = engine_property("direction", convert=np.asarray)
+    needle_nodes = engine_property("needle_nodes", "Vertex ids of the needle nodes.",
+                                   lambda nodes: np.asarray(nodes, dtype=np.int64))
+    sticking = engine_property("sticking", "True per needle node that sticks (False: slips).",
+                               lambda sticking: np.asarray(sticking, dtype=bool))
+    d_perp = engine_property("d_perp", "Each needle node's offset from the shaft (held while the needle moves), metres.")
+    d_needle = engine_property("d_needle", "Each needle node's position along the shaft from the entry point "
+                                           "(deformed).")
+    dynamic_thresholds = engine_property("dynamic_thresholds")
+    static_thresholds = engine_property("static_thresholds")
+    friction = engine_property("friction", "Friction force along the shaft on each slipping node (0 for sticking "
+                                           "ones).")
 
     def needle_forces(self) -> np.ndarray:
         """Forces the needle exerts on the body at its needle nodes (support plus friction),

@@ -19,6 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from snede import _snede, series_files
+from snede._engine import engine_property
 from snede.distributed import agreed
 from snede.mesh import Mesh
 
@@ -59,13 +60,8 @@ class SeriesWriter:
     def h5_path(self) -> Path:
         return Path(self._impl.h5_path)
 
-    @property
-    def n_steps(self) -> int:
-        return self._impl.n_steps
-
-    @property
-    def n_meshes(self) -> int:
-        return self._impl.n_meshes
+    n_steps = engine_property("n_steps")
+    n_meshes = engine_property("n_meshes")
 
     def write(self, body, time: float = 0.0, displacement=None, point_fields: dict | None = None,
               **cell_fields) -> None:

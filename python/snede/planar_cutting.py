@@ -12,7 +12,8 @@ import math
 
 import numpy as np
 
-from snede import _snede
+from snede import _checks, _snede
+from snede._engine import engine_property
 from snede._snede import PlanarCutReport
 from snede.cutting import body_and_mesh, move_along
 
@@ -34,12 +35,7 @@ def _threshold(value, name: str) -> float:
 
 
 def _point(value) -> np.ndarray:
-    a = np.asarray(value, dtype=np.float64)
-    if a.shape != (2,):
-        raise ValueError(f"the scalpel is a point with 2 coordinates, got shape {a.shape}")
-    if not np.all(np.isfinite(a)):
-        raise ValueError(f"the scalpel point has non-finite coordinates: {a.tolist()}")
-    return a
+    return _checks.coordinates(value, (2,), "the scalpel, a point with 2 coordinates,")
 
 
 def sample_path(path, step: float) -> np.ndarray:
@@ -61,17 +57,9 @@ class IncisionCutter:
     """What the Delaunay cutters (2D sheets, surfaces in 3D) share: their thresholds, the
     incision's active node and edges, and lifting the scalpel. ``_impl`` is the engine's cutter."""
 
-    @property
-    def eps_edge(self) -> float:
-        return self._impl.eps_edge
-
-    @property
-    def eps_entry(self) -> float:
-        return self._impl.eps_entry
-
-    @property
-    def eps_exit(self) -> float:
-        return self._impl.eps_exit
+    eps_edge = engine_property("eps_edge")
+    eps_entry = engine_property("eps_entry")
+    eps_exit = engine_property("eps_exit")
 
     def lift(self) -> None:
         """Lift the scalpel: an incision in progress stays as it is; the next move only places it."""

@@ -15,8 +15,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from snede import _snede
-from snede.cutting import _points, body_and_mesh, move_along
+from snede import _checks, _snede
+from snede.cutting import body_and_mesh, move_along
 from snede.planar_cutting import IncisionCutter, PlanarCutReport, _threshold
 
 
@@ -64,7 +64,7 @@ class SurfaceCutter(IncisionCutter):
         return nodes[0] if nodes else None
 
     def move(self, segment) -> PlanarCutReport:
-        segment = _points(segment, (2, 3), "segment")
+        segment = _checks.coordinates(segment, (2, 3), "segment")
         if np.array_equal(segment[0], segment[1]):
             raise ValueError(f"segment: the scalpel's two ends coincide: {segment.tolist()}")
         return self._impl.move(segment)
