@@ -12,7 +12,7 @@ from snede.scene_file.frames import VIEW, Frames, clipped
 from snede.scene_file.reading import SceneFileError
 from snede.scene_file.recipe import Recipe
 from snede.scene_file.tools import Needle
-from snede.scenes import Scene, briefly, material, solve_entries
+from snede.scenes import Scene, briefly, material, shaft_force, solve_entries
 from snede.scenes.incision import incision_cells, lips_gap
 
 
@@ -117,7 +117,7 @@ class ToolRun:
         """What the last tool measures: the needle's force along its shaft, or how wide the cut opened."""
         last = self.tools[-1]
         if isinstance(last, Needle):
-            return 0.0 if self.needle is None else last.shaft_force(self.needle)
+            return 0.0 if self.needle is None else shaft_force(self.needle)
         return lips_gap(body, self.incision())
 
 

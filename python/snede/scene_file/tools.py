@@ -160,10 +160,6 @@ class Needle:
         run.insertion = run.needle.insert(self.depth, step, progress=after)
         return run.insertion.converged
 
-    def shaft_force(self, needle) -> float:
-        """The force the needle exerts on the body along its shaft (N)."""
-        return float((needle.needle_forces() @ self.direction).sum())
-
 
 def _span(mesh) -> str:
     low, high = mesh.points.min(axis=0), mesh.points.max(axis=0)

@@ -2,7 +2,8 @@
 ``builders()`` names them. ``Scene`` and the helpers the scene modules share are in
 ``snede.scenes.scene`` (re-exported here): the modules import them from there, not from this
 package, which imports the modules."""
-from snede.scenes.scene import MATERIAL_NAMES, Scene, briefly, material, solve_entries  # noqa: F401
+from snede.scenes.scene import (MATERIAL_NAMES, Scene, briefly, material, shaft_force,  # noqa: F401
+                                solve_entries)
 
 
 def builders() -> dict:

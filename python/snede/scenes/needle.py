@@ -12,7 +12,7 @@ import numpy as np
 
 import snede
 from snede.plotting import animate, draw_2d
-from snede.scenes.scene import Scene, material
+from snede.scenes.scene import Scene, material, shaft_force
 from snede.scenes.needle_slab import DEPTH, DIRECTION, ENTRY, POISSON, YOUNG, h, held, needle_for, slab_body
 
 OPTIONS = ("divisions", "speed", "formulation")  # the scene options it uses (the command line refuses the others)
@@ -108,10 +108,6 @@ class Insertion:
     def decorate(self, ax) -> None:
         draw_needle(ax, self.frames[-1])
 
-    def shaft_force(self) -> float:
-        """Total force the needle exerts on the body along its shaft (N)."""
-        return float((self.needle.needle_forces() @ np.asarray(DIRECTION)).sum())
-
 
 def _h_start(divisions: int | None) -> int:
     if divisions is None:
@@ -132,7 +128,7 @@ def build(options) -> Scene:
     insertion = Insertion(body, speed)
     return Scene(
         name="needle", description=DESCRIPTION, body=body, default_method="cg" if name == "linear" else "newton",
-        probe_name="needle force along shaft [N]", probe=lambda b: insertion.shaft_force(), default_rtol=1e-3,
+        probe_name="needle force along shaft [N]", probe=lambda b: shaft_force(insertion.needle), default_rtol=1e-3,
         evolve=insertion.evolve, decorate=insertion.decorate, fixed=held,
         picture=lambda: {"loads": False},  # the needle and its nodes' states show the friction
         details={"h_start": h_start, "h_ref": H_REF, "speed_h_ref_per_update": speed, "depth_m": DEPTH})

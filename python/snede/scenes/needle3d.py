@@ -26,7 +26,7 @@ import numpy as np
 import snede
 from snede.needle_forces import liver_profile, liver_young
 from snede.plotting import _figure, animate, draw_3d, save_3d
-from snede.scenes.scene import Scene, material
+from snede.scenes.scene import Scene, material, shaft_force
 
 SIZE, DEPTH, RADIUS = 0.1, 0.07, 1e-3
 # Liver's shear modulus (snede.needle_forces); ν = 0.4 stays below the ratio at which linear
@@ -270,10 +270,6 @@ class Insertion:
         plt.close(figure)
         return path
 
-    def shaft_force(self) -> float:
-        """Total force the needle exerts on the body along its shaft (N)."""
-        return float((self.needle.needle_forces() @ np.asarray(DIRECTION)).sum())
-
 
 def build(options) -> Scene:
     name = options.material or "linear"
@@ -285,7 +281,7 @@ def build(options) -> Scene:
     insertion = Insertion(body, SIZE / divisions, speed)
     return Scene(
         name="needle3d", description=DESCRIPTION, body=body, default_method="cg" if name == "linear" else "newton",
-        probe_name="needle force along shaft [N]", probe=lambda b: insertion.shaft_force(), default_rtol=1e-3,
+        probe_name="needle force along shaft [N]", probe=lambda b: shaft_force(insertion.needle), default_rtol=1e-3,
         evolve=insertion.evolve, fixed=held, decorate=insertion.draw_needle,
         picture=lambda: {"loads": False, "view": ENTRY_VIEW, "fixed": held_in_view(body.mesh.points)},
         details={"h_ref_m": SIZE / divisions, "radius_m": RADIUS, "speed_h_ref_per_update": speed, "depth_m": DEPTH,

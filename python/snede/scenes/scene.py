@@ -57,6 +57,11 @@ def briefly(result) -> str:
     return f"{state} ({result.reason}) after {result.iterations} iterations, {result.seconds:.2f} s"
 
 
+def shaft_force(needle) -> float:
+    """The force a ``snede.NeedleInsertion`` exerts on the body along its shaft (N): the needle scenes' probe."""
+    return float((needle.needle_forces() @ needle.direction).sum())
+
+
 def solve_entries(results) -> dict:
     """Summary entries (those of ``run_scene.solve_once``) of a scene that solves many times:
     converged only if every solve did, with the first failure's reason (else the last solve's);
