@@ -1,5 +1,6 @@
 #include "bindings.hpp"
 #include "petsc4py_interop.hpp"
+#include "record_binding.hpp"
 #include "solve/distributed_static.hpp"
 #include "solve/dynamic_relaxation.hpp"
 
@@ -8,13 +9,16 @@
 namespace snede::bindings {
 
 void bind_dynamics(py::module_& m) {
+  bind_record<DynamicRelaxationOptions>(
+      m, "DynamicRelaxationOptions",
+      "A dynamic relaxation's settings (snede.DynamicRelaxation documents each; ``dt`` 0 takes the CFL\n"
+      "estimate); the engine's struct. A negative or non-finite damping or step is a ValueError.");
+
   py::class_<DynamicRelaxation>(m, "DynamicRelaxation")
-      .def(py::init<Model&, double, double, const std::string&, const OptionList&>(), py::arg("model"),
-           py::arg("damping"), py::arg("dt"), py::arg("options_prefix"), py::arg("petsc_options"),
+      .def(py::init<Model&, const DynamicRelaxationOptions&>(), py::arg("model"), py::arg("options"),
            py::keep_alive<1, 2>())
       // The same solver over a distributed problem, on its communicator (collective).
-      .def(py::init<Problem&, double, double, const std::string&, const OptionList&>(), py::arg("problem"),
-           py::arg("damping"), py::arg("dt"), py::arg("options_prefix"), py::arg("petsc_options"),
+      .def(py::init<Problem&, const DynamicRelaxationOptions&>(), py::arg("problem"), py::arg("options"),
            py::keep_alive<1, 2>())
       .def("step", &DynamicRelaxation::step, py::arg("n"))
       .def("run", &DynamicRelaxation::run, py::arg("rtol"), py::arg("max_steps"))

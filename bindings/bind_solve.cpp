@@ -46,23 +46,6 @@ py::object assembled_tangent_at(Model& model, const DoubleArray& u, const std::s
 
 }  // namespace
 
-StaticOptions static_options(const std::string& method, double rtol, const std::string& criterion,
-                             double round_tolerance, int max_iterations, const std::string& prefix,
-                             const OptionList& petsc_options) {
-  StaticOptions options;
-  if (method == "cg") options.method = StaticMethod::linear_cg;
-  else if (method == "ncg") options.method = StaticMethod::nonlinear_cg;
-  else if (method == "newton") options.method = StaticMethod::newton;
-  else throw std::invalid_argument("method must be 'cg', 'ncg' or 'newton', got '" + method + "'");
-  options.stopping.criterion = stopping_criterion(criterion);
-  options.stopping.rtol = rtol;
-  options.stopping.round_tolerance = round_tolerance;
-  options.max_iterations = max_iterations;
-  options.options_prefix = prefix;
-  options.petsc_options = petsc_options;
-  return options;
-}
-
 void bind_solve(py::module_& m) {
   bind_record<SolveResult>(
       m, "SolveResult",
@@ -130,27 +113,9 @@ void bind_solve(py::module_& m) {
 
   py::class_<Problem>(m, "Problem", "A static problem on a communicator, which the solvers drive (problem.hpp).");
 
-  const StaticOptions defaults;
-  py::class_<StaticOptions>(m, "StaticOptions",
-                            "A static solver's settings (snede.StaticSolver documents each); the engine's struct.")
-      .def(py::init([](const std::string& method, double rtol, const std::string& criterion, double round_tolerance,
-                       int max_iterations, const std::string& prefix, const OptionList& petsc_options,
-                       const std::string& preconditioner) {
-             StaticOptions options =
-                 static_options(method, rtol, criterion, round_tolerance, max_iterations, prefix, petsc_options);
-             options.preconditioner = preconditioner;
-             return options;
-           }),
-           py::kw_only(), py::arg("method") = "newton", py::arg("rtol") = defaults.stopping.rtol,
-           py::arg("criterion") = "6.9", py::arg("round_tolerance") = defaults.stopping.round_tolerance,
-           py::arg("max_iterations") = defaults.max_iterations, py::arg("options_prefix") = defaults.options_prefix,
-           py::arg("petsc_options") = OptionList{}, py::arg("preconditioner") = defaults.preconditioner)
-      .def_property_readonly("rtol", [](const StaticOptions& o) { return o.stopping.rtol; })
-      .def_property_readonly("round_tolerance", [](const StaticOptions& o) { return o.stopping.round_tolerance; })
-      .def_readonly("max_iterations", &StaticOptions::max_iterations)
-      .def_readonly("options_prefix", &StaticOptions::options_prefix)
-      .def_readonly("petsc_options", &StaticOptions::petsc_options)
-      .def_readonly("preconditioner", &StaticOptions::preconditioner);
+  bind_record<StaticOptions>(m, "StaticOptions",
+                             "A static solver's settings (snede.StaticSolver documents each); the engine's struct.\n"
+                             "``method`` and ``criterion`` are their names (``\"ncg\"``, ``\"6.9\"``).");
 
   py::class_<StaticSolver>(m, "StaticSolver")
       .def(py::init([](Model& model, StaticOptions options, const Bisection* bisection) {

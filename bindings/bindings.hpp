@@ -41,10 +41,6 @@ using IndexArray = py::array_t<std::int64_t, py::array::c_style | py::array::for
 std::vector<std::int32_t> vertex_ids(const IndexArray& a);
 // Barycentric parents from vertex ids and their weights (checked by VertexParents).
 VertexParents parents_of(const IndexArray& vertices, const DoubleArray& weights);
-// A static solver's options from the Python arguments; std::invalid_argument names a bad one.
-StaticOptions static_options(const std::string& method, double rtol, const std::string& criterion,
-                             double round_tolerance, int max_iterations, const std::string& prefix,
-                             const OptionList& petsc_options);
 inline std::span<const double> view(const DoubleArray& a) { return {a.data(), static_cast<std::size_t>(a.size())}; }
 
 // A (rows, columns) numpy array holding a copy of `values`.

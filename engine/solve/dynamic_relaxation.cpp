@@ -39,30 +39,27 @@ std::string blow_up_failure(Vec u) {
 
 // ---- DynamicRelaxation --------------------------------------------------------------------
 
-DynamicRelaxation::DynamicRelaxation(Model& model, double damping_eta, double dt, const std::string& options_prefix,
-                                     const OptionList& petsc_options)
-    : DynamicRelaxation(std::make_unique<ModelProblem>(model), nullptr, damping_eta, dt, options_prefix,
-                        petsc_options) {}
+DynamicRelaxation::DynamicRelaxation(Model& model, const DynamicRelaxationOptions& options)
+    : DynamicRelaxation(std::make_unique<ModelProblem>(model), nullptr, options) {}
 
-DynamicRelaxation::DynamicRelaxation(Problem& problem, double damping_eta, double dt,
-                                     const std::string& options_prefix, const OptionList& petsc_options)
-    : DynamicRelaxation(nullptr, &problem, damping_eta, dt, options_prefix, petsc_options) {}
+DynamicRelaxation::DynamicRelaxation(Problem& problem, const DynamicRelaxationOptions& options)
+    : DynamicRelaxation(nullptr, &problem, options) {}
 
-DynamicRelaxation::DynamicRelaxation(std::unique_ptr<Problem> owned, Problem* problem, double damping_eta, double dt,
-                                     const std::string& options_prefix, const OptionList& petsc_options)
+DynamicRelaxation::DynamicRelaxation(std::unique_ptr<Problem> owned, Problem* problem,
+                                     const DynamicRelaxationOptions& options)
     : owned_problem_(std::move(owned)),
       problem_(problem ? *problem : *owned_problem_),
-      option_database_(options_prefix, petsc_options) {
+      option_database_(options.options_prefix, options.petsc_options) {
   InputDigest options_digest;
-  for (const auto& [name, value] : petsc_options) options_digest.add(name).add(value);
+  for (const auto& [name, value] : options.petsc_options) options_digest.add(name).add(value);
   RankAgreement("DynamicRelaxation")
-      .input("damping", damping_eta)
-      .input("dt", dt)
-      .input("options_prefix", options_prefix)
+      .input("damping", options.damping)
+      .input("dt", options.dt)
+      .input("options_prefix", options.options_prefix)
       .input("petsc_options", options_digest)
       .require(problem_.comm());
-  require_valid_damping(damping_eta);
-  require(dt == 0 || positive_finite(dt), "dt", "positive and finite (or 0 for the CFL estimate)", dt);
+  options.validate();  // after the agreement, so that every rank gives the same verdict
+  const double dt = options.dt;
   try {
     generation_ = problem_.generation();
     Vec u = problem_.state();
@@ -81,8 +78,8 @@ DynamicRelaxation::DynamicRelaxation(std::unique_ptr<Problem> owned, Problem* pr
     option_database_.use_for(snes);
     const double default_dt = dt > 0 ? dt : cfl_time_step();
     require(positive_finite(default_dt), "the CFL time step", "positive and finite (is the mesh empty?)", default_dt);
-    set_up_ss22(ts_, {options_prefix, damping_eta, default_dt, this, acceleration_callback, post_step_callback, u,
-                      velocity_});
+    set_up_ss22(ts_, {options.options_prefix, options.damping, default_dt, this, acceleration_callback,
+                      post_step_callback, u, velocity_});
     option_database_.mark_read_options_used();
     follows_cfl_ = dt == 0 && time_step() == default_dt;
   } catch (...) {

@@ -8,8 +8,8 @@
 // G(u) = −M⁻¹ P ∇Π(u) (the net force on the free motions) and carries an options prefix
 // (default "dynamic_"), so -dynamic_ts_monitor, -dynamic_ts_max_steps, -dynamic_ts_dt and
 // -dynamic_ts_ss22_damping apply; TSSetFromOptions runs after snede's defaults. The TS reads
-// its own options database (core/solver_options.hpp): the constructor's petsc_options, then
-// the command line over them.
+// its own options database (core/solver_options.hpp): the options' petsc_options, then the
+// command line over them.
 //
 // It drives any Problem (problem.hpp): a serial Model, whose mesh may be cut or refined between
 // calls, or a DistributedStatic on its communicator, with the same steps on any number of ranks.
@@ -25,6 +25,7 @@
 
 #include "core/solver_options.hpp"
 #include "fem/stable_time_step.hpp"
+#include "solve/dynamic_relaxation_options.hpp"
 #include "solve/model.hpp"
 #include "solve/problem.hpp"
 #include "solve/solve_result.hpp"
@@ -39,15 +40,11 @@ std::string blow_up_failure(Vec u);
 
 class DynamicRelaxation {
  public:
-  // damping_eta: η ≥ 0 (1/s). dt: the time step (s), or 0 for the CFL estimate (2.61), which
-  // is then renewed whenever the mesh changes size. petsc_options: this solver's PETSc options,
-  // without the prefix.
-  DynamicRelaxation(Model& model, double damping_eta, double dt = 0, const std::string& options_prefix = "dynamic_",
-                    const OptionList& petsc_options = {});
+  // Throws std::invalid_argument for invalid options (DynamicRelaxationOptions::validate).
+  DynamicRelaxation(Model& model, const DynamicRelaxationOptions& options);
   // Collective on problem.comm(); the problem must outlive the solver. Throws
-  // std::invalid_argument (the same on every rank) for arguments that differ between the ranks.
-  DynamicRelaxation(Problem& problem, double damping_eta, double dt = 0,
-                    const std::string& options_prefix = "dynamic_", const OptionList& petsc_options = {});
+  // std::invalid_argument (the same on every rank) for options that differ between the ranks.
+  DynamicRelaxation(Problem& problem, const DynamicRelaxationOptions& options);
   ~DynamicRelaxation();
   DynamicRelaxation(const DynamicRelaxation&) = delete;
   DynamicRelaxation& operator=(const DynamicRelaxation&) = delete;
@@ -81,8 +78,7 @@ class DynamicRelaxation {
 
  private:
   // The problem given, or else the one owned.
-  DynamicRelaxation(std::unique_ptr<Problem> owned, Problem* problem, double damping_eta, double dt,
-                    const std::string& options_prefix, const OptionList& petsc_options);
+  DynamicRelaxation(std::unique_ptr<Problem> owned, Problem* problem, const DynamicRelaxationOptions& options);
 
   enum class Mode { steps, relaxation, stability_trial };
   SolveResult advance(PetscInt n_steps, Mode mode, double rtol);

@@ -4,12 +4,26 @@
 
 #include <string>
 
+#include "core/enum_names.hpp"
 #include "core/solver_options.hpp"
 #include "solve/stopping.hpp"
 
 namespace snede {
 
 enum class StaticMethod { linear_cg, nonlinear_cg, newton };
+
+// Every method with the name users give it (method=): the one list both directions read.
+inline constexpr std::array static_method_names{
+    named(StaticMethod::linear_cg, "cg"),
+    named(StaticMethod::nonlinear_cg, "ncg"),
+    named(StaticMethod::newton, "newton"),
+};
+// The bindings find a field's names here: Python reads and writes the method by name.
+constexpr const auto& enum_names(StaticMethod) { return static_method_names; }
+
+// A name of static_method_names; anything else is a std::invalid_argument naming the value.
+inline StaticMethod static_method(const std::string& name) { return enum_value(static_method_names, "method", name); }
+inline std::string static_method_name(StaticMethod method) { return enum_name(static_method_names, method); }
 
 struct StaticOptions {
   StaticMethod method = StaticMethod::newton;
@@ -27,6 +41,20 @@ struct StaticOptions {
   // Empty: -<prefix>pc_type if given, else "auto". -<prefix>pc_type on the command line wins.
   std::string preconditioner;
   OptionList petsc_options;  // this solver's PETSc options, without the prefix
+
+  // Every setting with its name (the stopping rule's by theirs; force_scale and n_dofs are the
+  // model's, not settings): the one list that bindings read.
+  template <class Visit>
+  static void visit_fields(Visit&& visit) {
+    visit("method", &StaticOptions::method);
+    visit("rtol", [](auto& options) -> auto& { return options.stopping.rtol; });
+    visit("criterion", [](auto& options) -> auto& { return options.stopping.criterion; });
+    visit("round_tolerance", [](auto& options) -> auto& { return options.stopping.round_tolerance; });
+    visit("max_iterations", &StaticOptions::max_iterations);
+    visit("options_prefix", &StaticOptions::options_prefix);
+    visit("petsc_options", &StaticOptions::petsc_options);
+    visit("preconditioner", &StaticOptions::preconditioner);
+  }
 };
 
 }  // namespace snede

@@ -8,6 +8,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "core/enum_names.hpp"
+
 namespace snede {
 
 // E·H² (volumes) or E·t·H (sheets and membranes, which carry force through their thickness t):
@@ -18,11 +20,20 @@ inline double force_scale(double young_modulus, int cell_dim, double thickness, 
 
 enum class StoppingCriterion { load_relative /* (6.8) */, with_reactions /* (6.9) */ };
 
-// "6.8" or "6.9"; anything else is a std::invalid_argument naming the value.
+// Every criterion with the name users give it (criterion=): the one list both directions read.
+inline constexpr std::array stopping_criterion_names{
+    named(StoppingCriterion::load_relative, "6.8"),
+    named(StoppingCriterion::with_reactions, "6.9"),
+};
+// The bindings find a field's names here: Python reads and writes the criterion by name.
+constexpr const auto& enum_names(StoppingCriterion) { return stopping_criterion_names; }
+
+// A name of stopping_criterion_names; anything else is a std::invalid_argument naming the value.
 inline StoppingCriterion stopping_criterion(const std::string& name) {
-  if (name == "6.9") return StoppingCriterion::with_reactions;
-  if (name == "6.8") return StoppingCriterion::load_relative;
-  throw std::invalid_argument("criterion must be '6.8' or '6.9', got '" + name + "'");
+  return enum_value(stopping_criterion_names, "criterion", name);
+}
+inline std::string criterion_name(StoppingCriterion criterion) {
+  return enum_name(stopping_criterion_names, criterion);
 }
 
 struct StoppingRule {

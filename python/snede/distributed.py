@@ -203,10 +203,11 @@ class DistributedRelaxation:
         def checked():
             if dt is not None and not (np.isfinite(dt) and dt > 0):
                 raise ValueError(f"dt must be positive and finite (or None for the CFL estimate), got {dt}")
-            return float(damping), float(dt or 0.0), str(options_prefix), option_list(petsc_options)
+            return _snede.DynamicRelaxationOptions(damping=damping, dt=dt or 0.0, options_prefix=options_prefix,
+                                                   petsc_options=option_list(petsc_options))
 
         self.problem = problem
-        self._impl = _snede.DynamicRelaxation(problem._impl, *agreed(problem.part.comm, checked))
+        self._impl = _snede.DynamicRelaxation(problem._impl, agreed(problem.part.comm, checked))
 
     @property
     def dt(self) -> float:

@@ -61,8 +61,9 @@ class DynamicRelaxation(RunsOnRanks):
             self._start_relaxation()
             self._impl = None
             return
-        self._impl = _snede.DynamicRelaxation(body._model, float(damping), float(dt or 0.0), options_prefix,
-                                              option_list(petsc_options))
+        options = _snede.DynamicRelaxationOptions(damping=damping, dt=dt or 0.0, options_prefix=options_prefix,
+                                                  petsc_options=option_list(petsc_options))
+        self._impl = _snede.DynamicRelaxation(body._model, options)
 
     def _start_relaxation(self) -> None:
         damping, dt, prefix, petsc_options = self._settings

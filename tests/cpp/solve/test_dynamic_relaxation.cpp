@@ -45,11 +45,20 @@ struct Spring {
   }
 };
 
+// A damping η, a step (0: the CFL estimate) and the test's own options prefix.
+DynamicRelaxationOptions relaxation(double damping, double dt, const std::string& prefix) {
+  DynamicRelaxationOptions options;
+  options.damping = damping;
+  options.dt = dt;
+  options.options_prefix = prefix;
+  return options;
+}
+
 }  // namespace
 
 TEST(DynamicRelaxation, SettlesInTheStaticSolutionOfTheSpring) {
   Spring spring;
-  DynamicRelaxation dynamics(spring.model, 200.0, 0.0, "cpp_spring_");
+  DynamicRelaxation dynamics(spring.model, relaxation(200.0, 0.0, "cpp_spring_"));
   const SolveResult result = dynamics.run(1e-8, 100000);
   ASSERT_TRUE(result.converged) << result.reason;
   EXPECT_EQ(result.reason, "CONVERGED_FNORM_ABS");
@@ -63,13 +72,13 @@ TEST(DynamicRelaxation, SettlesInTheStaticSolutionOfTheSpring) {
 TEST(DynamicRelaxation, StabilityLimitIsTwoOverTheHighestFrequency) {
   Spring spring;
   const double limit = spring.stability_limit();
-  DynamicRelaxation below(spring.model, 0.0, 0.99 * limit, "cpp_below_");
+  DynamicRelaxation below(spring.model, relaxation(0.0, 0.99 * limit, "cpp_below_"));
   const SolveResult bounded = below.step(5000);
   EXPECT_TRUE(bounded.converged) << bounded.reason;
   EXPECT_EQ(bounded.reason, "CONVERGED_ITS");
   EXPECT_EQ(bounded.iterations, 5000);
   SNEDE_PETSC(VecZeroEntries(spring.model.displacement()));
-  DynamicRelaxation above(spring.model, 0.0, 1.01 * limit, "cpp_above_");
+  DynamicRelaxation above(spring.model, relaxation(0.0, 1.01 * limit, "cpp_above_"));
   const SolveResult blown = above.step(5000);
   EXPECT_FALSE(blown.converged);
   EXPECT_EQ(blown.reason, "DIVERGED_BLOW_UP");
@@ -78,7 +87,7 @@ TEST(DynamicRelaxation, StabilityLimitIsTwoOverTheHighestFrequency) {
 
 TEST(DynamicRelaxation, CriticalStepSearchLandsWithinOneReductionOfTheLimit) {
   Spring spring;
-  DynamicRelaxation dynamics(spring.model, 50.0, 0.0, "cpp_search_");
+  DynamicRelaxation dynamics(spring.model, relaxation(50.0, 0.0, "cpp_search_"));
   const double limit = spring.stability_limit();
   for (double start : {0.0, 0.3 * limit, 3.0 * limit}) {  // from the CFL estimate, below and above
     const double found = dynamics.critical_time_step(2e6, start, 0.15, 200);
@@ -94,7 +103,7 @@ TEST(DynamicRelaxation, OptionsPrefixReachesTheTs) {
   SNEDE_PETSC(PetscOptionsSetValue(nullptr, "-cpp_options_ts_max_steps", "4"));
   SNEDE_PETSC(PetscOptionsSetValue(nullptr, "-cpp_options_ts_ss22_damping", "7.5"));
   Spring spring;
-  DynamicRelaxation dynamics(spring.model, 1.0, 0.0, "cpp_options_");
+  DynamicRelaxation dynamics(spring.model, relaxation(1.0, 0.0, "cpp_options_"));
   TSType type = nullptr;
   SNEDE_PETSC(TSGetType(dynamics.ts(), &type));
   EXPECT_STREQ(type, ts_ss22);
@@ -109,7 +118,7 @@ TEST(DynamicRelaxation, OptionsPrefixReachesTheTs) {
 
 TEST(DynamicRelaxation, RejectsNegativeDampingAndStep) {
   Spring spring;
-  EXPECT_THROW(DynamicRelaxation(spring.model, -1.0), std::invalid_argument);
-  EXPECT_THROW(DynamicRelaxation(spring.model, 1.0, -1e-3), std::invalid_argument);
-  EXPECT_THROW(DynamicRelaxation(spring.model, 1.0, std::nan("")), std::invalid_argument);
+  EXPECT_THROW(DynamicRelaxation(spring.model, relaxation(-1.0, 0.0, "dynamic_")), std::invalid_argument);
+  EXPECT_THROW(DynamicRelaxation(spring.model, relaxation(1.0, -1e-3, "dynamic_")), std::invalid_argument);
+  EXPECT_THROW(DynamicRelaxation(spring.model, relaxation(1.0, std::nan(""), "dynamic_")), std::invalid_argument);
 }
