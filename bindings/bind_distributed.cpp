@@ -51,8 +51,6 @@ void bind_distributed(py::module_& m) {
            }),
            py::arg("part"), py::arg("material"), py::arg("density"), py::arg("thickness"), py::arg("fixed"), py::arg("fixed_values"),
            py::arg("loaded"), py::arg("forces"), py::arg("gravity"), py::keep_alive<1, 2>())
-      .def("solve", &DistributedStatic::solve, py::arg("method"), py::arg("preconditioner"), py::arg("rtol"),
-           py::arg("max_iterations"), py::arg("prefix"), py::arg("criterion"), py::arg("round_tolerance"))
       .def(
           "set_displacement",
           [](DistributedStatic& s, py::array_t<double, py::array::c_style | py::array::forcecast> serial) {

@@ -123,6 +123,11 @@ void bind_solve(py::module_& m) {
                                                    bisection ? &bisection->hierarchy() : nullptr);
            }),
            py::arg("model"), py::arg("options"), py::arg("bisection"), py::keep_alive<1, 2>(), py::keep_alive<1, 4>())
+      // Any problem on its communicator (a DistributedStatic): collective.
+      .def(py::init([](Problem& problem, StaticOptions options) {
+             return std::make_unique<StaticSolver>(problem, std::move(options));
+           }),
+           py::arg("problem"), py::arg("options"), py::keep_alive<1, 2>())
       .def_property_readonly("preconditioner", &StaticSolver::preconditioner)
       .def_property_readonly("multigrid_levels", &StaticSolver::multigrid_levels)
       .def_property_readonly("multigrid_unknowns", &StaticSolver::multigrid_unknowns)

@@ -1,7 +1,5 @@
 #include "solve/distributed_static.hpp"
 
-#include <petscsnes.h>
-
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -16,8 +14,6 @@
 #include "core/petsc_util.hpp"
 #include "mesh/element_quality.hpp"
 #include "fem/stable_time_step.hpp"
-#include "solve/failed_solve.hpp"
-#include "solve/static_solver.hpp"
 #include "solve/stopping.hpp"
 
 namespace snede {
@@ -59,44 +55,6 @@ bool require_same_inputs_everywhere(MPI_Comm comm, const Material& material, dou
       .input("gravity", c.gravity)
       .require(comm);
   return true;
-}
-
-PetscErrorCode residual_callback(SNES snes, Vec u, Vec F, void* context) {
-  return petsc_callback("snede distributed residual", [&] {
-    // Every rank agrees on the verdict, so line searches shorten the same step everywhere.
-    if (!static_cast<DistributedStatic*>(context)->residual(u, F).admissible())
-      SNEDE_PETSC(SNESSetFunctionDomainError(snes));
-  });
-}
-
-PetscErrorCode jacobian_callback(SNES, Vec u, Mat J, Mat P, void* context) {
-  return petsc_callback("snede distributed Jacobian", [&] {
-    auto* problem = static_cast<DistributedStatic*>(context);
-    problem->linearize_at(u);
-    if (P != J) problem->assemble_tangent();
-  });
-}
-
-// The (6.8)/(6.9) rule on the true residual, as the serial StaticSolver's tests; PETSc's default
-// test first catches NaN norms and the iteration limit.
-PetscErrorCode snes_rule_callback(SNES snes, PetscInt it, PetscReal xnorm, PetscReal snorm, PetscReal fnorm,
-                                  SNESConvergedReason* reason, void* context) {
-  return petsc_callback("snede distributed stopping criterion", [&] {
-    SNEDE_PETSC(SNESConvergedDefault(snes, it, xnorm, snorm, fnorm, reason, nullptr));
-    if (*reason < 0) return;
-    const double tolerance = static_cast<DistributedStatic*>(context)->stopping_tolerance();
-    if (!std::isfinite(tolerance)) *reason = SNES_DIVERGED_FNORM_NAN;
-    else *reason = fnorm <= tolerance ? SNES_CONVERGED_FNORM_ABS : SNES_CONVERGED_ITERATING;
-  });
-}
-
-// For a linear problem CG's residual b − Jδ is −F(u₀ + δ), so the rule applies to it directly.
-PetscErrorCode ksp_rule_callback(KSP, PetscInt, PetscReal rnorm, KSPConvergedReason* reason, void* context) {
-  return petsc_callback("snede distributed stopping criterion", [&] {
-    const double tolerance = static_cast<DistributedStatic*>(context)->stopping_tolerance();
-    if (!std::isfinite(rnorm) || !std::isfinite(tolerance)) *reason = KSP_DIVERGED_NANORINF;
-    else *reason = rnorm <= tolerance ? KSP_CONVERGED_ATOL : KSP_CONVERGED_ITERATING;
-  });
 }
 
 PetscErrorCode diagonal_callback(Mat A, Vec diagonal) {
@@ -355,16 +313,30 @@ double DistributedStatic::cfl_time_step() {
   return dt;
 }
 
-Mat DistributedStatic::assembled_tangent() {
-  if (!assembled_)
-    assembled_ = std::make_unique<DistributedAssembledTangent>(part_, body_, local_rows_, fixed_local_,
-                                                               static_cast<PetscInt>(owned_rows_.size()));
-  return assembled_->mat();
-}
+// The MPIAIJ tangent at a state, scaled like the shell.
+class AssembledDistributedTangent final : public AssembledProblemTangent {
+ public:
+  explicit AssembledDistributedTangent(DistributedStatic& problem)
+      : problem_(problem),
+        tangent_(problem.part_, problem.body_, problem.local_rows_, problem.fixed_local_,
+                 static_cast<PetscInt>(problem.owned_rows_.size())),
+        u_local_(problem.u_local_.size()) {}
+  Mat mat() const override { return tangent_.mat(); }
+  void assemble(Vec u) override {
+    problem_.to_local(u, u_local_);
+    tangent_.assemble(u_local_);
+    if (problem_.operator_scale_ != 1) SNEDE_PETSC(MatScale(tangent_.mat(), problem_.operator_scale_));
+  }
+  bool matches() const override { return true; }  // a distributed mesh is not edited
 
-void DistributedStatic::assemble_tangent() {
-  assembled_tangent();
-  assembled_->assemble(u_linearization_);
+ private:
+  DistributedStatic& problem_;
+  DistributedAssembledTangent tangent_;
+  std::vector<double> u_local_;
+};
+
+std::unique_ptr<AssembledProblemTangent> DistributedStatic::make_assembled_tangent(MatrixFormat) {
+  return std::make_unique<AssembledDistributedTangent>(*this);
 }
 
 void DistributedStatic::tangent_mult(Vec d, Vec out) {
@@ -380,6 +352,7 @@ void DistributedStatic::tangent_mult(Vec d, Vec out) {
   SNEDE_PETSC(VecZeroEntries(out));
   add_to_global(out_local_, out);
   set_fixed_rows(out, d, 0.0);
+  if (operator_scale_ != 1) SNEDE_PETSC(VecScale(out, operator_scale_));
 }
 
 void DistributedStatic::set_fixed_rows(Vec out, Vec source, double value) {
@@ -412,153 +385,15 @@ void DistributedStatic::tangent_diagonal(Vec diagonal) {
   SNEDE_PETSC(VecZeroEntries(diagonal));
   add_to_global(out_local_, diagonal);
   set_fixed_rows(diagonal, nullptr, 1.0);
-}
-
-SolveResult DistributedStatic::solve(const std::string& method, const std::string& preconditioner, double rtol,
-                                     int max_iterations, const std::string& prefix, const std::string& criterion,
-                                     double round_tolerance) {
-  RankAgreement("DistributedStatic.solve")
-      .input("method", method)
-      .input("preconditioner", preconditioner)
-      .input("rtol", rtol)
-      .input("max_iterations", max_iterations)
-      .input("options_prefix", prefix)
-      .input("criterion", criterion)
-      .input("round_tolerance", round_tolerance)
-      .require(part_.comm);
-  if (method != "cg" && method != "newton" && method != "ncg")
-    throw std::invalid_argument("DistributedStatic.solve: method must be \"cg\", \"newton\" or \"ncg\", got \"" +
-                                method + "\"");
-  if (preconditioner != "none" && preconditioner != "jacobi" && preconditioner != "gamg" &&
-      preconditioner != "bjacobi" && preconditioner != "sor" && preconditioner != "lu")
-    throw std::invalid_argument(
-        "DistributedStatic.solve: preconditioner must be \"none\", \"jacobi\", \"gamg\", \"bjacobi\", \"sor\" or "
-        "\"lu\", got \"" + preconditioner + "\"");
-  if (method == "ncg" && preconditioner != "none")
-    throw std::invalid_argument("DistributedStatic.solve: nonlinear CG ('ncg') takes no preconditioner, got \"" +
-                                preconditioner + "\"");
-  if (!(rtol > 0) || !std::isfinite(rtol))
-    throw std::invalid_argument("DistributedStatic.solve: rtol must be positive and finite, got " + std::to_string(rtol));
-  if (criterion == "relative" && !(rtol < 1))
-    throw std::invalid_argument("DistributedStatic.solve: a relative rtol must be below 1, got " + std::to_string(rtol));
-  if (criterion != "relative" && criterion != "6.9" && criterion != "6.8")
-    throw std::invalid_argument("DistributedStatic.solve: criterion must be \"relative\", \"6.9\" or \"6.8\", got \"" +
-                                criterion + "\"");
-  if (!(round_tolerance >= 0) || !std::isfinite(round_tolerance))
-    throw std::invalid_argument("DistributedStatic.solve: round_tolerance must be ≥ 0 and finite");
-  // The serial StaticSolver's rule: the criterion's, or (6.9) under PETSc's relative tests,
-  // where it only decides whether the start is already in equilibrium (below).
-  const StoppingRule rule{criterion == "relative" ? StoppingCriterion::with_reactions : stopping_criterion(criterion),
-                          rtol, round_tolerance, force_scale(), static_cast<double>(n_global_dofs())};
-  stopping_.reset();
-  if (criterion != "relative") stopping_ = rule;
-  stopping_external_norm_ = external_force_norm();
-  const double start = wall_seconds();
-  SolveResult result;
-  const bool admissible_start = residual(u_, work_).admissible();
-  result.initial_residual_norm = vec_norm(work_);
-  stopping_reaction_norm_.reset();
-  if (method == "cg") stopping_reaction_norm_ = last_reaction_norm_;
-  // A start already in equilibrium by that rule is converged without an iteration, as
-  // serially: the relative tests' ‖F‖ ≤ rtol ‖F(u₀)‖ is out of reach of a residual already at
-  // round-off (Newton ended DIVERGED_LINE_SEARCH there, issue 38).
-  const double equilibrium_tolerance = rule.tolerance(stopping_external_norm_, last_reaction_norm_);
-  const bool at_equilibrium = admissible_start && result.initial_residual_norm <= equilibrium_tolerance;
-  if (at_equilibrium) {
-    result.converged = true;
-    result.reason = method == "cg" ? "CONVERGED_ATOL" : "CONVERGED_FNORM_ABS";  // PETSc's, for a met absolute test
-  } else {
-    run_petsc(method, preconditioner, rtol, max_iterations, prefix, result);
-  }
-  // An inverted element or a non-finite state is never converged, and a rule is checked on
-  // the final state (the factor allows CG's recursive residual to differ by round-off). The
-  // relative tests stay PETSc's verdict: preconditioned CG measures another norm.
-  const bool admissible = residual(u_, work_).admissible();
-  result.residual_norm = vec_norm(work_);
-  result.tolerance = at_equilibrium ? equilibrium_tolerance
-                     : stopping_    ? stopping_tolerance()
-                                    : rtol * result.initial_residual_norm;
-  if (!admissible || !std::isfinite(result.residual_norm)) result.converged = false;
-  if (result.converged && stopping_ && result.residual_norm > 2 * result.tolerance) {
-    result.converged = false;
-    result.reason = "DIVERGED_RESIDUAL_ABOVE_TOLERANCE (PETSc: " + result.reason + ")";
-  }
-  stopping_.reset();
-  result.energy = energy();
-  result.seconds = wall_seconds() - start;
-  return result;
-}
-
-void DistributedStatic::run_petsc(const std::string& method, const std::string& preconditioner, double rtol,
-                                  int max_iterations, const std::string& prefix, SolveResult& result) {
-  SnesHandle snes;
-  SNEDE_PETSC(SNESCreate(part_.comm, snes.out()));
-  SNEDE_PETSC(SNESSetOptionsPrefix(snes, prefix.c_str()));
-  SNEDE_PETSC(SNESSetFunction(snes, work_, residual_callback, this));
-  // The shell needs no assembly: SNES's Jacobian step sets the linearisation point (and fills
-  // GAMG's assembled copy). Nonlinear CG's line search takes K(x)d from it too.
-  // none and Jacobi need no matrix; GAMG, block Jacobi (ILU(0) on each rank's block), SOR
-  // (symmetric sweeps over each rank's rows, PETSc's default on MPIAIJ) and LU (MUMPS, the
-  // parallel direct solver in Debian's PETSc) take the assembled one.
-  const bool assembled = preconditioner != "none" && preconditioner != "jacobi";
-  SNEDE_PETSC(SNESSetJacobian(snes, tangent_, assembled ? assembled_tangent() : tangent_.get(), jacobian_callback, this));
-  KSP ksp = nullptr;
-  PC pc = nullptr;
-  SNEDE_PETSC(SNESGetKSP(snes, &ksp));
-  SNEDE_PETSC(KSPSetType(ksp, KSPCG));
-  SNEDE_PETSC(KSPGetPC(ksp, &pc));
-  SNEDE_PETSC(PCSetType(pc, preconditioner.c_str()));  // PETSc's names
-  if (preconditioner == "lu") SNEDE_PETSC(PCFactorSetMatSolverType(pc, MATSOLVERMUMPS));
-  // PETSc's relative tolerance (< 1), or its default when a rule (whose rtol may be ≥ 1) stops.
-  const double relative = stopping_ ? PETSC_DEFAULT : rtol;
-  if (method == "cg") {
-    SNEDE_PETSC(SNESSetType(snes, SNESKSPONLY));
-    SNEDE_PETSC(KSPSetTolerances(ksp, relative, 0.0, PETSC_DEFAULT, max_iterations));
-  } else if (method == "newton") {
-    SNEDE_PETSC(SNESSetType(snes, SNESNEWTONLS));
-    SNEDE_PETSC(SNESSetTolerances(snes, 0.0, relative, 0.0, max_iterations, PETSC_DEFAULT));
-  } else {
-    register_line_searches();
-    SNEDE_PETSC(SNESSetType(snes, SNESNCG));
-    SNEDE_PETSC(SNESNCGSetType(snes, SNES_NCG_PRP));
-    SNESLineSearch line_search = nullptr;
-    SNEDE_PETSC(SNESGetLineSearch(snes, &line_search));
-    SNEDE_PETSC(SNESLineSearchSetType(line_search, "snede_secant"));
-    SNEDE_PETSC(SNESSetTolerances(snes, 0.0, relative, 0.0, max_iterations, PETSC_DEFAULT));
-  }
-  if (stopping_) {
-    SNEDE_PETSC(SNESSetConvergenceTest(snes, snes_rule_callback, this, nullptr));
-    if (method == "cg") {
-      SNEDE_PETSC(KSPSetNormType(ksp, KSP_NORM_UNPRECONDITIONED));
-      SNEDE_PETSC(KSPSetConvergenceTest(ksp, ksp_rule_callback, this, nullptr));
-    }
-  }
-  SNEDE_PETSC(SNESSetFromOptions(snes));
-  solve_through(ksp, [&] { SNEDE_PETSC(SNESSolve(snes, nullptr, u_)); });
-  SNESConvergedReason reason = SNES_CONVERGED_ITERATING;
-  SNEDE_PETSC(SNESGetConvergedReason(snes, &reason));
-  PetscInt iterations = 0, linear = 0;
-  SNEDE_PETSC(SNESGetIterationNumber(snes, &iterations));
-  SNEDE_PETSC(SNESGetLinearSolveIterations(snes, &linear));
-  if (method == "cg") {
-    KSPConvergedReason ksp_reason = KSP_CONVERGED_ITERATING;
-    SNEDE_PETSC(KSPGetConvergedReason(ksp, &ksp_reason));
-    result.converged = ksp_reason > 0 && reason >= 0;
-    // CG's own reason (DIVERGED_ITS, DIVERGED_INDEFINITE_MAT), unless CG never ran.
-    result.reason = ksp_reason != KSP_CONVERGED_ITERATING ? KSPConvergedReasons[ksp_reason] : SNESConvergedReasons[reason];
-    result.iterations = static_cast<int>(linear);
-  } else {
-    result.converged = reason > 0;
-    result.reason = SNESConvergedReasons[reason];
-    result.iterations = static_cast<int>(iterations);
-    result.linear_iterations = static_cast<int>(linear);
-  }
+  if (operator_scale_ != 1) SNEDE_PETSC(VecScale(diagonal, operator_scale_));
 }
 
 double DistributedStatic::energy(Vec u) {
   to_local(u, u_local_);
   EvaluationReport report;
   double local = body_.energy(u_local_, report);
+  // NaN on a rank with a non-finite element (which the kernels skip) makes the sum NaN.
+  if (!report.domain_errors.empty()) local = std::numeric_limits<double>::quiet_NaN();
   PetscInt start = 0, end = 0;
   SNEDE_PETSC(VecGetOwnershipRange(u, &start, &end));
   const PetscScalar* x = nullptr;
@@ -569,8 +404,6 @@ double DistributedStatic::energy(Vec u) {
   MPI_Allreduce(&local, &total, 1, MPI_DOUBLE, MPI_SUM, part_.comm);
   return total;
 }
-
-void DistributedStatic::linearize_at(Vec u) { to_local(u, u_linearization_); }
 
 std::vector<double> DistributedStatic::local_displacement() {
   std::vector<double> u(u_local_.size());

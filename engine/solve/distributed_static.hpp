@@ -4,9 +4,10 @@
 // scatters the state to the rank's vertices (owned and ghosts), evaluates locally, and adds
 // the ghosts' contributions into their owners (a VecScatter, forward then reverse with
 // ADD_VALUES); energies are summed over the ranks. The tangent is a matrix-free MatShell on the
-// communicator, so PETSc's SNES and KSP run unchanged on any number of ranks; GAMG gets an
-// assembled MPIAIJ copy (distributed_assembly.hpp). It is a Problem (problem.hpp), which the
-// one DynamicRelaxation drives on any number of ranks.
+// communicator, so PETSc's SNES and KSP run unchanged on any number of ranks; GAMG and the
+// other preconditioners that need entries get an assembled MPIAIJ copy
+// (distributed_assembly.hpp). It is a Problem (problem.hpp): the one StaticSolver and the one
+// DynamicRelaxation drive it on any number of ranks, as they drive the serial Model.
 //
 // Constraints and loads are given by the serial mesh's vertex ids, the same on every rank:
 // fixed vertices (all components), their displacements, nodal forces, and gravity. A fixed dof's
@@ -15,7 +16,6 @@
 
 #include <cstdint>
 #include <memory>
-#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -25,8 +25,6 @@
 #include "mesh/distributed_mesh.hpp"
 #include "solve/distributed_assembly.hpp"
 #include "solve/problem.hpp"
-#include "solve/solve_result.hpp"
-#include "solve/stopping.hpp"
 
 namespace snede {
 
@@ -50,26 +48,10 @@ class DistributedStatic final : public Problem {
   DistributedStatic(const DistributedStatic&) = delete;
   DistributedStatic& operator=(const DistributedStatic&) = delete;
 
-  // Collective. "cg": one Newton step solved by CG (linear problems); "newton": Newton with
-  // CG inside; "ncg": nonlinear CG (Polak-Ribière) with the secant line search of §4.4.2.
-  // Preconditioner (cg and newton) "none", "jacobi" (the tangent's diagonal, assembled across
-  // the ranks), or on the assembled tangent "gamg", "bjacobi" (ILU(0) per rank), "sor" (local
-  // symmetric sweeps) or "lu" (MUMPS); options under `prefix`. Stopping:
-  // criterion "relative" is PETSc's relative test (‖F‖ ≤ rtol ‖F(u₀)‖; CG ‖r‖ ≤ rtol ‖b‖ in
-  // its preconditioned norm); "6.9" and "6.8" are the serial StaticSolver's (§6.6,
-  // stopping.hpp), on the true residual, with the same round-off floor. A start that already
-  // meets the serial rule ((6.9) at rtol under "relative") is converged with no iteration.
-  SolveResult solve(const std::string& method, const std::string& preconditioner, double rtol, int max_iterations,
-                    const std::string& prefix, const std::string& criterion = "relative",
-                    double round_tolerance = 1e-12);
   // Collective: the state from a displacement in the serial mesh's vertex order
   // (n_global_vertices × dim, the same on every rank), a solve's starting point; the fixed
   // vertices keep their prescribed displacements. Empty: zero.
   void set_displacement(std::span<const double> serial_displacement);
-  // The threshold of the running solve's (6.8)/(6.9) rule at the latest residual.
-  double stopping_tolerance() const {
-    return stopping_->tolerance(stopping_external_norm_, stopping_reaction_norm_.value_or(last_reaction_norm_));
-  }
   // Π(u) = Π_int(u) − f_extᵀu over the whole body (collective), at the state or at u.
   double energy() { return energy(u_); }
   double energy(Vec u) override;
@@ -99,24 +81,30 @@ class DistributedStatic final : public Problem {
   // The fixed owned rows of `u` set to their prescribed displacements.
   void enforce_constraints(Vec u) override;
   bool every_dof_prescribed() const override;
-  void linearize_at(Vec u);
+  Mat tangent() const override { return tangent_; }
+  void set_linearization_point(Vec u) override { to_local(u, u_linearization_); }
+  void set_operator_scale(double scale) override { operator_scale_ = scale; }
+  // An MPIAIJ copy of the tangent (distributed_assembly.hpp; vertex blocks of size dim, either
+  // format), for GAMG, block Jacobi, SOR, MUMPS's LU and Galerkin multigrid levels.
+  std::unique_ptr<AssembledProblemTangent> make_assembled_tangent(MatrixFormat format) override;
+  std::int64_t n_global_cells() const override { return part_.n_global_cells; }
+  // The constraints are fixed when the problem is made.
+  std::uint64_t projection_fingerprint() const override { return 0; }
+  // The parts of the rank's mesh: its cells, vertices, which it owns and their rows; per local
+  // dof whether it is fixed (for multigrid levels made on each rank's vertices).
+  const DistributedMesh& part() const { return part_; }
+  std::span<const std::uint8_t> fixed_local_dofs() const { return fixed_local_; }
   void tangent_mult(Vec d, Vec out);
   void tangent_diagonal(Vec diagonal);
-  // The assembled tangent (for GAMG), made on first use; assemble_tangent() fills it at the
-  // linearisation point.
-  Mat assembled_tangent();
-  void assemble_tangent();
 
   Vec state() const override { return u_; }
   MPI_Comm comm() const override { return part_.comm; }
   int dim() const override { return dim_; }
-  const Material& material() const { return body_.material(); }
+  const Material& material() const override { return body_.material(); }
   std::int64_t n_global_dofs() const override { return part_.n_global_vertices * dim_; }
 
  private:
-  // SNES (or its KSP, for "cg") from the current state; its reason and iteration counts.
-  void run_petsc(const std::string& method, const std::string& preconditioner, double rtol, int max_iterations,
-                 const std::string& prefix, SolveResult& result);
+  friend class AssembledDistributedTangent;
   void to_local(Vec global, std::vector<double>& local);
   void add_to_global(const std::vector<double>& local, Vec global);
   // The fixed owned rows of `out` set to `source`'s entries, or to `value` without a source.
@@ -136,15 +124,9 @@ class DistributedStatic final : public Problem {
   Vec local_vec_ = nullptr;                 // sequential, all local dofs
   VecScatter scatter_ = nullptr;
   MatHandle tangent_;
-  std::unique_ptr<DistributedAssembledTangent> assembled_;
+  double operator_scale_ = 1;
   double last_reaction_norm_ = 0;
   std::string last_failure_;
-  // The (6.8)/(6.9) rule of the running solve, or none for PETSc's relative tests.
-  std::optional<StoppingRule> stopping_;
-  double stopping_external_norm_ = 0;
-  // Linear CG's reactions, fixed at the starting state as the serial solver's (its KSP
-  // evaluates no residual); the nonlinear methods use the latest residual's.
-  std::optional<double> stopping_reaction_norm_;
   std::vector<double> u_local_, u_linearization_, d_local_, out_local_;
 };
 

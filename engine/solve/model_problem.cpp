@@ -1,12 +1,36 @@
 #include "solve/model_problem.hpp"
 
+#include <limits>
 #include <vector>
 
 #include "core/norms.hpp"
 #include "core/petsc_util.hpp"
 #include "fem/stable_time_step.hpp"
+#include "solve/tangent_assembly.hpp"
 
 namespace snede {
+namespace {
+
+class AssembledModelTangent final : public AssembledProblemTangent {
+ public:
+  AssembledModelTangent(const Model& model, MatrixFormat format)
+      : model_(model), tangent_(model, format, MembraneTangent::positive_part) {
+    set_rigid_body_near_null_space(model, tangent_.mat());
+  }
+  Mat mat() const override { return tangent_.mat(); }
+  void assemble(Vec u) override { tangent_.assemble(model_, u); }
+  bool matches() const override { return tangent_.matches(model_); }
+
+ private:
+  const Model& model_;
+  AssembledTangent tangent_;
+};
+
+}  // namespace
+
+std::unique_ptr<AssembledProblemTangent> ModelProblem::make_assembled_tangent(MatrixFormat format) {
+  return std::make_unique<AssembledModelTangent>(model_, format);
+}
 
 ResidualCheck ModelProblem::residual(Vec u, Vec F) {
   EvaluationReport report;
@@ -21,7 +45,8 @@ std::string ModelProblem::inadmissible(Vec u) {
 
 double ModelProblem::energy(Vec u) {
   EvaluationReport report;
-  return model_.potential_energy(u, report);
+  const double energy = model_.potential_energy(u, report);
+  return report.domain_errors.empty() ? energy : std::numeric_limits<double>::quiet_NaN();
 }
 
 double ModelProblem::external_force_norm() { return euclidean_norm(model_.external_forces()); }

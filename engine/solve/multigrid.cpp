@@ -76,6 +76,17 @@ void set_direct_coarse_solve(PC pc, const SolverOptions& options) {
   PC direct = nullptr;
   SNEDE_PETSC(KSPGetPC(coarse, &direct));
   options.use_for(direct);
+  PetscMPIInt ranks = 1;
+  SNEDE_PETSC(MPI_Comm_size(PetscObjectComm(reinterpret_cast<PetscObject>(pc)), &ranks));
+  if (ranks > 1) {
+    // On several ranks every rank factors the whole (small) coarsest level (PCREDUNDANT).
+    SNEDE_PETSC(PCSetType(direct, PCREDUNDANT));
+    KSP inner = nullptr;
+    SNEDE_PETSC(PCRedundantGetKSP(direct, &inner));
+    options.use_for(inner);
+    SNEDE_PETSC(KSPGetPC(inner, &direct));
+    options.use_for(direct);
+  }
   SNEDE_PETSC(PCSetType(direct, PCLU));
   // A cut can leave a piece held by a hinge (an edge, a vertex) whose coarse stiffness is
   // singular: an exact zero pivot is shifted instead of filling the step with NaN (measured: the

@@ -100,7 +100,8 @@ void set_chebyshev_jacobi_smoother(KSP smoother, const SolverOptions& options, d
 // The largest eigenvalues Chebyshev estimated on the smoothed levels of a PCMG (finest last);
 // empty if a level did not estimate (fixed bounds, another smoother).
 std::vector<double> chebyshev_estimates(PC pc);
-// The coarsest level's solve: a direct factorisation of its assembled matrix.
+// The coarsest level's solve: a direct factorisation of its assembled matrix (on every rank,
+// of the whole level, when the PC is on several ranks).
 void set_direct_coarse_solve(PC pc, const SolverOptions& options);
 
 }  // namespace snede

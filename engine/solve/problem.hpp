@@ -6,10 +6,14 @@
 // the same code on any number of processes. Every member is collective on comm().
 #pragma once
 
+#include <petscmat.h>
 #include <petscvec.h>
 
 #include <cstdint>
+#include <memory>
 #include <string>
+
+#include "fem/material.hpp"
 
 namespace snede {
 
@@ -20,12 +24,30 @@ struct ResidualCheck {
   bool admissible() const { return finite && !inverted; }
 };
 
+// An assembled copy of a problem's tangent, for the preconditioners that need entries (GAMG,
+// ILU, LU, Galerkin multigrid levels): the same J = P K P + I − P as the shell, times the
+// operator scale, with the rigid-body motions as near null space.
+class AssembledProblemTangent {
+ public:
+  virtual ~AssembledProblemTangent() = default;
+  virtual Mat mat() const = 0;
+  // Fills the entries at the state u (collective).
+  virtual void assemble(Vec u) = 0;
+  // Whether the sparsity is still the problem's (no edit of the mesh since it was made).
+  virtual bool matches() const = 0;
+};
+
+// How an assembled tangent stores its entries: AIJ for PETSc's preconditioners, vertex blocks
+// (BAIJ) where multigrid levels read them by blocks.
+enum class MatrixFormat { aij, baij };
+
 class Problem {
  public:
   virtual ~Problem() = default;
 
   virtual MPI_Comm comm() const = 0;
   virtual int dim() const = 0;
+  virtual const Material& material() const = 0;
   // The displacement, solved in place (block size dim; the rows this rank owns).
   virtual Vec state() const = 0;
 
@@ -35,13 +57,29 @@ class Problem {
   virtual double last_reaction_norm() const = 0;
   // Why `u` cannot be a result ("DIVERGED_INVERTED_ELEMENTS", …), or empty.
   virtual std::string inadmissible(Vec u) = 0;
-  // Π(u) = Π_int(u) − f_extᵀu.
+  // Π(u) = Π_int(u) − f_extᵀu: +∞ for an inverted element of a material that forbids it, NaN
+  // when an element's energy is not finite (the kernels skip such an element).
   virtual double energy(Vec u) = 0;
 
   // The scales of (6.9): ‖f_ext‖, the force scale E·H² (E·t·H in 2D), and the dofs.
   virtual double external_force_norm() = 0;
   virtual double force_scale() = 0;
   virtual std::int64_t n_global_dofs() const = 0;
+
+  // The tangent J = P K P + I − P at the linearisation point, applied matrix-free (a MatShell
+  // on comm() with MatMult and MatGetDiagonal), times the operator scale.
+  virtual Mat tangent() const = 0;
+  virtual void set_linearization_point(Vec u) = 0;
+  // A solver divides a whole system by a force scale to keep CG's dot products in range: the
+  // shell and the assembled tangent then apply scale·J; 1 otherwise.
+  virtual void set_operator_scale(double scale) = 0;
+  // A new assembled tangent in `format` for the current mesh (sparsity found now).
+  virtual std::unique_ptr<AssembledProblemTangent> make_assembled_tangent(MatrixFormat format) = 0;
+  // Cells over all ranks.
+  virtual std::int64_t n_global_cells() const = 0;
+  // Changes whenever the constraints' projection changes (a vertex fixed, released or made to
+  // slide): what a preconditioner filled for earlier constraints compares.
+  virtual std::uint64_t projection_fingerprint() const = 0;
 
   // Puts u on the constraints (prescribed values, sliding lines).
   virtual void enforce_constraints(Vec u) = 0;

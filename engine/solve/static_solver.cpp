@@ -14,9 +14,12 @@
 #include "core/norms.hpp"
 #include "core/petsc_util.hpp"
 #include "solve/aggregation_multigrid.hpp"
+#include "core/rank_agreement.hpp"
 #include "solve/bisection_multigrid.hpp"
+#include "solve/distributed_static.hpp"
 #include "solve/failed_solve.hpp"
 #include "solve/grid_multigrid.hpp"
+#include "solve/rank_aggregation_multigrid.hpp"
 #include "solve/tangent_assembly.hpp"
 
 namespace snede {
@@ -25,13 +28,13 @@ namespace {
 // The tangent shell applies J/scale while a solve runs on the scaled system.
 class ScaledOperator {
  public:
-  ScaledOperator(Model& model, double scale) : model_(model) { model_.set_operator_scale(1.0 / scale); }
-  ~ScaledOperator() { model_.set_operator_scale(1.0); }
+  ScaledOperator(Problem& problem, double scale) : problem_(problem) { problem_.set_operator_scale(1.0 / scale); }
+  ~ScaledOperator() { problem_.set_operator_scale(1.0); }
   ScaledOperator(const ScaledOperator&) = delete;
   ScaledOperator& operator=(const ScaledOperator&) = delete;
 
  private:
-  Model& model_;
+  Problem& problem_;
 };
 
 bool is_linear(const Material& material) { return std::holds_alternative<LinearElastic>(material); }
@@ -66,28 +69,64 @@ constexpr double newton_stall = 1e-6;
 // 600–700). Nonlinear CG takes none.
 constexpr std::size_t multigrid_from_cells = 1000;
 
-std::string automatic_preconditioner(const Model& model, StaticMethod method) {
-  if (method == StaticMethod::nonlinear_cg || model.body().mesh().n_cells() < multigrid_from_cells) return PCNONE;
+std::string automatic_preconditioner(const Problem& problem, StaticMethod method) {
+  if (method == StaticMethod::nonlinear_cg ||
+      problem.n_global_cells() < static_cast<std::int64_t>(multigrid_from_cells))
+    return PCNONE;
   return PCMG;
+}
+
+Model* serial_model(Problem& problem) {
+  auto* serial = dynamic_cast<ModelProblem*>(&problem);
+  return serial ? &serial->model() : nullptr;
+}
+
+// Every rank must solve with the same options: a rank with another method or tolerance would
+// wait in a collective call the others never make.
+void require_same_options_everywhere(MPI_Comm comm, const StaticOptions& options) {
+  InputDigest petsc_options;
+  for (const auto& [name, value] : options.petsc_options) petsc_options.add(name).add(value);
+  RankAgreement("StaticSolver")
+      .input("method", static_cast<double>(options.method))
+      .input("criterion", static_cast<double>(options.stopping.criterion))
+      .input("rtol", options.stopping.rtol)
+      .input("round_tolerance", options.stopping.round_tolerance)
+      .input("max_iterations", options.max_iterations)
+      .input("options_prefix", options.options_prefix)
+      .input("preconditioner", options.preconditioner)
+      .input("petsc_options", petsc_options)
+      .require(comm);
 }
 
 }  // namespace
 
 StaticSolver::StaticSolver(Model& model, StaticOptions options, const RefinementHierarchy* hierarchy)
-    : model_(model),
+    : StaticSolver(std::make_unique<ModelProblem>(model), nullptr, std::move(options), hierarchy) {}
+
+StaticSolver::StaticSolver(Problem& problem, StaticOptions options)
+    : StaticSolver(nullptr, &problem, std::move(options), nullptr) {}
+
+StaticSolver::StaticSolver(std::unique_ptr<ModelProblem> owned, Problem* problem, StaticOptions options,
+                           const RefinementHierarchy* hierarchy)
+    : owned_problem_(std::move(owned)),
+      problem_(problem ? *problem : *owned_problem_),
+      model_(serial_model(problem_)),
       options_(std::move(options)),
       option_database_(options_.options_prefix, options_.petsc_options),
       hierarchy_(hierarchy),
-      reuse_(number_option("mg_refresh_ratio", PreconditionerReuse::default_refresh_ratio)),
-      piece_holding_(model.body().mesh()) {
+      reuse_(number_option("mg_refresh_ratio", PreconditionerReuse::default_refresh_ratio)) {
+  require_same_options_everywhere(problem_.comm(), options_);
+  if (model_) piece_holding_.emplace(model_->body().mesh());
   if (options_.stopping.rtol <= 0 || !std::isfinite(options_.stopping.rtol))
     throw std::invalid_argument("rtol must be positive, got " + std::to_string(options_.stopping.rtol));
   if (!(options_.stopping.round_tolerance >= 0) || !std::isfinite(options_.stopping.round_tolerance))
     throw std::invalid_argument("round_tolerance must be finite and non-negative, got " +
                                 std::to_string(options_.stopping.round_tolerance));
+  if (options_.stopping.criterion == StoppingCriterion::relative && !(options_.stopping.rtol < 1))
+    throw std::invalid_argument("a relative rtol must be below 1, got " + std::to_string(options_.stopping.rtol));
   if (options_.max_iterations < 1)
     throw std::invalid_argument("max_iterations must be at least 1, got " + std::to_string(options_.max_iterations));
-  if (options_.method == StaticMethod::linear_cg && !is_linear(model.body().material()))
+  if (options_.method == StaticMethod::linear_cg && !is_linear(problem_.material()))
     throw std::invalid_argument(
         "method 'cg' (linear CG) solves the linear problem and needs LinearElastic; use 'ncg' or 'newton' for "
         "nonlinear materials");
@@ -96,14 +135,14 @@ StaticSolver::StaticSolver(Model& model, StaticOptions options, const Refinement
                  .value_or(options_.preconditioner.empty() ? std::string("auto") : options_.preconditioner);
   if (pc_type_ == "auto") {
     automatic_ = true;
-    pc_type_ = automatic_preconditioner(model, options_.method);
+    pc_type_ = automatic_preconditioner(problem_, options_.method);
     // -<prefix>pc_type auto is snede's: PETSc, which reads the option again, must see the choice.
     if (option_database_.string_option(options_.options_prefix + "pc_type"))
       option_database_.set_string_option(options_.options_prefix + "pc_type", pc_type_);
   }
   if (options_.method == StaticMethod::nonlinear_cg && pc_type_ != PCNONE)
     throw std::invalid_argument("a preconditioner ('" + pc_type_ + "') applies to the CG of methods 'cg' and 'newton'; "
-                                "nonlinear CG ('ncg') takes none");
+                                "nonlinear CG ('ncg') takes no preconditioner");
   if (pc_type_ != PCMG && !automatic_ && option_database_.string_option(options_.options_prefix + "mg_refresh_ratio"))
     throw std::invalid_argument("-" + options_.options_prefix + "mg_refresh_ratio applies to the preconditioner 'mg'; "
                                 "this solver's is '" + pc_type_ + "'");
@@ -154,12 +193,12 @@ KSP StaticSolver::ksp() const {
 }
 
 void StaticSolver::create_objects() {
-  generation_ = model_.generation();
+  generation_ = problem_.generation();
   if (!multigrid_) build_multigrid();  // before the operators: Galerkin levels need the assembled tangent
-  SNEDE_PETSC(VecDuplicate(model_.displacement(), residual_.out()));
+  SNEDE_PETSC(VecDuplicate(problem_.state(), residual_.out()));
   const char* prefix = options_.options_prefix.c_str();
   if (options_.method == StaticMethod::linear_cg) {
-    SNEDE_PETSC(KSPCreate(PETSC_COMM_SELF, ksp_.out()));
+    SNEDE_PETSC(KSPCreate(problem_.comm(), ksp_.out()));
     option_database_.use_for(ksp_);
     SNEDE_PETSC(KSPSetOptionsPrefix(ksp_, prefix));
     SNEDE_PETSC(KSPSetType(ksp_, KSPCG));
@@ -169,7 +208,7 @@ void StaticSolver::create_objects() {
     SNEDE_PETSC(PCSetType(pc, pc_type_.c_str()));
     SNEDE_PETSC(PCSetUseAmat(pc, PETSC_FALSE));  // see the Newton branch
     if (multigrid_) configure_multigrid(pc);
-    SNEDE_PETSC(KSPSetOperators(ksp_, model_.tangent(), preconditioning_matrix()));
+    SNEDE_PETSC(KSPSetOperators(ksp_, problem_.tangent(), preconditioning_matrix()));
     SNEDE_PETSC(KSPSetTolerances(ksp_, 0.0, 0.0, PETSC_DEFAULT, options_.max_iterations));
     SNEDE_PETSC(KSPSetConvergenceTest(ksp_, ksp_converged_callback, this, nullptr));
     // The criterion is on the equilibrium residual b − Jδ itself: with a preconditioner CG
@@ -181,7 +220,7 @@ void StaticSolver::create_objects() {
     option_database_.mark_read_options_used();
     return;
   }
-  SNEDE_PETSC(SNESCreate(PETSC_COMM_SELF, snes_.out()));
+  SNEDE_PETSC(SNESCreate(problem_.comm(), snes_.out()));
   option_database_.use_for(snes_);
   SNEDE_PETSC(SNESSetOptionsPrefix(snes_, prefix));  // also creates the KSP
   KSP inner = nullptr;
@@ -196,7 +235,7 @@ void StaticSolver::create_objects() {
   SNEDE_PETSC(SNESSetTolerances(snes_, 0.0, 0.0, 0.0, options_.max_iterations, -1));
   SNEDE_PETSC(SNESSetConvergenceTest(snes_, snes_converged_callback, this, nullptr));
   // Nonlinear CG's line searches take K(x)d from the Jacobian too (line_search.cpp).
-  SNEDE_PETSC(SNESSetJacobian(snes_, model_.tangent(), preconditioning_matrix(), jacobian_callback, this));
+  SNEDE_PETSC(SNESSetJacobian(snes_, problem_.tangent(), preconditioning_matrix(), jacobian_callback, this));
   if (options_.method == StaticMethod::nonlinear_cg) {
     SNEDE_PETSC(SNESSetType(snes_, SNESNCG));
     SNEDE_PETSC(SNESNCGSetType(snes_, SNES_NCG_PRP));
@@ -247,15 +286,15 @@ void StaticSolver::follow_mesh_changes() {
   // A needle's refinement grows a mesh of a few hundred cells, where "auto" chose no
   // preconditioner, past the size where multigrid pays (and collapses or removed pieces may
   // shrink one): choose again, with solver objects made afresh for the new choice.
-  if (automatic_ && automatic_preconditioner(model_, options_.method) != pc_type_) {
+  if (automatic_ && automatic_preconditioner(problem_, options_.method) != pc_type_) {
     choose_preconditioner_again();
     return;
   }
-  const bool resized = generation_ != model_.generation();
-  const bool stale_matrix = needs_matrix_ && (!assembled_ || !assembled_->matches(model_));
-  const bool stale_multigrid = multigrid_ && !multigrid_->matches(model_);
+  const bool resized = generation_ != problem_.generation();
+  const bool stale_matrix = needs_matrix_ && (!assembled_ || !assembled_->matches());
+  const bool stale_multigrid = multigrid_ && !levels_match();
   if (!resized && !stale_matrix && !stale_multigrid) return;
-  if (!resized && !stale_matrix && multigrid_->matches_mesh(model_)) {
+  if (!resized && !stale_matrix && levels_match_mesh()) {
     // Only the constraints changed (a needle's stick-slip): a change of a few vertices. Galerkin
     // levels that Newton keeps across solves keep their interpolation, made for the earlier
     // constraints, and are refilled at the next solve (fine matrix and Galerkin products, no new
@@ -265,25 +304,25 @@ void StaticSolver::follow_mesh_changes() {
     take_over_constraints();
     return;
   }
-  generation_ = model_.generation();
-  if (resized) SNEDE_PETSC(VecDuplicate(model_.displacement(), residual_.out()));
+  generation_ = problem_.generation();
+  if (resized) SNEDE_PETSC(VecDuplicate(problem_.state(), residual_.out()));
   assembled_.reset();  // its sparsity was the old mesh's (a flip or a cut changes it)
   multigrid_.reset();
   build_multigrid();
   if (ksp_) {
     SNEDE_PETSC(KSPReset(ksp_));
-    SNEDE_PETSC(KSPSetOperators(ksp_, model_.tangent(), preconditioning_matrix()));
+    SNEDE_PETSC(KSPSetOperators(ksp_, problem_.tangent(), preconditioning_matrix()));
   } else {
     SNEDE_PETSC(SNESReset(snes_));
     // SNESReset keeps the SNES's DM, whose global vector still has the old size (NCG
     // duplicates it): a fresh shell DM, then the callbacks it carries set again.
     DmHandle dm;
-    SNEDE_PETSC(DMShellCreate(PETSC_COMM_SELF, dm.out()));
+    SNEDE_PETSC(DMShellCreate(problem_.comm(), dm.out()));
     SNEDE_PETSC(DMShellSetGlobalVector(dm, residual_));
     SNEDE_PETSC(SNESSetDM(snes_, dm));  // the SNES holds its own reference
     SNEDE_PETSC(SNESSetObjective(snes_, objective_callback, this));
     SNEDE_PETSC(SNESSetFunction(snes_, residual_, residual_callback, this));
-    SNEDE_PETSC(SNESSetJacobian(snes_, model_.tangent(), preconditioning_matrix(), jacobian_callback, this));
+    SNEDE_PETSC(SNESSetJacobian(snes_, problem_.tangent(), preconditioning_matrix(), jacobian_callback, this));
   }
   if (needs_matrix_ || pc_type_ == PCMG) {
     // A reset PCGAMG keeps its levels' sizes ("Cannot change local size of Amat after use"):
@@ -298,7 +337,7 @@ void StaticSolver::follow_mesh_changes() {
 }
 
 Mat StaticSolver::preconditioning_matrix() {
-  if (!needs_matrix_) return model_.tangent();
+  if (!needs_matrix_) return problem_.tangent();
   if (!assembled_) {
     static const PetscLogEvent event = log_event("SnedeTangentSparsity");
     ScopedEvent logged(event);
@@ -306,8 +345,7 @@ Mat StaticSolver::preconditioning_matrix() {
     // elements must not make the PC indefinite.
     const MatrixFormat format =
         pc_needs_matrix_ || !multigrid_ ? MatrixFormat::aij : multigrid_->assembled_tangent_format();
-    assembled_ = std::make_unique<AssembledTangent>(model_, format, MembraneTangent::positive_part);
-    set_rigid_body_near_null_space(model_, assembled_->mat());
+    assembled_ = problem_.make_assembled_tangent(format);
     preconditioner_filled_ = false;
   }
   return assembled_->mat();
@@ -347,13 +385,17 @@ void StaticSolver::build_multigrid() {
   // A mesh read from a file and refined locally (along a needle) has that mesh, or more, as the
   // coarsest bisection level: a direct solve on it costs more than the grid levels (a
   // 21k-tetrahedron liver took 1.6 s per factorisation). Its roots tell before the levels are made.
+  if (!model_) {
+    build_rank_multigrid(coarsening, max_levels);
+    return;
+  }
   const bool small_roots =
-      hierarchy_ && small_coarsest_level(hierarchy_->roots().size(), model_.body().mesh().n_cells());
+      hierarchy_ && small_coarsest_level(hierarchy_->roots().size(), model_->body().mesh().n_cells());
   if (coarsening != "aggregation" && coarsening != "grid" && hierarchy_ && (small_roots || coarsening == "bisection")) {
     try {
       static const PetscLogEvent event = log_event("SnedeBisectionLevels");
       ScopedEvent logged(event);
-      multigrid_ = std::make_unique<BisectionMultigrid>(model_, *hierarchy_, max_levels);
+      multigrid_ = std::make_unique<BisectionMultigrid>(*model_, *hierarchy_, max_levels);
       const std::vector<std::size_t> unknowns = multigrid_->level_unknowns();
       if (coarsening == "auto" && !small_coarsest_level(unknowns.front(), unknowns.back())) multigrid_.reset();
     } catch (const std::invalid_argument&) {
@@ -366,7 +408,7 @@ void StaticSolver::build_multigrid() {
     if (max_levels > 2) throw std::invalid_argument(prefix + "pc_mg_levels: grid coarsening gives 2 levels");
     static const PetscLogEvent event = log_event("SnedeGridLevels");
     ScopedEvent logged(event);
-    multigrid_ = std::make_unique<GridMultigrid>(model_, number_option("mg_grid_width", GridMultigrid::default_grid_width));
+    multigrid_ = std::make_unique<GridMultigrid>(*model_, number_option("mg_grid_width", GridMultigrid::default_grid_width));
   }
   const std::string smoothing =
       option_database_.string_option(options_.options_prefix + "mg_aggregation_smoothing").value_or("false");
@@ -374,7 +416,7 @@ void StaticSolver::build_multigrid() {
     throw std::invalid_argument(prefix + "mg_aggregation_smoothing must be true or false, got '" + smoothing + "'");
   if (!multigrid_)
     multigrid_ = std::make_unique<AggregationMultigrid>(
-        model_, max_levels, smoothing == "true",
+        *model_, max_levels, smoothing == "true",
         number_option("mg_aggregate_width", AggregationMultigrid::default_aggregate_width));
   // An option for another kind of levels than those made is a mistake the user should hear of,
   // except the grid's width on bisection levels chosen by "auto": grid levels take over after
@@ -393,9 +435,47 @@ void StaticSolver::build_multigrid() {
   ++multigrid_builds_;
 }
 
+void StaticSolver::build_rank_multigrid(const std::string& coarsening, int max_levels) {
+  const std::string prefix = "-" + options_.options_prefix;
+  if (coarsening != "auto" && coarsening != "aggregation")
+    throw std::invalid_argument(prefix + "mg_coarsening " + coarsening + ": on MPI ranks 'mg' coarsens by aggregation "
+                                "of each rank's vertices (bisection and grid levels need the whole mesh)");
+  for (const char* name : {"mg_grid_width", "mg_aggregation_smoothing"})
+    if (option_database_.string_option(options_.options_prefix + name))
+      throw std::invalid_argument(prefix + name + " does not apply on MPI ranks, whose 'mg' levels are aggregates of "
+                                  "each rank's vertices");
+  auto& distributed = dynamic_cast<DistributedStatic&>(problem_);
+  multigrid_ = std::make_unique<RankAggregationMultigrid>(
+      distributed, max_levels, number_option("mg_aggregate_width", AggregationMultigrid::default_aggregate_width));
+  needs_matrix_ = true;
+  ++multigrid_builds_;
+}
+
+void StaticSolver::anchor_relative_rule(double initial_norm) {
+  if (rule_.criterion != StoppingCriterion::relative) return;
+  // A start already in equilibrium by (6.9) is converged with no iteration: ε‖r(u₀)‖ is out of
+  // reach of a residual at round-off (Newton ended DIVERGED_LINE_SEARCH there, issue 38).
+  StoppingRule equilibrium = rule_;
+  equilibrium.criterion = StoppingCriterion::with_reactions;
+  if (initial_norm <= equilibrium.tolerance(external_norm_, problem_.last_reaction_norm())) {
+    rule_ = equilibrium;
+    return;
+  }
+  rule_.initial_residual_norm = initial_norm;
+}
+
+bool StaticSolver::levels_match() const { return !model_ || multigrid_->matches(*model_); }
+
+bool StaticSolver::levels_match_mesh() const { return !model_ || multigrid_->matches_mesh(*model_); }
+
+Model& StaticSolver::model() {
+  if (!model_) throw std::logic_error("StaticSolver::model(): this solver's problem is distributed, not a Model");
+  return *model_;
+}
+
 void StaticSolver::choose_preconditioner_again() {
   const std::string previous = pc_type_;
-  pc_type_ = automatic_preconditioner(model_, options_.method);
+  pc_type_ = automatic_preconditioner(problem_, options_.method);
   // The levels are made before the solver's objects are replaced: an option they refuse (the
   // -<prefix>mg_ options are checked only once mg is chosen) leaves the solver as it was, and
   // the next solve refuses it again.
@@ -485,7 +565,7 @@ void StaticSolver::fill_preconditioner(Vec u) {
   if (assembled_) {
     static const PetscLogEvent event = log_event("SnedeTangentAssembly");
     ScopedEvent logged(event);
-    assembled_->assemble(model_, u);
+    assembled_->assemble(u);
   }
   if (multigrid_) {
     static const PetscLogEvent event = log_event("SnedeLevelsUpdate");
@@ -496,12 +576,12 @@ void StaticSolver::fill_preconditioner(Vec u) {
   preconditioner_filled_ = true;
   filled_in_this_solve_ = true;
   filled_at_scale_ = system_scale_;
-  filled_for_constraints_ = model_.constraints().projection_fingerprint();
+  filled_for_constraints_ = problem_.projection_fingerprint();
 }
 
 bool StaticSolver::filled_for_current_system() const {
   return preconditioner_filled_ && filled_at_scale_ == system_scale_ &&
-         filled_for_constraints_ == model_.constraints().projection_fingerprint();
+         filled_for_constraints_ == problem_.projection_fingerprint();
 }
 
 bool StaticSolver::keeps_galerkin_levels() const {
@@ -526,7 +606,7 @@ void StaticSolver::take_over_constraints() {
 }
 
 double StaticSolver::current_tolerance() const {
-  return rule_.tolerance(external_norm_, ksp_ ? reaction_norm_ : model_.last_reaction_norm());
+  return rule_.tolerance(external_norm_, ksp_ ? reaction_norm_ : problem_.last_reaction_norm());
 }
 
 SolveResult StaticSolver::solve() {
@@ -535,7 +615,7 @@ SolveResult StaticSolver::solve() {
   {
     static const PetscLogEvent event = log_event("SnedePieceCheck");
     ScopedEvent logged(event);
-    piece_holding_.require_held(model_.constraints());
+    if (piece_holding_) piece_holding_->require_held(model_->constraints());
   }
   const double follow_start = wall_seconds();
   {
@@ -545,17 +625,17 @@ SolveResult StaticSolver::solve() {
   }
   follow_seconds_ = wall_seconds() - follow_start;
   history_.clear();
-  external_norm_ = euclidean_norm(model_.external_forces());
+  external_norm_ = problem_.external_force_norm();
   // The force scale is a scan of the mesh: once per solve, not once per iteration.
   rule_ = options_.stopping;
-  rule_.force_scale = model_.force_scale();
-  rule_.n_dofs = static_cast<double>(model_.n_dofs());
+  rule_.force_scale = problem_.force_scale();
+  rule_.n_dofs = static_cast<double>(problem_.n_global_dofs());
   // Every method solves the system divided by the force scale E·t·H (E·H² in 3D), so that its
   // dot products stay in range whatever the units (E = 1e155 Pa overflows p·Ap otherwise):
   // linear CG its right-hand side and operator, SNES its function, objective (energy) and
   // tangent. The iterate keeps its units and the stopping tests multiply back.
   system_scale_ = std::isfinite(rule_.force_scale) && rule_.force_scale > 0 ? rule_.force_scale : 1.0;
-  model_.enforce_constraints(model_.displacement());
+  problem_.enforce_constraints(problem_.state());
   SolveResult result = ksp_ ? solve_linear() : solve_nonlinear();
   if (result.converged) remember_smoother_bounds();
   option_database_.mark_read_options_used();  // a solve reads more (-snes_view, -ksp_converged_reason)
@@ -566,31 +646,29 @@ SolveResult StaticSolver::solve_linear() {
   SolveResult result;
   const double start = wall_seconds();
   const double start_flops = logged_flops();
-  Vec u = model_.displacement();
+  Vec u = problem_.state();
   VecHandle rhs, step;
   SNEDE_PETSC(VecDuplicate(u, rhs.out()));
   SNEDE_PETSC(VecDuplicate(u, step.out()));
-  EvaluationReport report;
-  model_.residual(u, residual_, report);
-  throw_if_domain_error(report);
-  reaction_norm_ = model_.last_reaction_norm();
+  // A start that is not finite makes the right-hand side NaN: CG stops at once
+  // (DIVERGED_NANORINF) and finish() reports the state.
+  problem_.residual(u, residual_);
+  reaction_norm_ = problem_.last_reaction_norm();
   result.initial_residual_norm = vec_norm(residual_);
+  anchor_relative_rule(result.initial_residual_norm);
   // One Newton step of the quadratic problem: J δ = −F(u), solved by CG (§3.1).
-  model_.set_linearization_point(u);
+  problem_.set_linearization_point(u);
   SNEDE_PETSC(VecCopy(residual_, rhs));
   SNEDE_PETSC(VecScale(rhs, -1.0 / system_scale_));
   SNEDE_PETSC(VecSet(step, 0.0));
-  const ScaledOperator scaled(model_, system_scale_);
+  const ScaledOperator scaled(problem_, system_scale_);
   // Linear CG solves linear elasticity, whose tangent does not depend on the state: what was
   // filled for an earlier solve of the same system is the same matrix.
   if (!filled_for_current_system()) fill_preconditioner(u);
   solve_through(ksp_, [&] { SNEDE_PETSC(KSPSolve(ksp_, rhs, step)); });
-  {
-    // Onto the allowed motions (6.7), as Newton's steps (descent_direction_callback): CG's
-    // iterate under a preconditioner that is not projected leaves sliding vertices' lines.
-    WriteView values(step);
-    model_.constraints().project(values.span());
-  }
+  // Onto the allowed motions (6.7), as Newton's steps (descent_direction_callback): CG's
+  // iterate under a preconditioner that is not projected leaves sliding vertices' lines.
+  problem_.project_onto_allowed_motions(step);
   SNEDE_PETSC(VecAXPY(u, 1.0, step));
   KSPConvergedReason reason;
   PetscInt iterations = 0;
@@ -607,13 +685,13 @@ SolveResult StaticSolver::solve_nonlinear() {
   SolveResult result;
   const double start = wall_seconds();
   const double start_flops = logged_flops();
-  Vec u = model_.displacement();
-  EvaluationReport report;
-  model_.residual(u, residual_, report);
+  Vec u = problem_.state();
+  problem_.residual(u, residual_);
   result.initial_residual_norm = vec_norm(residual_);
+  anchor_relative_rule(result.initial_residual_norm);
   SNESConvergedReason reason;
   PetscInt iterations = 0, linear = 0;
-  const ScaledOperator scaled(model_, system_scale_);
+  const ScaledOperator scaled(problem_, system_scale_);
   // Galerkin levels (an assembled tangent, its products with the interpolation, a coarse
   // factorisation) are built at the first Newton iteration of a solve and kept through its other
   // iterations, unless the options lag otherwise: rebuilding them cost more than the CG
@@ -626,7 +704,7 @@ SolveResult StaticSolver::solve_nonlinear() {
   filled_in_this_solve_ = false;
   if (keeps_levels_through_solve_) {
     const bool reuse = filled_for_current_system() && reuse_.keep();
-    if (!reuse_.keep() && !multigrid_->matches(model_)) take_over_constraints();
+    if (!reuse_.keep() && !levels_match()) take_over_constraints();
     SNEDE_PETSC(SNESSetLagPreconditioner(snes_, reuse ? -1 : -2));
     if (!reuse) preconditioner_filled_ = false;
   }
@@ -676,22 +754,21 @@ SolveResult StaticSolver::solve_nonlinear() {
   if (keeps_levels_through_solve_)
     // Levels refilled on an interpolation of earlier constraints do not set a new baseline.
     reuse_.record(result.iterations, result.linear_iterations, result.converged,
-                  filled_in_this_solve_ && multigrid_->matches(model_));
+                  filled_in_this_solve_ && levels_match());
   return result;
 }
 
 void StaticSolver::finish(SolveResult& result, double start_seconds, double start_flops) {
-  Vec u = model_.displacement();
+  Vec u = problem_.state();
   // The verdict is checked on the final state, whatever PETSc said (§ "results, not crashes").
-  std::string why;
-  if (!model_.admissible(u, &why)) {
+  if (const std::string why = problem_.inadmissible(u); !why.empty()) {
     result.converged = false;
     result.reason = why;
   }
-  EvaluationReport report;
-  model_.residual(u, residual_, report);
+  const ResidualCheck check = problem_.residual(u, residual_);
   result.residual_norm = vec_norm(residual_);
-  if (!report.domain_errors.empty() || !std::isfinite(result.residual_norm)) {
+  // (A distributed problem's residual is NaN at an inverted state, already named above.)
+  if (!check.finite || (!check.inverted && !std::isfinite(result.residual_norm))) {
     result.converged = false;
     result.reason = "DIVERGED_NONFINITE_STATE";
   }
@@ -708,8 +785,7 @@ void StaticSolver::finish(SolveResult& result, double start_seconds, double star
     result.converged = false;
     result.reason = "DIVERGED_RESIDUAL_ABOVE_TOLERANCE (PETSc: " + result.reason + ")";
   }
-  EvaluationReport energy_report;
-  result.energy = model_.potential_energy(u, energy_report);
+  result.energy = problem_.energy(u);
   result.residual_history = history_;
   result.seconds = wall_seconds() - start_seconds;
   result.flops = logged_flops() - start_flops;
@@ -718,20 +794,20 @@ void StaticSolver::finish(SolveResult& result, double start_seconds, double star
 PetscErrorCode StaticSolver::residual_callback(SNES snes, Vec x, Vec F, void* context) {
   return petsc_callback("snede static residual", [&] {
     auto* self = &callback_owner<StaticSolver>(context, "StaticSolver");
-    EvaluationReport report;
-    self->model_.residual(x, F, report);
+    const ResidualCheck check = self->problem_.residual(x, F);
     SNEDE_PETSC(VecScale(F, 1.0 / self->system_scale_));
-    const bool inverted = !report.inverted.empty() && forbids_inversion(self->model_.body().material());
-    if (!report.domain_errors.empty() || inverted) SNEDE_PETSC(SNESSetFunctionDomainError(snes));
+    // Every rank of a distributed problem gets the same verdict, so line searches shorten the
+    // same step everywhere.
+    if (!check.admissible()) SNEDE_PETSC(SNESSetFunctionDomainError(snes));
   });
 }
 
 PetscErrorCode StaticSolver::objective_callback(SNES snes, Vec x, PetscReal* value, void* context) {
   return petsc_callback("snede static objective", [&] {
     auto* self = &callback_owner<StaticSolver>(context, "StaticSolver");
-    EvaluationReport report;
-    *value = self->model_.potential_energy(x, report) / self->system_scale_;
-    if (!report.domain_errors.empty()) {
+    // +∞ for an inverted element of a material that forbids it; NaN for a non-finite element.
+    *value = self->problem_.energy(x) / self->system_scale_;
+    if (std::isnan(*value)) {
       *value = std::numeric_limits<double>::infinity();
       SNEDE_PETSC(SNESSetFunctionDomainError(snes));
     }
@@ -741,7 +817,7 @@ PetscErrorCode StaticSolver::objective_callback(SNES snes, Vec x, PetscReal* val
 PetscErrorCode StaticSolver::jacobian_callback(SNES snes, Vec x, Mat J, Mat P, void* context) {
   return petsc_callback("snede static jacobian", [&] {
     StaticSolver& self = callback_owner<StaticSolver>(context, "StaticSolver");
-    self.model_.set_linearization_point(x);
+    self.problem_.set_linearization_point(x);
     SNEDE_PETSC(MatAssemblyBegin(J, MAT_FINAL_ASSEMBLY));
     SNEDE_PETSC(MatAssemblyEnd(J, MAT_FINAL_ASSEMBLY));
     if (P != J || self.multigrid_) self.refill_preconditioner(snes, x);
@@ -763,10 +839,7 @@ PetscErrorCode StaticSolver::descent_direction_callback(SNESLineSearch line_sear
     // random directions: Jacobi's Newton stopped with DIVERGED_LINE_SEARCH, mg took 39 iterations
     // of a linear problem where no preconditioner took 5). The slope F·step is unchanged, F
     // being projected already.
-    auto project = [&](Vec v) {
-      WriteView values(v);
-      self.model_.constraints().project(values.span());
-    };
+    auto project = [&](Vec v) { self.problem_.project_onto_allowed_motions(v); };
     project(step);
     *changed = PETSC_TRUE;
     // An indefinite multigrid preconditioner is made positive definite for the next Newton

@@ -5,6 +5,10 @@
 // Every object carries the options prefix and reads the solver's own options database
 // (core/solver_options.hpp); SetFromOptions is called after snede's defaults, so the
 // solver's options override the defaults and the command line overrides everything.
+//
+// It drives any Problem (problem.hpp) on its communicator (issue 36): the serial Model, whose
+// mesh may be cut or refined between solves, or a DistributedStatic on N ranks — the same
+// methods, criteria and preconditioners ("mg" by aggregation on ranks, rank_aggregation.hpp).
 #pragma once
 
 #include <petscksp.h>
@@ -13,17 +17,20 @@
 #include <string>
 #include <vector>
 
-#include "core/solver_options.hpp"
 #include <memory>
+#include <optional>
 
-#include "solve/multigrid.hpp"
-#include "topology/refinement_hierarchy.hpp"
+#include "core/solver_options.hpp"
 #include "solve/model.hpp"
+#include "solve/model_problem.hpp"
+#include "solve/multigrid.hpp"
 #include "solve/preconditioner_reuse.hpp"
+#include "solve/problem.hpp"
 #include "solve/tangent_assembly.hpp"
 #include "solve/solve_result.hpp"
 #include "solve/static_options.hpp"
 #include "solve/stopping.hpp"
+#include "topology/refinement_hierarchy.hpp"
 
 namespace snede {
 
@@ -32,11 +39,14 @@ class StaticSolver {
   // hierarchy: the mesh's bisection hierarchy, which "mg" coarsens along when it can (may be
   // null); it must outlive the solver.
   StaticSolver(Model& model, StaticOptions options, const RefinementHierarchy* hierarchy = nullptr);
+  // Collective on problem.comm(); the problem must outlive the solver. Throws
+  // std::invalid_argument (the same on every rank) for options that differ between the ranks.
+  StaticSolver(Problem& problem, StaticOptions options);
   ~StaticSolver();
   StaticSolver(const StaticSolver&) = delete;
   StaticSolver& operator=(const StaticSolver&) = delete;
 
-  // Relaxes the model's displacement in place (starting from it, constraints enforced).
+  // Relaxes the problem's state in place (starting from it, constraints enforced).
   SolveResult solve();
   KSP ksp() const;  // linear CG's KSP, or Newton's inner KSP
   SNES snes() const { return snes_; }
@@ -55,7 +65,9 @@ class StaticSolver {
     return multigrid_ ? multigrid_->level_unknowns() : std::vector<std::size_t>{};
   }
   std::string multigrid_source() const { return multigrid_ ? multigrid_->source() : ""; }
-  Model& model() { return model_; }
+  // The serial model solved (std::logic_error for a distributed problem).
+  Model& model();
+  Problem& problem() { return problem_; }
   // Seconds the last solve spent following mesh and constraint changes before iterating: new
   // vectors, the assembled tangent's sparsity, the multigrid levels (0 when nothing changed).
   double follow_seconds() const { return follow_seconds_; }
@@ -71,6 +83,12 @@ class StaticSolver {
   void use_hierarchy(const RefinementHierarchy* hierarchy) { hierarchy_ = hierarchy; }
 
  private:
+  // Solves `problem`, or the model problem `owned` when it is null.
+  StaticSolver(std::unique_ptr<ModelProblem> owned, Problem* problem, StaticOptions options,
+               const RefinementHierarchy* hierarchy);
+  // Whether the multigrid levels are still those of the mesh (and of its constraints' projections).
+  bool levels_match() const;
+  bool levels_match_mesh() const;
   void create_objects();
   // After a mesh change: new vectors if the size changed (same solver objects, so a user's
   // handle and options survive), a new assembled tangent if its sparsity is out of date.
@@ -85,6 +103,8 @@ class StaticSolver {
   // PC "mg": the levels for the current mesh (bisection when the hierarchy gives them, else a
   // grid or aggregation), and whether the PC then needs the assembled tangent.
   void build_multigrid();
+  // "mg" on a distributed problem: aggregation levels on each rank's vertices.
+  void build_rank_multigrid(const std::string& coarsening, int max_levels);
   // The levels built anew and configured on `pc`.
   void set_up_multigrid(PC pc);
   // Configures `pc` as a PCMG over the current levels.
@@ -106,6 +126,8 @@ class StaticSolver {
   // A number from the option database (-<prefix>name), or `fallback`.
   double number_option(const std::string& name, double fallback) const;
   double current_tolerance() const;
+  // Criterion "relative": ε‖r(u₀)‖ from the starting residual's norm.
+  void anchor_relative_rule(double initial_norm);
   SolveResult solve_linear();
   SolveResult solve_nonlinear();
   void finish(SolveResult& result, double start_seconds, double start_flops);
@@ -121,7 +143,9 @@ class StaticSolver {
   static PetscErrorCode ksp_converged_callback(KSP, PetscInt it, PetscReal rnorm, KSPConvergedReason* reason,
                                                void* context);
 
-  Model& model_;
+  std::unique_ptr<ModelProblem> owned_problem_;  // made for a Model
+  Problem& problem_;
+  Model* model_;  // the serial model, or null on a distributed problem (no edits, no hierarchy)
   StaticOptions options_;
   SolverOptions option_database_;  // read by the PETSc objects below
   KspHandle ksp_;    // linear CG only
@@ -131,7 +155,7 @@ class StaticSolver {
   bool automatic_ = false;             // pc_type_ was chosen by "auto": chosen again as the mesh grows
   bool pc_needs_matrix_ = false;       // the PC type needs entries (not none, jacobi or mg)
   bool needs_matrix_ = false;          // the PC needs an assembled tangent (that, or Galerkin mg)
-  std::unique_ptr<AssembledTangent> assembled_;  // that tangent, for the current mesh
+  std::unique_ptr<AssembledProblemTangent> assembled_;  // that tangent, for the current mesh
   const RefinementHierarchy* hierarchy_ = nullptr;
   std::unique_ptr<Multigrid> multigrid_;  // PC "mg": the levels for the current mesh
   std::vector<double> smoother_bounds_;  // mg: Chebyshev's estimates from an earlier set-up, reused
@@ -152,7 +176,8 @@ class StaticSolver {
   double reaction_norm_ = 0;  // reactions used by the KSP test (at the start of a linear solve)
   std::vector<double> history_;
   double follow_seconds_ = 0;
-  PieceHolding piece_holding_;  // whether every piece of the body is held (checked before each solve)
+  // Whether every piece of the body is held (checked before each solve; serial models).
+  std::optional<PieceHolding> piece_holding_;
 };
 
 // Registers snede's line searches with PETSc (idempotent): snede_newton, snede_secant.

@@ -14,10 +14,9 @@
 #include "core/csr_matrix.hpp"
 #include "core/petsc_handle.hpp"
 #include "solve/model.hpp"
+#include "solve/problem.hpp"
 
 namespace snede {
-
-enum class MatrixFormat { aij, baij };
 
 // What a membrane element contributes: its exact tangent, or its positive part (eigenvalues
 // raised to a small positive floor) for a preconditioner, which must stay positive semidefinite where

@@ -95,8 +95,9 @@ class DistributedStatic:
     :class:`DistributedRelaxation`.
 
     ``solve(method="cg" | "newton" | "ncg", rtol=1e-8, preconditioner="none" | "jacobi" |
-    "gamg" | "bjacobi" | "sor" | "lu")`` returns a :class:`snede.SolveResult` with PETSc's reason; ``-<prefix>snes_*``/
-    ``-<prefix>ksp_*``/``-<prefix>pc_*`` options apply (prefix ``dstatic_``)."""
+    "gamg" | "mg" | "bjacobi" | "sor" | "lu" | ...)`` returns a :class:`snede.SolveResult` with
+    PETSc's reason; ``-<prefix>snes_*``/``-<prefix>ksp_*``/``-<prefix>pc_*`` options apply
+    (prefix ``dstatic_``)."""
 
     def __init__(self, part: DistributedMesh, material, *, density: float = 1000.0, thickness=None, fixed=(),
                  fixed_values=None, forces=None, gravity=None):
@@ -131,28 +132,32 @@ class DistributedStatic:
         self._impl = _snede.DistributedStatic(part._impl, material, *arguments)
 
     def solve(self, method: str = "cg", rtol: float = 1e-8, max_iterations: int = 10000, preconditioner: str = "none",
-              options_prefix: str = "dstatic_", criterion: str = "relative",
-              round_tolerance: float = 1e-12) -> SolveResult:
-        """``method`` "cg" (linear), "newton" or "ncg" (nonlinear CG, no preconditioner);
-        ``preconditioner`` "none", "jacobi" (the tangent's diagonal, summed across the ranks) or
-        "gamg" (PETSc's algebraic multigrid on the assembled tangent, MPIAIJ), "bjacobi" (block
-        Jacobi, ILU(0) on each rank's block of it; ``-dstatic_sub_pc_type icc`` for ICC), "sor"
-        (symmetric SOR sweeps over each rank's rows of it) or "lu" (its LU factors by MUMPS, a
-        direct solve: one CG iteration for a linear body). Starts from the
-        current state (the previous solve's answer, or :meth:`set_displacement`'s).
+              options_prefix: str = "dstatic_", criterion: str = "relative", round_tolerance: float = 1e-12,
+              petsc_options: dict | None = None) -> SolveResult:
+        """The serial :class:`snede.StaticSolver`'s engine on this problem: ``method`` "cg"
+        (linear), "newton" or "ncg" (nonlinear CG, no preconditioner); ``preconditioner`` "none",
+        "jacobi" (the tangent's diagonal, summed across the ranks), "mg" (multigrid by aggregation
+        of each rank's vertices, Galerkin levels of the assembled tangent), or any PETSc PC on the
+        assembled MPIAIJ tangent: "gamg", "bjacobi" (ILU(0) on each rank's block;
+        ``-dstatic_sub_pc_type icc`` for ICC), "sor" (symmetric sweeps over each rank's rows), "lu"
+        (MUMPS's factors: one CG iteration for a linear body). Starts from the current state (the
+        previous solve's answer, or :meth:`set_displacement`'s).
 
-        ``criterion`` "relative" (default): PETSc's relative tests and verdict, ‖F‖ ≤
-        rtol·‖F(u₀)‖ (CG: ‖r‖ ≤ rtol·‖b‖ in its preconditioned norm, on its recursive
-        residual; ``tolerance`` in the result is rtol·‖F(u₀)‖). "6.9" or "6.8": the serial
-        :class:`snede.StaticSolver`'s criteria (§6.6) on the true residual, ‖F‖ ≤
-        rtol·√(‖f_ext‖² + ‖f_react‖²) plus ``round_tolerance``'s floor, or ‖F‖ ≤ rtol·‖f_ext‖;
-        ``tolerance`` in the result is the threshold. A start that already meets the serial
-        solver's criterion ((6.9) under "relative", which a residual at round-off cannot meet)
-        is converged with no iteration, as serially, ``tolerance`` that threshold."""
-        arguments = agreed(self.part.comm, lambda: (str(method), str(preconditioner), float(rtol),
-                                                    _checks.count(max_iterations, "max_iterations"), str(options_prefix),
-                                                    str(criterion), float(round_tolerance)))
-        return self._impl.solve(*arguments)
+        ``criterion`` "relative" (default): ‖F‖ ≤ rtol·‖F(u₀)‖ on the true residual (CG's
+        unpreconditioned one); "6.9" or "6.8": the criteria of §6.6, ‖F‖ ≤ rtol·√(‖f_ext‖² +
+        ‖f_react‖²) plus ``round_tolerance``'s floor, or ‖F‖ ≤ rtol·‖f_ext‖; ``tolerance`` in
+        the result is the threshold. A start that already meets (6.9) is converged with no
+        iteration under "relative" too (a residual at round-off cannot meet ε‖F(u₀)‖)."""
+        def checked():
+            if method not in ("cg", "newton", "ncg"):
+                raise ValueError(f"method must be 'cg', 'newton' or 'ncg', got {method!r}")
+            return _snede.StaticOptions(method=method, rtol=float(rtol), criterion=str(criterion),
+                                        round_tolerance=float(round_tolerance),
+                                        max_iterations=_checks.count(max_iterations, "max_iterations"),
+                                        options_prefix=str(options_prefix), petsc_options=option_list(petsc_options),
+                                        preconditioner=str(preconditioner))
+
+        return _snede.StaticSolver(self._impl, agreed(self.part.comm, checked)).solve()
 
     def set_displacement(self, displacement) -> None:
         """Start the next solve (or relaxation) from ``displacement``, (n_global_vertices, dim) in

@@ -9,9 +9,10 @@ channels, which do not depend on the state) become a :class:`snede.DistributedSt
 starts from the body's displacement, the solve runs on all ranks to the serial solver's
 criterion, and the displacement is gathered back into the Body on every rank, so the script
 goes on as serially. The distribution is kept while the mesh is unchanged (a cut or a
-refinement of the serial body, done on every rank, makes the next solve distribute anew). What
-cannot be taken over raises NotImplementedError on every rank: sliding constraints and
-membranes.
+refinement of the serial body, done on every rank, makes the next solve distribute anew), and
+the distributed problem while the conditions are too (the next solve starts from the body's
+displacement). What cannot be taken over raises NotImplementedError on every rank: sliding
+constraints and membranes.
 """
 from __future__ import annotations
 
@@ -28,10 +29,12 @@ class DistributedBody:
     def __init__(self, body, comm):
         self.body, self.comm = body, comm
         self.part, self._revision, self._last = None, None, None
+        self._problem, self._conditions = None, None
 
     def problem(self) -> DistributedStatic:
-        """A DistributedStatic with the body's current conditions, on the mesh as it is now.
-        Every rank's body must be rank 0's: one that differs (a load, a fixed vertex, an edit
+        """A DistributedStatic with the body's current conditions, on the mesh as it is now,
+        starting from the body's displacement (the previous one while mesh and conditions are
+        unchanged). Every rank's body must be rank 0's: one that differs (a load, a fixed vertex, an edit
         made on some ranks only) makes every rank raise ValueError naming what differs."""
         body, comm = self.body, self.comm
         inputs = _inputs(body)
@@ -53,15 +56,18 @@ class DistributedBody:
         revision = comm.bcast(body.mesh._impl.revision if comm.rank == 0 else None, root=0)
         if self.part is None or revision != self._revision:
             self.part = distribute(body.mesh if comm.rank == 0 else None, comm)
-            self._revision = revision
-        loads = body.external_forces()
-        loaded = np.flatnonzero(np.any(loads != 0, axis=1))
-        problem = DistributedStatic(self.part, body.material, density=body.density, thickness=body.thickness,
-                                    fixed=fixed, fixed_values=anchors,
-                                    forces={int(v): f for v, f in zip(loaded, loads[loaded])})
-        problem.set_displacement(body.displacement)  # where the serial solve would start
+            self._revision, self._problem = revision, None
+        conditions = {name: value for name, value in inputs.items() if name != "displacement"}
+        if self._problem is None or conditions != self._conditions:
+            loads = body.external_forces()
+            loaded = np.flatnonzero(np.any(loads != 0, axis=1))
+            self._problem = DistributedStatic(self.part, body.material, density=body.density,
+                                              thickness=body.thickness, fixed=fixed, fixed_values=anchors,
+                                              forces={int(v): f for v, f in zip(loaded, loads[loaded])})
+            self._conditions = conditions
+        self._problem.set_displacement(body.displacement)  # where the serial solve would start
         self._last = inputs
-        return problem
+        return self._problem
 
     def gather_into_body(self, problem: DistributedStatic) -> None:
         """The answer into the body on every rank; should it not fit one rank's body, every

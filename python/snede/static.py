@@ -11,7 +11,6 @@ from snede.distributed_body import DistributedBody, RunsOnRanks
 from snede._snede import SolveResult
 
 METHODS = ("cg", "ncg", "newton")
-DISTRIBUTED_PRECONDITIONERS = (None, "none", "jacobi", "gamg", "bjacobi", "sor", "lu")
 LINE_SEARCHES = ("cp", "snede_newton", "snede_secant", "bt", "l2", "basic")
 
 
@@ -78,16 +77,17 @@ class StaticSolver(RunsOnRanks):
       over the argument. The shell stays the operator in every case.
 
     * ``comm`` (an mpi4py communicator): ``solve()`` is collective and runs over all its ranks
-      (issue 18, ``snede.distributed_body``), one included: rank 0's body is
-      distributed, its fixed vertices and external forces become a
-      :class:`snede.DistributedStatic` solved from the body's displacement, to the same
-      ``criterion``, and the result is gathered into ``body.displacement`` on every rank. The
-      preconditioner is ``"gamg"`` (default), ``"jacobi"``, ``"none"``, ``"bjacobi"`` (ILU(0)
-      on each rank's block), ``"sor"`` (each rank's rows) or ``"lu"`` (MUMPS);
-      ``part`` is this rank's part. ``petsc_options``, ``line_search`` and ``ncg_type`` are
-      refused there (NotImplementedError): the distributed solve reads the command line's
-      ``-<prefix>snes_*``/``-<prefix>ksp_*`` options only. None (default): the body's ``comm``,
-      and without one the serial solver.
+      (issue 18, ``snede.distributed_body``), one included: rank 0's body is distributed, its
+      fixed vertices and external forces become a :class:`snede.DistributedStatic`, and the same
+      engine solver (the same methods, criteria, options and preconditioners) solves it from the
+      body's displacement; the result is gathered into ``body.displacement`` on every rank. The
+      problem and its solver are kept while the body's mesh and conditions stay the same. On
+      ranks ``"mg"`` coarsens by aggregation of each rank's vertices (``-static_mg_coarsening``
+      aggregation or auto; bisection and grid levels need the whole mesh), ``"lu"`` and
+      ``"cholesky"`` factor with MUMPS, ``"bjacobi"`` is ILU(0) on each rank's block and
+      ``"sor"`` sweeps each rank's rows; ``"auto"`` chooses as serially. ``part`` is this rank's
+      part. Every rank must pass the same arguments (else every rank raises ValueError naming
+      them). None (default): the body's ``comm``, and without one the serial solver.
 
     ``solve()`` first checks that every piece of the body (cells joined through faces) is held:
     a piece with fewer constrained displacement components than rigid motions (3 in 2D, 6 in 3D
@@ -99,6 +99,8 @@ class StaticSolver(RunsOnRanks):
     ``-static_ksp_monitor`` prints residual norms divided by it, while ``SolveResult``
     reports them in newtons.
     """
+
+    _on_ranks = "solve() and part (the others after the first solve())"
 
     def __init__(self, body, method: str = "newton", rtol: float = 1e-6, *, criterion: str = "6.9",
                  round_tolerance: float = 1e-12, max_iterations: int = 10000, line_search: str | None = None,
@@ -125,26 +127,16 @@ class StaticSolver(RunsOnRanks):
                              f"got {preconditioner!r}")
         self.body = body
         self.method = method
-        self._distributed = None
+        self._settings = _snede.StaticOptions(method=method, rtol=float(rtol), criterion=criterion,
+                                              round_tolerance=float(round_tolerance), max_iterations=max_iterations,
+                                              options_prefix=options_prefix, petsc_options=option_list(options),
+                                              preconditioner=preconditioner or "")
+        self._distributed, self._problem, self._impl = None, None, None
         comm = getattr(body, "comm", None) if comm is None else comm
         if comm is not None:
-            if options:  # the distributed solve reads PETSc's global options only
-                raise NotImplementedError(f"petsc_options, line_search and ncg_type on MPI ranks (comm): give "
-                                          f"-{options_prefix}snes_* and -{options_prefix}ksp_* options on the "
-                                          "command line, which every rank reads")
-            if preconditioner not in DISTRIBUTED_PRECONDITIONERS:
-                raise NotImplementedError(f"preconditioner {preconditioner!r} on MPI ranks (comm): distributed "
-                                          f"solves take {DISTRIBUTED_PRECONDITIONERS}")
             self._distributed = DistributedBody(body, comm)
-            self._distributed_settings = (method, rtol, max_iterations, preconditioner, options_prefix, criterion,
-                                          round_tolerance)
-            self._impl = None
             return
-        settings = _snede.StaticOptions(method=method, rtol=float(rtol), criterion=criterion,
-                                        round_tolerance=float(round_tolerance), max_iterations=max_iterations,
-                                        options_prefix=options_prefix, petsc_options=option_list(options),
-                                        preconditioner=preconditioner or "")
-        self._impl = _snede.StaticSolver(body._model, settings, body.mesh._bisection_if_any())
+        self._impl = _snede.StaticSolver(body._model, self._settings, body.mesh._bisection_if_any())
 
     def solve(self) -> SolveResult:
         if self._distributed is not None:
@@ -154,13 +146,12 @@ class StaticSolver(RunsOnRanks):
         return self._impl.solve()
 
     def _solve_distributed(self) -> SolveResult:
-        method, rtol, max_iterations, preconditioner, prefix, criterion, round_tolerance = self._distributed_settings
         problem = self._distributed.problem()
         # The serial check, on the body every rank now agrees on: all ranks raise, none waits.
         self.body._model.require_held()
-        chosen = "none" if method == "ncg" else (preconditioner or "gamg")
-        result = problem.solve(method, rtol=rtol, max_iterations=max_iterations, preconditioner=chosen,
-                               options_prefix=prefix, criterion=criterion, round_tolerance=round_tolerance)
+        if problem is not self._problem:  # a new mesh or new conditions: a solver for them
+            self._problem, self._impl = problem, _snede.StaticSolver(problem._impl, self._settings)
+        result = self._impl.solve()
         self._distributed.gather_into_body(problem)
         return result
 
