@@ -14,8 +14,9 @@ and the seconds per CG iteration (the slowest rank's). Not a test; the machine h
 so 2 ranks is the most that can show a speed-up.
 
 With --to-tolerance the same body is instead solved to ‖r‖ ≤ 1e-8 ‖r₀‖ by CG with each
-preconditioner (none, Jacobi, GAMG on the assembled MPIAIJ tangent): iterations and seconds,
-GAMG's assembly and set-up included. With --cantilever N the same comparison runs on the
+preconditioner (none, Jacobi, GAMG on the assembled MPIAIJ tangent, mg by aggregation of each
+rank's vertices, block Jacobi, SOR, MUMPS's LU): iterations and seconds, assembly and set-up
+included. With --cantilever N the same comparison runs on the
 slender `cantilever` scene (--divisions N) through StaticSolver(body, "cg", comm=...).
 """
 from __future__ import annotations
@@ -60,7 +61,7 @@ def main() -> None:
         return
     problem = problem()
     comm.Barrier()
-    result = problem.solve("cg", rtol=1e-30, max_iterations=arguments.iterations)
+    result = problem.solve("cg", rtol=1e-30, round_tolerance=0.0, max_iterations=arguments.iterations)
     seconds = comm.allreduce(result.seconds, op=MPI.MAX)
     ghosts = int((~part.owned).sum())
     rows = comm.gather((comm.rank, part.local.n_cells, int(part.owned.sum()), ghosts, 2 * ghosts * 3 * 8), root=0)
@@ -74,7 +75,7 @@ def main() -> None:
         print(f"(x spans {x[:, 0].min():.2f}..{x[:, 0].max():.2f} on rank 0)")
 
 
-PRECONDITIONERS = ("none", "jacobi", "gamg", "bjacobi", "sor", "lu")
+PRECONDITIONERS = ("none", "jacobi", "gamg", "mg", "bjacobi", "sor", "lu")
 
 
 def compare_preconditioners(problem, comm, part) -> None:
