@@ -105,6 +105,12 @@ def _parser() -> argparse.ArgumentParser:
     demo = commands.add_parser("demo", help="run the default scenes and the cutting demo")
     demo.add_argument("--quiet", action="store_true", default=argparse.SUPPRESS, help=quiet)
     demo.add_argument("--out", type=Path, default=Path("out"), help="output folder (default out/)")
+    replay = commands.add_parser("replay", help="replay a recorded tool session headless (snede.interactive)")
+    replay.add_argument("recording", type=Path, help="the recording (JSON, from `view --record`)")
+    replay.add_argument("--check", action="store_true",
+                        help="exit 0 only if the final mesh and displacement match the recording's digest "
+                             "(to 1e-12 relative)")
+    replay.add_argument("--out", type=Path, help="write the series and a picture to OUT/SCENE/")
     return parser
 
 
@@ -130,7 +136,7 @@ def main(argv: list[str] | None = None) -> int:
 
     parser = _parser()
     ours, petsc = split(sys.argv[1:] if argv is None else list(argv))
-    if "-help" in petsc and not any(command in ours for command in ("list", "run", "demo")):
+    if "-help" in petsc and not any(command in ours for command in ("list", "run", "demo", "replay")):
         parser.print_help()  # PETSc printed its general help at initialisation
         print("\nPETSc's options of a scene's solvers: python -m snede run SCENE -help")
         return 0
@@ -180,6 +186,8 @@ def _command(parser, args, unknown, petsc) -> int:
         from snede import demo
 
         return demo.run(args.out, progress=not args.quiet)
+    if args.command == "replay":
+        return _replay(args)
     if args.scene.endswith(".py"):
         script = Path(args.scene)
         if not script.exists():
@@ -207,6 +215,20 @@ def _command(parser, args, unknown, petsc) -> int:
     if summary.get("rank", 0) == 0:  # on several MPI ranks, rank 0 reports
         run_scene.print_table([summary])
     return 0 if summary["converged"] else 1
+
+
+def _replay(args) -> int:
+    from snede.interactive import replay
+
+    result = replay(args.recording, args.out)
+    state = "matches" if result.matches else "does NOT match"
+    print(f"replayed {result.moves} moves of the {result.scene} scene: the final state {state} the recording's digest"
+          + "".join(f"; wrote {path}" for path in result.files.values()))
+    if args.check and not result.matches:
+        for line in result.mismatches:
+            print(f"replay --check: {line}", file=sys.stderr)
+        return 1
+    return 0
 
 
 def _end_every_rank(code: int) -> None:

@@ -1,0 +1,82 @@
+"""``ToolSession(scene, options)``: a built-in scene driven by pointer events, headless — the
+window (``snede.interactive.window``) shows one and feeds it the mouse, tests feed it scripted
+events. Every tool move is carried out at once (the body relaxes after each) and recorded with
+its time: ``recording()`` is the JSON a replay repeats (``snede.interactive.recording``).
+"""
+from __future__ import annotations
+
+from argparse import Namespace
+
+from snede.interactive.recording import make as make_recording
+from snede.interactive.events import PointerEvent
+from snede.interactive.tools import TOOLS, Relaxation
+
+OPTIONS = ("divisions", "material", "formulation", "speed")  # the scenes' own, as `run` takes them
+
+
+def _scene(name: str, options: dict):
+    from snede.scenes import builders
+
+    if name not in TOOLS:
+        known = ", ".join(TOOLS)
+        raise ValueError(f"unknown scene {name!r}: the interactive scenes are {known}" if name not in builders() else
+                         f"the {name} scene has no interactive tool (the interactive scenes are {known})")
+    unknown = sorted(set(options) - set(OPTIONS))
+    if unknown:
+        raise ValueError(f"unknown scene option(s) {', '.join(unknown)} (the options: {', '.join(OPTIONS)})")
+    module = builders()[name]
+    given = [key for key, value in options.items() if value is not None and key != "material" and key not in module.OPTIONS]
+    if given:
+        raise ValueError(f"option {given[0]!r} does not apply to the {name} scene (its options: "
+                         f"{', '.join(module.OPTIONS)})")
+    return module.build(Namespace(**{key: options.get(key) for key in OPTIONS}))
+
+
+class ToolSession:
+    """The scene ``name`` (``cut``: the scalpel; ``needle``: the needle) built with
+    ``options`` (``divisions``, ``material``, ``formulation``, ``speed``, as for ``run``),
+    relaxed with the scene's method and tolerance (or ``method``, ``rtol``)."""
+
+    def __init__(self, name: str, options: dict | None = None, method: str | None = None, rtol: float | None = None):
+        from snede.run_scene import fitting_method
+
+        self.name, self.options = name, dict(options or {})
+        self.scene = _scene(name, self.options)
+        self.method = method or fitting_method(self.scene)
+        self.rtol = rtol or self.scene.default_rtol
+        self.tool = TOOLS[name](self.scene, self.method, self.rtol)
+        self.view = self.tool.view
+        self.moves: list[dict] = []
+        self.last: Relaxation | None = self.tool.first
+
+    @property
+    def body(self):
+        return self.scene.body
+
+    def handle(self, event: PointerEvent) -> list[Relaxation]:
+        """Carry out what the event does with the scene's tool; the relaxations of its moves."""
+        if event.tool != self.tool.name:
+            raise ValueError(f"the {self.name} scene's tool is the {self.tool.name}, not the {event.tool}")
+        point = self.view.on_plane(event.x, event.y, *self.tool.plane)
+        if event.type == "press":
+            moves = self.tool.press(point)
+        elif self.tool.held:
+            moves = self.tool.drag(point) if event.type == "move" else self.tool.release(point)
+        else:
+            moves = []  # hovering
+        return [r for r in (self.apply(move, event.t) for move in moves) if r is not None]
+
+    def apply(self, move: dict, t: float) -> Relaxation | None:
+        """Carry out one move (a recorded one in a replay), relax, and record it at time ``t``."""
+        relaxation = self.tool.apply(move)
+        entry = {"t": float(t), **move}
+        if relaxation is not None:
+            entry |= {"converged": relaxation.converged, "reason": relaxation.reason}
+            if move["tool"] == "scalpel":
+                entry["faces_dissected"] = relaxation.faces_dissected
+            self.last = relaxation
+        self.moves.append(entry)
+        return relaxation
+
+    def recording(self) -> dict:
+        return make_recording(self)
