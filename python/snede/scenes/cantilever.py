@@ -3,7 +3,7 @@ Beam theory gives the tip deflection y = 4F/(Ed) (l/h)³ = 8.64 mm (Table 3.1)."
 import numpy as np
 
 import snede
-from snede.scenes.scene import Scene, material
+from snede.scenes.scene import Scene, divisions, material
 
 LENGTH, HEIGHT, DEPTH, YOUNG, LOAD = 1.2, 0.2, 0.3, 1e6, 3.0
 VIEW = (20.0, 30.0, 0.0, "y")  # the picture's camera: y up, the beam bending down across the picture
@@ -17,11 +17,7 @@ def held(points) -> np.ndarray:
 
 
 def build(options) -> Scene:
-    n = 16 if options.divisions is None else options.divisions
-    if n <= 0:
-        raise ValueError(f"--divisions must be positive, got {n}")
-    if n % 4:
-        raise ValueError(f"--divisions for the cantilever must be a multiple of 4 (n × n/4 × n/4 cubes), got {n}")
+    n = divisions(options, 16, 4, "for the cantilever must be a multiple of 4 (n × n/4 × n/4 cubes)")
     mesh = snede.meshing.box((LENGTH, HEIGHT, DEPTH), (n, n // 4, n // 4))
     body = snede.Body(mesh, material(options.material or "linear", YOUNG, 0.0), density=1000.0, formulation=getattr(options, "formulation", None) or "p1")
     x = mesh.points

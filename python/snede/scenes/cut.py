@@ -17,7 +17,8 @@ import numpy as np
 
 import snede
 from snede.plotting import HIGHLIGHT, animate, draw_3d
-from snede.scenes.scene import Scene, briefly, material, solve_entries
+from snede.scenes.cantilever import held  # the beam is held as the cantilever is: its end x = 0
+from snede.scenes.scene import Scene, briefly, divisions, material, solve_entries
 from snede.scenes.incision import incision_cells, lips_gap
 
 LENGTH, WIDTH, HEIGHT = 0.2, 0.05, 0.05
@@ -168,17 +169,8 @@ class Cut:
                       color=HIGHLIGHT)
 
 
-def held(points) -> np.ndarray:
-    """The vertices the beam is held at: its end x = 0."""
-    return np.isclose(points[:, 0], 0.0)
-
-
 def build(options) -> Scene:
-    n = 24 if options.divisions is None else options.divisions
-    if n <= 0:
-        raise ValueError(f"--divisions must be positive, got {n}")
-    if n % 4:
-        raise ValueError(f"--divisions for the cut must be a multiple of 4 (n × n/4 × n/4 cubes), got {n}")
+    n = divisions(options, 24, 4, "for the cut must be a multiple of 4 (n × n/4 × n/4 cubes)")
     mesh = snede.meshing.box((LENGTH, WIDTH, HEIGHT), (n, n // 4, n // 4))
     body = snede.Body(mesh, material(options.material or "neohookean", YOUNG, POISSON), density=DENSITY,
                       formulation=getattr(options, "formulation", None) or "p1")

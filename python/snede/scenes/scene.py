@@ -50,6 +50,17 @@ def material(name: str, young: float, poisson: float, gamma: float = 8.0):
     return makers[name]()
 
 
+def divisions(options, default: int, multiple_of: int, rule: str) -> int:
+    """The scene's ``--divisions`` (``default`` when not given), checked: positive, and a
+    multiple of ``multiple_of``, else ValueError with ``rule`` (what it must be, and why)."""
+    n = default if options.divisions is None else options.divisions
+    if n <= 0:
+        raise ValueError(f"--divisions must be positive, got {n}")
+    if n % multiple_of:
+        raise ValueError(f"--divisions {rule}, got {n}")
+    return n
+
+
 def briefly(result) -> str:
     """The start of ``str(result)``, for a line of a scene's progress: converged or not,
     PETSc's reason, iterations and the time."""

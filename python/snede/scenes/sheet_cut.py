@@ -19,7 +19,7 @@ import numpy as np
 import snede
 from snede.planar_cutting import PlanarCutReport, sample_path
 from snede.plotting import HIGHLIGHT, animate, draw_2d
-from snede.scenes.scene import Scene, briefly, material, solve_entries
+from snede.scenes.scene import Scene, briefly, divisions, material, solve_entries
 from snede.scenes.incision import incision_cells, lips_gap
 
 LENGTH, HEIGHT, THICKNESS = 0.1, 0.06, 0.001
@@ -159,11 +159,7 @@ def held(points) -> np.ndarray:
 
 
 def build(options) -> Scene:
-    n = 40 if options.divisions is None else options.divisions
-    if n <= 0:
-        raise ValueError(f"--divisions must be positive, got {n}")
-    if n % 5:
-        raise ValueError(f"--divisions for the sheet-cut must be a multiple of 5 (n × 3n/5 squares), got {n}")
+    n = divisions(options, 40, 5, "for the sheet-cut must be a multiple of 5 (n × 3n/5 squares)")
     name = options.material or "linear"
     mesh = snede.meshing.rectangle((LENGTH, HEIGHT), (n, 3 * n // 5))
     body = snede.Body(mesh, material(name, YOUNG, POISSON), density=DENSITY, thickness=THICKNESS, formulation=getattr(options, "formulation", None) or "p1")

@@ -6,7 +6,7 @@ import numpy as np
 
 import snede
 from snede.plotting import LOAD
-from snede.scenes.scene import Scene, material
+from snede.scenes.scene import Scene, divisions, material
 
 SIZE, THICKNESS, DEPTH, TOTAL_FORCE = 0.1, 0.01, 0.07, 0.2
 PLOT_SCALE = 20.0  # the slab moves half a millimetre: exaggerated in the picture
@@ -26,11 +26,7 @@ def held(points) -> np.ndarray:
 
 
 def build(options) -> Scene:
-    n = 16 if options.divisions is None else options.divisions
-    if n <= 0:
-        raise ValueError(f"--divisions must be positive, got {n}")
-    if n % 2:
-        raise ValueError(f"--divisions for the slab must be even (the load line is y = 0.05), got {n}")
+    n = divisions(options, 16, 2, "for the slab must be even (the load line is y = 0.05)")
     mesh = snede.meshing.rectangle((SIZE, SIZE), (n, n))
     body = snede.Body(mesh, material(options.material or "linear", 34e3, 0.34), density=1000.0, thickness=THICKNESS,
                       formulation=getattr(options, "formulation", None) or "p1")
