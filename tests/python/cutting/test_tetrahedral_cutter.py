@@ -35,6 +35,18 @@ def planar_path(normal, offset, centre, sweep_from, sweep_to, steps):
     return [scalpel_across(n, base + s * travel, blade) for s in np.linspace(sweep_from, sweep_to, steps)], n, travel
 
 
+def sagging_beam(size, cells, material, method, rtol):
+    """A box beam clamped at x = 0 under gravity, solved by a StaticSolver (asserted to
+    converge): its mesh, body and solver."""
+    mesh = snede.meshing.box(size, cells)
+    body = snede.Body(mesh, material)
+    body.fix(np.where(mesh.points[:, 0] < 1e-9)[0])
+    body.add_gravity((0, 0, -9.81))
+    solver = snede.StaticSolver(body, method, rtol=rtol)
+    assert solver.solve().converged
+    return mesh, body, solver
+
+
 def distance_to_plane(points, normal, offset):
     n = np.asarray(normal, float) / np.linalg.norm(normal)
     return np.abs(points @ n - offset)
@@ -146,12 +158,7 @@ def test_cutting_the_deformed_body_puts_deformed_vertices_on_the_deformed_plane(
 
 
 def test_a_piece_cut_free_of_its_supports_is_fixed_and_the_solve_converges():
-    mesh = snede.meshing.box((0.2, 0.05, 0.05), (12, 3, 3))
-    body = snede.Body(mesh, snede.NeoHookean(1e5, 0.3))
-    body.fix(np.where(mesh.points[:, 0] < 1e-9)[0])
-    body.add_gravity((0, 0, -9.81))
-    solver = snede.StaticSolver(body, "newton", rtol=1e-6)
-    assert solver.solve().converged
+    _, body, solver = sagging_beam((0.2, 0.05, 0.05), (12, 3, 3), snede.NeoHookean(1e5, 0.3), "newton", 1e-6)
     cutter = snede.TetrahedralCutter(body)
     cutter.move([[0.11, -1, 1], [0.11, 1, 1]])
     report = cutter.move([[0.11, -1, -1], [0.11, 1, -1]])
@@ -172,12 +179,7 @@ def test_free_pieces_are_only_reported_when_fixing_is_off():
 
 
 def test_static_and_dynamic_solvers_continue_after_a_cut_from_the_carried_state():
-    mesh = snede.meshing.box((0.1, 0.02, 0.02), (10, 2, 2))
-    body = snede.Body(mesh, snede.LinearElastic(1e5, 0.3))
-    body.fix(np.where(mesh.points[:, 0] < 1e-9)[0])
-    body.add_gravity((0, 0, -9.81))
-    static = snede.StaticSolver(body, "cg", rtol=1e-8)
-    assert static.solve().converged
+    mesh, body, static = sagging_beam((0.1, 0.02, 0.02), (10, 2, 2), snede.LinearElastic(1e5, 0.3), "cg", 1e-8)
     tip_before = body.displacement[:, 2].min()
     cutter = snede.TetrahedralCutter(body)
     # From above the deformed beam down to the middle of its deformed section at x = 0.052.
