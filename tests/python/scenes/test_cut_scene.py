@@ -17,7 +17,7 @@ from PIL import Image
 from snede import run_scene
 from snede.scenes import cut
 
-from test_scenes import ROOT, assert_gif_shows_the_cut, not_blank, red_pixels, run_cli
+from test_scenes import ROOT, assert_gif_shows_the_cut, not_blank, red_pixels, run_cli, run_cutting_scene_cli
 
 DIVISIONS = 12  # 12 × 3 × 3 cubes, 4 moves of the blade: about 2 seconds
 
@@ -122,15 +122,8 @@ def test_series_follows_the_cut_meshes_and_marks_the_incision(cut_beam):
 
 
 def test_cli_runs_the_cut_with_a_line_per_step(tmp_path):
-    out = run_cli("run", "cut", "--divisions", "8", "--out", str(tmp_path))
-    assert out.returncode == 0, out.stderr
-    moves = re.findall(r"^cut: move +(\d+)/(\d+), blade .*faces dissected.*; relaxed: converged \(CONVERGED_\w+\)",
-                       out.stdout, re.M)
-    assert moves and [int(k) for k, _ in moves] == list(range(1, int(moves[0][1]) + 1)), out.stdout
-    assert re.search(r"^cut: sagging under gravity: converged \(CONVERGED_\w+\)", out.stdout, re.M)
-    assert re.search(r"^cut\s+\d+\s+NeoHookean\s+newton\s+\d+\s+CONVERGED_\w+\s", out.stdout, re.M), out.stdout
+    out = run_cutting_scene_cli("cut", 8, tmp_path, "blade .*faces dissected.*", "sagging under gravity", "NeoHookean", "newton")
     assert "widest gap between the lips" in out.stdout
-    assert all((tmp_path / "cut" / f"cut.{kind}").exists() for kind in ("xdmf", "h5", "png", "gif"))
 
 
 @pytest.mark.parametrize("args, message", [

@@ -135,6 +135,21 @@ def run_cli(*args, cwd=None):
                           cwd=cwd or ROOT, timeout=300)
 
 
+def run_cutting_scene_cli(scene, divisions, out_dir, move, loaded, material, method):
+    """Runs a cutting scene from the command line and checks what each prints: a line per move
+    (numbered 1 to the last, `move` after the number, its relaxation converged), the loading
+    solve's line (`loaded`, converged), the summary row (material, method, converged) and the
+    four output files. Returns the finished process."""
+    out = run_cli("run", scene, "--divisions", str(divisions), "--out", str(out_dir))
+    assert out.returncode == 0, out.stderr
+    moves = re.findall(rf"^{scene}: move +(\d+)/(\d+), {move}; relaxed: converged \(CONVERGED_\w+\)", out.stdout, re.M)
+    assert moves and [int(k) for k, _ in moves] == list(range(1, int(moves[0][1]) + 1)), out.stdout
+    assert re.search(rf"^{scene}: {loaded}: converged \(CONVERGED_\w+\)", out.stdout, re.M), out.stdout
+    assert re.search(rf"^{scene}\s+\d+\s+{material}\s+{method}\s+\d+\s+CONVERGED_\w+\s", out.stdout, re.M), out.stdout
+    assert all((out_dir / scene / f"{scene}.{kind}").exists() for kind in ("xdmf", "h5", "png", "gif"))
+    return out
+
+
 def test_list_and_help():
     listed = run_cli("list")
     assert listed.returncode == 0 and all(name in listed.stdout for name in ("cantilever", "cylinder", "slab"))

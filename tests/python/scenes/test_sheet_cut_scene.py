@@ -20,7 +20,7 @@ from PIL import Image
 from snede import run_scene
 from snede.scenes import sheet_cut
 
-from test_scenes import assert_gif_shows_the_cut, not_blank, red_pixels, run_cli
+from test_scenes import assert_gif_shows_the_cut, not_blank, red_pixels, run_cli, run_cutting_scene_cli
 
 DIVISIONS = 20  # 20 × 12 squares, 38 moves: about 4 seconds with the animation
 
@@ -163,16 +163,9 @@ def test_picture_and_animation_show_the_incision(sheet):
 
 
 def test_cli_prints_a_line_per_move_with_the_solve_reason(tmp_path):
-    out = run_cli("run", "sheet-cut", "--divisions", "10", "--out", str(tmp_path))
-    assert out.returncode == 0, out.stderr
-    moves = re.findall(r"^sheet-cut: move +(\d+)/(\d+), scalpel at .*; relaxed: converged \(CONVERGED_\w+\)",
-                       out.stdout, re.M)
-    assert moves and [int(k) for k, _ in moves] == list(range(1, int(moves[0][1]) + 1)), out.stdout
-    assert re.search(r"^sheet-cut: stretched 8% by the grips: converged \(CONVERGED_\w+\)", out.stdout, re.M)
-    assert re.search(r"^sheet-cut\s+\d+\s+LinearElastic\s+cg\s+\d+\s+CONVERGED_\w+\s", out.stdout, re.M), out.stdout
+    out = run_cutting_scene_cli("sheet-cut", 10, tmp_path, "scalpel at .*", "stretched 8% by the grips", "LinearElastic", "cg")
     assert re.search(r"\d+ → \d+ triangles in [\d.]+ ms; \d+ solves in [\d.]+ s; the lips open by up to [\d.]+ mm",
                      out.stdout)
-    assert all((tmp_path / "sheet-cut" / f"sheet-cut.{kind}").exists() for kind in ("xdmf", "h5", "png", "gif"))
 
 
 def test_a_solve_that_does_not_converge_is_reported_and_stops_the_cut(tmp_path):
