@@ -3,7 +3,6 @@ relaxation after each. Every relaxation converges, the cut stays a notch (one pi
 series follows the cut meshes and marks the incision, the picture and the animation show it in
 red, and the load opens it: the lips, made from the same vertices, are apart in the deformed
 beam, widest at the mouth. Also the command line and the example script examples/scalpel_cut.py."""
-import argparse
 import json
 import re
 from pathlib import Path
@@ -17,16 +16,14 @@ from PIL import Image
 from snede import run_scene
 from snede.scenes import cut
 
-from test_scenes import ROOT, assert_gif_shows_the_cut, not_blank, red_pixels, run_cli, run_cutting_scene_cli
+from test_scenes import ROOT, assert_gif_shows_the_cut, built_and_run, not_blank, red_pixels, run_cli, run_cutting_scene_cli, written_files
 
 DIVISIONS = 12  # 12 × 3 × 3 cubes, 4 moves of the blade: about 2 seconds
 
 
 @pytest.fixture(scope="module")
 def cut_beam(tmp_path_factory):
-    out = tmp_path_factory.mktemp("cut")
-    scene = cut.build(argparse.Namespace(material=None, divisions=DIVISIONS, mesh_size=None, speed=None))
-    return scene, run_scene.run(scene, None, None, out, progress=False), out
+    return built_and_run(cut, "cut", tmp_path_factory, DIVISIONS)
 
 
 def lips(scene):
@@ -88,9 +85,7 @@ def test_the_load_opens_the_cut(cut_beam):
 
 def test_files_are_written_and_show_the_incision(cut_beam):
     _, summary, _ = cut_beam
-    files = {kind: Path(path) for kind, path in summary["files"].items()}
-    assert set(files) == {"xdmf", "h5", "png", "gif"} and all(path.exists() for path in files.values())
-    assert not_blank(files["png"])
+    files = written_files(summary)
     with Image.open(files["png"]) as png:
         assert red_pixels(png) > 100
     assert summary["frames"] == summary["moves"] + 2  # unloaded, sagging, each move

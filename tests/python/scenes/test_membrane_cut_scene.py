@@ -4,19 +4,16 @@ with a branching cut. Every solve converges; the cuts count the entries, exits a
 paths make; the lips open (measured from the written series alone: boundary vertices sharing a
 reference position); the loop cuts a piece out; the fold falls into two pieces; the files and
 pictures are written; the command line prints a line per move and refuses bad options."""
-import argparse
 import re
-from pathlib import Path
 
 import numpy as np
 import pytest
 from PIL import Image
 
-from snede import run_scene
 from snede.output import read_series
 from snede.scenes import membrane_cut
 
-from test_scenes import assert_gif_shows_the_cut, not_blank, red_pixels, run_cli
+from test_scenes import assert_gif_shows_the_cut, built_and_run, not_blank, red_pixels, run_cli, written_files
 from test_sheet_cut_scene import lip_pairs, widest_gap
 
 DIVISIONS = 10  # 200 triangles: about 3 seconds with the pictures
@@ -24,9 +21,7 @@ DIVISIONS = 10  # 200 triangles: about 3 seconds with the pictures
 
 @pytest.fixture(scope="module")
 def membrane(tmp_path_factory):
-    out = tmp_path_factory.mktemp("membrane-cut")
-    scene = membrane_cut.build(argparse.Namespace(material=None, divisions=DIVISIONS, mesh_size=None, speed=None))
-    return scene, run_scene.run(scene, None, None, out, progress=False)
+    return built_and_run(membrane_cut, "membrane-cut", tmp_path_factory, DIVISIONS)[:2]
 
 
 def test_every_relaxation_converges(membrane):
@@ -87,9 +82,7 @@ def test_the_fold_branches_and_falls_in_two(membrane):
 
 def test_files_and_pictures(membrane):
     _, summary = membrane
-    files = {kind: Path(path) for kind, path in summary["files"].items()}
-    assert set(files) == {"xdmf", "h5", "png", "gif", "fold_png", "fold_xdmf", "fold_h5"}
-    assert all(path.stat().st_size > 0 for path in files.values())
+    files = written_files(summary, ("xdmf", "h5", "png", "gif", "fold_png", "fold_xdmf", "fold_h5"))
     for png in (files["png"], files["fold_png"]):
         assert not_blank(png)
         with Image.open(png) as image:

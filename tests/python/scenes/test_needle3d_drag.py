@@ -1,25 +1,21 @@
 """The needle3d scene with liver's forces (issue 33): the tissue at the entry is dragged by
 millimetres, as a hand estimate from the cited force and stiffness says, and the pictures
 (the cube with the needle, the section through the needle's axis) are written."""
-import argparse
 from pathlib import Path
 
 import numpy as np
 import pytest
 
-from snede import run_scene
 from snede.needle_forces import INSERTION_FORCE, LIVER_SHEAR_MODULUS
 from snede.scenes import needle3d
 
-from test_scenes import not_blank
+from test_scenes import built_and_run, not_blank
 
 
 @pytest.fixture(scope="module")
 def inserted(tmp_path_factory):
     """h_ref = 0.1 m / 32, one h_ref per update: about 25 updates, a few seconds."""
-    out = tmp_path_factory.mktemp("needle3d_drag")
-    scene = needle3d.build(argparse.Namespace(material=None, divisions=32, mesh_size=None, speed=1.0))
-    return scene, run_scene.run(scene, None, None, out, progress=False)
+    return built_and_run(needle3d, "needle3d_drag", tmp_path_factory, 32, speed=1.0)[:2]
 
 
 def test_the_scene_is_liver():

@@ -1,7 +1,6 @@
 """The needle3d scene (§6.9, Figure 6.14): a short, coarse insertion converges, refines along the
 shaft, writes the series with the needle node state, the pictures (cube, needle surface), the
 animation and the summary, and is listed by the command line."""
-import argparse
 from pathlib import Path
 
 import h5py
@@ -9,18 +8,15 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from snede import run_scene
 from snede.scenes import builders, needle3d
 
-from test_scenes import not_blank
+from test_scenes import built_and_run, not_blank
 
 
 @pytest.fixture(scope="module")
 def inserted(tmp_path_factory):
     """h_ref = 0.1 m / 32, one h_ref per update: about 25 updates, a few seconds."""
-    out = tmp_path_factory.mktemp("needle3d")
-    scene = needle3d.build(argparse.Namespace(material=None, divisions=32, mesh_size=None, speed=1.0))
-    return scene, run_scene.run(scene, None, None, out, progress=False), out
+    return built_and_run(needle3d, "needle3d", tmp_path_factory, 32, speed=1.0)
 
 
 def test_insertion_converges_refines_and_reports(inserted):

@@ -1,6 +1,5 @@
 """The needle scene: a short insertion writes a series whose steps follow the refined mesh and
 carry the needle node state, a picture, an animation and a summary."""
-import argparse
 import json
 import re
 from pathlib import Path
@@ -14,15 +13,13 @@ from PIL import Image
 from snede import run_scene
 from snede.scenes import needle
 
-from test_scenes import not_blank, run_cli
+from test_scenes import built_and_run, run_cli, written_files
 
 
 @pytest.fixture(scope="module")
 def inserted(tmp_path_factory):
     """h_start = h2, one h_ref per update: 45 updates, a couple of seconds."""
-    out = tmp_path_factory.mktemp("needle")
-    scene = needle.build(argparse.Namespace(material=None, divisions=4, mesh_size=None, speed=1.0))
-    return scene, run_scene.run(scene, None, None, out, progress=False), out
+    return built_and_run(needle, "needle", tmp_path_factory, 4, speed=1.0)
 
 
 def test_insertion_converges_and_reports_rates(inserted):
@@ -37,9 +34,7 @@ def test_insertion_converges_and_reports_rates(inserted):
 
 def test_files_are_written(inserted):
     _, summary, _ = inserted
-    files = {kind: Path(path) for kind, path in summary["files"].items()}
-    assert set(files) == {"xdmf", "h5", "png", "gif"} and all(path.exists() for path in files.values())
-    assert not_blank(files["png"])
+    files = written_files(summary)
     with Image.open(files["gif"]) as gif:
         assert gif.n_frames == summary["frames"]
 

@@ -135,6 +135,24 @@ def run_cli(*args, cwd=None):
                           cwd=cwd or ROOT, timeout=300)
 
 
+def written_files(summary, kinds=("xdmf", "h5", "png", "gif")):
+    """The files a scene's summary lists, by kind, checked: exactly `kinds`, none empty, and
+    the picture ("png") not blank."""
+    files = {kind: Path(path) for kind, path in summary["files"].items()}
+    assert set(files) == set(kinds)
+    assert all(path.stat().st_size > 0 for path in files.values())
+    assert not_blank(files["png"])
+    return files
+
+
+def built_and_run(module, folder, tmp_path_factory, divisions, speed=None):
+    """The scene of `module` built with these options (no material or mesh size) and run into
+    a fresh folder named `folder`: the scene, its summary and the folder."""
+    out = tmp_path_factory.mktemp(folder)
+    scene = module.build(argparse.Namespace(material=None, divisions=divisions, mesh_size=None, speed=speed))
+    return scene, run_scene.run(scene, None, None, out, progress=False), out
+
+
 def run_cutting_scene_cli(scene, divisions, out_dir, move, loaded, material, method):
     """Runs a cutting scene from the command line and checks what each prints: a line per move
     (numbered 1 to the last, `move` after the number, its relaxation converged), the loading

@@ -4,7 +4,6 @@ triangles and stays valid, the series follows the cut meshes, and the tension op
 measured here from the written files alone (the lips are boundary vertices that share a
 reference position, found from the cells, not from the cutter), by millimetres, along the
 path. Also the pictures, the command line, a solve that does not converge, and neo-Hookean."""
-import argparse
 import json
 import math
 import re
@@ -20,16 +19,14 @@ from PIL import Image
 from snede import run_scene
 from snede.scenes import sheet_cut
 
-from test_scenes import assert_gif_shows_the_cut, not_blank, red_pixels, run_cli, run_cutting_scene_cli
+from test_scenes import assert_gif_shows_the_cut, built_and_run, red_pixels, run_cli, run_cutting_scene_cli, written_files
 
 DIVISIONS = 20  # 20 × 12 squares, 38 moves: about 4 seconds with the animation
 
 
 @pytest.fixture(scope="module")
 def sheet(tmp_path_factory):
-    out = tmp_path_factory.mktemp("sheet-cut")
-    scene = sheet_cut.build(argparse.Namespace(material=None, divisions=DIVISIONS, mesh_size=None, speed=None))
-    return scene, run_scene.run(scene, None, None, out, progress=False)
+    return built_and_run(sheet_cut, "sheet-cut", tmp_path_factory, DIVISIONS)[:2]
 
 
 def written_steps(summary):
@@ -153,10 +150,7 @@ def test_series_has_a_frame_every_few_moves_that_meshio_reads(sheet):
 
 def test_picture_and_animation_show_the_incision(sheet):
     _, summary = sheet
-    files = {kind: Path(path) for kind, path in summary["files"].items()}
-    assert set(files) == {"xdmf", "h5", "png", "gif"}
-    assert all(path.stat().st_size > 0 for path in files.values())
-    assert not_blank(files["png"])
+    files = written_files(summary)
     with Image.open(files["png"]) as png:
         assert red_pixels(png) > 100
     assert_gif_shows_the_cut(files["gif"], summary["frames"], 20)
