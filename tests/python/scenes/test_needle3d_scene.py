@@ -10,6 +10,7 @@ from PIL import Image
 
 from snede.scenes import builders, needle3d
 
+from test_needle_scene import assert_insertion_converged
 from test_scenes import built_and_run, not_blank
 
 
@@ -21,12 +22,8 @@ def inserted(tmp_path_factory):
 
 def test_insertion_converges_refines_and_reports(inserted):
     scene, summary, _ = inserted
-    assert summary["converged"], summary
-    assert summary["method"] == "cg" and summary["rtol"] == 1e-3
-    assert summary["updates"] >= 20 and summary["rearrangements"] >= summary["updates"]
+    assert_insertion_converged(summary, 20)
     assert summary["tetrahedra"] > 384  # refined from the 384-tetrahedron start mesh
-    assert summary["needle_nodes"] == summary["stick"] + summary["slip"] > 0
-    assert summary["value"] > 0  # friction drags the cube along the insertion
     assert summary["mean_iterations"] < 30  # multigrid on the needle's refinement
 
 
