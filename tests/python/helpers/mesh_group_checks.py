@@ -1,8 +1,10 @@
 """Measures of named groups (python/snede/mesh_groups.py), computed here independently of the
-engine, and the invariants a group keeps through edits (see mesh/test_mesh_groups_edits.py):
-for the tests of the mesh, the cutters and the bodies."""
+engine, the invariants a group keeps through edits (see mesh/test_mesh_groups_edits.py) and a
+body held and loaded by group names: for the tests of the mesh, the cutters and the bodies."""
 import numpy as np
 import pytest
+
+import snede
 
 
 # -- measures ----------------------------------------------------------------------------------
@@ -76,3 +78,16 @@ def label_partition(mesh, rng, n_groups=3):
     for k, name in enumerate(names):
         mesh.add_cell_group(name, which == k)
     return names
+
+
+def body_held_and_loaded_by_groups(mesh, traction, **body_options):
+    """A linear elastic body on `mesh` held by its group "clamped" and pulled down by
+    `traction` (Pa) on its group "loaded", whose area makes that 10 N (checked), solved by CG:
+    the body, with the solve converged and the clamped vertices unmoved (checked)."""
+    body = snede.Body(mesh, snede.LinearElastic(1e6, 0.3), **body_options)
+    body.fix("clamped")
+    body.add_traction("loaded", (0.0, 0.0, -traction))
+    np.testing.assert_allclose(body.external_forces().sum(axis=0), (0.0, 0.0, -10.0), atol=1e-12)
+    assert snede.StaticSolver(body, "cg", rtol=1e-8).solve().converged
+    assert np.all(body.displacement[mesh.group_vertices("clamped")] == 0)
+    return body
