@@ -17,21 +17,17 @@ void bind_planar_cutting(py::module_& m) {
       "``a + b``: counts and times add, ``triangles_after`` is ``b``'s.")
       .def("__str__", [](const PlanarCutReport& r) { return summary(r); });
 
-  py::class_<DelaunayCutter>(m, "DelaunayCutter")
+  py::class_<DelaunayCutter> cutter(m, "DelaunayCutter");
+  def_delaunay_cutter_common(cutter);
+  cutter
       .def(py::init([](Mesh& mesh, Model* model, double eps_edge, double eps_entry, double eps_exit, double angle) {
              return std::make_unique<DelaunayCutter>(mesh, displacement_of(model, mesh, "DelaunayCutter"),
-                                                     DelaunayCutterOptions{eps_edge, eps_entry, eps_exit, angle});
+                                                     DelaunayCutterOptions{{eps_edge, eps_entry, eps_exit}, angle});
            }),
            py::arg("mesh"), py::arg("model"), py::arg("eps_edge"), py::arg("eps_entry"), py::arg("eps_exit"),
            py::arg("short_edge_angle"), py::keep_alive<1, 2>(), py::keep_alive<1, 3>())
       .def("move", [](DelaunayCutter& c, const DoubleArray& point) { return c.move(view(point)); }, py::arg("point"))
-      .def("lift", &DelaunayCutter::lift)
-      .def_property_readonly("active_node", &DelaunayCutter::active_node)
-      .def_property_readonly("cutting", &DelaunayCutter::cutting)
-      .def_property_readonly("eps_edge", [](const DelaunayCutter& c) { return c.options().eps_edge; })
-      .def_property_readonly("eps_entry", [](const DelaunayCutter& c) { return c.options().eps_entry; })
-      .def_property_readonly("eps_exit", [](const DelaunayCutter& c) { return c.options().eps_exit; })
-      .def("incision_edges", [](const DelaunayCutter& c) { return to_array(c.incision_edges(), 2); });
+      .def_property_readonly("active_node", &DelaunayCutter::active_node);
 }
 
 }  // namespace snede::bindings

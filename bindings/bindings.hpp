@@ -52,4 +52,16 @@ py::array_t<T> to_array(const std::vector<T>& values, py::ssize_t columns) {
   return out;
 }
 
+// What the 2D and the surface Delaunay cutter share: lift, cutting, the distances of §5.4 as
+// resolved (a 0 given is the default from the mean edge length) and incision_edges.
+template <class Cutter>
+void def_delaunay_cutter_common(py::class_<Cutter>& cutter) {
+  cutter.def("lift", &Cutter::lift)
+      .def_property_readonly("cutting", &Cutter::cutting)
+      .def_property_readonly("eps_edge", [](const Cutter& c) { return c.options().eps_edge; })
+      .def_property_readonly("eps_entry", [](const Cutter& c) { return c.options().eps_entry; })
+      .def_property_readonly("eps_exit", [](const Cutter& c) { return c.options().eps_exit; })
+      .def("incision_edges", [](const Cutter& c) { return to_array(c.incision_edges(), 2); });
+}
+
 }  // namespace snede::bindings

@@ -8,7 +8,6 @@
 #include <utility>
 
 #include "core/error.hpp"
-#include "core/petsc_util.hpp"
 #include "core/predicates.hpp"
 #include "cutting/cut_thresholds.hpp"
 #include "cutting/incision_star.hpp"
@@ -83,11 +82,7 @@ DelaunayCutter::DelaunayCutter(Mesh& mesh, DisplacementSource displacement, Dela
   require(options.short_edge_angle >= 0 && options.short_edge_angle < std::acos(-1.0) / 2,
           "DelaunayCutter: short_edge_angle", "in [0, π/2) radians", options.short_edge_angle);
   // §5.4: thresholds as fractions of the mean edge length.
-  const CutThresholds thresholds =
-      resolved_thresholds("DelaunayCutter", mesh, {options.eps_edge, options.eps_entry, options.eps_exit});
-  options_.eps_edge = thresholds.eps_edge;
-  options_.eps_entry = thresholds.eps_entry;
-  options_.eps_exit = thresholds.eps_exit;
+  static_cast<CutThresholds&>(options_) = resolved_thresholds("DelaunayCutter", mesh, options);
 }
 
 DelaunayCutter::Point DelaunayCutter::reference(VertexId v) const {
@@ -187,12 +182,8 @@ PlanarCutReport DelaunayCutter::move(std::span<const double> point) {
   if (point.size() != 2)
     throw std::invalid_argument("DelaunayCutter.move: the scalpel is a point, 2 coordinates; got " + std::to_string(point.size()));
   require_finite_points(point.data(), point.size(), 2, "DelaunayCutter.move", "point");
-  watch_.settle_before_move();
-  const IncisionWatch::OwnEdits own(watch_);
-  const double start = wall_seconds();
-  PlanarCutReport report;
-  report.moves = 1;
-  report.triangles_before = mesh_.n_cells();
+  CutterMove this_move(watch_, mesh_);
+  PlanarCutReport& report = this_move.report();
   const Point now{point[0], point[1]};
   if (exit_point_ && distance(now, *exit_point_) > 2 * options_.eps_exit) {
     exit_point_.reset();
@@ -241,9 +232,7 @@ PlanarCutReport DelaunayCutter::move(std::span<const double> point) {
   legalize(report);
   batch.reset();
   watch_.follow(phase_ == Phase::outside ? std::span<const VertexId>{} : std::span<const VertexId>(&active_, 1));
-  report.triangles_after = mesh_.n_cells();
-  report.seconds = wall_seconds() - start;
-  return report;
+  return this_move.finished();
 }
 
 void DelaunayCutter::legalize(PlanarCutReport& report) {

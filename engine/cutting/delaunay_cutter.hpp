@@ -40,17 +40,14 @@
 #include <vector>
 
 #include "cutting/cut_body.hpp"
+#include "cutting/cut_thresholds.hpp"
 #include "cutting/incision_star.hpp"
 #include "cutting/planar_cut_report.hpp"
 
 namespace snede {
 
-struct DelaunayCutterOptions {
-  // Distances in the reference configuration; 0 means the thesis's defaults from the mean
-  // edge length h̄ (§5.4): ε_edge = h̄/3, ε_entry = ε_exit = h̄/6.
-  double eps_edge = 0;
-  double eps_entry = 0;
-  double eps_exit = 0;
+// The distances (CutThresholds: 0 means the thesis's default) and the short-edge angle.
+struct DelaunayCutterOptions : CutThresholds {
   // > 0 (radians): an interior neighbour of the active node is removed when every angle
   // facing their edge is below this, instead of the distance ε_edge (scale free, §5.5).
   double short_edge_angle = 0;

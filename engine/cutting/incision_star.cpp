@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <string>
 
+#include "core/petsc_util.hpp"
 #include "topology/local_star.hpp"
 
 namespace snede {
@@ -187,6 +188,24 @@ void IncisionWatch::settle_before_move() {
   const std::string why = std::move(lost_);
   lost_.clear();
   throw IncisionLost(why);
+}
+
+// The watch settles before OwnEdits counts what follows as the cutter's own.
+IncisionWatch& CutterMove::settled(IncisionWatch& watch) {
+  watch.settle_before_move();
+  return watch;
+}
+
+CutterMove::CutterMove(IncisionWatch& watch, const Mesh& mesh)
+    : mesh_(mesh), own_(settled(watch)), start_(wall_seconds()) {
+  report_.moves = 1;
+  report_.triangles_before = mesh.n_cells();
+}
+
+PlanarCutReport CutterMove::finished() {
+  report_.triangles_after = mesh_.n_cells();
+  report_.seconds = wall_seconds() - start_;
+  return report_;
 }
 
 }  // namespace snede

@@ -11,6 +11,7 @@
 #include <unordered_set>
 #include <vector>
 
+#include "cutting/planar_cut_report.hpp"
 #include "mesh/mesh.hpp"
 #include "topology/flip_edge.hpp"
 
@@ -163,6 +164,24 @@ class IncisionWatch {
   std::string lost_;                    // why incisions were given up, for the next move
   Recorder recorder_{*this};
   Settler settler_{*this};
+};
+
+// One move of a Delaunay cutter, from its start — edits by others settled (settle_before_move,
+// which may raise IncisionLost), the cutter's own edits from then on (OwnEdits), the clock and
+// the triangle count taken — to finished(), which completes and returns its report.
+class CutterMove {
+ public:
+  CutterMove(IncisionWatch& watch, const Mesh& mesh);
+  PlanarCutReport& report() { return report_; }
+  PlanarCutReport finished();
+
+ private:
+  static IncisionWatch& settled(IncisionWatch& watch);
+
+  const Mesh& mesh_;
+  IncisionWatch::OwnEdits own_;
+  double start_;
+  PlanarCutReport report_;
 };
 
 }  // namespace snede

@@ -8,7 +8,6 @@
 #include <utility>
 
 #include "core/error.hpp"
-#include "core/petsc_util.hpp"
 #include "cutting/cut_thresholds.hpp"
 #include "cutting/incision_star.hpp"
 #include "cutting/swept_intersections.hpp"
@@ -60,11 +59,7 @@ SurfaceCutter::SurfaceCutter(Mesh& mesh, DisplacementSource displacement, Surfac
     throw std::invalid_argument("SurfaceCutter: the mesh must be a surface (triangles in 3D), got cell_dim " +
                                 std::to_string(mesh.cell_dim()) + " in " + std::to_string(mesh.space_dim()) + "D");
   // §5.4: thresholds as fractions of the mean edge length.
-  const CutThresholds thresholds =
-      resolved_thresholds("SurfaceCutter", mesh, {options.eps_edge, options.eps_entry, options.eps_exit});
-  options_.eps_edge = thresholds.eps_edge;
-  options_.eps_entry = thresholds.eps_entry;
-  options_.eps_exit = thresholds.eps_exit;
+  static_cast<CutThresholds&>(options_) = resolved_thresholds("SurfaceCutter", mesh, options);
   for (VertexId v = 0; v < mesh.n_points(); ++v)
     if (mesh.is_vertex(v) && mesh.connectivity().n_vertex_uses(v) > 0) surface_normals_[v] = star_area(v);
   for (const auto& [v, normal] : surface_normals_) {
@@ -352,12 +347,8 @@ PlanarCutReport SurfaceCutter::move(std::span<const double> segment) {
   require_finite_points(segment.data(), segment.size(), 3, "SurfaceCutter.move", "segment");
   const Segment now{{segment[0], segment[1], segment[2]}, {segment[3], segment[4], segment[5]}};
   if (now.head == now.tail) throw std::invalid_argument("SurfaceCutter.move: the scalpel's two ends coincide (segment)");
-  watch_.settle_before_move();
-  const IncisionWatch::OwnEdits own(watch_);
-  const double start = wall_seconds();
-  PlanarCutReport report;
-  report.moves = 1;
-  report.triangles_before = mesh_.n_cells();
+  CutterMove this_move(watch_, mesh_);
+  PlanarCutReport& report = this_move.report();
   displacement_.clear();
   moved_.clear();
   if (body_displacement_) {
@@ -382,9 +373,7 @@ PlanarCutReport SurfaceCutter::move(std::span<const double> segment) {
     legalize(report);
   }
   watch_.follow(active_nodes());
-  report.triangles_after = mesh_.n_cells();
-  report.seconds = wall_seconds() - start;
-  return report;
+  return this_move.finished();
 }
 
 void SurfaceCutter::lift() {

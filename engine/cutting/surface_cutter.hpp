@@ -56,6 +56,7 @@
 #include <vector>
 
 #include "cutting/cut_body.hpp"
+#include "cutting/cut_thresholds.hpp"
 #include "cutting/delaunay_cutter.hpp"
 #include "cutting/incision_star.hpp"
 #include "cutting/sweep_triangle.hpp"
@@ -63,13 +64,8 @@
 
 namespace snede {
 
-struct SurfaceCutterOptions {
-  // Reference distances; 0 means the thesis's defaults from the mean edge length h̄ (§5.4):
-  // ε_edge = h̄/3, ε_entry = ε_exit = h̄/6.
-  double eps_edge = 0;
-  double eps_entry = 0;
-  double eps_exit = 0;
-};
+// The distances (0 means the thesis's default); the surface cutter has no other option.
+using SurfaceCutterOptions = CutThresholds;
 
 class SurfaceCutter {
  public:
