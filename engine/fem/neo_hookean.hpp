@@ -49,10 +49,6 @@ struct NeoHookean {
     const T J = sqrt(C.determinant());
     return {inverse<T, 3>(C), -(T(lame.lambda) * (J - T(1)) * J - T(lame.mu)), T(0.5 * lame.lambda) * (T(2) * J - T(1)) * J};
   }
-  template <class T>
-  Tensor<T, 3> stress_derivative(const Tensor<T, 3>& C, const Tensor<T, 3>& H) const {
-    return stress_tangent<T>(C)(H);
-  }
   // Plane stress: with C = diag(C₂, c), d = det C₂ and s = √c, S₃₃ = 0 reads
   // (μ + λ d) s² − λ √d s − μ = 0, whose positive root is taken (closed form), divided by μ
   // (r = λ/μ): λ² overflows from E = 1e155 Pa and underflows below E = 1e-160 Pa.

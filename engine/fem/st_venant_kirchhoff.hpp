@@ -37,10 +37,6 @@ struct StVenantKirchhoff {
   StressTangent<T> stress_tangent(const Tensor<T, 3>&) const {
     return {lame.mu, 0.5 * lame.lambda};
   }
-  template <class T>
-  Tensor<T, 3> stress_derivative(const Tensor<T, 3>& C, const Tensor<T, 3>& H) const {
-    return stress_tangent<T>(C)(H);
-  }
   // Plane stress: S₃₃ = μ (c − 1) + λ/2 (tr C₂ + c − 3) = 0 is linear in c = C₃₃, so
   // c = 1 − λ/2 (tr C₂ − 2) / (μ + λ/2) (closed form).
   template <class T>

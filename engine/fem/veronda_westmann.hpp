@@ -64,10 +64,6 @@ struct VerondaWestmann {
     const T e = exp(T(gamma) * (C.trace() - T(3)));
     return {inverse<T, 3>(C), T(lame.mu) * (T(2 * gamma) * e - T(1)), C.determinant(), lame.mu, 0.5 * lame.lambda};
   }
-  template <class T>
-  Tensor<T, 3> stress_derivative(const Tensor<T, 3>& C, const Tensor<T, 3>& H) const {
-    return stress_tangent<T>(C)(H);
-  }
   // Plane stress: with C = diag(C₂, c), t = tr C₂, d = det C₂,
   // S₃₃(c) = 2μ e^{γ(t + c − 3)} − μ t + λ/2 (d − 1/c), strictly increasing in c, from −∞
   // at c → 0 to +∞: one root, found per element by Newton's method safeguarded by
