@@ -60,7 +60,7 @@ import numpy as np
 sys.path.append(str(Path(__file__).resolve().parents[2]))  # the repository root: studies.experiments
 
 import snede
-from studies.experiments.common import Column, markdown_table, parse_arguments, pyplot, write_csv
+from studies.experiments.common import Column, markdown_table, parse_arguments, pyplot, save_figure, write_csv
 from studies.experiments.delaunay_cut import (LARGE_ANGLE, SMALL_ANGLE, angle_columns, arc, densify, draw_mesh,
                                               incision_segments, inside, mean_edge_length, plot_angles,
                                               resample)
@@ -245,9 +245,7 @@ def plot_meshes(cases: dict, out) -> None:
             added = next(r["added"] for r in rows if r["method"] == method)
             draw_mesh(axes[row, column], points, cells, PATHS[path_name],
                       f"{surface_name}, {path_name}\n{method}: {added:+d}", segments[..., :2])
-    figure.tight_layout()
-    figure.savefig(out, dpi=110)
-    plt.close(figure)
+    save_figure(figure, out, 110)
 
 
 def main(argv=None) -> list[dict]:

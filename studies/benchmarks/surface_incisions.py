@@ -55,7 +55,7 @@ import numpy as np
 sys.path.append(str(Path(__file__).resolve().parents[2]))  # the repository root: studies.experiments
 
 import snede
-from studies.experiments.common import Column, markdown_table, parse_arguments, pyplot, write_csv
+from studies.experiments.common import Column, markdown_table, parse_arguments, pyplot, save_figure, write_csv
 from studies.experiments.delaunay_cut import angle_columns, arc, resample
 from organ_meshes import organ_mesh
 
@@ -310,9 +310,7 @@ def plot(meshes: dict, out) -> None:
         axis.set(xlim=(-0.1, 1.1), ylim=(-0.1, 1.1), zlim=(-0.1, 0.6), title=f"{name}\n{count} pieces")
         axis.view_init(elev=28, azim=-60)
         axis.set_axis_off()
-    figure.tight_layout()
-    figure.savefig(out, dpi=100)
-    plt.close(figure)
+    save_figure(figure, out, 100)
 
 
 def main(argv=None) -> list[dict]:

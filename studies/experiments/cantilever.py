@@ -16,7 +16,7 @@ import numpy as np
 
 import snede
 from studies.experiments.common import (Column, PageTemplate, markdown_table, options_prefix, parse_arguments, pyplot,
-                                        run_solve, write_csv)
+                                        run_solve, save_figure, write_csv)
 
 LENGTH, HEIGHT, DEPTH, YOUNG, LOAD = 1.2, 0.2, 0.3, 1e6, 3.0
 SHEAR_COEFFICIENT = 5 / 6  # Timoshenko's κ for a rectangular section
@@ -203,9 +203,7 @@ def plot(table, path: Path) -> None:
     axes.set_title("§3.3 cantilever, linear CG, ‖r‖ < 1e-8 ‖f‖")
     axes.grid(True, which="both", alpha=0.3)
     axes.legend(fontsize=8)
-    figure.tight_layout()
-    figure.savefig(path, dpi=120)
-    plt.close(figure)
+    save_figure(figure, path, 120)
 
 
 TABLE_COLUMNS = [

@@ -153,3 +153,10 @@ def pyplot():
     import matplotlib.pyplot as plt
 
     return plt
+
+
+def save_figure(figure, path, dpi: int) -> None:
+    """Lays `figure` out, writes it to `path` at `dpi` and frees it."""
+    figure.tight_layout()
+    figure.savefig(path, dpi=dpi)
+    pyplot().close(figure)

@@ -35,7 +35,7 @@ import numpy as np
 import snede
 from studies.experiments import organ_cuts
 from studies.experiments.common import (Column, PageTemplate, markdown_table, options_prefix, parse_arguments, pyplot,
-                                        write_csv)
+                                        save_figure, write_csv)
 
 DIVISIONS = 8  # 8 × 8 × 8 cubes of 6 tetrahedra: 3072 tetrahedra, 729 nodes (§3.3)
 YOUNG, POISSON = 1e4, 0.25  # Pa; ν = 1/4 as in §3.3 (E only scales the displacement)
@@ -412,9 +412,7 @@ def plot_quality(meshes: dict, path: Path) -> None:
         left.set_xlabel("aspect ratio (min height / max edge); dotted: 0.01, 0.05, 0.1")
         right.set_xlabel("largest dihedral angle [°]; dotted: 0.99π")
     figure.suptitle("§3.3 cube (3072 tetrahedra): element quality before and after the cut")
-    figure.tight_layout()
-    figure.savefig(path, dpi=110)
-    plt.close(figure)
+    save_figure(figure, path, 110)
 
 
 def plot_scan(rows, path: Path) -> None:
@@ -432,9 +430,7 @@ def plot_scan(rows, path: Path) -> None:
     axes.set_title("Cube, one-move cuts at 18 orientations")
     axes.grid(True, which="both", alpha=0.3)
     axes.legend(fontsize=8)
-    figure.tight_layout()
-    figure.savefig(path, dpi=120)
-    plt.close(figure)
+    save_figure(figure, path, 120)
 
 
 def plot_incisions(bodies: dict, path: Path) -> None:
@@ -463,9 +459,7 @@ def plot_incisions(bodies: dict, path: Path) -> None:
         axes.view_init(elev=22, azim=50)  # looking at the diagonal plane x + y = 1 from its side
         axes.set_title(name, fontsize=9)
         axes.set_axis_off()
-    figure.tight_layout()
-    figure.savefig(path, dpi=110)
-    plt.close(figure)
+    save_figure(figure, path, 110)
 
 
 # --- the report -------------------------------------------------------------------------------

@@ -43,7 +43,7 @@ from pathlib import Path
 import numpy as np
 
 import snede
-from studies.experiments.common import Column, PageTemplate, markdown_table, parse_arguments, pyplot, write_csv
+from studies.experiments.common import Column, PageTemplate, markdown_table, parse_arguments, pyplot, save_figure, write_csv
 from snede.planar_cutting import PlanarCutReport, sample_path
 from snede.subdivision_cutting import SubdivisionCutter
 
@@ -496,9 +496,7 @@ def plot_meshes(rows, meshes, references, path, out: Path, reference_of: str | N
         segments, _ = incision_segments(meshes[reference_of])
         draw_mesh(axes[-1], points, cells, path, f"Triangle 'pq30YY' of the {reference_of} domain: "
                   f"{len(cells)}", segments)
-    figure.tight_layout()
-    figure.savefig(out, dpi=120)
-    plt.close(figure)
+    save_figure(figure, out, 120)
 
 
 def plot_angles(groups: dict, out: Path) -> None:
@@ -523,9 +521,7 @@ def plot_angles(groups: dict, out: Path) -> None:
             if row == 0:
                 axis.set_title(title, fontsize=10)
                 axis.legend(fontsize=8)
-    figure.tight_layout()
-    figure.savefig(out, dpi=110)
-    plt.close(figure)
+    save_figure(figure, out, 110)
 
 
 def plot_scan(eps, random, out: Path) -> None:
@@ -554,9 +550,7 @@ def plot_scan(eps, random, out: Path) -> None:
     right.set_ylabel("smallest angle after the cut [°]")
     right.set_title("random paths", fontsize=10)
     right.legend(fontsize=8)
-    figure.tight_layout()
-    figure.savefig(out, dpi=110)
-    plt.close(figure)
+    save_figure(figure, out, 110)
 
 
 # --- the page ------------------------------------------------------------------------------

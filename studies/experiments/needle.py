@@ -32,7 +32,7 @@ from pathlib import Path
 import numpy as np
 
 import snede
-from studies.experiments.common import PageTemplate, options_prefix, parse_arguments, pyplot, write_csv
+from studies.experiments.common import PageTemplate, options_prefix, parse_arguments, pyplot, save_figure, write_csv
 from snede.scenes.needle_slab import DEPTH, ENTRY, SIZE, YOUNG, h, needle_for, slab_body
 
 ROUND_TOLERANCE = 1e-8  # ε_round of (6.9), §6.8.1
@@ -624,9 +624,7 @@ def plot_rates(rows: list[dict], path: Path) -> None:
     axes.grid(True, which="both", color="0.9")
     axes.legend(fontsize=8)
     axes.set_title("Table 6.5: update rates (h_start = h3)", fontsize=10)
-    figure.tight_layout()
-    figure.savefig(path, dpi=130)
-    plt.close(figure)
+    save_figure(figure, path, 130)
 
 
 def plot_nonlinear(states: dict, scale: float, path: Path) -> None:
@@ -667,9 +665,7 @@ def plot_nonlinear(states: dict, scale: float, path: Path) -> None:
             ax.legend(loc="upper right", fontsize=7)
     figure.suptitle(f"Figure 6.12: sideways insertion into a slab fixed at the bottom, ν = 0 "
                     f"(friction profile ×{scale:g})", fontsize=11)
-    figure.tight_layout()
-    figure.savefig(path, dpi=110)
-    plt.close(figure)
+    save_figure(figure, path, 110)
 
 
 # --- the results page -----------------------------------------------------------------------

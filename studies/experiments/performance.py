@@ -17,7 +17,8 @@ import numpy as np
 import snede
 from snede import PETSc
 from studies.experiments.common import (
-    Column, PageTemplate, best_seconds, markdown_table, options_prefix, parse_arguments, pyplot, write_csv,
+    Column, PageTemplate, best_seconds, markdown_table, options_prefix, parse_arguments, pyplot, save_figure,
+    write_csv,
 )
 
 YOUNG, POISSON = 1e6, 0.25  # §3.3
@@ -312,9 +313,7 @@ def plot(rows, path) -> None:
         ax.legend(fontsize=8)
     left.set_title("tangent action: MatShell against MatMult")
     right.set_title("memory")
-    figure.tight_layout()
-    figure.savefig(path, dpi=110)
-    plt.close(figure)
+    save_figure(figure, path, 110)
 
 
 PRODUCT_COLUMNS = [

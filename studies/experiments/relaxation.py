@@ -25,7 +25,7 @@ import numpy as np
 import snede
 from snede import PETSc
 from studies.experiments.common import (Column, PageTemplate, markdown_table, options_prefix, parse_arguments, pyplot,
-                                        write_csv)
+                                        save_figure, write_csv)
 
 MESHES = Path(__file__).resolve().parents[2] / "meshes"
 GRAVITY, DENSITY, YOUNG, POISSON, VERONDA_GAMMA = 9.8, 1000.0, 1e4, 0.3, 8.0
@@ -581,9 +581,7 @@ def plot_convergence(curves: dict, case_name: str, meshes, path: Path) -> None:
             ax.set_title(f"{case_name}, {mesh} mesh" + (" (slow runs clipped)" if clipped else ""))
             ax.grid(True, which="both", alpha=0.3)
         row[0].legend(fontsize=7)
-    figure.tight_layout()
-    figure.savefig(path, dpi=110)
-    plt.close(figure)
+    save_figure(figure, path, 110)
 
 
 def plot_short_edge(curves: dict, path: Path) -> None:
@@ -600,9 +598,7 @@ def plot_short_edge(curves: dict, path: Path) -> None:
         ax.set_ylabel("energy error (e,e)_K [J]")
         ax.grid(True, which="both", alpha=0.3)
         ax.legend(fontsize=7)
-    figure.tight_layout()
-    figure.savefig(path, dpi=110)
-    plt.close(figure)
+    save_figure(figure, path, 110)
 
 
 def settings_for(quick: bool) -> dict:

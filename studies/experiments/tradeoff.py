@@ -22,7 +22,7 @@ import numpy as np
 import snede
 from studies.experiments.cantilever import LENGTH, YOUNG, cantilever_body, tip_deflections
 from studies.experiments.common import (Column, PageTemplate, markdown_table, options_prefix, parse_arguments, pyplot,
-                                        run_solve, write_csv)
+                                        run_solve, save_figure, write_csv)
 
 MESHES = Path(__file__).resolve().parents[2] / "meshes"
 TARGETS_PCT = (1.0, 5.0, 20.0)
@@ -321,9 +321,7 @@ def plot(all_rows: list[dict], scene_names, path: Path) -> None:
         axis.set_title(name)
         axis.grid(True, which="both", alpha=0.3)
         axis.legend(fontsize=7, ncol=2)
-    figure.tight_layout()
-    figure.savefig(path, dpi=120)
-    plt.close(figure)
+    save_figure(figure, path, 120)
 
 
 RUN_COLUMNS = [Column("mesh", "mesh"), Column("cells", "cells"), Column("solver", "solver"),
