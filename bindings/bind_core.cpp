@@ -24,9 +24,13 @@ void bind_core(py::module_& m) {
       throw;
     }
   });
-  // The solvers ask between iterations whether to stop: Python's signal handlers run here (the
-  // GIL is held during solves), and a SIGINT leaves a KeyboardInterrupt set and stops the solve.
-  set_interrupt_check([] { return PyErr_CheckSignals() != 0; });
+  // The solvers ask between iterations whether to stop: Python's signal handlers run here, and a
+  // SIGINT leaves a KeyboardInterrupt set and stops the solve. Long calls release the GIL (so a
+  // window's thread runs during a solve, issue 37): the check takes it back first.
+  set_interrupt_check([] {
+    py::gil_scoped_acquire gil;
+    return PyErr_CheckSignals() != 0;
+  });
   m.def("petsc_allocated_bytes", &petsc_allocated_bytes,
         "Bytes currently allocated by PETSc (tracked only with -malloc_debug or -malloc_view).");
   m.def("option_real", &option_real, py::arg("name"),

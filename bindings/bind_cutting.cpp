@@ -47,10 +47,11 @@ void bind_cutting(py::module_& m) {
            py::arg("min_aspect_ratio"), py::arg("large_angle"), py::arg("fix_free_pieces"), py::arg("max_fragment_elements"),
            py::keep_alive<1, 2>(),
            py::keep_alive<1, 3>())
+      // Without the GIL (other Python threads run), as the solves.
       .def("cut_triangle", [](TetrahedralCutter& c, const DoubleArray& corners) { return c.cut_triangle(view(corners)); },
-           py::arg("corners"))
+           py::arg("corners"), py::call_guard<py::gil_scoped_release>())
       .def("move", [](TetrahedralCutter& c, const DoubleArray& scalpel) { return c.move(view(scalpel)); },
-           py::arg("scalpel"))
+           py::arg("scalpel"), py::call_guard<py::gil_scoped_release>())
       .def("lift", &TetrahedralCutter::lift)
       .def_property_readonly("placed", &TetrahedralCutter::placed)
       .def("incision_faces", [](const TetrahedralCutter& c) { return to_array(c.incision_faces(), 3); });

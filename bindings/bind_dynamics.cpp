@@ -20,8 +20,10 @@ void bind_dynamics(py::module_& m) {
       // The same solver over a distributed problem, on its communicator (collective).
       .def(py::init<Problem&, const DynamicRelaxationOptions&>(), py::arg("problem"), py::arg("options"),
            py::keep_alive<1, 2>())
-      .def("step", &DynamicRelaxation::step, py::arg("n"))
-      .def("run", &DynamicRelaxation::run, py::arg("rtol"), py::arg("max_steps"))
+      // Without the GIL (other Python threads run); the interrupt check and petsc4py's callbacks take it.
+      .def("step", &DynamicRelaxation::step, py::arg("n"), py::call_guard<py::gil_scoped_release>())
+      .def("run", &DynamicRelaxation::run, py::arg("rtol"), py::arg("max_steps"),
+           py::call_guard<py::gil_scoped_release>())
       .def("cfl_time_step", &DynamicRelaxation::cfl_time_step)
       .def("critical_time_step", &DynamicRelaxation::critical_time_step, py::arg("flop_budget"), py::arg("initial"),
            py::arg("reduction"), py::arg("min_steps"))

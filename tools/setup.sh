@@ -8,6 +8,8 @@ APT_PACKAGES=(
   petsc-dev libptscotch-dev libhdf5-openmpi-dev libeigen3-dev libcgal-dev pkg-config ninja-build libgtest-dev
   # system libraries the gmsh and VTK wheels load
   libglu1-mesa libxcursor1 libxft2 libxinerama1 libegl1 libgl1-mesa-dri
+  # the display the live window's tests start (python -m snede view; VTK renders through Mesa's GLX on it)
+  xvfb
 )
 PETSC_DIR_DEBIAN=/usr/lib/petscdir/petsc3.18/x86_64-linux-gnu-real
 PYTHON=${PYTHON:-python3}

@@ -105,6 +105,18 @@ def _parser() -> argparse.ArgumentParser:
     demo = commands.add_parser("demo", help="run the default scenes and the cutting demo")
     demo.add_argument("--quiet", action="store_true", default=argparse.SUPPRESS, help=quiet)
     demo.add_argument("--out", type=Path, default=Path("out"), help="output folder (default out/)")
+    view = commands.add_parser("view", help="the live window: the mouse drives the scene's tool (snede.interactive)",
+                               description="The live window (pyvista): the mouse drives the scalpel (cut) or the "
+                                           "needle (needle) while the body relaxes. Keys: s scalpel, n needle, "
+                                           "p pause, r reset, c screenshot, w write the series, q quit.")
+    view.add_argument("scene", help="cut or needle")
+    view.add_argument("--material", choices=MATERIAL_NAMES, help="material model (default: the scene's)")
+    view.add_argument("--divisions", type=_positive_int, help="the scene's mesh resolution (as for run)")
+    view.add_argument("--speed", type=_positive_float, help="needle: h_ref per update (as for run)")
+    view.add_argument("--events", type=Path, help="play pointer events (JSON) as if from the mouse")
+    view.add_argument("--screenshot", type=Path, help="save the last frame (PNG)")
+    view.add_argument("--exit", action="store_true", help="close once the events are played and the body relaxed")
+    view.add_argument("--record", type=Path, help="write the session's recording (JSON, for replay) at the end")
     replay = commands.add_parser("replay", help="replay a recorded tool session headless (snede.interactive)")
     replay.add_argument("recording", type=Path, help="the recording (JSON, from `view --record`)")
     replay.add_argument("--check", action="store_true",
@@ -136,7 +148,7 @@ def main(argv: list[str] | None = None) -> int:
 
     parser = _parser()
     ours, petsc = split(sys.argv[1:] if argv is None else list(argv))
-    if "-help" in petsc and not any(command in ours for command in ("list", "run", "demo", "replay")):
+    if "-help" in petsc and not any(command in ours for command in ("list", "run", "demo", "replay", "view")):
         parser.print_help()  # PETSc printed its general help at initialisation
         print("\nPETSc's options of a scene's solvers: python -m snede run SCENE -help")
         return 0
@@ -188,6 +200,8 @@ def _command(parser, args, unknown, petsc) -> int:
         return demo.run(args.out, progress=not args.quiet)
     if args.command == "replay":
         return _replay(args)
+    if args.command == "view":
+        return _view(args)
     if args.scene.endswith(".py"):
         script = Path(args.scene)
         if not script.exists():
@@ -215,6 +229,36 @@ def _command(parser, args, unknown, petsc) -> int:
     if summary.get("rank", 0) == 0:  # on several MPI ranks, rank 0 reports
         run_scene.print_table([summary])
     return 0 if summary["converged"] else 1
+
+
+def _view(args) -> int:
+    from snede.interactive import events
+    from snede.interactive.recording import save
+    from snede.interactive.session import ToolSession
+
+    if sys.platform.startswith("linux") and not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
+        _command_line.fail("view needs a display: none is set (DISPLAY); without one, run it under xvfb-run")
+    played = events.load(args.events) if args.events else []
+    options = {name: getattr(args, name) for name in ("divisions", "material", "speed") if getattr(args, name)}
+    from snede.interactive.window import Window
+
+    window = Window(partial(ToolSession, args.scene, options))
+    tool = window.worker.session.tool.name
+    for index, event in enumerate(played):
+        if event.tool != tool:
+            raise ValueError(f"events file {args.events}: event {index}: 'tool' is {event.tool}, but the "
+                             f"{args.scene} scene's tool is the {tool}")
+    window.run(played, args.screenshot, close=args.exit)
+    session = window.worker.session
+    if args.record:
+        save(session.recording(), args.record)
+    print(f"view: {len(session.moves)} moves on the {args.scene} scene, {window.frames} frames"
+          + (f"; recorded to {args.record}" if args.record else "")
+          + (f"; screenshot {args.screenshot}" if args.screenshot else ""))
+    if window.worker.error:
+        print(_command_line.error_line(window.worker.error), file=sys.stderr)
+        return _command_line.BAD_INPUT
+    return 0
 
 
 def _replay(args) -> int:

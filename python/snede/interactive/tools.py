@@ -60,8 +60,8 @@ class Scalpel:
         self.first = _relaxation(self.solver.solve())  # the beam sags under gravity before any cut
         self.cutter = snede.TetrahedralCutter(self.body)
         self.edge = None  # where the blade's edge meets y = 0, while pressed
-        centre = (cut.LENGTH / 2, cut.WIDTH / 2, -0.01)
-        self.view = View(centre, tuple(direction_from_angles(*cut.VIEW)), (0.0, 0.0, 1.0), height=0.16)
+        centre = (cut.LENGTH / 2, cut.WIDTH / 2, -0.03)  # the beam sagging to some 10 cm at its tip
+        self.view = View(centre, tuple(direction_from_angles(*cut.VIEW)), (0.0, 0.0, 1.0), height=0.24)
         self.plane = ((0.0, 0.0, 0.0), (0.0, 1.0, 0.0))
 
     @property
@@ -102,6 +102,10 @@ class Scalpel:
     def lips(self) -> np.ndarray:
         """The incision's faces ((m, 3) vertex ids)."""
         return self.cutter.incision_faces()
+
+    def marks(self) -> dict:
+        """What the window draws besides the body: the blade's edge (deformed coordinates)."""
+        return {"blade": None if self.edge is None else np.array(self.blade(self.edge))}
 
     def write(self, writer, time: float) -> None:
         from snede.scenes.incision import incision_cells
@@ -167,6 +171,17 @@ class Needle:
         report = self.needle.advance(float(distance))
         return Relaxation(bool(report.converged), str(report.reason), float(report.seconds),
                           int(report.solver_iterations))
+
+    def lips(self) -> np.ndarray:
+        return np.zeros((0, 3), dtype=np.int64)  # the needle makes none
+
+    def marks(self) -> dict:
+        """What the window draws besides the body: the needle from a centimetre outside the
+        entry to its tip, its sticking and slipping nodes (deformed coordinates)."""
+        ends = np.array([self.entry - 0.01 * self.direction, self.entry + self.needle.depth * self.direction])
+        x = self.body.mesh.points + self.body.displacement
+        state = self.needle.node_state()
+        return {"needle": ends, "stick": x[state == 1], "slip": x[state == 2]}
 
     def write(self, writer, time: float) -> None:
         writer.write(self.body, time=time, point_fields={"needle_state": self.needle.node_state()})

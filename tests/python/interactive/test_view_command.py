@@ -1,0 +1,62 @@
+"""``python -m snede view SCENE --events FILE --screenshot PNG --exit --record FILE`` under Xvfb:
+the scripted session's recording replays with --check; bad input gives one line and status 2."""
+import json
+import subprocess
+import sys
+
+import pytest
+
+from tool_scripts import CUT_DIVISIONS, cut_events, cut_session, needle_events, needle_session
+
+pytest.importorskip("pyvista", reason="the window needs pyvista (tools/requirements.txt)")
+
+
+def snede(*arguments, env=None):
+    return subprocess.run([sys.executable, "-m", "snede", *map(str, arguments)], capture_output=True, text=True,
+                          timeout=300, env=env)
+
+
+def test_a_scripted_cut_is_recorded_and_replays(display, tmp_path):
+    scripted = tmp_path / "drag.json"
+    scripted.write_text(json.dumps(cut_events(cut_session())))
+    shot, recording = tmp_path / "cut.png", tmp_path / "cut.json"
+    done = snede("view", "cut", "--divisions", CUT_DIVISIONS, "--events", scripted, "--screenshot", shot, "--exit",
+                 "--record", recording)
+    assert done.returncode == 0, done.stderr
+    assert shot.stat().st_size > 0
+    moves = json.loads(recording.read_text())["moves"]
+    assert sum(m.get("faces_dissected", 0) for m in moves) > 0
+    assert snede("replay", recording, "--check").returncode == 0
+
+
+@pytest.mark.parametrize("arguments, fragment", [
+    (("view", "nope", "--exit"), "unknown scene 'nope'"),
+    (("view", "cut", "--events", "missing.json", "--exit"), "events file missing.json does not exist"),
+    (("view", "needle", "--divisions", "8", "--events", "SCALPEL", "--exit"),
+     "event 0: 'tool' is scalpel, but the needle scene's tool is the needle"),
+])
+def test_bad_input_gives_one_line(display, tmp_path, monkeypatch, arguments, fragment):
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "SCALPEL").write_text(json.dumps(cut_events(cut_session())))
+    done = snede(*arguments)
+    lines = done.stderr.strip().splitlines()
+    assert done.returncode == 2 and len(lines) == 1 and fragment in lines[0], done.stderr
+
+
+def test_without_a_display_view_says_so(tmp_path):
+    import os
+
+    env = {key: value for key, value in os.environ.items() if key not in ("DISPLAY", "WAYLAND_DISPLAY")}
+    done = snede("view", "cut", "--exit", env=env)
+    assert done.returncode == 2 and "view needs a display" in done.stderr
+
+
+def test_a_scripted_push_is_recorded(display, tmp_path):
+    scripted = tmp_path / "push.json"
+    scripted.write_text(json.dumps(needle_events(needle_session(), 0.01)))
+    recording = tmp_path / "needle.json"
+    done = snede("view", "needle", "--divisions", 8, "--speed", 1, "--events", scripted, "--exit", "--record",
+                 recording)
+    assert done.returncode == 0, done.stderr
+    assert any(m["action"] == "advance" for m in json.loads(recording.read_text())["moves"])
+    assert snede("replay", recording, "--check").returncode == 0

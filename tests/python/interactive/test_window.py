@@ -1,0 +1,100 @@
+"""The live window under Xvfb (issue 37): scripted pointer events drive the scene's tool through
+the mouse's path, the screenshot shows the incision's lips, and the window keeps rendering while
+the worker solves (the engine releases the GIL)."""
+import time
+
+import numpy as np
+import pytest
+
+import snede
+from snede.interactive.events import events
+from tool_scripts import cut_events, cut_session, needle_events, needle_session
+
+pytest.importorskip("pyvista", reason="the window needs pyvista (tools/requirements.txt)")
+
+
+def red_pixels(path) -> int:
+    """Pixels where red dominates: the lips' colour (snede.plotting.HIGHLIGHT, shaded); viridis,
+    the body's colour map, and the black edges have none."""
+    from PIL import Image
+
+    rgb = np.asarray(Image.open(path).convert("RGB"), dtype=float) / 255
+    return int(((rgb[..., 0] > 0.4) & (rgb[..., 1] < 0.5 * rgb[..., 0]) & (rgb[..., 2] < 0.5 * rgb[..., 0])).sum())
+
+
+def show(make_session, scripted, screenshot=None, tick=None):
+    from snede.interactive.window import Window
+
+    window = Window(make_session)
+    window.run(events(scripted), screenshot, close=True, tick=tick)
+    return window
+
+
+def test_a_scripted_drag_in_the_window_cuts_the_beam_and_shows_the_lips(display, tmp_path):
+    untouched = show(cut_session, [], tmp_path / "before.png")
+    window = show(cut_session, cut_events(cut_session()), tmp_path / "cut.png")
+    session = window.worker.session
+    assert window.worker.error is None
+    assert len(session.tool.lips()) > 0
+    assert sum(m.get("faces_dissected", 0) for m in session.moves) > 0
+    assert session.moves[-1]["action"] == "lift"
+    picture = np.asarray(__import__("PIL.Image").Image.open(tmp_path / "cut.png").convert("RGB"))
+    assert picture.shape == (600, 800, 3) and len(np.unique(picture.reshape(-1, 3), axis=0)) > 50  # not blank
+    assert red_pixels(tmp_path / "before.png") == 0 and untouched.worker.session.moves == []
+    assert red_pixels(tmp_path / "cut.png") > 100
+
+
+def test_the_window_and_the_headless_session_make_the_same_cut(display):
+    """The window's pointer goes through pixels; the cut it records replays to its digest."""
+    from snede.interactive import replay
+
+    window = show(cut_session, cut_events(cut_session()))
+    assert replay(window.worker.session.recording()).matches
+
+
+def test_a_scripted_push_in_the_window_inserts_the_needle(display):
+    window = show(needle_session, needle_events(needle_session(), 0.02))
+    needle = window.worker.session.tool.needle
+    assert needle.depth > 0.015 and len(needle.needle_nodes) > 0
+
+
+def slow_static_solve():
+    """A neo-Hookean beam of 12 288 tetrahedra by Newton with unpreconditioned CG to ε = 1e-10."""
+    body = beam((32, 8, 8), snede.NeoHookean(1e4, 0.3))
+    return snede.StaticSolver(body, "newton", rtol=1e-10, preconditioner="none").solve
+
+
+def slow_dynamic_relaxation():
+    """A linear beam of 384 tetrahedra by explicit damped dynamics to ε = 1e-6 (some 20 000 steps)."""
+    body = beam((16, 4, 4), snede.LinearElastic(1e5, 0.3))
+    return lambda: snede.DynamicRelaxation(body, damping=20.0).run(1e-6)
+
+
+def beam(divisions, material):
+    body = snede.Body(snede.meshing.box((1.0, 0.2, 0.2), divisions), material)
+    body.fix(np.isclose(body.mesh.points[:, 0], 0.0))
+    body.add_gravity((0.0, 0.0, -9.81))
+    return body
+
+
+@pytest.mark.parametrize("slow", [slow_static_solve, slow_dynamic_relaxation])
+def test_the_window_renders_while_the_worker_solves(display, slow):
+    """A deliberately slow solve in the worker: the window's loop keeps turning meanwhile — it
+    could not if the solve held the GIL."""
+    from snede.interactive.window import Window
+
+    solve, frames = {}, []
+
+    def in_the_worker(session):
+        run = slow()
+        solve["start"] = time.perf_counter()
+        solve["result"] = run()
+        solve["end"] = time.perf_counter()
+
+    window = Window(needle_session)
+    window.worker.inbox.put(in_the_worker)
+    window.run([], close=True, tick=lambda: frames.append(time.perf_counter()))
+    assert solve["result"].converged
+    assert solve["end"] - solve["start"] > 0.3, "the solve was too quick to tell"
+    during = [t for t in frames if solve["start"] < t < solve["end"]]
+    assert len(during) >= 3, f"{len(during)} frames in a {solve['end'] - solve['start']:.2f} s solve"
