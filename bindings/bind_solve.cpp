@@ -78,24 +78,19 @@ void bind_solve(py::module_& m) {
       .def("external_forces", [](Model& s) { return to_array(s.external_forces(), s.dim()); })
       .def("reaction_forces", &reactions_of)
       .def_property_readonly("n_constrained", [](const Model& s) { return s.constraints().n_constrained(); })
-      // (fixed vertices, their anchors (n, dim), sliding vertices, their directions and anchors
-      // (m, dim) each): what a distributed solve takes over from the serial body.
+      // (fixed vertices, their anchors (n, dim), sliding vertices): what a distributed solve
+      // takes over from the serial body.
       .def("constraint_table", [](const Model& s) {
              const Constraints& c = s.constraints();
              std::vector<std::int64_t> fixed, sliding;
-             std::vector<double> anchors, directions, sliding_anchors;
+             std::vector<double> anchors;
              for (VertexId v = 0; v < c.n_points(); ++v) {
-               if (c[v].kind == ConstraintKind::slide) {
-                 sliding.push_back(v);
-                 directions.insert(directions.end(), c[v].direction.begin(), c[v].direction.begin() + s.dim());
-                 sliding_anchors.insert(sliding_anchors.end(), c[v].anchor.begin(), c[v].anchor.begin() + s.dim());
-               }
+               if (c[v].kind == ConstraintKind::slide) sliding.push_back(v);
                if (c[v].kind != ConstraintKind::fixed) continue;
                fixed.push_back(v);
                anchors.insert(anchors.end(), c[v].anchor.begin(), c[v].anchor.begin() + s.dim());
              }
-             return py::make_tuple(to_array(fixed, 1), to_array(anchors, s.dim()), to_array(sliding, 1),
-                                   to_array(directions, s.dim()), to_array(sliding_anchors, s.dim()));
+             return py::make_tuple(to_array(fixed, 1), to_array(anchors, s.dim()), to_array(sliding, 1));
            })
       // The corners of one cell of each piece the constraints do not hold, (n_pieces, cell_dim + 1).
       .def("loose_piece_cells", [](Model& s) {
