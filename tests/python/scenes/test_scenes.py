@@ -181,7 +181,8 @@ def test_single_dash_help_is_petscs_and_then_snedes():
     PETSc's general help and then snede's usage, exit 0."""
     out = run_cli("-help")
     assert out.returncode == 0, out.stderr
-    assert "PETSc" in out.stdout and "usage: python -m snede" in out.stdout and "{list,run,demo}" in out.stdout
+    assert "PETSc" in out.stdout and "usage: python -m snede" in out.stdout
+    assert re.search(r"\{list,run,demo(,\w+)*\}", out.stdout), out.stdout  # snede's commands
     assert "elp" not in out.stderr and "Traceback" not in out.stderr
 
 
