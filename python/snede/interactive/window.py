@@ -53,6 +53,7 @@ class Worker(threading.Thread):
         while (item := self.inbox.get()) is not None:
             self.busy = True
             try:
+                moves = len(self.session.moves)
                 if callable(item):  # a task on the worker's thread (tests: a slow solve)
                     item(self.session)
                 elif item == "reset":
@@ -61,9 +62,10 @@ class Worker(threading.Thread):
                     for relaxation in self.session.handle(item):
                         self.relaxations += 1
                         self.solve_seconds += relaxation.seconds
-                snapshot = Snapshot.of(self.session)
-                with self.lock:
-                    self.snapshot, self.version = snapshot, self.version + 1
+                if not isinstance(item, PointerEvent) or len(self.session.moves) != moves:  # else nothing moved
+                    snapshot = Snapshot.of(self.session)
+                    with self.lock:
+                        self.snapshot, self.version = snapshot, self.version + 1
             except ValueError as error:
                 self.error = str(error)
             finally:
@@ -89,6 +91,7 @@ class Window:
         self.tool = self.worker.session.tool.name
         self.paused, self.waiting, self.closed = False, [], False
         self.frames, self.start, self.shown = 0, time.perf_counter(), -1
+        self.surface = self.body_actor = None
         self.frame_times: list[float] = []
         self.plotter = pyvista.Plotter(window_size=WINDOW, off_screen=off_screen, title=f"snede: {self.scene}")
         self.plotter.enable_parallel_projection()
@@ -185,8 +188,15 @@ class Window:
             faces = np.column_stack([np.full(len(snapshot.faces), 3), snapshot.faces]).ravel()
             surface = pyvista.PolyData(snapshot.points, faces)
             surface.point_data[MAGNITUDE] = snapshot.magnitude
-            self.plotter.add_mesh(surface, name="body", scalars=MAGNITUDE, cmap="viridis", show_edges=True,
-                                  edge_color="black", line_width=0.5, scalar_bar_args={"title": MAGNITUDE})
+            largest = max(float(snapshot.magnitude.max(initial=0.0)), 1e-12)
+            if self.surface is None:
+                self.surface = surface
+                self.body_actor = self.plotter.add_mesh(surface, scalars=MAGNITUDE, cmap="viridis", show_edges=True,
+                                                        edge_color="black", line_width=0.5,
+                                                        scalar_bar_args={"title": MAGNITUDE})
+            else:  # in place: a new actor and scalar bar each time would cost more than the frame
+                self.surface.copy_from(surface)
+            self.body_actor.mapper.scalar_range = (0.0, largest)
             self._optional("lips", snapshot.lips, lambda: pyvista.PolyData(
                 snapshot.points, np.column_stack([np.full(len(snapshot.lips), 3), snapshot.lips]).ravel()),
                 color=HIGHLIGHT, show_edges=False)

@@ -28,8 +28,11 @@ def display():
     server = subprocess.Popen([xvfb, "-displayfd", str(write), "-screen", "0", "1024x768x24", "-nolisten", "tcp"],
                               pass_fds=(write,), stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     os.close(write)
-    number = os.read(read, 32).decode().strip()
-    os.close(read)
+    # Up to its newline, and the pipe kept open: Xvfb dies if its write meets a closed pipe.
+    answer = b""
+    while not answer.endswith(b"\n") and (chunk := os.read(read, 32)):
+        answer += chunk
+    number = answer.decode().strip()
     if not number:
         server.wait()
         pytest.fail(f"Xvfb did not start (status {server.returncode})")
@@ -38,6 +41,7 @@ def display():
     yield os.environ["DISPLAY"]
     server.terminate()
     server.wait()
+    os.close(read)
     if before is None:
         del os.environ["DISPLAY"]
     else:
