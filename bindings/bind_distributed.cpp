@@ -3,6 +3,7 @@
 #include "mesh/distributed_mesh.hpp"
 #include "solve/dynamic_relaxation.hpp"
 #include "solve/distributed_static.hpp"
+#include "solve/model.hpp"
 
 #include <pybind11/stl.h>
 
@@ -40,17 +41,38 @@ void bind_distributed(py::module_& m) {
       },
       py::arg("comm"), py::arg("caller"), py::arg("inputs"));
 
+  // A serial Model's sliding vertices with their lines' unit directions and anchors (each
+  // (n, dim)): what a distributed solve takes over from Body.slide.
+  m.def(
+      "sliding_lines",
+      [](const Model& model) {
+        const Constraints& c = model.constraints();
+        const int dim = model.dim();
+        std::vector<std::int64_t> sliding;
+        std::vector<double> directions, anchors;
+        for (VertexId v = 0; v < c.n_points(); ++v) {
+          if (c[v].kind != ConstraintKind::slide) continue;
+          sliding.push_back(v);
+          directions.insert(directions.end(), c[v].direction.begin(), c[v].direction.begin() + dim);
+          anchors.insert(anchors.end(), c[v].anchor.begin(), c[v].anchor.begin() + dim);
+        }
+        return py::make_tuple(to_array(sliding, 1), to_array(directions, dim), to_array(anchors, dim));
+      },
+      py::arg("model"));
+
   py::class_<DistributedStatic, Problem>(m, "DistributedStatic")
       .def(py::init([](DistributedMesh& part, const py::handle& material, double density, double thickness,
-                       std::vector<std::int64_t> fixed, std::vector<double> fixed_values, std::vector<std::int64_t> loaded,
-                       std::vector<double> forces, std::vector<double> gravity) {
+                       std::vector<std::int64_t> fixed, std::vector<double> fixed_values, std::vector<std::int64_t> sliding,
+                       std::vector<double> sliding_directions, std::vector<double> sliding_anchors,
+                       std::vector<std::int64_t> loaded, std::vector<double> forces, std::vector<double> gravity) {
              return std::make_unique<DistributedStatic>(
                  part, material_from(material), density, thickness,
-                 DistributedConditions{std::move(fixed), std::move(fixed_values), std::move(loaded), std::move(forces),
-                                       std::move(gravity)});
+                 DistributedConditions{std::move(fixed), std::move(fixed_values), std::move(sliding),
+                                       std::move(sliding_directions), std::move(sliding_anchors), std::move(loaded),
+                                       std::move(forces), std::move(gravity)});
            }),
            py::arg("part"), py::arg("material"), py::arg("density"), py::arg("thickness"), py::arg("fixed"), py::arg("fixed_values"),
-           py::arg("loaded"), py::arg("forces"), py::arg("gravity"), py::keep_alive<1, 2>())
+           py::arg("sliding"), py::arg("sliding_directions"), py::arg("sliding_anchors"), py::arg("loaded"), py::arg("forces"), py::arg("gravity"), py::keep_alive<1, 2>())
       .def(
           "set_displacement",
           [](DistributedStatic& s, py::array_t<double, py::array::c_style | py::array::forcecast> serial) {

@@ -64,7 +64,7 @@ std::string agreed_problem(MPI_Comm comm, const Mesh* serial) {
   return problem;
 }
 
-// The signed volume (area) of a simplex, to restore snede's positive orientation.
+// The signed volume (area) of a volume mesh's simplex, to restore snede's positive orientation.
 double orientation(const std::vector<double>& points, int space_dim, const std::vector<std::int64_t>& cell) {
   const auto at = [&](std::size_t k, int d) { return points[static_cast<std::size_t>(cell[k]) * space_dim + d]; };
   if (cell.size() == 3) {
@@ -91,8 +91,6 @@ DistributedMesh distribute_mesh(MPI_Comm comm, const Mesh* serial) {
   MPI_Bcast(shape, 4, MPI_INT64_T, 0, comm);
   const int cell_dim = static_cast<int>(shape[0]), space_dim = static_cast<int>(shape[1]);
   const PetscInt corners = cell_dim + 1;
-  if (cell_dim != space_dim)
-    throw std::invalid_argument("distribute_mesh: distributes 2D triangle and 3D tetrahedral meshes, not surfaces");
 
   std::vector<PetscInt> cells;
   std::vector<PetscReal> coordinates;
@@ -170,7 +168,9 @@ DistributedMesh distribute_mesh(MPI_Comm comm, const Mesh* serial) {
     SNEDE_PETSC(DMPlexGetCone(part, c, &cone));
     std::vector<std::int64_t> cell(cone, cone + size);
     for (auto& v : cell) v -= v_start;
-    if (orientation(points, space_dim, cell) < 0) std::swap(cell[0], cell[1]);  // DMPlex may reorient
+    // DMPlex may reorient. A membrane's triangle (in 3D) has no signed area; its cone keeps the
+    // serial corners' order, and its energy does not depend on the order.
+    if (cell_dim == space_dim && orientation(points, space_dim, cell) < 0) std::swap(cell[0], cell[1]);
     local_cells.insert(local_cells.end(), cell.begin(), cell.end());
   }
 

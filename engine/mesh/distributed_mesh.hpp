@@ -28,9 +28,11 @@ struct DistributedMesh {
   std::int64_t n_global_cells = 0;
 };
 
-// Collective on `comm`. Rank 0 passes the serial mesh (every vertex used by a cell); the other
-// ranks pass nullptr. Throws the same std::invalid_argument on every rank when rank 0's mesh is
-// missing or has unused vertices (the decision is broadcast, so no rank waits for another).
+// Collective on `comm`. Rank 0 passes the serial mesh, every vertex used by a cell: triangles
+// in 2D, tetrahedra in 3D, or a membrane's surface (triangles in 3D: cell_dim 2, space_dim 3,
+// which DMPlex distributes alike); the other ranks pass nullptr. Throws the same
+// std::invalid_argument on every rank when rank 0's mesh is missing or has unused vertices (the
+// decision is broadcast, so no rank waits for another).
 DistributedMesh distribute_mesh(MPI_Comm comm, const Mesh* serial);
 
 }  // namespace snede

@@ -1,14 +1,33 @@
 #include "solve/distributed_assembly.hpp"
 
 #include "core/error.hpp"
+#include "solve/projected_stiffness.hpp"
 
 namespace snede {
+namespace {
+
+// P's blocks when whole dofs are fixed: diagonal, 0 on a fixed dof and 1 on a free one.
+std::vector<double> diagonal_projection(std::span<const std::uint8_t> fixed_local, int dim) {
+  std::vector<double> blocks(fixed_local.size() * static_cast<std::size_t>(dim));
+  for (std::size_t dof = 0; dof < fixed_local.size(); ++dof)
+    blocks[dof * dim + dof % dim] = fixed_local[dof] ? 0.0 : 1.0;
+  return blocks;
+}
+
+}  // namespace
 
 DistributedAssembledTangent::DistributedAssembledTangent(const DistributedMesh& part, const ElasticBody& body,
                                                          std::span<const PetscInt> local_rows,
                                                          std::span<const std::uint8_t> fixed_local, PetscInt n_owned_dofs)
+    : DistributedAssembledTangent(part, body, local_rows, diagonal_projection(fixed_local, part.local->dim()),
+                                  n_owned_dofs) {}
+
+DistributedAssembledTangent::DistributedAssembledTangent(const DistributedMesh& part, const ElasticBody& body,
+                                                         std::span<const PetscInt> local_rows,
+                                                         std::span<const double> projection, PetscInt n_owned_dofs)
     : part_(part), body_(body), local_rows_(local_rows.begin(), local_rows.end()),
-      fixed_local_(fixed_local.begin(), fixed_local.end()) {
+      projection_(projection.begin(), projection.end()),
+      complement_(complement_blocks(projection_, part.local->dim())) {
   const int dim = part.local->dim();
   const std::vector<double> at_rest(local_rows_.size(), 0.0);
   MatHandle sparsity;
@@ -44,25 +63,24 @@ DistributedAssembledTangent::DistributedAssembledTangent(const DistributedMesh& 
 
 void DistributedAssembledTangent::add_elements(Mat target, std::span<const double> u) {
   const auto dim = static_cast<std::size_t>(part_.local->dim());
+  const bool membrane = part_.local->is_surface();
+  MembranePositivePart positive_part;
   std::vector<PetscInt> rows;
-  std::vector<double> masked;
-  body_.for_each_element_stiffness(u, [&](ElementId, std::span<const VertexId> vertices, std::span<const double> K) {
+  for_each_projected_element_matrix(body_, u, projection_, [&](ElementId, std::span<const VertexId> vertices,
+                                                               std::span<const double> element_matrix) {
+    const std::span<const double> K = membrane ? positive_part(element_matrix) : element_matrix;
     const std::size_t n = vertices.size() * dim;
     rows.resize(n);
-    masked.assign(K.begin(), K.end());
-    for (std::size_t i = 0; i < n; ++i) {
-      const std::size_t dof = static_cast<std::size_t>(vertices[i / dim]) * dim + i % dim;
-      rows[i] = local_rows_[dof];
-      if (!fixed_local_[dof]) continue;
-      for (std::size_t j = 0; j < n; ++j) masked[i * n + j] = masked[j * n + i] = 0.0;
-    }
-    SNEDE_PETSC(MatSetValues(target, static_cast<PetscInt>(n), rows.data(), static_cast<PetscInt>(n), rows.data(),
-                             masked.data(), ADD_VALUES));
+    for (std::size_t i = 0; i < n; ++i) rows[i] = local_rows_[static_cast<std::size_t>(vertices[i / dim]) * dim + i % dim];
+    SNEDE_PETSC(MatSetValues(target, static_cast<PetscInt>(n), rows.data(), static_cast<PetscInt>(n), rows.data(), K.data(),
+                             ADD_VALUES));
   });
-  // Every owned row gets its diagonal entry (1 on a fixed row, 0 added elsewhere).
-  for (std::size_t dof = 0; dof < local_rows_.size(); ++dof)
-    if (part_.owned[dof / dim])
-      SNEDE_PETSC(MatSetValue(target, local_rows_[dof], local_rows_[dof], fixed_local_[dof] ? 1.0 : 0.0, ADD_VALUES));
+  // + (I − P) on every owned vertex's diagonal block (zero for a free one), so every owned row
+  // has its diagonal entry and a constrained direction a unit diagonal, as in the shell.
+  for (std::size_t v = 0; v < part_.owned.size(); ++v)
+    if (part_.owned[v])
+      SNEDE_PETSC(MatSetValues(target, static_cast<PetscInt>(dim), &local_rows_[v * dim], static_cast<PetscInt>(dim),
+                               &local_rows_[v * dim], &complement_[v * dim * dim], ADD_VALUES));
   SNEDE_PETSC(MatAssemblyBegin(target, MAT_FINAL_ASSEMBLY));
   SNEDE_PETSC(MatAssemblyEnd(target, MAT_FINAL_ASSEMBLY));
 }

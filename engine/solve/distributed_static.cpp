@@ -1,8 +1,10 @@
 #include "solve/distributed_static.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <numeric>
 #include <span>
 #include <stdexcept>
 #include <string>
@@ -14,15 +16,19 @@
 #include "core/petsc_util.hpp"
 #include "mesh/element_quality.hpp"
 #include "fem/stable_time_step.hpp"
+#include "solve/projected_stiffness.hpp"
 #include "solve/stopping.hpp"
 
 namespace snede {
 namespace {
 
 void check_conditions(const DistributedConditions& c, int dim, std::int64_t n_vertices) {
-  const auto check = [&](const std::vector<std::int64_t>& ids, std::size_t values, const char* what) {
+  // `what` names the ids, `values_name` their values (the ids' name when empty).
+  const auto check = [&](const std::vector<std::int64_t>& ids, std::size_t values, const char* what,
+                         std::string values_name = {}) {
+    if (values_name.empty()) values_name = what;
     if (values != ids.size() * static_cast<std::size_t>(dim))
-      throw std::invalid_argument(std::string("DistributedStatic: ") + what + " needs " + std::to_string(dim) +
+      throw std::invalid_argument("DistributedStatic: " + values_name + " needs " + std::to_string(dim) +
                                   " values per vertex: " + std::to_string(ids.size()) + " vertices, " +
                                   std::to_string(values) + " values");
     for (std::int64_t v : ids)
@@ -31,7 +37,44 @@ void check_conditions(const DistributedConditions& c, int dim, std::int64_t n_ve
                                     " is not a vertex of the serial mesh (0.." + std::to_string(n_vertices - 1) + ")");
   };
   check(c.fixed, c.fixed_values.size(), "fixed");
+  check(c.sliding, c.sliding_directions.size(), "sliding", "sliding_directions");
+  check(c.sliding, c.sliding_anchors.size(), "sliding", "sliding_anchors");
   check(c.loaded, c.forces.size(), "loaded");
+  // What Constraints::fix and ::slide would refuse, refused here on every rank alike (a rank
+  // holds only its vertices' constraints).
+  const auto vertex_values = [&](const std::vector<double>& values, std::size_t k) {
+    return std::span<const double>(values).subspan(k * dim, dim);
+  };
+  const auto finite = [](std::span<const double> x) {
+    return std::all_of(x.begin(), x.end(), [](double v) { return std::isfinite(v); });
+  };
+  std::unordered_map<std::int64_t, std::size_t> fixed_entry;
+  for (std::size_t k = 0; k < c.fixed.size(); ++k) {
+    const std::string vertex = " vertex " + std::to_string(c.fixed[k]);
+    if (!finite(vertex_values(c.fixed_values, k)))
+      throw std::invalid_argument("DistributedStatic: fixed_values of" + vertex + " are not finite");
+    const auto [first, new_vertex] = fixed_entry.try_emplace(c.fixed[k], k);
+    const auto earlier = vertex_values(c.fixed_values, first->second), these = vertex_values(c.fixed_values, k);
+    if (!new_vertex && !std::equal(earlier.begin(), earlier.end(), these.begin()))
+      throw std::invalid_argument("DistributedStatic: fixed" + vertex + " is listed twice (entries " +
+                                  std::to_string(first->second) + " and " + std::to_string(k) + ") with different values");
+  }
+  std::unordered_map<std::int64_t, std::size_t> sliding_entry;
+  for (std::size_t k = 0; k < c.sliding.size(); ++k) {
+    const std::string vertex = " vertex " + std::to_string(c.sliding[k]);
+    const auto direction = vertex_values(c.sliding_directions, k);
+    const double norm = std::sqrt(std::inner_product(direction.begin(), direction.end(), direction.begin(), 0.0));
+    if (!(norm > 0 && std::isfinite(norm)))
+      throw std::invalid_argument("DistributedStatic: sliding" + vertex + "'s direction must be non-zero and finite");
+    if (!finite(vertex_values(c.sliding_anchors, k)))
+      throw std::invalid_argument("DistributedStatic: sliding_anchors of" + vertex + " are not finite");
+    if (fixed_entry.count(c.sliding[k]))
+      throw std::invalid_argument("DistributedStatic: vertex " + std::to_string(c.sliding[k]) +
+                                  " is both fixed and sliding; a vertex has one constraint");
+    if (const auto [first, new_vertex] = sliding_entry.try_emplace(c.sliding[k], k); !new_vertex)
+      throw std::invalid_argument("DistributedStatic: sliding" + vertex + " is listed twice (entries " +
+                                  std::to_string(first->second) + " and " + std::to_string(k) + ")");
+  }
   if (!c.gravity.empty() && c.gravity.size() != static_cast<std::size_t>(dim))
     throw std::invalid_argument("DistributedStatic: gravity needs " + std::to_string(dim) + " components, got " +
                                 std::to_string(c.gravity.size()));
@@ -51,6 +94,9 @@ bool require_same_inputs_everywhere(MPI_Comm comm, const Material& material, dou
       .input("thickness", thickness)
       .input("fixed", c.fixed)
       .input("fixed_values", c.fixed_values)
+      .input("sliding", c.sliding)
+      .input("sliding_directions", c.sliding_directions)
+      .input("sliding_anchors", c.sliding_anchors)
       .input("forces", InputDigest().add(c.loaded).add(c.forces))
       .input("gravity", c.gravity)
       .require(comm);
@@ -80,7 +126,9 @@ DistributedStatic::DistributedStatic(DistributedMesh& part, Material material, d
     : part_(part),
       inputs_agreed_(require_same_inputs_everywhere(part.comm, material, density, thickness, conditions)),
       body_(*part.local, material, density, thickness),
-      dim_(part.local->dim()) {
+      dim_(part.local->dim()),
+      constraints_(dim_),
+      owned_constraints_(dim_) {
   check_conditions(conditions, dim_, part.n_global_vertices);
   const MPI_Comm comm = part.comm;
   const std::size_t n_local = static_cast<std::size_t>(part.local->n_points());
@@ -88,14 +136,27 @@ DistributedStatic::DistributedStatic(DistributedMesh& part, Material material, d
   std::unordered_map<std::int64_t, std::size_t> local_of;
   for (std::size_t v = 0; v < n_local; ++v) local_of[part.global_vertex[v]] = v;
 
-  fixed_local_.assign(n_dofs, 0);
-  fixed_value_local_.assign(n_dofs, 0.0);
+  // The serial Constraints of the rank's vertices, set as Body.fix and Body.slide set them.
+  constraints_.resize(static_cast<VertexId>(n_local));
+  std::vector<VertexId> fixed;
+  std::vector<double> fixed_values;
   for (std::size_t k = 0; k < conditions.fixed.size(); ++k)
-    if (const auto found = local_of.find(conditions.fixed[k]); found != local_of.end())
-      for (int d = 0; d < dim_; ++d) {
-        fixed_local_[found->second * dim_ + d] = 1;
-        fixed_value_local_[found->second * dim_ + d] = conditions.fixed_values[k * dim_ + d];
-      }
+    if (const auto found = local_of.find(conditions.fixed[k]); found != local_of.end()) {
+      fixed.push_back(static_cast<VertexId>(found->second));
+      fixed_values.insert(fixed_values.end(), conditions.fixed_values.begin() + k * dim_,
+                          conditions.fixed_values.begin() + (k + 1) * dim_);
+    }
+  constraints_.fix(fixed, fixed_values);
+  std::vector<double> sliding_anchors(n_dofs, 0.0);
+  for (std::size_t k = 0; k < conditions.sliding.size(); ++k)
+    if (const auto found = local_of.find(conditions.sliding[k]); found != local_of.end()) {
+      const auto v = static_cast<VertexId>(found->second);
+      std::copy_n(conditions.sliding_anchors.begin() + k * dim_, dim_, sliding_anchors.begin() + v * dim_);
+      constraints_.slide(std::span(&v, 1), std::span(conditions.sliding_directions).subspan(k * dim_, dim_),
+                         sliding_anchors);
+    }
+  projection_ = projection_blocks(constraints_, constraints_.n_points());
+  complement_ = complement_blocks(projection_, dim_);
   std::vector<double> load_local(n_dofs, 0.0);
   for (std::size_t k = 0; k < conditions.loaded.size(); ++k)
     if (const auto found = local_of.find(conditions.loaded[k]); found != local_of.end())
@@ -112,8 +173,10 @@ DistributedStatic::DistributedStatic(DistributedMesh& part, Material material, d
   SNEDE_PETSC(VecDuplicate(u_, work_.out()));
   PetscInt start = 0, end = 0;
   SNEDE_PETSC(VecGetOwnershipRange(u_, &start, &end));
+  owned_constraints_.resize(static_cast<VertexId>(n_owned));
   for (std::size_t v = 0; v < n_local; ++v)
-    if (part.owned[v])
+    if (part.owned[v]) {
+      owned_constraints_.assign(static_cast<VertexId>((rows[v * dim_] - start) / dim_), constraints_[static_cast<VertexId>(v)]);
       for (int d = 0; d < dim_; ++d) {
         const PetscInt row = rows[v * dim_ + d];
         if (row < start || row >= end)
@@ -122,6 +185,7 @@ DistributedStatic::DistributedStatic(DistributedMesh& part, Material material, d
         owned_local_dof_.push_back(static_cast<PetscInt>(v * dim_ + d));
         load_owned_.push_back(load_local[v * dim_ + d]);
       }
+    }
 
   SNEDE_PETSC(VecCreateSeq(PETSC_COMM_SELF, static_cast<PetscInt>(n_dofs), &local_vec_));
   IS from = nullptr;
@@ -162,16 +226,15 @@ void DistributedStatic::set_displacement(std::span<const double> serial) {
     if (!std::isfinite(x)) throw std::invalid_argument("DistributedStatic.set_displacement: values must be finite");
   PetscInt start = 0, end = 0;
   SNEDE_PETSC(VecGetOwnershipRange(u_, &start, &end));
-  PetscScalar* u = nullptr;
-  SNEDE_PETSC(VecGetArray(u_, &u));
-  for (std::size_t k = 0; k < owned_rows_.size(); ++k) {
-    const auto dof = static_cast<std::size_t>(owned_local_dof_[k]);
-    const auto vertex = static_cast<std::size_t>(part_.global_vertex[dof / dim_]);
-    u[owned_rows_[k] - start] = fixed_local_[dof] ? fixed_value_local_[dof]
-                                : serial.empty()  ? 0.0
-                                                  : serial[vertex * dim_ + dof % dim_];
+  {
+    const WriteView u(u_);
+    for (std::size_t k = 0; k < owned_rows_.size(); ++k) {
+      const auto dof = static_cast<std::size_t>(owned_local_dof_[k]);
+      const auto vertex = static_cast<std::size_t>(part_.global_vertex[dof / dim_]);
+      u.span()[owned_rows_[k] - start] = serial.empty() ? 0.0 : serial[vertex * dim_ + dof % dim_];
+    }
   }
-  SNEDE_PETSC(VecRestoreArray(u_, &u));
+  enforce_constraints(u_);
 }
 
 DistributedStatic::~DistributedStatic() {
@@ -208,31 +271,28 @@ ResidualCheck DistributedStatic::residual(Vec u, Vec F) {
   add_to_global(f, F);
   PetscInt start = 0, end = 0;
   SNEDE_PETSC(VecGetOwnershipRange(F, &start, &end));
-  PetscScalar* r = nullptr;
-  const PetscScalar* x = nullptr;
-  SNEDE_PETSC(VecGetArray(F, &r));
-  SNEDE_PETSC(VecGetArrayRead(u, &x));
+  const WriteView F_view(F);
+  const ReadView u_view(u);
+  const std::span<double> r = F_view.span();
+  for (std::size_t k = 0; k < owned_rows_.size(); ++k) r[owned_rows_[k] - start] -= load_owned_[k];
+  // The reactions (I − P)(−f_int − f_ext), then r = P(−f_int − f_ext) + (I − P)(u − ū), as the
+  // serial Model has it.
+  std::vector<double> reaction(r.begin(), r.end());
+  owned_constraints_.project_complement(reaction);
+  owned_constraints_.project(r);
+  std::vector<double> held(u_view.span().begin(), u_view.span().end());
+  owned_constraints_.enforce(held);
+  for (std::size_t i = 0; i < r.size(); ++i) r[i] += u_view.span()[i] - held[i];
   const bool inverted = !report.inverted.empty() && forbids_inversion(body_.material());
   // Ranks with an inverted element, ranks with a non-finite one, ‖reactions‖².
-  double sums[3] = {inverted ? 1.0 : 0.0, report.domain_errors.empty() ? 0.0 : 1.0, 0.0};
-  for (std::size_t k = 0; k < owned_rows_.size(); ++k) {
-    const PetscInt i = owned_rows_[k] - start;
-    const auto dof = static_cast<std::size_t>(owned_local_dof_[k]);
-    r[i] -= load_owned_[k];
-    if (fixed_local_[dof]) {
-      sums[2] += r[i] * r[i];
-      r[i] = x[i] - fixed_value_local_[dof];
-    }
-  }
+  double sums[3] = {inverted ? 1.0 : 0.0, report.domain_errors.empty() ? 0.0 : 1.0,
+                    std::inner_product(reaction.begin(), reaction.end(), reaction.begin(), 0.0)};
   MPI_Allreduce(MPI_IN_PLACE, sums, 3, MPI_DOUBLE, MPI_SUM, part_.comm);
   last_reaction_norm_ = std::sqrt(sums[2]);
   last_failure_ = sums[1] > 0 ? "DIVERGED_NONFINITE_STATE" : sums[0] > 0 ? "DIVERGED_INVERTED_ELEMENTS" : "";
   const ResidualCheck check{sums[1] == 0, sums[0] > 0};
   // A failure on any rank makes the residual NaN everywhere: no solver can call it converged.
-  if (!check.admissible())
-    for (std::size_t k = 0; k < owned_rows_.size(); ++k) r[owned_rows_[k] - start] = std::numeric_limits<double>::quiet_NaN();
-  SNEDE_PETSC(VecRestoreArrayRead(u, &x));
-  SNEDE_PETSC(VecRestoreArray(F, &r));
+  if (!check.admissible()) std::fill(r.begin(), r.end(), std::numeric_limits<double>::quiet_NaN());
   return check;
 }
 
@@ -245,22 +305,14 @@ std::string DistributedStatic::inadmissible(Vec u) {
   return last_failure_;
 }
 
-void DistributedStatic::enforce_constraints(Vec u) {
-  PetscInt start = 0, end = 0;
-  SNEDE_PETSC(VecGetOwnershipRange(u, &start, &end));
-  PetscScalar* x = nullptr;
-  SNEDE_PETSC(VecGetArray(u, &x));
-  for (std::size_t k = 0; k < owned_rows_.size(); ++k)
-    if (const auto dof = static_cast<std::size_t>(owned_local_dof_[k]); fixed_local_[dof])
-      x[owned_rows_[k] - start] = fixed_value_local_[dof];
-  SNEDE_PETSC(VecRestoreArray(u, &x));
-}
+void DistributedStatic::enforce_constraints(Vec u) { owned_constraints_.enforce(WriteView(u).span()); }
+
+void DistributedStatic::project_onto_allowed_motions(Vec v) { owned_constraints_.project(WriteView(v).span()); }
 
 bool DistributedStatic::every_dof_prescribed() const {
-  std::int64_t fixed = 0;
-  for (std::size_t k = 0; k < owned_rows_.size(); ++k) fixed += fixed_local_[static_cast<std::size_t>(owned_local_dof_[k])];
+  auto constrained = static_cast<std::int64_t>(owned_constraints_.n_constrained_components());
   std::int64_t total = 0;
-  MPI_Allreduce(&fixed, &total, 1, MPI_INT64_T, MPI_SUM, part_.comm);
+  MPI_Allreduce(&constrained, &total, 1, MPI_INT64_T, MPI_SUM, part_.comm);
   return total == n_global_dofs();
 }
 
@@ -318,7 +370,7 @@ class AssembledDistributedTangent final : public AssembledProblemTangent {
  public:
   explicit AssembledDistributedTangent(DistributedStatic& problem)
       : problem_(problem),
-        tangent_(problem.part_, problem.body_, problem.local_rows_, problem.fixed_local_,
+        tangent_(problem.part_, problem.body_, problem.local_rows_, std::span<const double>(problem.projection_),
                  static_cast<PetscInt>(problem.owned_rows_.size())),
         u_local_(problem.u_local_.size()) {}
   Mat mat() const override { return tangent_.mat(); }
@@ -342,49 +394,37 @@ std::unique_ptr<AssembledProblemTangent> DistributedStatic::make_assembled_tange
 void DistributedStatic::tangent_mult(Vec d, Vec out) {
   // (P K P + I − P) d, K at the linearisation point.
   to_local(d, d_local_);
-  for (std::size_t i = 0; i < d_local_.size(); ++i)
-    if (fixed_local_[i]) d_local_[i] = 0.0;
+  constraints_.project(d_local_);
   std::fill(out_local_.begin(), out_local_.end(), 0.0);
   EvaluationReport report;
   body_.tangent_apply(u_linearization_, d_local_, out_local_, report);
-  for (std::size_t i = 0; i < out_local_.size(); ++i)
-    if (fixed_local_[i]) out_local_[i] = 0.0;
   SNEDE_PETSC(VecZeroEntries(out));
   add_to_global(out_local_, out);
-  set_fixed_rows(out, d, 0.0);
+  {
+    // P is vertex by vertex: projecting the owners' sums is projecting every rank's share.
+    const WriteView y(out);
+    owned_constraints_.project(y.span());
+    owned_constraints_.add_complement(ReadView(d).span(), y.span());
+  }
   if (operator_scale_ != 1) SNEDE_PETSC(VecScale(out, operator_scale_));
 }
 
-void DistributedStatic::set_fixed_rows(Vec out, Vec source, double value) {
-  PetscInt start = 0, end = 0;
-  SNEDE_PETSC(VecGetOwnershipRange(out, &start, &end));
-  PetscScalar* y = nullptr;
-  const PetscScalar* x = nullptr;
-  SNEDE_PETSC(VecGetArray(out, &y));
-  if (source) SNEDE_PETSC(VecGetArrayRead(source, &x));
-  for (std::size_t k = 0; k < owned_rows_.size(); ++k)
-    if (const PetscInt i = owned_rows_[k] - start; fixed_local_[static_cast<std::size_t>(owned_local_dof_[k])])
-      y[i] = x ? x[i] : value;
-  if (source) SNEDE_PETSC(VecRestoreArrayRead(source, &x));
-  SNEDE_PETSC(VecRestoreArray(out, &y));
-}
-
 void DistributedStatic::tangent_diagonal(Vec diagonal) {
-  // diag(P K P + I − P): the element stiffnesses' diagonals on this rank's cells, the ghosts'
-  // shares added into their owners, 1 on fixed dofs (for PCJACOBI).
+  // diag(P K P + I − P): the projected element stiffnesses' diagonals on this rank's cells and
+  // the owned vertices' diag(I − P) (1 on a fixed dof, for PCJACOBI), the ghosts' shares added
+  // into their owners.
   std::fill(out_local_.begin(), out_local_.end(), 0.0);
   const auto d = static_cast<std::size_t>(dim_);
-  body_.for_each_element_stiffness(u_linearization_, [&](ElementId, std::span<const VertexId> vertices,
-                                                           std::span<const double> K) {
+  for_each_projected_element_matrix(body_, u_linearization_, projection_, [&](ElementId, std::span<const VertexId> vertices,
+                                                                              std::span<const double> K) {
     const std::size_t n = vertices.size() * d;
     for (std::size_t row = 0; row < n; ++row)
       out_local_[static_cast<std::size_t>(vertices[row / d]) * d + row % d] += K[row * n + row];
   });
-  for (std::size_t i = 0; i < out_local_.size(); ++i)
-    if (fixed_local_[i]) out_local_[i] = 0.0;
+  for (std::size_t dof = 0; dof < out_local_.size(); ++dof)
+    if (part_.owned[dof / d]) out_local_[dof] += complement_[dof * d + dof % d];
   SNEDE_PETSC(VecZeroEntries(diagonal));
   add_to_global(out_local_, diagonal);
-  set_fixed_rows(diagonal, nullptr, 1.0);
   if (operator_scale_ != 1) SNEDE_PETSC(VecScale(diagonal, operator_scale_));
 }
 

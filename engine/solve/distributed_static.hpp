@@ -10,8 +10,11 @@
 // DynamicRelaxation drive it on any number of ranks, as they drive the serial Model.
 //
 // Constraints and loads are given by the serial mesh's vertex ids, the same on every rank:
-// fixed vertices (all components), their displacements, nodal forces, and gravity. A fixed dof's
-// residual is u − ū and its tangent row the identity, as in the serial Model.
+// fixed vertices (all components) and their displacements, sliding vertices (each along a line
+// through a given displacement), nodal forces, and gravity. Each rank holds the constraints of
+// its vertices as the serial Model does (constraints.hpp, §3.1, §6.6): P the projection onto
+// the allowed motions, the residual P(−f_int − f_ext) + (I − P)(u − ū), the tangent
+// P K P + I − P.
 #pragma once
 
 #include <cstdint>
@@ -23,6 +26,7 @@
 #include "core/petsc_handle.hpp"
 #include "fem/elastic_body.hpp"
 #include "mesh/distributed_mesh.hpp"
+#include "solve/constraints.hpp"
 #include "solve/distributed_assembly.hpp"
 #include "solve/problem.hpp"
 
@@ -31,6 +35,9 @@ namespace snede {
 struct DistributedConditions {
   std::vector<std::int64_t> fixed;     // serial vertex ids
   std::vector<double> fixed_values;    // dim per fixed vertex
+  std::vector<std::int64_t> sliding;   // serial vertex ids, none of them fixed
+  std::vector<double> sliding_directions;  // dim per sliding vertex: its line's direction (normalised here)
+  std::vector<double> sliding_anchors;     // dim per sliding vertex: a displacement on its line (Body.slide: where it was)
   std::vector<std::int64_t> loaded;    // serial vertex ids
   std::vector<double> forces;          // dim per loaded vertex
   std::vector<double> gravity;         // dim components (m/s²), or empty for none
@@ -39,8 +46,9 @@ struct DistributedConditions {
 class DistributedStatic final : public Problem {
  public:
   // Collective. Throws std::invalid_argument (the same on every rank) for conditions of the
-  // wrong size, ids outside the serial mesh, or arguments that differ between the ranks
-  // (naming them, core/rank_agreement.hpp). The density sets gravity's load (ρ|τ|g shared
+  // wrong size, ids outside the serial mesh, a vertex fixed at two displacements, sliding twice
+  // or both fixed and sliding, a zero or non-finite direction or displacement, or arguments that
+  // differ between the ranks (naming them, core/rank_agreement.hpp). The density sets gravity's load (ρ|τ|g shared
   // by each cell's corners, as serially) and the lumped masses of dynamic relaxation.
   DistributedStatic(DistributedMesh& part, Material material, double density, double thickness,
                     const DistributedConditions& conditions);
@@ -49,8 +57,9 @@ class DistributedStatic final : public Problem {
   DistributedStatic& operator=(const DistributedStatic&) = delete;
 
   // Collective: the state from a displacement in the serial mesh's vertex order
-  // (n_global_vertices × dim, the same on every rank), a solve's starting point; the fixed
-  // vertices keep their prescribed displacements. Empty: zero.
+  // (n_global_vertices × dim, the same on every rank), a solve's starting point, made to meet
+  // the constraints (Constraints::enforce: fixed vertices at their prescribed displacements,
+  // sliding ones moved onto their lines). Empty: zero.
   void set_displacement(std::span<const double> serial_displacement);
   // Π(u) = Π_int(u) − f_extᵀu over the whole body (collective), at the state or at u.
   double energy() { return energy(u_); }
@@ -62,7 +71,7 @@ class DistributedStatic final : public Problem {
   // F = P(−f_int(u) − f_ext) + (I − P)(u − ū). Not admissible when an element on some rank is
   // inverted (for a material that forbids it) or not finite; F is then NaN on every rank.
   ResidualCheck residual(Vec u, Vec F) override;
-  // ‖reactions‖ (the residual −f_int − f_ext on the fixed dofs) from the latest residual().
+  // ‖reactions‖ ((I − P)(−f_int − f_ext), the constrained directions') from the latest residual().
   double last_reaction_norm() const override { return last_reaction_norm_; }
   std::string inadmissible(Vec u) override;
   // Why the latest residual() failed ("DIVERGED_INVERTED_ELEMENTS", "DIVERGED_NONFINITE_STATE"),
@@ -76,9 +85,9 @@ class DistributedStatic final : public Problem {
   // (2.61) on the whole mesh: the smallest over the ranks.
   double cfl_time_step() override;
   double flops_per_residual() const override;
-  // The fixed owned rows of `v` set to zero (a motion the constraints allow).
-  void project_onto_allowed_motions(Vec v) override { set_fixed_rows(v, nullptr, 0.0); }
-  // The fixed owned rows of `u` set to their prescribed displacements.
+  // v ← P v (a motion the constraints allow).
+  void project_onto_allowed_motions(Vec v) override;
+  // u ← P u + (I − P) ū: the nearest displacement that meets the constraints.
   void enforce_constraints(Vec u) override;
   bool every_dof_prescribed() const override;
   Mat tangent() const override { return tangent_; }
@@ -90,10 +99,11 @@ class DistributedStatic final : public Problem {
   std::int64_t n_global_cells() const override { return part_.n_global_cells; }
   // The constraints are fixed when the problem is made.
   std::uint64_t projection_fingerprint() const override { return 0; }
-  // The parts of the rank's mesh: its cells, vertices, which it owns and their rows; per local
-  // dof whether it is fixed (for multigrid levels made on each rank's vertices).
+  // The parts of the rank's mesh: its cells, vertices, which it owns and their rows; the
+  // constraints of its local vertices, owned and ghost (for multigrid levels made on each
+  // rank's vertices).
   const DistributedMesh& part() const { return part_; }
-  std::span<const std::uint8_t> fixed_local_dofs() const { return fixed_local_; }
+  const Constraints& local_constraints() const { return constraints_; }
   void tangent_mult(Vec d, Vec out);
   void tangent_diagonal(Vec diagonal);
 
@@ -107,15 +117,14 @@ class DistributedStatic final : public Problem {
   friend class AssembledDistributedTangent;
   void to_local(Vec global, std::vector<double>& local);
   void add_to_global(const std::vector<double>& local, Vec global);
-  // The fixed owned rows of `out` set to `source`'s entries, or to `value` without a source.
-  void set_fixed_rows(Vec out, Vec source, double value);
 
   DistributedMesh& part_;
   bool inputs_agreed_;  // checked across the ranks before anything below can throw on one alone
   ElasticBody body_;
   int dim_;
-  std::vector<std::uint8_t> fixed_local_;   // per local dof
-  std::vector<double> fixed_value_local_;   // per local dof
+  Constraints constraints_;        // per local vertex (owned and ghost), for the element kernels
+  Constraints owned_constraints_;  // per owned vertex in row order, for the rank's entries of a Vec
+  std::vector<double> projection_, complement_;  // P's and I − P's block of each local vertex
   std::vector<double> load_owned_;          // per owned dof (forces counted once, at the owner)
   std::vector<PetscInt> local_rows_;        // global row of each local dof (owned and ghost)
   std::vector<PetscInt> owned_rows_;        // global row of each owned dof, in local order

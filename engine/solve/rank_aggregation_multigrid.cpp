@@ -6,7 +6,7 @@ namespace snede {
 
 RankAggregationMultigrid::RankAggregationMultigrid(DistributedStatic& problem, int max_levels, double aggregate_width)
     : n_cells_(problem.n_global_cells()),
-      levels_(rank_aggregation_levels(problem.part(), problem.fixed_local_dofs(), aggregate_width, max_levels)) {}
+      levels_(rank_aggregation_levels(problem.part(), problem.local_constraints(), aggregate_width, max_levels)) {}
 
 std::vector<std::size_t> RankAggregationMultigrid::level_sizes() const {
   std::vector<std::size_t> sizes = level_unknowns();

@@ -1,7 +1,5 @@
 #include "solve/tangent_assembly.hpp"
 
-#include <Eigen/Eigenvalues>
-
 #include <algorithm>
 #include <array>
 #include <memory>
@@ -14,6 +12,7 @@
 #include "core/error.hpp"
 #include "core/petsc_util.hpp"
 #include "mesh/traversal.hpp"
+#include "solve/projected_stiffness.hpp"
 
 namespace snede {
 namespace {
@@ -22,95 +21,9 @@ namespace {
 // dim displacement components.
 int corners_per_cell(const Model& model) { return model.body().mesh().cell_dim() + 1; }
 
-// A membrane's element tangent is indefinite wherever the sheet is compressed (it has no
-// bending stiffness to resist wrinkling), and multigrid built from it made CG's directions
-// useless (DIVERGED_LINE_SEARCH at once on a hanging box skin). A preconditioner takes each
-// membrane element matrix's positive part instead (its negative eigenvalues raised to a small
-// floor: projected Newton, Teran et al. 2005); the operator of every solve stays the exact
-// tangent.
-class MembranePositivePart {
- public:
-  static constexpr int n = 9;  // 3 corners × 3 components
-  // Eigenvalues are raised to at least this fraction of the element's largest: a slack element
-  // has none across the sheet, and a singular coarse operator made mg fail on a sheet loaded
-  // across its plane before it was stretched (studies/benchmarks/membrane_preconditioners.py: with 1e-4
-  // it converged at 128 and 512 triangles, with 0 at 512 only). Measured 0, 1e-4, 1e-3, 1e-2,
-  // 1e-1: 1e-4 took the fewest iterations on the taut and the sagging sheets and the
-  // membrane-cut scene (574 Newton iterations against 615 with 0 and 851 with 1e-3).
-  static constexpr double slack_floor = 1e-4;
-  std::span<const double> operator()(std::span<const double> K) {
-    const Eigen::Map<const Eigen::Matrix<double, n, n, Eigen::RowMajor>> matrix(K.data());
-    solver_.compute(matrix);
-    const Eigen::Matrix<double, n, 1> positive =
-        solver_.eigenvalues().cwiseMax(slack_floor * std::max(solver_.eigenvalues().maxCoeff(), 0.0));
-    Eigen::Map<Eigen::Matrix<double, n, n, Eigen::RowMajor>>(part_.data()) =
-        solver_.eigenvectors() * positive.asDiagonal() * solver_.eigenvectors().transpose();
-    return part_;
-  }
-
- private:
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, n, n>> solver_;
-  std::array<double, n * n> part_{};
-};
-
-// Every vertex's block of P (dim × dim, row-major), one after another.
+// Every vertex's block of the model's P (projected_stiffness.hpp).
 std::vector<double> projection_blocks(const Model& model) {
-  const int d = model.dim();
-  const VertexId n = model.body().mesh().n_points();
-  std::vector<double> blocks(static_cast<std::size_t>(n) * d * d);
-  for (VertexId v = 0; v < n; ++v)
-    model.constraints().projection_block(v, std::span<double>(blocks).subspan(static_cast<std::size_t>(v) * d * d, d * d));
-  return blocks;
-}
-
-// Calls visit(e, vertices, K_e) for every element with its stiffness at u projected on both
-// sides, P_a K_ab P_b (P from projection_blocks), rows and columns ordered by the element's oriented vertices, then by
-// component (ElasticBody::element_stiffness's order). Inverted elements of a material that
-// forbids inversion are left out, as the shell leaves them out.
-template <class Visit>
-void for_each_projected_element_matrix(const Model& model, std::span<const double> u, const std::vector<double>& P,
-                                       Visit&& visit) {
-  const int d = model.dim();
-  std::vector<bool> free(model.body().mesh().n_points());
-  for (VertexId v = 0; v < static_cast<VertexId>(free.size()); ++v)
-    free[v] = model.constraints()[v].kind == ConstraintKind::free;
-  std::vector<double> left, projected;
-  model.body().for_each_element_stiffness(u, [&](ElementId e, std::span<const VertexId> vertices,
-                                                 std::span<const double> K) {
-    if (std::all_of(vertices.begin(), vertices.end(), [&](VertexId v) { return free[v]; })) {
-      visit(e, vertices, K);
-      return;
-    }
-    // A P1 element has corners_per_cell vertices, a smoothed formulation's patch any number.
-    const int corners = static_cast<int>(vertices.size()), n = corners * d;
-    left.resize(static_cast<std::size_t>(n) * n);
-    projected.resize(static_cast<std::size_t>(n) * n);
-    // left = diag(P_a) K, then projected = left diag(P_b): block by block, dim × dim each.
-    for (int a = 0; a < corners; ++a)
-      for (int col = 0; col < n; ++col)
-        for (int i = 0; i < d; ++i) {
-          double sum = 0;
-          for (int m = 0; m < d; ++m)
-            sum += P[(static_cast<std::size_t>(vertices[a]) * d + i) * d + m] * K[static_cast<std::size_t>(a * d + m) * n + col];
-          left[static_cast<std::size_t>(a * d + i) * n + col] = sum;
-        }
-    for (int row = 0; row < n; ++row)
-      for (int b = 0; b < corners; ++b)
-        for (int j = 0; j < d; ++j) {
-          double sum = 0;
-          for (int m = 0; m < d; ++m)
-            sum += left[static_cast<std::size_t>(row) * n + b * d + m] * P[(static_cast<std::size_t>(vertices[b]) * d + m) * d + j];
-          projected[static_cast<std::size_t>(row) * n + b * d + j] = sum;
-        }
-    visit(e, vertices, std::span<const double>(projected));
-  });
-}
-
-// The (I − P) blocks from the P blocks of projection_blocks.
-std::vector<double> complement_blocks(const std::vector<double>& P, int d) {
-  std::vector<double> blocks(P.size());
-  for (std::size_t i = 0; i < blocks.size(); ++i) blocks[i] = ((i % (d * d)) % (d + 1) == 0 ? 1.0 : 0.0) - P[i];
-  return blocks;
+  return projection_blocks(model.constraints(), model.body().mesh().n_points());
 }
 
 }  // namespace
@@ -272,8 +185,8 @@ void AssembledTangent::add_entries(const Model& model, Vec u, const CsrView& A) 
         for (int j = 0; j < D; ++j) row[j] += s * K[i * stride + j];
       }
     };
-    for_each_projected_element_matrix(model, x.span(), P, [&](ElementId e, std::span<const VertexId> vertices,
-                                                              std::span<const double> element_matrix) {
+    for_each_projected_element_matrix(model.body(), x.span(), P, [&](ElementId e, std::span<const VertexId> vertices,
+                                                                  std::span<const double> element_matrix) {
       const std::span<const double> K = membrane ? positive_part(element_matrix) : element_matrix;
       const int corners = static_cast<int>(vertices.size());
       const std::size_t n = static_cast<std::size_t>(corners) * D;
@@ -313,8 +226,8 @@ void tangent_diagonal(const Model& model, Vec u, Vec diagonal) {
   std::vector<double> values(model.body().n_dofs(), 0.0);
   {
     ReadView x(u);
-    for_each_projected_element_matrix(model, x.span(), P, [&](ElementId, std::span<const VertexId> vertices,
-                                                              std::span<const double> K) {
+    for_each_projected_element_matrix(model.body(), x.span(), P, [&](ElementId, std::span<const VertexId> vertices,
+                                                                  std::span<const double> K) {
       const int n = static_cast<int>(vertices.size()) * d;
       for (int row = 0; row < n; ++row)
         values[static_cast<std::size_t>(vertices[row / d]) * d + row % d] += K[static_cast<std::size_t>(row) * n + row];

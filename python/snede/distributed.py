@@ -87,10 +87,15 @@ class DistributedStatic:
     """A static solve on a :class:`DistributedMesh` (collective throughout).
 
     ``DistributedStatic(part, material, *, density=1000.0, thickness=None, fixed=(),
-    fixed_values=None, forces=None, gravity=None)``: ``fixed`` are serial vertex ids held at
-    ``fixed_values`` ((len(fixed), dim), default zero); ``forces`` maps serial vertex ids to
+    fixed_values=None, sliding=(), sliding_directions=None, sliding_anchors=None, forces=None,
+    gravity=None)``: ``fixed`` are serial vertex ids held at ``fixed_values`` ((len(fixed), dim),
+    default zero); ``sliding`` are serial vertex ids that move only along the lines
+    ``sliding_anchors + s·sliding_directions`` (both (len(sliding), dim); the directions non-zero,
+    the anchors — displacements on the lines, what ``Body.slide`` takes from where the vertices
+    are — default zero), as ``Body.slide`` constrains them; ``forces`` maps serial vertex ids to
     nodal force vectors; ``gravity`` (m/s², dim components) loads the element masses as
-    ``Body.add_gravity`` does. Every rank passes the same arguments (else every rank raises
+    ``Body.add_gravity`` does. ``thickness`` is for triangles: plane-stress sheets in 2D and
+    membranes (a surface mesh, triangles in 3D). Every rank passes the same arguments (else every rank raises
     ValueError naming those that differ). The density also sets the masses of
     :class:`DistributedRelaxation`.
 
@@ -100,7 +105,8 @@ class DistributedStatic:
     (prefix ``dstatic_``)."""
 
     def __init__(self, part: DistributedMesh, material, *, density: float = 1000.0, thickness=None, fixed=(),
-                 fixed_values=None, forces=None, gravity=None):
+                 fixed_values=None, sliding=(), sliding_directions=None, sliding_anchors=None, forces=None,
+                 gravity=None):
         self.part = part
 
         def conditions():
@@ -108,9 +114,12 @@ class DistributedStatic:
                 raise TypeError(f"part must be a DistributedMesh (from snede.distribute), got {type(part).__name__}")
             dim = part.local.dim
             ids = np.asarray(fixed, dtype=np.int64).ravel()
-            values = np.zeros((len(ids), dim)) if fixed_values is None else np.asarray(fixed_values, dtype=np.float64)
-            if values.shape != (len(ids), dim):
-                raise ValueError(f"fixed_values must be ({len(ids)}, {dim}), got shape {values.shape}")
+            values = _per_vertex(fixed_values, len(ids), dim, "fixed_values")
+            sliding_ids = np.asarray(sliding, dtype=np.int64).ravel()
+            if sliding_directions is None and len(sliding_ids):
+                raise ValueError("sliding vertices need sliding_directions, (len(sliding), dim)")
+            directions = _per_vertex(sliding_directions, len(sliding_ids), dim, "sliding_directions")
+            anchors = _per_vertex(sliding_anchors, len(sliding_ids), dim, "sliding_anchors")
             if not isinstance(material, MATERIALS):
                 raise TypeError(f"material must be LinearElastic, StVenantKirchhoff, NeoHookean or VerondaWestmann, "
                                 f"got {type(material).__name__}")
@@ -122,7 +131,8 @@ class DistributedStatic:
             if len(loaded) and loads.shape[1] != dim:
                 raise ValueError(f"forces must be {dim}-vectors, got {loads.shape[1]} components")
             g = [] if gravity is None else np.asarray(gravity, dtype=np.float64).ravel().tolist()
-            return (float(density), float(thickness or 0.0), ids.tolist(), values.ravel().tolist(), loaded.tolist(),
+            return (float(density), float(thickness or 0.0), ids.tolist(), values.ravel().tolist(),
+                    sliding_ids.tolist(), directions.ravel().tolist(), anchors.ravel().tolist(), loaded.tolist(),
                     loads.ravel().tolist(), g)
 
         # A rank given no part has no communicator: it reports on the world's, which is the
@@ -162,7 +172,7 @@ class DistributedStatic:
     def set_displacement(self, displacement) -> None:
         """Start the next solve (or relaxation) from ``displacement``, (n_global_vertices, dim) in
         the serial mesh's vertex order, the same on every rank; fixed vertices keep their
-        prescribed displacements. Collective."""
+        prescribed displacements, sliding ones are moved onto their lines. Collective."""
         part = self.part
 
         def checked():
@@ -192,6 +202,14 @@ class DistributedStatic:
         for ids, values in pieces:
             out[ids] = values
         return out
+
+
+def _per_vertex(values, n: int, dim: int, name: str) -> np.ndarray:
+    """``values`` as (n, dim) floats (zeros for None), or ValueError naming ``name``."""
+    array = np.zeros((n, dim)) if values is None else np.asarray(values, dtype=np.float64)
+    if array.shape != (n, dim):
+        raise ValueError(f"{name} must be ({n}, {dim}), got shape {array.shape}")
+    return array
 
 
 class DistributedRelaxation:

@@ -4,15 +4,16 @@ and ``DynamicRelaxation(body, ..., comm=...)`` do, on any number of ranks.
 Every rank runs the same script and holds the same serial Body: a body that differs on some
 rank (its mesh, constraints, loads or displacement) raises ValueError on every rank, naming
 what differs, instead of being ignored for rank 0's (issue 38). Rank 0's mesh is distributed
-(``snede.distribute``), its fixed vertices and external forces (gravity and the nodal-force
-channels, which do not depend on the state) become a :class:`snede.DistributedStatic` that
+(``snede.distribute``; a membrane's too), its fixed and sliding vertices and external forces
+(gravity and the nodal-force channels, which do not depend on the state) become a
+:class:`snede.DistributedStatic` that
 starts from the body's displacement, the solve runs on all ranks to the serial solver's
 criterion, and the displacement is gathered back into the Body on every rank, so the script
 goes on as serially. The distribution is kept while the mesh is unchanged (a cut or a
 refinement of the serial body, done on every rank, makes the next solve distribute anew), and
 the distributed problem while the conditions are too (the next solve starts from the body's
-displacement). What cannot be taken over raises NotImplementedError on every rank: sliding
-constraints and membranes.
+displacement). What cannot be taken over raises NotImplementedError on every rank: a smoothed
+formulation.
 """
 from __future__ import annotations
 
@@ -41,16 +42,11 @@ class DistributedBody:
         self._require_same_on_every_rank({name: value for name, value in inputs.items() if name != "gravity"})
         # The gravity is the loads less the nodal forces, comparable once those agree.
         self._require_same_on_every_rank({"gravity": inputs["gravity"]})
-        fixed, anchors, sliding = body._model.constraint_table()
-        if body.mesh.is_surface:
-            raise NotImplementedError(f"a solve on {comm.size} MPI ranks: membranes (surface meshes) are not "
-                                      "distributed yet")
+        fixed, anchors, _ = body._model.constraint_table()
+        sliding, directions, sliding_anchors = _snede.sliding_lines(body._model)
         if body.formulation != "p1":
             raise NotImplementedError(f"a solve on {comm.size} MPI ranks: formulation {body.formulation!r} is not "
                                       "distributed yet (its vertex patches need two layers of ghost cells); use 'p1'")
-        if len(sliding):
-            raise NotImplementedError(f"a solve on {comm.size} MPI ranks: sliding constraints ({len(sliding)} "
-                                      "vertices) are not distributed yet; fix them instead")
         # The meshes are equal; rank 0 decides whether its mesh changed since the last
         # distribution, so that every rank distributes or none does.
         revision = comm.bcast(body.mesh._impl.revision if comm.rank == 0 else None, root=0)
@@ -63,6 +59,8 @@ class DistributedBody:
             loaded = np.flatnonzero(np.any(loads != 0, axis=1))
             self._problem = DistributedStatic(self.part, body.material, density=body.density,
                                               thickness=body.thickness, fixed=fixed, fixed_values=anchors,
+                                              sliding=sliding, sliding_directions=directions,
+                                              sliding_anchors=sliding_anchors,
                                               forces={int(v): f for v, f in zip(loaded, loads[loaded])})
             self._conditions = conditions
         self._problem.set_displacement(body.displacement)  # where the serial solve would start
@@ -94,11 +92,13 @@ def _inputs(body) -> dict:
     """What a distributed solve of ``body`` is made of, as bytes, by the names an error gives
     when the ranks' bodies differ."""
     mesh = body.mesh
-    fixed, anchors, sliding = body._model.constraint_table()
+    fixed, anchors, _ = body._model.constraint_table()
+    sliding, directions, sliding_anchors = _snede.sliding_lines(body._model)
     channels = {name: body.external_forces(name) for name in body.load_channels}
     loads = body.external_forces()
     return {"mesh": mesh.points.tobytes() + mesh.cells.tobytes(), "fixed vertices": fixed.tobytes(),
-            "prescribed displacements": anchors.tobytes(), "sliding vertices": sliding.tobytes(),
+            "prescribed displacements": anchors.tobytes(),
+            "sliding vertices": sliding.tobytes() + directions.tobytes() + sliding_anchors.tobytes(),
             "nodal forces": b"".join(name.encode() + b"\0" + f.tobytes() for name, f in sorted(channels.items())),
             "displacement": body.displacement.tobytes(),
             "gravity": (loads - sum(channels.values(), np.zeros_like(loads))).tobytes()}

@@ -105,9 +105,11 @@ def test_a_refined_body_is_distributed_anew():
 
 
 def test_what_is_not_distributed_is_refused_on_every_rank():
-    body = loaded_body(snede.LinearElastic(1e5, 0.3))
-    body.slide([0], (1.0, 0.0, 0.0))
-    with pytest.raises(NotImplementedError, match=r"on \d MPI ranks: sliding constraints \(1 vertices\)"):
+    mesh, _ = cantilever(3)
+    fixed, _, _ = conditions(mesh)
+    body = snede.Body(mesh, snede.LinearElastic(1e5, 0.3), formulation="smoothed")
+    body.fix(fixed)
+    with pytest.raises(NotImplementedError, match=r"on \d MPI ranks: formulation 'smoothed' is not distributed"):
         snede.StaticSolver(body, "cg", comm=COMM).solve()
     solver = snede.StaticSolver(loaded_body(snede.LinearElastic(1e5, 0.3)), "cg", comm=COMM)
     with pytest.raises(NotImplementedError, match="only solve"):

@@ -9,6 +9,7 @@ import pytest
 import snede
 from conftest import (all_materials, check_forces_are_minus_the_energy_gradient, check_tangent_is_the_force_derivative,
                       distorted, random_state)
+from membrane_sheets import pretensioned_sheet
 
 THICKNESS = 0.01
 
@@ -366,19 +367,6 @@ def test_the_assembled_tangent_and_its_diagonal_equal_the_shell(material_name):
     np.testing.assert_allclose(diagonal, body.assemble_tangent(u, "aij").getDiagonal().getArray(), rtol=1e-12)
     fixed = np.isclose(body.mesh.points[:, 0], 0.0)
     np.testing.assert_array_equal(diagonal.reshape(-1, 3)[fixed], 1.0)
-
-
-def pretensioned_sheet(divisions: int) -> snede.Body:
-    """A flat neo-Hookean square, its rim pulled out by 10 %, loaded across its plane: taut, so
-    its equilibrium is unique."""
-    mesh = lifted(snede.meshing.rectangle((1.0, 1.0), (divisions, divisions)), lambda x, y: 0 * x)
-    body = snede.Body(mesh, snede.NeoHookean(1e5, 0.3), thickness=0.001)
-    rim = np.unique(mesh.boundary_faces())
-    stretch = 0.1 * (mesh.points - [0.5, 0.5, 0.0])
-    stretch[:, 2] = 0
-    body.fix(rim, stretch[rim])
-    body.add_nodal_force(np.setdiff1d(np.arange(mesh.n_points), rim), (0.0, 0.0, -1e-3))
-    return body
 
 
 # GAMG is left out: on this sheet its Newton stops with DIVERGED_LINE_SEARCH (reported, not
