@@ -148,6 +148,14 @@ StaticSolver::StaticSolver(std::unique_ptr<ModelProblem> owned, Problem* problem
                                 "this solver's is '" + pc_type_ + "'");
   // Jacobi reads the shell's diagonal (MatGetDiagonal), mg builds its own levels (and needs
   // entries only for Galerkin levels); every other PC needs entries.
+  PetscMPIInt ranks = 1;
+  SNEDE_PETSC(MPI_Comm_size(problem_.comm(), &ranks));
+  // PETSc's incomplete factorisations are sequential: PETSc's own error names no remedy.
+  if (ranks > 1 && (pc_type_ == PCILU || pc_type_ == PCICC))
+    throw std::invalid_argument("preconditioner '" + pc_type_ + "' factors a whole matrix on one process; on " +
+                                std::to_string(ranks) + " MPI ranks use 'bjacobi' (" + pc_type_ +
+                                " of each rank's block: -" + options_.options_prefix + "sub_pc_type " + pc_type_ +
+                                "), 'mg' or 'gamg'");
   pc_needs_matrix_ = pc_type_ != PCNONE && pc_type_ != PCJACOBI && pc_type_ != PCMG;
   needs_matrix_ = pc_needs_matrix_;
   register_line_searches();

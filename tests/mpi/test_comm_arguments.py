@@ -138,6 +138,13 @@ def test_multigrid_on_ranks_gives_the_serial_displacement(method):
     assert relative_difference(body.displacement, reference.displacement) <= 1e-8
 
 
+@pytest.mark.skipif(COMM.size == 1, reason="one rank factors the whole matrix")
+def test_a_sequential_factorisation_on_ranks_names_the_block_version():
+    with pytest.raises(ValueError, match=r"on \d MPI ranks use 'bjacobi'"):
+        snede.StaticSolver(loaded_body(snede.LinearElastic(1e5, 0.3)), "cg", preconditioner="ilu", comm=COMM).solve()
+    assert COMM.allreduce(1) == COMM.size
+
+
 def test_solver_options_reach_every_rank_and_must_agree():
     """petsc_options, line_search and ncg_type apply on ranks as serially (one Newton iteration
     allowed: DIVERGED_MAX_IT on every rank); options that differ between the ranks raise the
