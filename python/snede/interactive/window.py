@@ -13,8 +13,8 @@ rendering — and leaves a ``Snapshot`` of what to draw. The camera is the scene
 (``snede.interactive.view``), so a window point means the same place as in a headless session.
 
 Keys: s scalpel, n needle (each scene has one of them), p pause (events wait), r reset,
-c screenshot (``snede_view.png``, or ``--screenshot``), w write the series so far
-(``out/view/SCENE``), q quit.
+c screenshot (``--screenshot``, else ``snede_view.png``), w write the series so far (the
+session's moves replayed headless into ``out/view/SCENE/``, as ``replay --out`` does), q quit.
 """
 from __future__ import annotations
 
@@ -47,11 +47,9 @@ class Worker(threading.Thread):
         self.snapshot, self.version = Snapshot.of(self.session), 0
         self.relaxations, self.solve_seconds = 0, 0.0
         self.error: str | None = None
-        self.busy = False
 
     def run(self) -> None:
         while (item := self.inbox.get()) is not None:
-            self.busy = True
             try:
                 moves = len(self.session.moves)
                 if callable(item):  # a task on the worker's thread (tests: a slow solve)
@@ -69,7 +67,6 @@ class Worker(threading.Thread):
             except ValueError as error:
                 self.error = str(error)
             finally:
-                self.busy = False
                 self.inbox.task_done()
 
     def idle(self) -> bool:
@@ -78,6 +75,14 @@ class Worker(threading.Thread):
     def stop(self) -> None:
         self.inbox.put(None)
         self.join()
+
+
+def write_series(session) -> None:
+    """The session so far as the usual series and picture: its moves replayed headless into
+    ``out/view/SCENE/`` (on the worker's thread: the window goes on meanwhile)."""
+    from snede.interactive.replay import replay
+
+    replay(session.recording(), Path("out") / "view")
 
 
 class Window:
@@ -92,6 +97,7 @@ class Window:
         self.paused, self.waiting, self.closed = False, [], False
         self.frames, self.start, self.shown = 0, time.perf_counter(), -1
         self.surface = self.body_actor = None
+        self.screenshot = Path("snede_view.png")  # the c key's
         self.frame_times: list[float] = []
         self.plotter = pyvista.Plotter(window_size=WINDOW, off_screen=off_screen, title=f"snede: {self.scene}")
         self.plotter.enable_parallel_projection()
@@ -130,17 +136,11 @@ class Window:
         elif name == "r":
             self.send("reset")
         elif name == "c":
-            self.save_screenshot(Path("snede_view.png"))
+            self.save_screenshot(self.screenshot)
         elif name == "w":
-            self.worker.inbox.put(self.write_series)
+            self.worker.inbox.put(write_series)
         elif name == "q":
             self.closed = True
-
-    def write_series(self, session) -> None:
-        from snede.output import SeriesWriter
-
-        writer = SeriesWriter(Path("out") / "view" / session.name / session.name)
-        session.tool.write(writer, session.moves[-1]["t"] if session.moves else 0.0)
 
     def play(self, event: PointerEvent) -> None:
         """A scripted event as if from the mouse: its tool taken up, the pointer put at its
@@ -192,7 +192,7 @@ class Window:
             if self.surface is None:
                 self.surface = surface
                 self.body_actor = self.plotter.add_mesh(surface, scalars=MAGNITUDE, cmap="viridis", show_edges=True,
-                                                        edge_color="black", line_width=0.5,
+                                                        edge_color="black", line_width=0.5, render=False,
                                                         scalar_bar_args={"title": MAGNITUDE})
             else:  # in place: a new actor and scalar bar each time would cost more than the frame
                 self.surface.copy_from(surface)
@@ -215,9 +215,9 @@ class Window:
 
     def _optional(self, name: str, items, make, **style) -> None:
         if len(items):
-            self.plotter.add_mesh(make(), name=name, **style)
+            self.plotter.add_mesh(make(), name=name, render=False, **style)  # one render a frame, in draw
         else:
-            self.plotter.remove_actor(name)
+            self.plotter.remove_actor(name, render=False)
 
     def frame_rate(self) -> float:
         """Frames per second over the last second (or what there is of it)."""
@@ -243,6 +243,7 @@ class Window:
         """Show the window: render, feed the scripted ``events`` at their times, process the
         mouse and the keys, until closed (``close``: once the events are done and the worker
         is idle). ``tick()``, if given, is called every frame (tests)."""
+        self.screenshot = Path(screenshot) if screenshot is not None else self.screenshot
         self.plotter.show(interactive_update=True, auto_close=False)
         self._listen()
         self.worker.start()

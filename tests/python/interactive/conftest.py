@@ -13,35 +13,52 @@ def needle_session():
     return tool_scripts.needle_session()
 
 
+def _reachable(display: str) -> bool:
+    """Whether an X client can open ``display`` now (Xlib's XOpenDisplay, as VTK calls it)."""
+    import ctypes
+    import ctypes.util
+
+    xlib = ctypes.CDLL(ctypes.util.find_library("X11"))
+    xlib.XOpenDisplay.restype = ctypes.c_void_p
+    xlib.XCloseDisplay.argtypes = [ctypes.c_void_p]
+    connection = xlib.XOpenDisplay(display.encode())
+    if connection:
+        xlib.XCloseDisplay(connection)
+    return bool(connection)
+
+
 @pytest.fixture(scope="session")
 def display():
-    """A display of our own for the window tests: Xvfb on the first free number (it writes the
-    number to us when it is ready), DISPLAY set to it for the tests and their subprocesses."""
+    """A display of our own for the window tests, DISPLAY set to it for the tests and their
+    subprocesses: Xvfb on a number no other server holds, away from the low numbers other test
+    runs on this machine take, once a client reaches it."""
     import os
     import shutil
     import subprocess
+    import time
 
     xvfb = shutil.which("Xvfb")
     if xvfb is None:
         pytest.skip("Xvfb is not installed (`make setup` installs it): the window tests need a display")
-    read, write = os.pipe()
-    server = subprocess.Popen([xvfb, "-displayfd", str(write), "-screen", "0", "1024x768x24", "-nolisten", "tcp"],
-                              pass_fds=(write,), stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    os.close(write)
-    # Up to its newline, and the pipe kept open: Xvfb dies if its write meets a closed pipe.
-    answer = b""
-    while not answer.endswith(b"\n") and (chunk := os.read(read, 32)):
-        answer += chunk
-    number = answer.decode().strip()
-    if not number:
+    for number in [100 + (os.getpid() + k) % 800 for k in range(20)]:
+        if os.path.exists(f"/tmp/.X{number}-lock") or os.path.exists(f"/tmp/.X11-unix/X{number}"):
+            continue
+        server = subprocess.Popen([xvfb, f":{number}", "-screen", "0", "1024x768x24", "-nolisten", "tcp"],
+                                  stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        deadline = time.monotonic() + 20
+        while server.poll() is None and not _reachable(f":{number}") and time.monotonic() < deadline:
+            time.sleep(0.05)
+        if server.poll() is None and _reachable(f":{number}"):
+            break
+        server.kill()
         server.wait()
-        pytest.fail(f"Xvfb did not start (status {server.returncode})")
+    else:
+        pytest.fail("Xvfb did not start on any of 20 display numbers")
     before = os.environ.get("DISPLAY")
     os.environ["DISPLAY"] = f":{number}"
     yield os.environ["DISPLAY"]
     server.terminate()
     server.wait()
-    os.close(read)
     if before is None:
         del os.environ["DISPLAY"]
     else:

@@ -98,3 +98,50 @@ def test_the_window_renders_while_the_worker_solves(display, slow):
     assert solve["end"] - solve["start"] > 0.3, "the solve was too quick to tell"
     during = [t for t in frames if solve["start"] < t < solve["end"]]
     assert len(during) >= 3, f"{len(during)} frames in a {solve['end'] - solve['start']:.2f} s solve"
+
+
+def press_keys(window, keys, on_frame: int = 1):
+    """A tick that types ``keys`` through the interactor at frame ``on_frame``."""
+    frames = []
+
+    def tick():
+        frames.append(None)
+        if len(frames) == on_frame:
+            interactor = window.plotter.iren.interactor
+            for key in keys:
+                interactor.SetKeySym(key)
+                interactor.InvokeEvent("KeyPressEvent")
+    return tick
+
+
+def test_keys_save_a_screenshot_and_write_the_series(display, tmp_path, monkeypatch):
+    from snede.interactive.window import Window
+
+    monkeypatch.chdir(tmp_path)
+    window = Window(cut_session)
+    window.run(events(cut_events(cut_session())), close=True, tick=press_keys(window, "cw"))
+    assert (tmp_path / "snede_view.png").stat().st_size > 0
+    for name in ("cut.xdmf", "cut.h5", "cut.png"):
+        assert (tmp_path / "out" / "view" / "cut" / name).stat().st_size > 0
+
+
+def test_pause_holds_the_events_and_reset_starts_again(display):
+    from snede.interactive.window import Window
+
+    scripted = cut_events(cut_session())
+    window = Window(cut_session)
+    window.key("p")  # what the interactor's p calls (the keys above come through it)
+    window.run(events(scripted), close=True)
+    assert window.paused and window.worker.session.moves == [] and len(window.waiting) == len(scripted)
+
+    window = Window(cut_session)
+    reset, lips = press_keys(window, "r"), []
+
+    def reset_after_the_cut():
+        moves = window.worker.session.moves
+        if moves and moves[-1]["action"] == "lift" and window.worker.idle() and not lips:
+            lips.append(len(window.worker.session.tool.lips()))
+            reset()
+    window.run(events(scripted), close=True, tick=reset_after_the_cut)
+    assert lips[0] > 0  # the drag had cut when r was pressed
+    assert window.worker.session.moves == [] and len(window.worker.session.tool.lips()) == 0
