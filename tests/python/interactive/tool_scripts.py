@@ -1,4 +1,6 @@
 """The scripts the interactive tests play: small scenes (seconds), the drags that cut and push."""
+from pathlib import Path
+
 import numpy as np
 
 from snede.interactive import ToolSession
@@ -47,3 +49,22 @@ def needle_events(session, push: float) -> list[dict]:
 def play(session, entries) -> None:
     for event in events(entries):
         session.handle(event)
+
+
+RECORDINGS = Path(__file__).parent / "recordings"
+
+
+def record_all() -> list[Path]:
+    """(Re)write the stored recordings (tests/python/interactive/recordings/) from the scripted
+    drag and push: run this file when a change of the solvers or cutters is meant to change them."""
+    from snede.interactive.recording import save
+
+    cut, needle = cut_session(), needle_session()
+    play(cut, cut_events(cut))
+    play(needle, needle_events(needle, 0.02))
+    return [save(cut.recording(), RECORDINGS / "cut_drag.json"), save(needle.recording(), RECORDINGS / "needle_push.json")]
+
+
+if __name__ == "__main__":
+    for path in record_all():
+        print(f"wrote {path}")
