@@ -145,3 +145,11 @@ def test_pause_holds_the_events_and_reset_starts_again(display):
     window.run(events(scripted), close=True, tick=reset_after_the_cut)
     assert lips[0] > 0  # the drag had cut when r was pressed
     assert window.worker.session.moves == [] and len(window.worker.session.tool.lips()) == 0
+
+
+def test_q_closes_the_window(display):
+    from snede.interactive.window import Window
+
+    window = Window(needle_session)
+    window.run([], close=False, tick=press_keys(window, "q", on_frame=3))  # returns: q closed it
+    assert window.closed and window.frames >= 3
