@@ -27,7 +27,7 @@ import numpy as np
 
 from snede.interactive.events import PointerEvent
 from snede.interactive.snapshot import Snapshot
-from snede.plotting import HIGHLIGHT
+from snede.plotting import HIGHLIGHT, LOAD
 
 WINDOW = (800, 600)  # pixels; the scenes' views have this aspect (4:3)
 MAGNITUDE = "displacement [m]"  # |u|: VTK's default font has no '|'
@@ -202,6 +202,7 @@ class Window:
                 color=HIGHLIGHT, show_edges=False)
             self._optional("held", snapshot.held, lambda: pyvista.PolyData(snapshot.held), color="black",
                            point_size=6, render_points_as_spheres=True)
+            self._loads(snapshot)
             for name in COLOURS:
                 marks = snapshot.marks.get(name, np.zeros((0, 3)))
                 line = name in ("blade", "needle")
@@ -212,6 +213,25 @@ class Window:
         self.plotter.render()
         self.frames += 1
         self.frame_times.append(time.perf_counter())
+
+    def _loads(self, snapshot) -> None:
+        """Nodal loads as arrows from their vertices (the largest a tenth of the body's size),
+        gravity as one arrow above the body's far end, in the pictures' load colour."""
+        import pyvista
+
+        size = float(np.ptp(snapshot.points, axis=0).max())
+
+        def arrows():
+            cloud = pyvista.PolyData(snapshot.loaded)
+            cloud["load"] = snapshot.loads
+            largest = float(np.linalg.norm(snapshot.loads, axis=1).max())
+            return cloud.glyph(orient="load", scale="load", factor=0.1 * size / largest, geom=pyvista.Arrow())
+
+        self._optional("loads", snapshot.loads, arrows, color=LOAD)
+        low, high = snapshot.points.min(axis=0), snapshot.points.max(axis=0)
+        top = (high[0], low[1], high[2] + 0.2 * size)  # above the far end: clear of the heads-up line
+        self._optional("gravity", [] if snapshot.gravity is None else [snapshot.gravity],
+                       lambda: pyvista.Arrow(start=top, direction=snapshot.gravity, scale=0.15 * size), color=LOAD)
 
     def _optional(self, name: str, items, make, **style) -> None:
         if len(items):

@@ -14,12 +14,13 @@ pytest.importorskip("pyvista", reason="the window needs pyvista (tools/requireme
 
 
 def red_pixels(path) -> int:
-    """Pixels where red dominates: the lips' colour (snede.plotting.HIGHLIGHT, shaded); viridis,
-    the body's colour map, and the black edges have none."""
+    """Pixels of the lips' red (snede.plotting.HIGHLIGHT, green and blue under a fifth of red,
+    shaded): viridis, the body's colour map, the black edges and the loads' orange
+    (snede.plotting.LOAD, green half of red) have none."""
     from PIL import Image
 
     rgb = np.asarray(Image.open(path).convert("RGB"), dtype=float) / 255
-    return int(((rgb[..., 0] > 0.4) & (rgb[..., 1] < 0.5 * rgb[..., 0]) & (rgb[..., 2] < 0.5 * rgb[..., 0])).sum())
+    return int(((rgb[..., 0] > 0.4) & (rgb[..., 1] < 0.3 * rgb[..., 0]) & (rgb[..., 2] < 0.3 * rgb[..., 0])).sum())
 
 
 def show(make_session, scripted, screenshot=None, tick=None):
@@ -153,3 +154,18 @@ def test_q_closes_the_window(display):
     window = Window(needle_session)
     window.run([], close=False, tick=press_keys(window, "q", on_frame=3))  # returns: q closed it
     assert window.closed and window.frames >= 3
+
+
+def test_the_window_draws_gravity_and_the_held_vertices(display):
+    from snede.interactive.snapshot import Snapshot
+    from snede.interactive.window import Window
+
+    session = cut_session()
+    snapshot = Snapshot.of(session)
+    assert np.allclose(snapshot.gravity, (0.0, 0.0, -9.81))  # the cut scene's beam hangs under gravity alone
+    assert len(snapshot.loads) == 0
+    held = session.scene.fixed(session.body.mesh.points)
+    assert len(snapshot.held) == held.sum() > 0
+    window, drawn = Window(cut_session), set()
+    window.run([], close=True, tick=lambda: drawn.update(window.plotter.actors))
+    assert {"held", "gravity"} <= drawn and "loads" not in drawn
