@@ -109,7 +109,7 @@ def _parser() -> argparse.ArgumentParser:
                                description="The live window (pyvista): the mouse drives the scalpel (cut) or the "
                                            "needle (needle) while the body relaxes. Keys: s scalpel, n needle, "
                                            "p pause, r reset, c screenshot, w write the series, q quit.")
-    view.add_argument("scene", help="cut or needle")
+    view.add_argument("scene", help="cut, needle, needle3d or a scene file (.toml) with a [[tool]] table")
     view.add_argument("--material", choices=MATERIAL_NAMES, help="material model (default: the scene's)")
     view.add_argument("--divisions", type=_positive_int, help="the scene's mesh resolution (as for run)")
     view.add_argument("--speed", type=_positive_float, help="needle: h_ref per update (as for run)")

@@ -1,11 +1,18 @@
 """Recordings of tool sessions (``python -m snede view SCENE --record FILE``; replayed by
 ``snede.interactive.replay``).
 
-A recording is JSON: the scene's name and options, the method and tolerance it relaxed with,
-the snede version, every tool move with its time (``ToolSession.moves``) and a digest of the
-final state. The digest keeps, per array (the mesh's points and cells, the displacement), its
-size, sum, norm and a weighted sum — not a hash of floats — so a replay matches it to a
-relative tolerance (1e-12 of the array's norm) rather than bit for bit.
+A recording is JSON: the scene's name (a scene file's path) and options, the method and
+tolerance it relaxed with, the snede version, every tool move with its time
+(``ToolSession.moves``) and a digest of the final state. After the window's reset (key r) it
+holds the moves since the last reset only, and its ``resets`` and ``note`` say so.
+
+A scene file's recording keeps the file's path and the sha256 of its bytes, not its text: the
+file may name a mesh file beside it (``[mesh] surface``), which its text alone would not bring
+along. A replay reads the file again and refuses, in one line, one that has changed.
+
+The digest keeps, per array (the mesh's points and cells, the displacement), its size, sum,
+norm and a weighted sum — not a hash of floats — so a replay matches it to a relative
+tolerance (1e-12 of the array's norm) rather than bit for bit.
 """
 from __future__ import annotations
 
@@ -70,7 +77,10 @@ def make(session) -> dict:
 
     return {"format": FORMAT, "snede": snede.__version__, "scene": session.name, "options": session.options,
             "method": session.method, "rtol": session.rtol, "moves": list(session.moves),
-            "digest": digest(session.body)}
+            "digest": digest(session.body), **({"scene_file": session.scene_file} if session.scene_file else {}),
+            **({"resets": session.resets, "note": f"the moves since the window's last reset (r, {session.resets} "
+                "in all): the moves before it are not recorded, and the replay starts from the scene as built"}
+               if session.resets else {})}
 
 
 def save(recording: dict, path) -> Path:
@@ -88,6 +98,10 @@ def checked(recording, source: str) -> dict:
         raise ValueError(f"{source}: not a recording, it has no {', '.join(repr(m) for m in missing)}")
     if recording["format"] != FORMAT:
         raise ValueError(f"{source}: recording format {recording['format']!r}; this snede reads format {FORMAT}")
+    scene_file = recording.get("scene_file")
+    if scene_file is not None and not (isinstance(scene_file, dict) and isinstance(scene_file.get("path"), str)
+                                       and isinstance(scene_file.get("sha256"), str)):
+        raise ValueError(f"{source}: 'scene_file' must be an object with the file's 'path' and 'sha256'")
     if not isinstance(recording["options"], dict) or not isinstance(recording["moves"], list):
         raise ValueError(f"{source}: 'options' must be an object and 'moves' a list")
     for index, move in enumerate(recording["moves"]):

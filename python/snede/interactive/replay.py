@@ -6,7 +6,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from snede.interactive.recording import checked, compare, digest, load
-from snede.interactive.session import ToolSession
+from snede.interactive.session import ToolSession, file_checksum
 
 
 @dataclass
@@ -27,13 +27,17 @@ def replay(recording, out=None) -> ReplayResult:
     its scene, and compare the final state with its digest. With ``out``, write the series
     (one frame per move) and a picture of the end to ``out/SCENE/``, as ``run`` does."""
     recording = load(recording) if isinstance(recording, (str, Path)) else checked(recording, "recording")
+    scene_file = recording.get("scene_file")
+    if scene_file is not None and file_checksum(scene_file["path"]) != scene_file["sha256"]:
+        raise ValueError(f"scene file {scene_file['path']} has changed since the recording was made (its sha256 is "
+                         f"no longer {scene_file['sha256'][:12]}…): the replay would not repeat the session")
     session = ToolSession(recording["scene"], recording["options"], recording.get("method"), recording.get("rtol"))
     writer = folder = None
     if out is not None:
         from snede.output import SeriesWriter
 
-        folder = Path(out) / session.name
-        writer = SeriesWriter(folder / session.name)
+        folder = Path(out) / session.scene.name
+        writer = SeriesWriter(folder / session.scene.name)
         session.tool.write(writer, 0.0)
     for index, move in enumerate(recording["moves"]):
         if move["tool"] != session.tool.name:
@@ -56,6 +60,6 @@ def _picture(session, folder: Path, writer) -> dict:
     from snede.run_scene import picture_arguments
 
     arguments = {**picture_arguments(session.scene, session.method), **session.tool.picture()}
-    arguments["title"] = f"{session.name}: replayed, {len(session.moves)} moves"
-    png = plot_body(session.body, folder / f"{session.name}.png", **arguments)
+    arguments["title"] = f"{session.scene.name}: replayed, {len(session.moves)} moves"
+    png = plot_body(session.body, folder / f"{session.scene.name}.png", **arguments)
     return {"xdmf": str(writer.xdmf_path), "h5": str(writer.h5_path), "png": str(png)}

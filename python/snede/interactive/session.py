@@ -5,13 +5,36 @@ its time: ``recording()`` is the JSON a replay repeats (``snede.interactive.reco
 """
 from __future__ import annotations
 
+import hashlib
 from argparse import Namespace
+from pathlib import Path
 
 from snede.interactive.recording import make as make_recording
 from snede.interactive.events import PointerEvent
-from snede.interactive.tools import TOOLS, Relaxation
+from snede.interactive.tools import TOOLS, Relaxation, file_tool
 
 OPTIONS = ("divisions", "material", "formulation", "speed")  # the scenes' own, as `run` takes them
+FILE_OPTIONS = ("material", "formulation")  # a scene file's, as `run` takes them
+
+
+def is_scene_file(name: str) -> bool:
+    from snede.scene_file import SUFFIX
+
+    return str(name).endswith(SUFFIX)
+
+
+def file_checksum(path) -> str:
+    """The sha256 of a scene file's bytes: a recording's check that the file is the one it was made with."""
+    try:
+        return hashlib.sha256(Path(path).read_bytes()).hexdigest()
+    except OSError as error:
+        raise ValueError(f"scene file {path}: cannot be read ({error.strerror or error})") from None
+
+
+def _options_checked(options: dict, allowed: tuple, what: str) -> None:
+    unknown = sorted(set(options) - set(allowed))
+    if unknown:
+        raise ValueError(f"unknown {what} option(s) {', '.join(unknown)} (the options: {', '.join(allowed)})")
 
 
 def _scene(name: str, options: dict):
@@ -19,11 +42,10 @@ def _scene(name: str, options: dict):
 
     if name not in TOOLS:
         known = ", ".join(TOOLS)
-        raise ValueError(f"unknown scene {name!r}: the interactive scenes are {known}" if name not in builders() else
+        raise ValueError(f"unknown scene {name!r}: the interactive scenes are {known} or a scene file (.toml)"
+                         if name not in builders() else
                          f"the {name} scene has no interactive tool (the interactive scenes are {known})")
-    unknown = sorted(set(options) - set(OPTIONS))
-    if unknown:
-        raise ValueError(f"unknown scene option(s) {', '.join(unknown)} (the options: {', '.join(OPTIONS)})")
+    _options_checked(options, OPTIONS, "scene")
     module = builders()[name]
     given = [key for key, value in options.items() if value is not None and key != "material" and key not in module.OPTIONS]
     if given:
@@ -32,21 +54,40 @@ def _scene(name: str, options: dict):
     return module.build(Namespace(**{key: options.get(key) for key in OPTIONS}))
 
 
+def _file_scene(path: str, options: dict):
+    """A scene file's scene and its tools (``scene_file``)."""
+    from snede.scene_file import read
+    from snede.scene_file.scene import build
+
+    _options_checked(options, FILE_OPTIONS, "scene file")
+    recipe = read(path)
+    return build(recipe, options.get("material"), options.get("formulation")), recipe.tools
+
+
 class ToolSession:
-    """The scene ``name`` (``cut``: the scalpel; ``needle``: the needle) built with
-    ``options`` (``divisions``, ``material``, ``formulation``, ``speed``, as for ``run``),
-    relaxed with the scene's method and tolerance (or ``method``, ``rtol``)."""
+    """The scene ``name`` (``cut``: the scalpel; ``needle``, ``needle3d``: the needle; a scene
+    file, ``*.toml``: the tool of its first ``[[tool]]`` table) built with ``options``
+    (``divisions``, ``material``, ``formulation``, ``speed``, as for ``run``; a scene file takes
+    ``material`` and ``formulation``), relaxed with the scene's method and tolerance (or
+    ``method``, ``rtol``)."""
 
     def __init__(self, name: str, options: dict | None = None, method: str | None = None, rtol: float | None = None):
         from snede.run_scene import fitting_method
 
-        self.name, self.options = name, dict(options or {})
-        self.scene = _scene(name, self.options)
+        self.name, self.options = str(name), dict(options or {})
+        self.scene_file = None  # a scene file's path and checksum (``recording``)
+        if is_scene_file(self.name):
+            self.scene_file = {"path": self.name, "sha256": file_checksum(self.name)}
+            self.scene, tools = _file_scene(self.name, self.options)
+        else:
+            self.scene = _scene(self.name, self.options)
         self.method = method or fitting_method(self.scene)
         self.rtol = rtol or self.scene.default_rtol
-        self.tool = TOOLS[name](self.scene, self.method, self.rtol)
+        self.tool = (file_tool(self.scene, tools, self.method, self.rtol) if self.scene_file else
+                     TOOLS[self.name](self.scene, self.method, self.rtol))
         self.view = self.tool.view
         self.moves: list[dict] = []
+        self.resets = 0  # how many times the window started the scene again before this session (key r)
         self.last: Relaxation | None = self.tool.first
 
     @property

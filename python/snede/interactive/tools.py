@@ -43,38 +43,28 @@ def _points(moves, name: str) -> np.ndarray:
 
 
 class Scalpel:
-    """The ``cut`` scene's scalpel: a blade along y, wider than the beam (as the scene's), its
-    edge where the pointer meets the beam's front face y = 0. A press places it, a drag moves
-    it in steps of at least the scene's STEP elements (shorter steps leave faces unselected:
-    ``scenes.cut``), a release lifts it: the next press starts a new incision."""
+    """A scalpel: a blade (a segment) whose place follows the pointer on the tool's plane
+    (``blade(point)``: the blade there). A press places it, a drag moves it in steps of at
+    least ``step`` (shorter steps leave faces unselected: ``scenes.cut``), a release lifts it:
+    the next press starts a new incision. The body is relaxed by ``solver`` once before the
+    first move (the loads) and after each."""
 
     name = "scalpel"
 
-    def __init__(self, scene, method: str, rtol: float):
-        from snede.scenes import cut
-
-        self.scene, self.body = scene, scene.body
-        self.width = cut.WIDTH
-        self.step = cut.STEP * cut.LENGTH / scene.details["divisions"][0]
-        self.solver = snede.StaticSolver(self.body, method, rtol=rtol)
-        self.first = _relaxation(self.solver.solve())  # the beam sags under gravity before any cut
+    def __init__(self, body, solver, blade, step: float, view: View, plane):
+        self.body, self.solver, self.blade, self.step = body, solver, blade, step
+        self.view, self.plane = view, plane
+        self.first = _relaxation(self.solver.solve())  # the body sags under its loads before any cut
         self.cutter = snede.TetrahedralCutter(self.body)
-        self.edge = None  # where the blade's edge meets y = 0, while pressed
-        centre = (cut.LENGTH / 2, cut.WIDTH / 2, -0.03)  # the beam sagging to some 10 cm at its tip
-        self.view = View(centre, tuple(direction_from_angles(*cut.VIEW)), (0.0, 0.0, 1.0), height=0.24)
-        self.plane = ((0.0, 0.0, 0.0), (0.0, 1.0, 0.0))
+        self.edge = None  # where the pointer holds the blade, while pressed
 
     @property
     def held(self) -> bool:
         return self.edge is not None
 
-    def blade(self, edge) -> list:
-        x, _, z = edge
-        return [[float(x), -0.5 * self.width, float(z)], [float(x), 1.5 * self.width, float(z)]]
-
     def press(self, point) -> list[dict]:
         self.edge = np.asarray(point, dtype=float)
-        return [{"tool": self.name, "action": "move", "blade": self.blade(self.edge)}]
+        return [{"tool": self.name, "action": "move", "blade": self.blade(self.edge).tolist()}]
 
     def drag(self, point) -> list[dict]:
         """Moves to ``point`` in equal steps of at least ``step``; none if it is nearer."""
@@ -83,7 +73,7 @@ class Scalpel:
         if count == 0:
             return []
         start, self.edge = self.edge, point
-        return [{"tool": self.name, "action": "move", "blade": self.blade(start + (point - start) * k / count)}
+        return [{"tool": self.name, "action": "move", "blade": self.blade(start + (point - start) * k / count).tolist()}
                 for k in range(1, count + 1)]
 
     def release(self, point) -> list[dict]:
@@ -105,7 +95,7 @@ class Scalpel:
 
     def marks(self) -> dict:
         """What the window draws besides the body: the blade's edge (deformed coordinates)."""
-        return {"blade": None if self.edge is None else np.array(self.blade(self.edge))}
+        return {"blade": None if self.edge is None else self.blade(self.edge)}
 
     def write(self, writer, time: float) -> None:
         from snede.scenes.incision import incision_cells
@@ -117,33 +107,27 @@ class Scalpel:
 
 
 class Needle:
-    """The ``needle`` scene's needle (the 2D slab, §6.8.1), entering at the slab's left side:
-    a drag pushes it by how far the pointer goes along the shaft (back is ignored: the needle
-    is not withdrawn), in updates of the scene's speed × h_ref, each relaxed with its
-    stick-slip rearrangements, up to the scene's depth."""
+    """A needle (``snede.NeedleInsertion``) entering at ``entry`` along ``direction``: a drag
+    pushes it by how far the pointer goes along the shaft (back is ignored: the needle is not
+    withdrawn), in updates of ``step``, each relaxed with its stick-slip rearrangements, up to
+    ``depth_limit``. ``picture``: the replay's picture arguments (``Needle.picture``)."""
 
     name = "needle"
 
-    def __init__(self, scene, method: str, rtol: float):
-        from snede.scenes import needle, needle_slab
-
-        self.scene, self.body = scene, scene.body
-        self.needle = needle_slab.needle_for(self.body, needle.H_REF, method=method, rtol=rtol)
-        self.step = scene.details["speed_h_ref_per_update"] * needle_slab.h(needle.H_REF)
-        self.depth_limit = needle_slab.DEPTH
-        self.entry, self.direction = np.asarray(needle_slab.ENTRY), np.asarray(needle_slab.DIRECTION)
+    def __init__(self, body, needle, entry, direction, step: float, depth_limit: float, view: View, plane,
+                 picture=None):
+        self.body, self.needle, self.step, self.depth_limit = body, needle, step, depth_limit
+        self.entry, self.direction = np.asarray(entry, dtype=float), np.asarray(direction, dtype=float)
+        self.view, self.plane, self._picture = view, plane, picture
         self.first = None
         self.grip = None  # (the pointer's place along the shaft, the depth) at the press
-        size = needle_slab.SIZE
-        self.view = View((size / 2, size / 2, 0.0), (0.0, 0.0, -1.0), (0.0, 1.0, 0.0), height=1.3 * size)
-        self.plane = ((0.0, 0.0, 0.0), (0.0, 0.0, 1.0))
 
     @property
     def held(self) -> bool:
         return self.grip is not None
 
     def _along(self, point) -> float:
-        return float((np.asarray(point, dtype=float)[:2] - self.entry) @ self.direction)
+        return float((np.asarray(point, dtype=float)[:len(self.entry)] - self.entry) @ self.direction)
 
     def press(self, point) -> list[dict]:
         self.grip = (self._along(point), self.needle.depth)
@@ -187,12 +171,99 @@ class Needle:
         writer.write(self.body, time=time, point_fields={"needle_state": self.needle.node_state()})
 
     def picture(self) -> dict:
-        from snede.scenes.needle import Frame, draw_needle
-
-        mesh = self.body.mesh
-        frame = Frame(mesh.points, mesh.cells, self.body.displacement.copy(), self.needle.node_state(),
-                      self.needle.depth)
-        return {"decorate": lambda ax: draw_needle(ax, frame)}
+        return {} if self._picture is None else self._picture(self)
 
 
-TOOLS = {"cut": Scalpel, "needle": Needle}  # the interactive scenes and the tool of each
+def _cut_scalpel(scene, method: str, rtol: float) -> Scalpel:
+    """The ``cut`` scene's scalpel (§3.2): the scene's blade, its edge where the pointer meets the
+    beam's front face y = 0, in steps of the scene's STEP elements."""
+    from snede.scenes import cut
+
+    centre = (cut.LENGTH / 2, cut.WIDTH / 2, -0.03)  # the beam sagging to some 10 cm at its tip
+    view = View(centre, tuple(direction_from_angles(*cut.VIEW)), (0.0, 0.0, 1.0), height=0.24)
+    return Scalpel(scene.body, snede.StaticSolver(scene.body, method, rtol=rtol), lambda edge: cut.blade(edge[0], edge[2]),
+                   cut.STEP * cut.LENGTH / scene.details["divisions"][0], view, ((0.0, 0.0, 0.0), (0.0, 1.0, 0.0)))
+
+
+def _slab_picture(tool: Needle) -> dict:
+    from snede.scenes.needle import Frame, draw_needle
+
+    mesh = tool.body.mesh
+    frame = Frame(mesh.points, mesh.cells, tool.body.displacement.copy(), tool.needle.node_state(), tool.needle.depth)
+    return {"decorate": lambda ax: draw_needle(ax, frame)}
+
+
+def _slab_needle(scene, method: str, rtol: float) -> Needle:
+    """The 2D ``needle`` scene's needle (§6.8.1: its slab and needle, ``scenes.needle_slab``),
+    entering at the slab's left side, in updates of the scene's speed × h_ref."""
+    from snede.scenes import needle, needle_slab
+
+    size = needle_slab.SIZE
+    return Needle(scene.body, needle_slab.needle_for(scene.body, needle.H_REF, method=method, rtol=rtol),
+                  needle_slab.ENTRY, needle_slab.DIRECTION,
+                  scene.details["speed_h_ref_per_update"] * needle_slab.h(needle.H_REF), needle_slab.DEPTH,
+                  View((size / 2, size / 2, 0.0), (0.0, 0.0, -1.0), (0.0, 1.0, 0.0), height=1.3 * size),
+                  ((0.0, 0.0, 0.0), (0.0, 0.0, 1.0)), picture=_slab_picture)
+
+
+def _whole_view(body, angles) -> View:
+    """A view of the whole body from ``angles`` (matplotlib's elevation, azimuth), z up."""
+    points = body.mesh.points
+    low, high = points.min(axis=0), points.max(axis=0)
+    return View(tuple((low + high) / 2), tuple(direction_from_angles(*angles)), (0.0, 0.0, 1.0),
+                height=1.6 * float((high - low).max()))
+
+
+def _plane_along(point, direction, view: View) -> tuple:
+    """The plane through ``point`` that holds ``direction`` and faces the view most."""
+    direction = np.asarray(direction, dtype=float) / np.linalg.norm(direction)
+    forward = view.axes()[2]
+    normal = forward - (forward @ direction) * direction
+    return tuple(np.asarray(point, dtype=float)), tuple(normal / np.linalg.norm(normal))
+
+
+def _needle3d(scene, method: str, rtol: float) -> Needle:
+    """The ``needle3d`` scene's needle (§6.9) entering the cube's left face, in updates of the
+    scene's speed × h_ref, seen from the cube's front; the pointer moves on the plane of the
+    shaft that faces the view."""
+    from snede.scenes import needle3d
+
+    h_ref = scene.details["h_ref_m"]
+    view = _whole_view(scene.body, needle3d.VIEW)
+    return Needle(scene.body, needle3d.needle_for(scene.body, h_ref, method, rtol), needle3d.ENTRY,
+                  needle3d.DIRECTION, scene.details["speed_h_ref_per_update"] * h_ref, needle3d.DEPTH, view,
+                  _plane_along(needle3d.ENTRY, needle3d.DIRECTION, view))
+
+
+TOOLS = {"cut": _cut_scalpel, "needle": _slab_needle, "needle3d": _needle3d}  # the interactive scenes, their tools
+
+
+def file_tool(scene, tools: list, method: str, rtol: float):
+    """The tool of a scene file (``scene_file``): its first ``[[tool]]`` table's, seen from the
+    file's picture's angles. A scalpel keeps the file's blade (its start): the pointer places the
+    blade's middle on the plane through the start's middle across the blade, in steps of the
+    file's (start to end over its moves). A needle enters where the file's line meets the body
+    its loads deformed, in updates of the file's (depth over its steps), up to its depth."""
+    from snede.run_scene import static_solver
+    from snede.scene_file.frames import VIEW
+    from snede.scene_file.tools import Scalpel as FileScalpel
+
+    if not tools:
+        raise ValueError(f"the scene file {scene.details['scene_file']} has no [[tool]] table: view drives a "
+                         "scalpel or a needle the file declares")
+    tool, view = tools[0], _whole_view(scene.body, VIEW)
+    if method not in tool.methods:
+        raise ValueError(f"method {method!r} cannot relax the {type(tool).__name__.lower()} of {tool.key}: it takes "
+                         f"{' or '.join(tool.methods)}")
+    solver = static_solver(scene, method, rtol)
+    if isinstance(tool, FileScalpel):
+        span = tool.start[1] - tool.start[0]
+        step = float(np.linalg.norm((tool.end - tool.start).mean(axis=0))) / tool.moves
+        return Scalpel(scene.body, solver, lambda middle: np.array([middle - span / 2, middle + span / 2]), step,
+                       view, (tuple(tool.start.mean(axis=0)), tuple(span / np.linalg.norm(span))))
+    first = _relaxation(solver.solve())  # the loads, before the needle enters
+    insertion = tool.insertion(scene.body, method, rtol, scene.solver_options)
+    needle = Needle(scene.body, insertion, tool.start, tool.direction, tool.depth / tool.steps, tool.depth, view,
+                    _plane_along(tool.start, tool.direction, view))
+    needle.first = first
+    return needle

@@ -54,8 +54,10 @@ class Worker(threading.Thread):
                 moves = len(self.session.moves)
                 if callable(item):  # a task on the worker's thread (tests: a slow solve)
                     item(self.session)
-                elif item == "reset":
+                elif item == "reset":  # a new session: its recording says how many resets came before
+                    resets = self.session.resets + 1
                     self.session = self.make_session()
+                    self.session.resets = resets
                 else:
                     for relaxation in self.session.handle(item):
                         self.relaxations += 1

@@ -41,15 +41,6 @@ class ToolRun:
         self.results.append(result)
         return result
 
-    def needle_options(self) -> dict:
-        """The scene's solver options as NeedleInsertion takes them."""
-        options = dict(self.scene.solver_options)
-        petsc = dict(options.pop("petsc_options", {}))
-        if options.get("preconditioner") is not None:
-            petsc["pc_type"] = options["preconditioner"]
-        return {"petsc_options": petsc, **({"max_iterations": options["max_iterations"]}
-                                            if "max_iterations" in options else {})}
-
     def record(self, label: str, tool=None) -> None:
         """A step of the series (with the cell field ``incision``) and a frame of the GIF."""
         incision = self.incision()

@@ -136,18 +136,23 @@ class Needle:
             self.table.fail("depth", f"{self.depth:g} m takes the tip out of the body: the needle's line leaves "
                                      f"it {leaves.distance:.4g} m past the entry point {hit.point.round(6).tolist()}")
 
-    def run(self, run) -> bool:
-        """Insert the needle from where its line meets the deformed surface; False if an update
-        did not converge."""
-        body = run.body
+    def insertion(self, body, method: str, rtol: float, solver_options: dict) -> snede.NeedleInsertion:
+        """The needle, its tip where its line meets the body as the loads deformed it (``start``),
+        relaxed with ``method``, ``rtol`` and the scene's ``solver_options``."""
         hit = body.mesh.ray_hit(self.entry, self.direction, body.displacement)
         if hit is None:
             self.table.fail("entry", "misses the body as the loads deformed it: the needle's line no longer "
                                      "meets it")
         self.start = hit.point
-        run.needle = snede.NeedleInsertion(
-            body, hit.point, self.direction, self.friction, static_factor=self.static_factor, h_ref=self.h_ref,
-            radius=self.radius, method=run.method, rtol=run.rtol, **run.needle_options())
+        return snede.NeedleInsertion(body, hit.point, self.direction, self.friction, static_factor=self.static_factor,
+                                     h_ref=self.h_ref, radius=self.radius, method=method, rtol=rtol,
+                                     **needle_options(solver_options))
+
+    def run(self, run) -> bool:
+        """Insert the needle from where its line meets the deformed surface; False if an update
+        did not converge."""
+        body = run.body
+        run.needle = self.insertion(body, run.method, run.rtol, run.scene.solver_options)
         step = self.depth / self.steps
 
         def after(done, total, report):
@@ -159,6 +164,16 @@ class Needle:
 
         run.insertion = run.needle.insert(self.depth, step, progress=after)
         return run.insertion.converged
+
+
+def needle_options(solver_options: dict) -> dict:
+    """A scene's solver options as NeedleInsertion takes them."""
+    options = dict(solver_options)
+    petsc = dict(options.pop("petsc_options", {}))
+    if options.get("preconditioner") is not None:
+        petsc["pc_type"] = options["preconditioner"]
+    return {"petsc_options": petsc, **({"max_iterations": options["max_iterations"]}
+                                        if "max_iterations" in options else {})}
 
 
 def _span(mesh) -> str:

@@ -35,6 +35,12 @@ METHODS = ("cg", "ncg", "newton")
 VIEW = (12.0, -70.0)  # camera (elevation, azimuth): the side and the top, where the V opens
 
 
+def blade(x: float, z: float) -> np.ndarray:
+    """The blade's edge at (x, z): a segment along y, half the beam's width past its front and
+    its back faces, so that it cuts all across the beam."""
+    return np.array([(x, -0.5 * WIDTH, z), (x, 1.5 * WIDTH, z)], dtype=float)
+
+
 @dataclass
 class Frame:
     """What a picture of the cut needs: the mesh's boundary, the incision, the state, the blade."""
@@ -71,7 +77,7 @@ class Cut:
         moves = math.ceil((start - end) / (STEP * h))
         path = np.empty((moves + 1, 2, 3))
         for k, z in enumerate(np.linspace(start, end, moves + 1)):
-            path[k] = [(x, -0.5 * WIDTH, z), (x, 1.5 * WIDTH, z)]
+            path[k] = blade(x, z)
         return path
 
     def _blade_depth(self, blade) -> str:

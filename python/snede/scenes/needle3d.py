@@ -55,6 +55,12 @@ def cube(material_, formulation: str = "p1"):
     return body
 
 
+def needle_for(body, h_ref: float, method: str, rtol: float) -> "snede.NeedleInsertion":
+    """The scene's needle at its entry, liver's forces, refining to ``h_ref``, multigrid on the refinement."""
+    return snede.NeedleInsertion(body, ENTRY, DIRECTION, liver_profile(DEPTH, RADIUS), radius=RADIUS, h_ref=h_ref,
+                                 method=method, rtol=rtol, petsc_options={"pc_type": "mg"})
+
+
 def held(points) -> np.ndarray:
     return np.isclose(points[:, 2], 0.0)
 
@@ -141,9 +147,7 @@ class Insertion:
 
         if method not in METHODS:
             raise ValueError(f"the needle3d scene solves with {', '.join(METHODS)}; got {method!r}")
-        self.needle = snede.NeedleInsertion(self.body, ENTRY, DIRECTION, liver_profile(DEPTH, RADIUS), radius=RADIUS,
-                                            h_ref=self.h_ref, method=method, rtol=rtol,
-                                            petsc_options={"pc_type": "mg"})
+        self.needle = needle_for(self.body, self.h_ref, method, rtol)
         self._record(writer)
         step = self.speed * self.h_ref
         total = math.ceil(DEPTH / step - 1e-9)
