@@ -59,7 +59,7 @@ void bind_needle(py::module_& m) {
       .def(py::init(&make_needle), py::arg("model"), py::arg("bisection"), py::arg("entry"), py::arg("direction"),
            py::arg("friction"), py::arg("options"), py::arg("solver_options"), py::keep_alive<1, 2>(),
            py::keep_alive<1, 3>())
-      .def("advance", &NeedleInsertion::advance, py::arg("distance"))
+      .def("advance", &NeedleInsertion::advance, py::arg("distance"), py::call_guard<py::gil_scoped_release>())
       .def("settle", &NeedleInsertion::settle)
       .def_property_readonly("depth", &NeedleInsertion::depth)
       .def_property_readonly("surface_depth", &NeedleInsertion::surface_depth)

@@ -71,6 +71,22 @@ def slow_dynamic_relaxation():
     return lambda: snede.DynamicRelaxation(body, damping=20.0).run(1e-6)
 
 
+def slow_needle_push():
+    """One update pushing the needle3d scene's needle 5 cm into a neo-Hookean cube of 24 576
+    tetrahedra sagging under gravity, by Newton with unpreconditioned CG to ε = 1e-10."""
+    from snede.needle_forces import liver_profile
+    from snede.scenes import needle3d
+
+    body = snede.Body(snede.meshing.box((needle3d.SIZE,) * 3, (16, 16, 16)),
+                      snede.NeoHookean(needle3d.YOUNG, needle3d.POISSON))
+    body.fix(needle3d.held(body.mesh.points))
+    body.add_gravity((0.0, 0.0, -9.81))
+    needle = snede.NeedleInsertion(body, needle3d.ENTRY, needle3d.DIRECTION,
+                                   liver_profile(needle3d.DEPTH, needle3d.RADIUS), radius=needle3d.RADIUS,
+                                   method="newton", rtol=1e-10, petsc_options={"pc_type": "none"})
+    return lambda: needle.advance(0.05)
+
+
 def beam(divisions, material):
     body = snede.Body(snede.meshing.box((1.0, 0.2, 0.2), divisions), material)
     body.fix(np.isclose(body.mesh.points[:, 0], 0.0))
@@ -78,10 +94,10 @@ def beam(divisions, material):
     return body
 
 
-@pytest.mark.parametrize("slow", [slow_static_solve, slow_dynamic_relaxation])
+@pytest.mark.parametrize("slow", [slow_static_solve, slow_dynamic_relaxation, slow_needle_push])
 def test_the_window_renders_while_the_worker_solves(display, slow):
-    """A deliberately slow solve in the worker: the window's loop keeps turning meanwhile — it
-    could not if the solve held the GIL."""
+    """A deliberately slow solve (or needle update) in the worker: the window's loop keeps
+    turning meanwhile — it could not if the engine held the GIL."""
     from snede.interactive.window import Window
 
     solve, frames = {}, []
@@ -146,6 +162,9 @@ def test_pause_holds_the_events_and_reset_starts_again(display):
     window.run(events(scripted), close=True, tick=reset_after_the_cut)
     assert lips[0] > 0  # the drag had cut when r was pressed
     assert window.worker.session.moves == [] and len(window.worker.session.tool.lips()) == 0
+    recording = window.worker.session.recording()
+    assert recording["resets"] == 1 and "since the window's last reset" in recording["note"]
+    assert "resets" not in cut_session().recording()  # without a reset the recording has every move
 
 
 def test_q_closes_the_window(display):
