@@ -1,4 +1,4 @@
-"""``ToolSession(scene, options)``: a built-in scene driven by pointer events, headless — the
+"""``ToolSession(scene, options)``: a built-in scene or a scene file driven by pointer events, headless — the
 window (``snede.interactive.window``) shows one and feeds it the mouse, tests feed it scripted
 events. Every tool move is carried out at once (the body relaxes after each) and recorded with
 its time: ``recording()`` is the JSON a replay repeats (``snede.interactive.recording``).

@@ -211,7 +211,7 @@ def _whole_view(body, angles) -> View:
     points = body.mesh.points
     low, high = points.min(axis=0), points.max(axis=0)
     return View(tuple((low + high) / 2), tuple(direction_from_angles(*angles)), (0.0, 0.0, 1.0),
-                height=1.6 * float((high - low).max()))
+                height=2.0 * float((high - low).max()))
 
 
 def _plane_along(point, direction, view: View) -> tuple:
@@ -224,12 +224,12 @@ def _plane_along(point, direction, view: View) -> tuple:
 
 def _needle3d(scene, method: str, rtol: float) -> Needle:
     """The ``needle3d`` scene's needle (§6.9) entering the cube's left face, in updates of the
-    scene's speed × h_ref, seen from the cube's front; the pointer moves on the plane of the
-    shaft that faces the view."""
+    scene's speed × h_ref, seen as the scene's picture sees it (from the entry's side); the
+    pointer moves on the plane of the shaft that faces the view."""
     from snede.scenes import needle3d
 
     h_ref = scene.details["h_ref_m"]
-    view = _whole_view(scene.body, needle3d.VIEW)
+    view = _whole_view(scene.body, needle3d.ENTRY_VIEW)
     return Needle(scene.body, needle3d.needle_for(scene.body, h_ref, method, rtol), needle3d.ENTRY,
                   needle3d.DIRECTION, scene.details["speed_h_ref_per_update"] * h_ref, needle3d.DEPTH, view,
                   _plane_along(needle3d.ENTRY, needle3d.DIRECTION, view))
