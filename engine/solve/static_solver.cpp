@@ -69,9 +69,16 @@ constexpr double newton_stall = 1e-6;
 // 600–700). Nonlinear CG takes none.
 constexpr std::size_t multigrid_from_cells = 1000;
 
+// Whether "mg" has levels for the problem: serially on any mesh; on ranks on volume meshes only
+// (rank_aggregation.hpp aggregates no membrane).
+bool has_multigrid(const Problem& problem) {
+  const auto* distributed = dynamic_cast<const DistributedStatic*>(&problem);
+  return !distributed || distributed->part().local->cell_dim() == problem.dim();
+}
+
 std::string automatic_preconditioner(const Problem& problem, StaticMethod method) {
   if (method == StaticMethod::nonlinear_cg ||
-      problem.n_global_cells() < static_cast<std::int64_t>(multigrid_from_cells))
+      problem.n_global_cells() < static_cast<std::int64_t>(multigrid_from_cells) || !has_multigrid(problem))
     return PCNONE;
   return PCMG;
 }

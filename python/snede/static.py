@@ -85,7 +85,8 @@ class StaticSolver(RunsOnRanks):
       ranks ``"mg"`` coarsens by aggregation of each rank's vertices (``-static_mg_coarsening``
       aggregation or auto; bisection and grid levels need the whole mesh), ``"lu"`` and
       ``"cholesky"`` factor with MUMPS, ``"bjacobi"`` is ILU(0) on each rank's block and
-      ``"sor"`` sweeps each rank's rows; ``"auto"`` chooses as serially. ``part`` is this rank's
+      ``"sor"`` sweeps each rank's rows; ``"auto"`` chooses as serially (but none on a
+      membrane, which has no ``"mg"`` on ranks). ``part`` is this rank's
       part. Every rank must pass the same arguments (else every rank raises ValueError naming
       them). None (default): the body's ``comm``, and without one the serial solver.
 

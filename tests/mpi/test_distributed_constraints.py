@@ -89,6 +89,18 @@ def test_a_membrane_on_ranks_gives_the_serial_displacement(preconditioner):
     assert len({u.tobytes() for u in COMM.allgather(body.displacement)}) == 1
 
 
+def test_auto_takes_no_multigrid_on_a_membrane_on_ranks():
+    """"auto" chooses "mg" from 1 000 cells serially, membranes included; on ranks a membrane has
+    no "mg" levels, so "auto" takes none there instead of refusing the solve."""
+    body, reference = pretensioned_sheet(24), pretensioned_sheet(24)  # 1 152 triangles
+    solver = snede.StaticSolver(body, "newton", rtol=1e-10, comm=COMM)
+    result = solver.solve()
+    assert result.converged and solver.preconditioner == "none", result
+    assert snede.StaticSolver(reference, "newton", rtol=1e-10).preconditioner == "mg"
+    assert snede.StaticSolver(reference, "newton", rtol=1e-12, preconditioner="none").solve().converged
+    assert relative_difference(body.displacement, reference.displacement) <= 1e-7
+
+
 def test_multigrid_on_a_membrane_on_ranks_is_refused_on_every_rank():
     with pytest.raises(ValueError, match="preconditioner 'mg' on MPI ranks .* not on a membrane"):
         snede.StaticSolver(pretensioned_sheet(10), "newton", preconditioner="mg", comm=COMM).solve()
