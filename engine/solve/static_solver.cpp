@@ -13,8 +13,8 @@
 #include "core/log_event.hpp"
 #include "core/norms.hpp"
 #include "core/petsc_util.hpp"
-#include "solve/aggregation_multigrid.hpp"
 #include "core/rank_agreement.hpp"
+#include "solve/aggregation_multigrid.hpp"
 #include "solve/bisection_multigrid.hpp"
 #include "solve/distributed_static.hpp"
 #include "solve/failed_solve.hpp"
@@ -153,8 +153,6 @@ StaticSolver::StaticSolver(std::unique_ptr<ModelProblem> owned, Problem* problem
   if (pc_type_ != PCMG && !automatic_ && option_database_.string_option(options_.options_prefix + "mg_refresh_ratio"))
     throw std::invalid_argument("-" + options_.options_prefix + "mg_refresh_ratio applies to the preconditioner 'mg'; "
                                 "this solver's is '" + pc_type_ + "'");
-  // Jacobi reads the shell's diagonal (MatGetDiagonal), mg builds its own levels (and needs
-  // entries only for Galerkin levels); every other PC needs entries.
   PetscMPIInt ranks = 1;
   SNEDE_PETSC(MPI_Comm_size(problem_.comm(), &ranks));
   // PETSc's incomplete factorisations are sequential: PETSc's own error names no remedy.
@@ -163,6 +161,8 @@ StaticSolver::StaticSolver(std::unique_ptr<ModelProblem> owned, Problem* problem
                                 std::to_string(ranks) + " MPI ranks use 'bjacobi' (" + pc_type_ +
                                 " of each rank's block: -" + options_.options_prefix + "sub_pc_type " + pc_type_ +
                                 "), 'mg' or 'gamg'");
+  // Jacobi reads the shell's diagonal (MatGetDiagonal), mg builds its own levels (and needs
+  // entries only for Galerkin levels); every other PC needs entries.
   pc_needs_matrix_ = pc_type_ != PCNONE && pc_type_ != PCJACOBI && pc_type_ != PCMG;
   needs_matrix_ = pc_needs_matrix_;
   register_line_searches();
@@ -397,13 +397,13 @@ void StaticSolver::build_multigrid() {
     throw std::invalid_argument(prefix + "mg_coarsening bisection: this mesh has no bisection hierarchy (refine it "
                                 "with mesh.refine_uniform or refine_around first, or use grid or aggregation)");
   multigrid_.reset();
-  // A mesh read from a file and refined locally (along a needle) has that mesh, or more, as the
-  // coarsest bisection level: a direct solve on it costs more than the grid levels (a
-  // 21k-tetrahedron liver took 1.6 s per factorisation). Its roots tell before the levels are made.
   if (!model_) {
     build_rank_multigrid(coarsening, max_levels);
     return;
   }
+  // A mesh read from a file and refined locally (along a needle) has that mesh, or more, as the
+  // coarsest bisection level: a direct solve on it costs more than the grid levels (a
+  // 21k-tetrahedron liver took 1.6 s per factorisation). Its roots tell before the levels are made.
   const bool small_roots =
       hierarchy_ && small_coarsest_level(hierarchy_->roots().size(), model_->body().mesh().n_cells());
   if (coarsening != "aggregation" && coarsening != "grid" && hierarchy_ && (small_roots || coarsening == "bisection")) {
