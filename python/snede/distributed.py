@@ -158,9 +158,7 @@ class DistributedStatic:
         ‖f_react‖²) plus ``round_tolerance``'s floor, or ‖F‖ ≤ rtol·‖f_ext‖; ``tolerance`` in
         the result is the threshold. A start that already meets (6.9) is converged with no
         iteration under "relative" too (a residual at round-off cannot meet ε‖F(u₀)‖)."""
-        def checked():
-            if method not in ("cg", "newton", "ncg"):
-                raise ValueError(f"method must be 'cg', 'newton' or 'ncg', got {method!r}")
+        def checked():  # the engine's options check every value (a ValueError naming it)
             return _snede.StaticOptions(method=method, rtol=float(rtol), criterion=str(criterion),
                                         round_tolerance=float(round_tolerance),
                                         max_iterations=_checks.count(max_iterations, "max_iterations"),
