@@ -121,7 +121,7 @@ def _parser() -> argparse.ArgumentParser:
     replay.add_argument("recording", type=Path, help="the recording (JSON, from `view --record`)")
     replay.add_argument("--check", action="store_true",
                         help="exit 0 only if the final mesh and displacement match the recording's digest "
-                             "(to 1e-12 relative)")
+                             "(cells exactly, floats to about the recorded rtol)")
     replay.add_argument("--out", type=Path, help="write the series and a picture to OUT/SCENE/")
     return parser
 

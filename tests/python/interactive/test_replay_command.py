@@ -1,6 +1,7 @@
 """``python -m snede replay FILE [--check] [--out DIR]``: status 0 only when the replay matches the
 digest, 1 when it does not, 2 with one line for a missing or bad file or an unknown scene."""
 import json
+import math
 import subprocess
 import sys
 
@@ -31,7 +32,9 @@ def test_a_recorded_cut_replays_and_checks(cut_recording, tmp_path):
 
 def test_a_tampered_digest_fails_the_check(cut_recording):
     recording = json.loads(cut_recording.read_text())
-    recording["digest"]["points"]["sum"] += 1e-6 * recording["digest"]["points"]["norm"]
+    digest = recording["digest"]
+    # twice the sum's tolerance, √n·rtol·|u| (recording.compare)
+    digest["points"]["sum"] += 2 * math.sqrt(digest["points"]["size"]) * recording["rtol"] * digest["displacement"]["norm"]
     cut_recording.write_text(json.dumps(recording))
     done = snede("replay", cut_recording, "--check")
     assert done.returncode == 1
