@@ -14,7 +14,9 @@ The digest keeps, per array (the mesh's points and cells, the displacement), its
 norm and a weighted sum — not a hash of floats — and a replay compares what the computation
 determines: sizes and the cells' integer sums exactly, the float sums to a tolerance derived
 from the recording's ``rtol`` (``compare``). The bits below that tolerance differ from one CPU to
-another (another SIMD width, fused multiply-adds) and are not the session's result.
+another (another SIMD width, fused multiply-adds) and are not the session's result. A digest
+value that is not a finite number (``Infinity`` would make the tolerance infinite) or an integer
+where one is due is refused when the recording is read.
 """
 from __future__ import annotations
 
@@ -121,7 +123,37 @@ def checked(recording, source: str) -> dict:
     for index, move in enumerate(recording["moves"]):
         if not isinstance(move, dict) or not {"t", "tool", "action"} <= set(move):
             raise ValueError(f"{source}: move {index} must be an object with 't', 'tool' and 'action', got {move!r}")
+    rtol = recording.get("rtol")
+    if rtol is not None and not (_is_number(rtol) and 0 < rtol < 1):
+        # the digest's tolerance grows with it (``compare``)
+        raise ValueError(f"{source}: 'rtol' must be a number in (0, 1), got {json.dumps(rtol)}")
+    _check_digest(recording["digest"], source)
     return recording
+
+
+def _is_number(value) -> bool:
+    """A finite JSON number (not a boolean; an integer too large for a float is not finite)."""
+    try:
+        return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
+    except OverflowError:
+        return False
+
+
+def _check_digest(values, source: str) -> None:
+    """Every value a digest must have, of its type: integers for sizes and the cells' sums, finite
+    numbers for the float sums (not Infinity or NaN, which no comparison would reject)."""
+    for name in (*FLOAT_ARRAYS, "cells"):
+        part = values.get(name) if isinstance(values, dict) else None
+        keys = CELL_KEYS if name == "cells" else FLOAT_KEYS
+        if not isinstance(part, dict):
+            raise ValueError(f"{source}: digest.{name} must be an object with {', '.join(keys)}")
+        for key in keys:
+            value = part.get(key)
+            integer = name == "cells" or key == "size"
+            if not (_is_number(value) and (isinstance(value, int) or not integer)):
+                shown = "missing" if key not in part else json.dumps(value)
+                raise ValueError(f"{source}: digest.{name}.{key} must be "
+                                 f"{'an integer' if integer else 'a finite number'}, got {shown}")
 
 
 def load(path) -> dict:
