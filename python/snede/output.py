@@ -71,9 +71,12 @@ class SeriesWriter:
 
         A field name must read back as it was written, from the HDF5 dataset it names and from
         the XDMF (XML) file: not empty, no '/', no control character (NUL, tab, newline, ...),
-        no U+FFFE or U+FFFF, no space at the end, and not taken by another field of the step.
-        Any other name raises ValueError naming the field and the reason, before the step
-        writes anything (the series stays readable, the writer usable)."""
+        no U+FFFE or U+FFFF, no space at the end, and not taken by another field of the step,
+        among them the fields the writer makes itself (``displacement``, ``aspect_ratio``,
+        ``min_angle``, ``inverted``, ``group:<name>`` of the mesh's groups), which a field of
+        the same name would replace. Any other name raises ValueError naming the field and the
+        reason, before the step writes anything (the series stays readable, the writer usable)."""
+        _refuse_built_in(cell_fields, ("inverted",), "cell")
         u = body.displacement if displacement is None else np.asarray(displacement, dtype=np.float64)
         inverted = np.zeros(body.mesh.n_cells)
         inverted[body.inverted_elements(u)] = 1.0
@@ -86,10 +89,15 @@ class SeriesWriter:
         cell fields, an optional (n_points, dim) ``displacement``, extra cell fields and
         ``point_fields`` (their names as ``write`` says). The mesh's named groups go along: a
         cell field ``group:<name>`` (1 on the group's cells) per cell group, a point field
-        ``group:<name>`` (1 on its faces' vertices) per boundary group."""
-        cell_fields = {**_group_fields(mesh.cell_groups, mesh.n_cells), **cell_fields}
+        ``group:<name>`` (1 on its faces' vertices) per boundary group. A field of the caller's
+        may not take the name of one of these."""
+        groups = _group_fields(mesh.cell_groups, mesh.n_cells)
+        _refuse_built_in(cell_fields, groups, "cell")
+        cell_fields = {**groups, **cell_fields}
         boundary = {name: np.unique(faces) for name, faces in mesh.boundary_groups.items()}
-        point_fields = {**_group_fields(boundary, mesh.n_points), **(point_fields or {})}
+        groups = _group_fields(boundary, mesh.n_points)
+        _refuse_built_in(point_fields or {}, groups, "point")
+        point_fields = {**groups, **(point_fields or {})}
         u, points, fields = _step_arrays(mesh, displacement, point_fields, cell_fields)
         self._impl.write_step(float(time), mesh._impl, u, fields, points)
 
@@ -123,11 +131,25 @@ def _step_arrays(mesh, displacement, point_fields, cell_fields):
     u = np.zeros((mesh.n_points, mesh.dim)) if displacement is None else np.asarray(displacement, dtype=np.float64)
     for name in [*(point_fields or {}), *cell_fields]:
         _check_encodable(name)
+    _refuse_built_in(cell_fields, QUALITY_FIELDS, "cell")
     points = {name: np.asarray(values, dtype=np.float64).ravel() for name, values in (point_fields or {}).items()}
     quality = mesh.quality()
     fields = {"aspect_ratio": quality.aspect_ratio, "min_angle": quality.min_dihedral}
     fields.update({name: np.asarray(values, dtype=np.float64) for name, values in cell_fields.items()})
     return np.ascontiguousarray(u), points, fields
+
+
+QUALITY_FIELDS = ("aspect_ratio", "min_angle")  # the cell fields of every step
+
+
+def _refuse_built_in(given: dict, built_in, kind: str) -> None:
+    """Refuse a field of the caller's named as one the writer makes itself (``built_in``): as
+    keyword arguments it would silently replace that field (or clash with the writer's own
+    keyword argument, a TypeError)."""
+    for name in given:
+        if name in built_in:
+            raise ValueError(f"{kind} field name {name!r} is taken: the writer writes a {kind} field of that "
+                             "name itself, which yours would replace; give yours another name")
 
 
 def _check_encodable(name) -> None:
