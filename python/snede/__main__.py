@@ -235,20 +235,26 @@ def _view(args) -> int:
     from snede.interactive import events
     from snede.interactive.recording import save
     from snede.interactive.session import ToolSession
+    from snede.interactive.window import Window, display_answers
 
-    if sys.platform.startswith("linux") and not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
+    display = os.environ.get("DISPLAY")
+    if sys.platform.startswith("linux") and not (display or os.environ.get("WAYLAND_DISPLAY")):
         _command_line.fail("view needs a display: none is set (DISPLAY); without one, run it under xvfb-run")
+    if sys.platform.startswith("linux") and display and not display_answers(display):
+        _command_line.fail(f"view needs a display: DISPLAY={display} does not answer (no X server there, or it "
+                           "refuses this user); without one, run it under xvfb-run")
     played = events.load(args.events) if args.events else []
     options = {name: getattr(args, name) for name in ("divisions", "material", "speed") if getattr(args, name)}
-    from snede.interactive.window import Window
-
     window = Window(partial(ToolSession, args.scene, options))
     tool = window.worker.session.tool.name
     for index, event in enumerate(played):
         if event.tool != tool:
             raise ValueError(f"events file {args.events}: event {index}: 'tool' is {event.tool}, but the "
                              f"{args.scene} scene's tool is the {tool}")
-    window.run(played, args.screenshot, close=args.exit)
+    try:
+        window.run(played, args.screenshot, close=args.exit)
+    except _mismatched_interactor() as error:  # VTK could not draw on the display (no GLX?) and went off-screen
+        _command_line.fail(f"view cannot open its window on DISPLAY={display}: {str(error).split('. ')[0]}")
     session = window.worker.session
     if args.record:
         save(session.recording(), args.record)
@@ -259,6 +265,13 @@ def _view(args) -> int:
         print(_command_line.error_line(window.worker.error), file=sys.stderr)
         return _command_line.BAD_INPUT
     return 0
+
+
+def _mismatched_interactor() -> tuple:
+    """pyvista's error for an interactor without its X window (none in older pyvista)."""
+    from pyvista.plotting import errors
+
+    return tuple(filter(None, [getattr(errors, "MismatchedInteractorError", None)]))
 
 
 def _replay(args) -> int:

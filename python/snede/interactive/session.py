@@ -32,9 +32,17 @@ def file_checksum(path) -> str:
 
 
 def _options_checked(options: dict, allowed: tuple, what: str) -> None:
+    """Known option names, with values of the kinds the command line's parser gives (a
+    recording's JSON may hold anything: "12" for divisions was a TypeError deep in a scene)."""
+    from snede.scene_file.reading import COUNT, POSITIVE, REFUSED, TEXT, shown
+
     unknown = sorted(set(options) - set(allowed))
     if unknown:
         raise ValueError(f"unknown {what} option(s) {', '.join(unknown)} (the options: {', '.join(allowed)})")
+    kinds = {"divisions": COUNT, "speed": POSITIVE, "material": TEXT, "formulation": TEXT}
+    for name, value in options.items():
+        if value is not None and kinds[name].convert(value) is REFUSED:
+            raise ValueError(f"{what} option {name!r} must be {kinds[name].what}, got {shown(value)}")
 
 
 def _scene(name: str, options: dict):

@@ -34,6 +34,25 @@ MAGNITUDE = "displacement [m]"  # |u|: VTK's default font has no '|'
 COLOURS = {"blade": (0.0, 0.0, 0.0), "needle": (0.35, 0.35, 0.35), "stick": (0.12, 0.47, 0.71), "slip": HIGHLIGHT}
 
 
+def display_answers(display: str) -> bool:
+    """Whether an X client can open ``display`` now (Xlib's XOpenDisplay, as VTK calls it); True
+    where Xlib is not found (VTK then says what it finds). VTK itself, given a display that does
+    not answer, renders off-screen (EGL) and its interactor fails at the first event."""
+    import ctypes
+    import ctypes.util
+
+    library = ctypes.util.find_library("X11")
+    if library is None:
+        return True
+    xlib = ctypes.CDLL(library)
+    xlib.XOpenDisplay.restype = ctypes.c_void_p
+    xlib.XCloseDisplay.argtypes = [ctypes.c_void_p]
+    connection = xlib.XOpenDisplay(display.encode())
+    if connection:
+        xlib.XCloseDisplay(connection)
+    return bool(connection)
+
+
 class Worker(threading.Thread):
     """Owns the session: takes pointer events (and resets) from ``inbox``, carries them out,
     and publishes a ``Snapshot`` after each; counts the relaxations and their seconds."""

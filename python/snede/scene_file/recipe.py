@@ -77,6 +77,9 @@ def read(path) -> Recipe:
         raise SceneFileError(f"{source}: could not be read: {error}") from None
     except tomllib.TOMLDecodeError as error:
         raise SceneFileError(f"{source}: not valid TOML: {error}") from None
+    except RecursionError:  # tomllib parses nested arrays and inline tables recursively
+        raise SceneFileError(f"{source}: nests arrays or tables too deeply to be read (no scene file nests more "
+                             "than 3 deep)") from None
     top = Table(values, "", source)
     for section in SECTIONS:  # a misspelled section is named before one it leaves missing
         top.has(section)

@@ -2,6 +2,8 @@
 import pytest
 import tool_scripts
 
+from snede.interactive.window import display_answers
+
 
 @pytest.fixture
 def cut_session():
@@ -11,20 +13,6 @@ def cut_session():
 @pytest.fixture
 def needle_session():
     return tool_scripts.needle_session()
-
-
-def _reachable(display: str) -> bool:
-    """Whether an X client can open ``display`` now (Xlib's XOpenDisplay, as VTK calls it)."""
-    import ctypes
-    import ctypes.util
-
-    xlib = ctypes.CDLL(ctypes.util.find_library("X11"))
-    xlib.XOpenDisplay.restype = ctypes.c_void_p
-    xlib.XCloseDisplay.argtypes = [ctypes.c_void_p]
-    connection = xlib.XOpenDisplay(display.encode())
-    if connection:
-        xlib.XCloseDisplay(connection)
-    return bool(connection)
 
 
 @pytest.fixture(scope="session")
@@ -46,9 +34,9 @@ def display():
         server = subprocess.Popen([xvfb, f":{number}", "-screen", "0", "1024x768x24", "-nolisten", "tcp"],
                                   stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
         deadline = time.monotonic() + 20
-        while server.poll() is None and not _reachable(f":{number}") and time.monotonic() < deadline:
+        while server.poll() is None and not display_answers(f":{number}") and time.monotonic() < deadline:
             time.sleep(0.05)
-        if server.poll() is None and _reachable(f":{number}"):
+        if server.poll() is None and display_answers(f":{number}"):
             break
         server.kill()
         server.wait()

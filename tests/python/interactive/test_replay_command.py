@@ -96,6 +96,11 @@ def tampered(name, key, value) -> str:
     (a_recording(digest={**GOOD_DIGEST, "cells": {"size": 4, "sum": 6}}), "digest.cells.weighted must be an integer, "
                                                                            "got missing"),
     (a_recording(rtol=1e300), "'rtol' must be a number in (0, 1), got 1e+300"),
+    # tracebacks with status 1 before (issue 48, item 11)
+    ("[" * 5000 + "]" * 5000, "nests lists or objects more than 32 deep (no recording does)"),
+    (a_recording(moves=[{"t": 0, "tool": "scalpel", "action": "move", "blade": json.loads("[" * 100 + "]" * 100)}]),
+     "nests lists or objects more than 32 deep"),
+    (a_recording(options={"divisions": "12"}), 'scene option \'divisions\' must be a positive integer, got "12"'),
 ])
 def test_bad_recordings_give_one_line(tmp_path, content, fragment):
     path = tmp_path / "recording.json"

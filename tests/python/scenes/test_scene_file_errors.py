@@ -77,6 +77,8 @@ MISTAKES = {
     "a value for a table": (edited(("[mesh]", 'solver = "newton"\n\n[mesh]')),
                             'solver must be a table ([solver] or {...}), got "newton"'),
     "not TOML at all": (edited(("E = 3e4", "E = ")), "not valid TOML: Invalid value (at line 9, column 5)"),
+    "TOML nested 5 000 deep": (edited("x = " + "[" * 5000 + "]" * 5000 + "\n"),
+                               "nests arrays or tables too deeply to be read"),
     # bad values
     "a negative modulus": (edited(("E = 3e4", "E = -3")), "material.E must be a positive number, got -3"),
     "an incompressible material": (edited(("nu = 0.3", "nu = 0.5")),
@@ -167,7 +169,7 @@ def test_a_missing_scene_file_is_named(tmp_path):
 
 
 @pytest.mark.parametrize("mistake", ["a negative modulus", "a misspelled section", "a missing mesh file",
-                                     "a needle that comes out the other side"])
+                                     "a needle that comes out the other side", "TOML nested 5 000 deep"])
 def test_the_command_line_says_the_line_and_exits_with_status_2(mistake, tmp_path):
     text, message = MISTAKES[mistake]
     (tmp_path / "my_scene.toml").write_text(text)
