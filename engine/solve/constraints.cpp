@@ -9,6 +9,8 @@
 #include <string>
 #include <unordered_map>
 
+#include <Eigen/Dense>
+
 #include "mesh/traversal.hpp"
 
 namespace snede {
@@ -222,20 +224,88 @@ void PieceHolding::label_pieces() {
   labelled_ = true;
 }
 
+namespace {
+
+// The rigid motions' values at x (relative to the piece's origin), (dim × n_motions) row-major
+// into `rows`: translations, then rotations, u = a + ω × x = a − [x]× ω (3D) or a + ω (−y, x) (2D).
+void rigid_motions_at(std::span<const double> x, int dim, std::span<double> rows) {
+  const int n = dim == 3 ? 6 : 3;
+  std::fill(rows.begin(), rows.end(), 0.0);
+  for (int k = 0; k < dim; ++k) rows[k * n + k] = 1;
+  if (dim == 2) {
+    rows[0 * n + 2] = -x[1];
+    rows[1 * n + 2] = x[0];
+    return;
+  }
+  // −[x]× in columns 3–5: (x × ω)_i = ε_ijk x_j ω_k, negated.
+  rows[0 * n + 4] = x[2], rows[0 * n + 5] = -x[1];
+  rows[1 * n + 3] = -x[2], rows[1 * n + 5] = x[0];
+  rows[2 * n + 3] = x[1], rows[2 * n + 4] = -x[0];
+}
+
+// A piece's constraint rows on its rigid motions, accumulated as the Gram matrix Σ Rᵀ(I − P)R.
+struct RigidMotionGram {
+  Eigen::MatrixXd gram;
+  double span = 0;  // largest |x − origin| over its constrained vertices: the rotations' scale
+  std::size_t components = 0;
+
+  // The rank of the rows: rotations scaled by 1/span so that every entry is O(1); the
+  // eigenvalues of a direction the rows do not constrain are then rounding, O(1e-16) relative,
+  // and 1e-10 leaves six orders of margin (it counts as a hinge a set of vertices off a line by
+  // less than 1e-5 of their span, which holds the piece no better numerically).
+  std::size_t rank() const {
+    if (components == 0) return 0;
+    const int n = static_cast<int>(gram.rows());
+    Eigen::VectorXd scale = Eigen::VectorXd::Ones(n);
+    if (span > 0) scale.tail(n / 2).setConstant(1 / span);
+    const Eigen::MatrixXd scaled = scale.asDiagonal() * gram * scale.asDiagonal();
+    const Eigen::VectorXd eigenvalues = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(scaled).eigenvalues();
+    const double largest = eigenvalues.maxCoeff();
+    return static_cast<std::size_t>((eigenvalues.array() > 1e-10 * largest).count());
+  }
+};
+
+}  // namespace
+
 std::vector<LoosePiece> PieceHolding::loose_pieces(const Constraints& constraints) {
   if (!labelled_ || labelled_revision_ != mesh_.connectivity().revision()) label_pieces();
   const int pieces = static_cast<int>(piece_cells_.size());
-  std::vector<std::size_t> held(pieces, 0);
+  const int dim = constraints.dim(), n_motions = dim == 3 ? 6 : 3;
+  std::vector<RigidMotionGram> grams(pieces, RigidMotionGram{Eigen::MatrixXd::Zero(n_motions, n_motions)});
+  std::vector<double> block(static_cast<std::size_t>(dim * dim)), rows(static_cast<std::size_t>(dim * n_motions));
+  Eigen::MatrixXd complement(dim, dim);
   const VertexId n = std::min(constraints.n_points(), static_cast<VertexId>(vertex_piece_.size()));
+  auto add = [&](VertexId v, int piece) {
+    const std::size_t components = constraints.constrained_components(v);
+    if (components == 0) return;
+    RigidMotionGram& g = grams[piece];
+    const auto origin = mesh_.point(mesh_.connectivity().element(piece_first_cell_[piece]).simplex.vertices()[0]);
+    std::array<double, 3> x{0, 0, 0};
+    for (int k = 0; k < dim; ++k) x[k] = mesh_.point(v)[k] - origin[k];
+    g.span = std::max(g.span, std::sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]));
+    g.components += components;
+    rigid_motions_at(x, dim, rows);
+    constraints.projection_block(v, block);
+    for (int i = 0; i < dim; ++i)
+      for (int j = 0; j < dim; ++j) complement(i, j) = (i == j) - block[static_cast<std::size_t>(i * dim + j)];
+    const Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>> R(rows.data(), dim,
+                                                                                                      n_motions);
+    g.gram += R.transpose() * complement * R;
+  };
   for (VertexId v = 0; v < n; ++v)
-    if (vertex_piece_[v] >= 0) held[vertex_piece_[v]] += constraints.constrained_components(v);
+    if (vertex_piece_[v] >= 0) add(v, vertex_piece_[v]);
   for (const auto& [v, piece] : hinge_pieces_)
-    if (v < n) held[piece] += constraints.constrained_components(v);
-  const std::size_t rigid_motions = constraints.dim() == 3 ? 6 : 3;
+    if (v < n) add(v, piece);
+  // A membrane has no bending stiffness: tension holds it, not the rank of its supports (a
+  // sheet hung from a straight rod is a membrane scene), so it keeps the count.
+  const bool by_count = mesh_.is_surface();
   std::vector<LoosePiece> loose;
-  for (int piece = 0; piece < pieces; ++piece)
-    if (held[piece] < rigid_motions)
-      loose.push_back({piece, pieces, piece_cells_[piece], piece_first_cell_[piece], held[piece], rigid_motions});
+  for (int piece = 0; piece < pieces; ++piece) {
+    const std::size_t stopped = grams[piece].rank();
+    if ((by_count ? grams[piece].components : stopped) < static_cast<std::size_t>(n_motions))
+      loose.push_back({piece, pieces, piece_cells_[piece], piece_first_cell_[piece], grams[piece].components, stopped,
+                       static_cast<std::size_t>(n_motions)});
+  }
   return loose;
 }
 
@@ -250,9 +320,11 @@ void PieceHolding::require_held(const Constraints& constraints) {
                               std::to_string(mesh_.connectivity().element(first.first_cell).simplex.vertices()[0]) +
                               " among them) has ";
   std::string message = "the body is not held: " + which + std::to_string(first.constrained_components) +
-                        " constrained displacement components where at least " +
+                        " constrained displacement components, which stop " +
+                        std::to_string(first.rigid_motions_stopped) + " of its " +
                         std::to_string(first.rigid_motions) +
-                        " are needed to stop its rigid motions (3 in 2D, 6 in 3D and on membranes)";
+                        " rigid motions (3 in 2D, 6 in 3D: vertices on one line leave a solid free to turn " +
+                        "about it; a membrane needs 6 constrained components)";
   if (first.pieces == 1)
     throw std::invalid_argument(message + "; fix some of its vertices with body.fix");
   message += "; " + std::to_string(loose.size()) + " of the " + std::to_string(first.pieces) + " pieces " +

@@ -70,33 +70,38 @@ class Constraints {
   std::vector<VertexConstraint> vertices_;
 };
 
-// A piece of a mesh (cells joined through faces, §3.3) with fewer constrained displacement
-// components than it has rigid motions.
+// A piece of a mesh (cells joined through faces, §3.3) whose constraints do not stop all of
+// its rigid motions.
 struct LoosePiece {
   int piece = 0;   // label in [0, pieces)
   int pieces = 0;  // in the mesh
   std::size_t cells = 0;
   ElementId first_cell = no_id;  // its lowest cell id
   std::size_t constrained_components = 0;
-  std::size_t rigid_motions = 0;  // 3 in 2D, 6 in 3D and on membranes
+  std::size_t rigid_motions_stopped = 0;  // rank of the constraints on the piece's rigid motions
+  std::size_t rigid_motions = 0;          // 3 in 2D, 6 in 3D and on membranes
 };
 
 // Whether constraints hold every piece of a mesh. A piece cut free of every support keeps its
 // rigid motions, so the static problem has no unique solution, however many components the
 // rest of the body has constrained: Newton spins to its iteration limit, CG meets an indefinite
-// matrix. So each piece needs at least as many constrained components as it has rigid motions
-// (necessary, not sufficient: three fixed vertices on a line pass, as for the whole body). A
-// constrained vertex where pieces meet without a face (a hinge) counts for each of them; a free
-// hinge for none, though it may help hold a piece: the check errs towards refusing, as a piece
-// hinged there still turns about it unless held by constraints of its own.
+// matrix. A piece is held when its constraints stop every rigid motion: the rows (I − P_v) R_v
+// of its constrained vertices, R_v = [I | −[x_v]×] the infinitesimal rigid motions at x_v, have
+// full rank (6 in 3D, 3 in 2D). A count of constrained components is not enough: two fixed
+// vertices (6 components) leave the rotation about the line through them. A membrane, which
+// tension holds (no bending stiffness: every support leaves it a linear mechanism), needs 6
+// constrained components, as before.
+// A constrained vertex where pieces meet without a face (a hinge) counts for each of them; a
+// free hinge for none, though it may help hold a piece: the check errs towards refusing, as a
+// piece hinged there still turns about it unless held by constraints of its own.
 class PieceHolding {
  public:
   explicit PieceHolding(const Mesh& mesh) : mesh_(mesh) {}
   // The pieces `constraints` do not hold, by label. The pieces are labelled once per mesh
-  // revision (O(n)); each call then counts the constrained vertices (one pass, no search).
+  // revision (O(n)); each call then accumulates each piece's constraint rows (one pass).
   std::vector<LoosePiece> loose_pieces(const Constraints& constraints);
-  // Throws std::invalid_argument naming the first loose piece (its size, a vertex, its
-  // constrained components against its rigid motions) and the remedies.
+  // Throws std::invalid_argument naming the first loose piece (its size, a vertex, the rigid
+  // motions its constraints stop against those it has) and the remedies.
   void require_held(const Constraints& constraints);
 
  private:

@@ -207,9 +207,11 @@ class Body:
     def fix_free_pieces(self) -> int:
         """Fix every piece of the body (cells joined through faces) that its constraints do not
         hold: the corners of one of its cells, where they are now, so that the static problem
-        stays well posed (§3.3). Returns how many pieces it fixed. A piece is held when it has at
-        least as many constrained displacement components as rigid motions (3 in 2D, 6 in 3D and
-        on membranes); a static solve refuses a body with a piece that is not. For pieces cut
+        stays well posed (§3.3). Returns how many pieces it fixed. A piece is held when its
+        constraints stop all its rigid motions (3 in 2D, 6 in 3D: two fixed vertices leave the
+        rotation about the line through them), or on a membrane, which tension holds, when it has
+        6 constrained displacement components; a static solve refuses a body with a piece that
+        is not. For pieces cut
         free by ``mesh.dissect`` or a ``DelaunayCutter``; a ``TetrahedralCutter`` fixes them as it
         cuts (``fix_free_pieces=True``)."""
         corners = self._model.loose_piece_cells().ravel()

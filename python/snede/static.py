@@ -91,8 +91,9 @@ class StaticSolver(RunsOnRanks):
       them). None (default): the body's ``comm``, and without one the serial solver.
 
     ``solve()`` first checks that every piece of the body (cells joined through faces) is held:
-    a piece with fewer constrained displacement components than rigid motions (3 in 2D, 6 in 3D
-    and on membranes), e.g. one a cut freed of its supports, has no static solution, and raises
+    a piece whose constraints do not stop all its rigid motions (3 in 2D, 6 in 3D; vertices on
+    one line leave the rotation about it), or a membrane piece with fewer than 6 constrained
+    displacement components, e.g. one a cut freed of its supports, has no static solution, and raises
     ValueError at once naming it (``body.fix_free_pieces()`` or ``body.fix`` holds it).
 
     Every method solves the system divided by the force scale E·t·H (E·H² in 3D), so that the

@@ -3,7 +3,9 @@ the body as a whole. A piece cut free of every support has rigid motions, and th
 problem then has no unique solution: Newton spun to its iteration limit on such a plate and
 linear CG stopped with an indefinite matrix. Every static method refuses it at once, with an
 error naming the piece; after ``body.fix_free_pieces()`` (or fixing some of its vertices) it
-solves. The pieces and their constrained components are checked against a count made here."""
+solves. The pieces and their constrained components are checked against a count made here, and
+the rigid motions their constraints stop against the rank of those constraints' rows computed
+here (issue 48 item 1: a count of components let a piece held on a line turn about it)."""
 import re
 
 import numpy as np
@@ -14,7 +16,7 @@ import snede
 RIGID_MOTIONS = {2: 3, 3: 6}  # by the displacement dimension: membranes have 3D's six
 
 NOT_HELD = re.compile(r"not held: piece (\d+) of (\d+) \((\d+) cells, vertex (\d+) among them\) has (\d+) constrained "
-                      r"displacement components where at least (\d+) are needed")
+                      r"displacement components, which stop (\d+) of its (\d+) rigid motions")
 
 
 def face_pieces(mesh):
@@ -73,14 +75,35 @@ def refusal(body, method, preconditioner=None):
     assert "body.fix" in message and "fix_free_pieces" in message, message
     match = NOT_HELD.search(message)
     assert match, message
-    piece, pieces, cells, vertex, components, needed = map(int, match.groups())
-    return dict(piece=piece, pieces=pieces, cells=cells, vertex=vertex, components=components, needed=needed,
-                message=message)
+    piece, pieces, cells, vertex, components, stopped, needed = map(int, match.groups())
+    return dict(piece=piece, pieces=pieces, cells=cells, vertex=vertex, components=components, stopped=stopped,
+                needed=needed, message=message)
 
 
-def check_named_piece(body, named):
+def rigid_motions_stopped(body, vertices, slides):
+    """The rank of the constraints of `vertices` on the rigid motions: each fixed vertex (the
+    body's constraint table) stops u(x) in every direction, a sliding one (`slides`: vertex →
+    the direction the test gave it) in the directions normal to its line; u(x) = a + ω × x
+    (a + ω (−y, x) in 2D). Rank by SVD."""
+    fixed, _, sliding = body._model.constraint_table()
+    assert set(np.intersect1d(vertices, sliding)) <= set(slides)
+    rows = []
+    for v in np.intersect1d(vertices, np.concatenate([fixed.ravel(), list(slides)]).astype(np.int64)):
+        x = body.mesh.points[v] - body.mesh.points[vertices[0]]
+        if body.dim == 2:
+            motions = np.array([[1.0, 0.0, -x[1]], [0.0, 1.0, x[0]]])
+        else:
+            motions = np.hstack([np.eye(3), -np.cross(np.eye(3), x)])  # row k: e_k · (ω × x) = −(e_k × x) · ω
+        if v in slides:
+            direction = np.asarray(slides[v], dtype=float) / np.linalg.norm(slides[v])
+            motions = motions - np.outer(direction, direction) @ motions
+        rows.append(motions)
+    return 0 if not rows else np.linalg.matrix_rank(np.vstack(rows), tol=1e-9 * np.abs(np.vstack(rows)).max())
+
+
+def check_named_piece(body, named, slides={}):
     """The named piece against the count made here: its size, that the vertex is one of its
-    cells', its constrained components, and that it is not held."""
+    cells', its constrained components, the rigid motions they stop, and that it is not held."""
     label = face_pieces(body.mesh)
     assert np.array_equal(label, vertex_pieces(body.mesh))  # dissect splits the vertices it cuts through
     assert named["pieces"] == label.max() + 1
@@ -89,7 +112,8 @@ def check_named_piece(body, named):
     assert np.all(label[rows] == piece)
     assert named["cells"] == np.count_nonzero(label == piece)
     assert named["components"] == constrained_components_per_piece(body, label)[piece]
-    assert named["needed"] == RIGID_MOTIONS[body.dim] > named["components"]
+    assert named["stopped"] == rigid_motions_stopped(body, np.unique(body.mesh.cells[label == piece]), slides)
+    assert named["needed"] == RIGID_MOTIONS[body.dim] > named["stopped"]
     return piece
 
 
@@ -187,7 +211,7 @@ def test_of_three_pieces_the_first_not_held_is_named_with_the_count():
     label = face_pieces(mesh)
     assert label.max() == 2 and sorted(constrained_components_per_piece(body, label)) == [0, 5, 27]
     named = refusal(body, "cg", "none")
-    check_named_piece(body, named)
+    check_named_piece(body, named, {middle[1]: (0.0, 0.0, 1.0)})
     assert "2 of the 3 pieces are not held" in named["message"]
     assert body.fix_free_pieces() == 2
     assert np.all(constrained_components_per_piece(body, label) >= 6)
@@ -250,3 +274,69 @@ def test_a_solve_on_mpi_ranks_refuses_a_free_piece_as_the_serial_one():
         snede.StaticSolver(body, "cg", comm=MPI.COMM_WORLD).solve()
     body.fix_free_pieces()
     assert snede.StaticSolver(body, "cg", rtol=1e-8, comm=MPI.COMM_WORLD).solve().converged
+
+
+ONE_PIECE = re.compile(r"not held: it is one piece of (\d+) cells with (\d+) constrained displacement components, "
+                       r"which stop (\d+) of its (\d+) rigid motions")
+
+
+def one_piece_refusal(body):
+    """(components, stopped, needed) from the refusal of a one-piece body's linear CG solve."""
+    with pytest.raises(ValueError) as error:
+        snede.StaticSolver(body, "cg", options_prefix="free_one_piece_").solve()
+    match = ONE_PIECE.search(str(error.value))
+    assert match and int(match.group(1)) == body.mesh.n_cells, str(error.value)
+    assert "vertices on one line leave a solid free to turn about it" in str(error.value)
+    return tuple(map(int, match.groups()[1:]))
+
+
+def test_a_box_held_on_a_line_is_refused_however_many_vertices_lie_on_it():
+    """Two fixed vertices are six constrained components, as many as a body has rigid motions,
+    but they leave the rotation about the line through them (issue 48 item 1: CG ran to its
+    iteration limit with |u| ~ 1e29). More vertices on the line stop no more; one off it does."""
+    mesh = snede.meshing.box((1.0, 1.0, 1.0), (2, 2, 2))
+    body = snede.Body(mesh, snede.LinearElastic(1e4, 0.3))
+    body.add_gravity((0.0, 0.0, -9.81))
+    x = mesh.points
+    on_edge = np.flatnonzero(np.isclose(x[:, 1], 0.0) & np.isclose(x[:, 2], 0.0))  # the x axis: 3 vertices
+    assert len(on_edge) == 3
+    for held in (on_edge[[0, 2]], on_edge):
+        body.fix(held)
+        components, stopped, needed = one_piece_refusal(body)
+        assert (components, stopped, needed) == (3 * len(held), 5, 6)
+        assert stopped == rigid_motions_stopped(body, np.arange(mesh.n_points), {})
+    body.fix(np.flatnonzero(np.all(np.isclose(x, (0.0, 1.0, 0.0)), axis=1)))
+    result = snede.StaticSolver(body, "cg", rtol=1e-8, options_prefix="free_line_held_").solve()
+    assert result.converged, result
+
+
+@pytest.mark.parametrize("direction, held", [((0.0, 1.0), False), ((1.0, 0.0), True)])
+def test_a_plate_pinned_at_a_corner_is_held_by_a_slide_only_across_the_rotation(direction, held):
+    """Pinned at (0, 0) and sliding at (1, 0): three components either way, but a slide along y
+    lets the plate turn about the pin, and a slide along x stops it."""
+    mesh = snede.meshing.rectangle((1.0, 0.5), (4, 2))
+    body = snede.Body(mesh, snede.LinearElastic(1e4, 0.3), thickness=0.01)
+    body.add_gravity((0.0, -9.81))
+    corner = lambda p: np.flatnonzero(np.all(np.isclose(mesh.points, p), axis=1))
+    body.fix(corner((0.0, 0.0)))
+    body.slide(corner((1.0, 0.0)), direction)
+    if held:
+        assert snede.StaticSolver(body, "cg", rtol=1e-8, options_prefix="free_pin_slide_").solve().converged
+        return
+    components, stopped, needed = one_piece_refusal(body)
+    assert (components, stopped, needed) == (3, 2, 3)
+    assert stopped == rigid_motions_stopped(body, np.arange(mesh.n_points), {corner((1.0, 0.0))[0]: direction})
+
+
+def test_fix_free_pieces_holds_a_piece_held_on_a_line():
+    """The piece cut free at x = 0.6 has two vertices of its far end fixed: fix_free_pieces holds
+    it on one of its cells, and the solve converges."""
+    body = box_cut_in_two_held_on_the_left(snede.NeoHookean(1e4, 0.3))
+    x = body.mesh.points
+    body.fix(np.flatnonzero(np.isclose(x[:, 0], 1.0) & np.isclose(x[:, 1], 0.0))[:2])
+    named = refusal(body, "newton")
+    check_named_piece(body, named)
+    assert (named["components"], named["stopped"]) == (6, 5)
+    assert body.fix_free_pieces() == 1
+    result = snede.StaticSolver(body, "newton", rtol=1e-8, options_prefix="free_line_fixed_").solve()
+    assert result.converged, result
