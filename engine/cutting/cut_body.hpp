@@ -8,6 +8,7 @@
 #include <span>
 #include <vector>
 
+#include "core/exclusive_use.hpp"
 #include "mesh/connectivity_watcher.hpp"
 
 namespace snede {
@@ -31,6 +32,8 @@ struct CutBody {
   // What becomes of such a piece (§3.3: fixed where it is, so that the next static solve is
   // well posed), given one of its faces' vertices.
   std::function<void(std::span<const VertexId> face)> hold_free_piece;
+  // The body's owner, claimed by each cut (one thread at a time); null for a bare mesh.
+  ExclusiveUse* exclusive_use = nullptr;
 };
 
 }  // namespace snede

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -42,8 +43,14 @@ bool TetrahedralCutter::constrained(VertexId v) const {
   return body_.is_support && body_.is_support(v);
 }
 
+std::optional<ExclusiveUse::Claim> TetrahedralCutter::claim_body() const {
+  if (!body_.exclusive_use) return std::nullopt;
+  return body_.exclusive_use->claim("a cut");
+}
+
 CutReport TetrahedralCutter::cut_triangle(std::span<const double> corners) {
   const SweepTriangle sweep(corners);  // validates before anything changes
+  const auto claim = claim_body();
   if (!cut_configuration_.empty() || !body_.displacement) return cut(sweep);
   // A sweep triangle given alone (not by a move of the placed scalpel) meets the body as it is.
   cut_configuration_ = displacement_now();
@@ -218,6 +225,7 @@ CutReport TetrahedralCutter::move(std::span<const double> scalpel) {
   std::copy(scalpel.begin(), scalpel.end(), now.begin());
   if (now[0] == now[3] && now[1] == now[4] && now[2] == now[5])
     throw std::invalid_argument("TetrahedralCutter.move: the scalpel's two ends coincide (a segment of zero length)");
+  const auto claim = claim_body();
   CutReport report;
   if (!scalpel_ && body_.displacement) cut_configuration_ = displacement_now();
   if (scalpel_) {

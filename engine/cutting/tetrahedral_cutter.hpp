@@ -89,6 +89,8 @@ class TetrahedralCutter : public ConnectivityWatcher {
   // largest piece); true if any.
   bool remove_fragments(CutReport& report);
   bool constrained(VertexId v) const;
+  // The body's owner for one cut, when the cutter has a body (cut_body.hpp).
+  std::optional<ExclusiveUse::Claim> claim_body() const;
   // A copy of the body's displacement as it is now.
   std::vector<double> displacement_now() const;
   // Where the scalpel meets the body: X + u with u the displacement the incision was begun in

@@ -152,6 +152,7 @@ NeedleStepReport NeedleInsertion::advance(double distance) {
   if (!(distance >= 0) || !std::isfinite(distance))
     throw std::invalid_argument("the needle advances by a non-negative, finite distance; got " +
                                 std::to_string(distance));
+  const ExclusiveUse::Claim claim = model_.exclusive_use().claim("a needle step");
   const double start = wall_seconds();
   NeedleStepReport report = advance_in_steps(distance, 0);
   report.seconds = wall_seconds() - start;

@@ -21,6 +21,7 @@ CutBody cut_body_of(Model* model, const Mesh& mesh, const std::string& cutter) {
   CutBody body;
   body.displacement = displacement_of(model, mesh, cutter);
   if (!model) return body;
+  body.exclusive_use = &model->exclusive_use();
   body.is_support = [model](VertexId v) { return model->constraints().constrained_components(v) > 0; };
   body.free_pieces = [model] {
     std::vector<ElementId> cells;

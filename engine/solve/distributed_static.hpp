@@ -112,8 +112,10 @@ class DistributedStatic final : public Problem {
   int dim() const override { return dim_; }
   const Material& material() const override { return body_.material(); }
   std::int64_t n_global_dofs() const override { return part_.n_global_vertices * dim_; }
+  ExclusiveUse& exclusive_use() override { return exclusive_use_; }
 
  private:
+  ExclusiveUse exclusive_use_;
   friend class AssembledDistributedTangent;
   void to_local(Vec global, std::vector<double>& local);
   void add_to_global(const std::vector<double>& local, Vec global);

@@ -161,6 +161,7 @@ double DynamicRelaxation::tolerance(double reaction_norm) const {
 }
 
 SolveResult DynamicRelaxation::advance(PetscInt n_steps, Mode mode, double rtol) {
+  const ExclusiveUse::Claim claim = problem_.exclusive_use().claim("a dynamic relaxation");
   reissue_sizes_if_mesh_changed();
   prepare_state();
   SolveResult result;

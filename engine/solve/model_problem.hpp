@@ -39,6 +39,7 @@ class ModelProblem final : public Problem {
   std::uint64_t generation() const override { return model_.generation(); }
   void add_carried_field(Vec* field) override { model_.add_carried_field(field); }
   void remove_carried_field(Vec* field) override { model_.remove_carried_field(field); }
+  ExclusiveUse& exclusive_use() override { return model_.exclusive_use(); }
 
   Model& model() { return model_; }
 

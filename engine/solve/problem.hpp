@@ -13,6 +13,7 @@
 #include <memory>
 #include <string>
 
+#include "core/exclusive_use.hpp"
 #include "fem/material.hpp"
 
 namespace snede {
@@ -100,6 +101,9 @@ class Problem {
   virtual std::uint64_t generation() const { return 0; }
   virtual void add_carried_field(Vec* /*field*/) {}
   virtual void remove_carried_field(Vec* /*field*/) {}
+
+  // The state's owner, claimed by each solve for its duration (one thread at a time).
+  virtual ExclusiveUse& exclusive_use() = 0;
 };
 
 }  // namespace snede

@@ -625,6 +625,7 @@ double StaticSolver::current_tolerance() const {
 }
 
 SolveResult StaticSolver::solve() {
+  const ExclusiveUse::Claim claim = problem_.exclusive_use().claim("a static solve");
   // A piece with rigid motions has no unique static solution: refused before any set-up, as no
   // method or preconditioner would converge (Newton spun to its iteration limit).
   {

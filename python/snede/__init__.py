@@ -7,6 +7,7 @@ import importlib
 
 from snede._petsc import PETSc  # noqa: F401  (initialises PETSc before the engine loads)
 from snede._snede import (  # noqa: F401
+    BodyInUse,
     DomainError,
     EditResult,
     FileError,
@@ -37,7 +38,7 @@ __all__ = [
     "IncisionLost",
     "SubdivisionCutter", "DistributedMesh", "DistributedRelaxation", "DistributedStatic", "distribute",
     "LinearElastic", "StVenantKirchhoff", "NeoHookean", "VerondaWestmann",
-    "EditResult", "FileError", "InvalidMesh", "PetscError", "DomainError", "LockingWarning", "formulations", "PETSc",
+    "BodyInUse", "EditResult", "FileError", "InvalidMesh", "PetscError", "DomainError", "LockingWarning", "formulations", "PETSc",
     "output_folder",
 ]
 __version__ = "0.1.0"
