@@ -521,6 +521,12 @@ void Connectivity::add_watcher(ConnectivityWatcher* watcher, WatchMode mode) {
   watcher->init(*this);
 }
 
+std::string Connectivity::watcher_refusal(const Simplex& cell) const {
+  for (const auto& [watcher, mode] : watchers_)
+    if (std::string why = watcher->refuses(cell); !why.empty()) return why;
+  return {};
+}
+
 void Connectivity::remove_watcher(ConnectivityWatcher* watcher) {
   std::erase_if(watchers_, [watcher](const auto& entry) { return entry.first == watcher; });
 }

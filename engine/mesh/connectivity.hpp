@@ -128,6 +128,8 @@ class Connectivity {
   void notify_vertex_events();
 
   void add_watcher(ConnectivityWatcher* watcher, WatchMode mode = WatchMode::merged);
+  // The first watcher's reason to refuse a planned new cell (ConnectivityWatcher::refuses), or empty.
+  std::string watcher_refusal(const Simplex& cell) const;
   void remove_watcher(ConnectivityWatcher* watcher);
 
   // Batches (nestable; see ChangeBatch): merged watchers hear of the operations in a batch

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -54,6 +55,10 @@ class ConnectivityWatcher {
   // Called after every operation (replace_elements, change_elements, a vertex move or
   // removal), or once per batch, when the mesh is valid again.
   virtual void on_change(const Connectivity& connectivity, const ConnectivityChange& change) = 0;
+  // Why a cell an edit plans to add would break this watcher's fields (a body: inverted in its
+  // deformed configuration), or empty. Edits that choose among several retriangulations ask
+  // before they commit to one (remove_vertex_by_flips), so they choose one every field admits.
+  virtual std::string refuses(const Simplex& /*cell*/) const { return {}; }
 };
 
 }  // namespace snede

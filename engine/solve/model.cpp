@@ -2,6 +2,7 @@
 
 #include <petsc/private/petscimpl.h>  // PetscObjectStateGet: a Vec's write count
 
+#include <array>
 #include <cmath>
 #include <limits>
 #include <numeric>
@@ -10,6 +11,7 @@
 #include "core/growable_vec.hpp"
 #include "core/norms.hpp"
 #include "core/petsc_util.hpp"
+#include "core/predicates.hpp"
 #include "solve/stopping.hpp"
 #include "solve/tangent_assembly.hpp"
 
@@ -240,6 +242,22 @@ bool Model::admissible(Vec u, std::string* why) const {
     }
   }
   return true;
+}
+
+std::string Model::refuses(const Simplex& cell) const {
+  if (!forbids_inversion(body_.material())) return {};
+  const Mesh& mesh = body_.mesh();
+  const int space = mesh.space_dim(), corners = cell.count();
+  const ReadView u(u_);
+  std::array<std::array<double, 3>, max_dimension + 1> x{};
+  const auto vertices = cell.oriented_vertices();
+  for (int i = 0; i < corners; ++i)
+    for (int k = 0; k < space; ++k)
+      x[i][k] = mesh.point(vertices[i])[k] + u.span()[static_cast<std::size_t>(vertices[i]) * space + k];
+  const bool inverted = mesh.is_surface() ? collinear_3d(x[0].data(), x[1].data(), x[2].data())
+                        : space == 2      ? orientation_2d(x[0].data(), x[1].data(), x[2].data()) <= 0
+                                          : orientation_3d(x[0].data(), x[1].data(), x[2].data(), x[3].data()) <= 0;
+  return inverted ? "would be inverted by the body's displacement (its material forbids it)" : std::string();
 }
 
 void Model::tangent_mult(Vec d, Vec out) {

@@ -23,6 +23,7 @@
 #include <string>
 #include <vector>
 
+#include "core/exclusive_use.hpp"
 #include "core/petsc_handle.hpp"
 #include "fem/elastic_body.hpp"
 #include "solve/constraints.hpp"
@@ -42,6 +43,8 @@ class Model : public ConnectivityWatcher {
   PetscInt n_dofs() const { return static_cast<PetscInt>(body_.n_dofs()); }
   // Increases whenever vector sizes change; solvers compare it to rebuild their objects.
   std::uint64_t generation() const { return generation_; }
+  // Claimed by every solve, cut and needle step on this body (one thread at a time).
+  ExclusiveUse& exclusive_use() { return exclusive_use_; }
 
   Constraints& constraints() { return constraints_; }
   const Constraints& constraints() const { return constraints_; }
@@ -100,6 +103,9 @@ class Model : public ConnectivityWatcher {
 
   void init(const Connectivity&) override {}
   void on_change(const Connectivity& connectivity, const ConnectivityChange& change) override;
+  // A planned cell the displacement would invert (a material that forbids it, as admissible()
+  // judges: det F ≤ 0, or a membrane triangle collapsed to a line), exactly, in X + u.
+  std::string refuses(const Simplex& cell) const override;
 
  private:
   void create_vectors();
@@ -139,6 +145,7 @@ class Model : public ConnectivityWatcher {
   VecHandle u_linearization_;
   MatHandle tangent_;
   std::uint64_t generation_ = 0;
+  ExclusiveUse exclusive_use_;
   double last_reaction_norm_ = 0;
   double operator_scale_ = 1;
 };

@@ -66,6 +66,16 @@ bool strictly_between(std::span<const double> x, std::span<const double> v, std:
   return opposite;
 }
 
+// Why the caller's check or a watcher of the mesh (a body whose displacement it would invert,
+// issue 48 item 7) refuses `triangle`, or empty.
+std::string refusal(const Mesh& mesh, const TriangleCheck& acceptable, const Simplex& triangle) {
+  const std::string vertices = vertex_list({triangle.vertex(0), triangle.vertex(1), triangle.vertex(2)});
+  if (acceptable && !acceptable(triangle)) return "the caller refuses triangle " + vertices;
+  if (std::string why = mesh.connectivity().watcher_refusal(triangle); !why.empty())
+    return "triangle " + vertices + " " + why;
+  return {};
+}
+
 // Ear clipping of `polygon` (counter-clockwise in `plane`): the triangles, or the reason the
 // greedy choice got stuck.
 std::optional<std::vector<Simplex>> ear_triangulation(const Mesh& mesh, const RetriangulationPlane& plane,
@@ -89,8 +99,7 @@ std::optional<std::vector<Simplex>> ear_triangulation(const Mesh& mesh, const Re
       }
       if (problem.empty() && has_edge(mesh.connectivity(), previous, following))
         problem = "edge " + vertex_list({previous, following}) + " already exists";
-      if (problem.empty() && acceptable && !acceptable(Simplex(1, {previous, tip, following})))
-        problem = "the caller refuses triangle " + vertex_list({previous, tip, following});
+      if (problem.empty()) problem = refusal(mesh, acceptable, Simplex(1, {previous, tip, following}));
       if (!problem.empty()) {
         last_problem = problem;
         continue;
@@ -109,8 +118,7 @@ std::optional<std::vector<Simplex>> ear_triangulation(const Mesh& mesh, const Re
     remaining.erase(remaining.begin() + static_cast<std::ptrdiff_t>(i));
   }
   std::string problem = plane.triangle_problem(remaining[0], remaining[1], remaining[2]);
-  if (problem.empty() && acceptable && !acceptable(Simplex(1, {remaining[0], remaining[1], remaining[2]})))
-    problem = "the caller refuses triangle " + vertex_list({remaining[0], remaining[1], remaining[2]});
+  if (problem.empty()) problem = refusal(mesh, acceptable, Simplex(1, {remaining[0], remaining[1], remaining[2]}));
   if (!problem.empty()) {
     why_not = problem;
     return std::nullopt;

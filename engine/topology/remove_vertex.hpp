@@ -22,7 +22,9 @@ namespace snede {
 // retriangulated the same way. The whole retriangulation is planned first: refused, leaving
 // the mesh unchanged, when it cannot be completed (the greedy ear choice may refuse a link
 // with collinear vertices that some other triangulation would handle).
-// `acceptable`, when given, may refuse ears too (a cutter's own shape checks). Watchers hear
+// `acceptable`, when given, may refuse ears too (a cutter's own shape checks), and so may the
+// mesh's watchers (ConnectivityWatcher::refuses: a body refuses a triangle its displacement
+// would invert, so the carried state stays admissible). Watchers hear
 // one change (a ChangeBatch). Throws std::invalid_argument for a tetrahedral mesh or a v that
 // is not a live vertex.
 using TriangleCheck = std::function<bool(const Simplex&)>;
