@@ -399,12 +399,14 @@ class Mesh(MeshEdits):
     def read(cls, path) -> "Mesh":
         """Read a mesh file: gmsh ``.msh`` (formats 1, 2 and 4), VTK legacy ``.vtk`` (unstructured
         grids, and POLYDATA surfaces) and ``.vtu``, Medit ``.mesh``, XDMF, and the surface formats
-        STL, OBJ, OFF and PLY — meshio's reader first, gmsh's own where meshio fails. Tetrahedra
+        STL, OBJ, OFF and PLY — meshio's reader first, gmsh's own where meshio fails (in a child
+        process: it crashes on some damaged files), snede's own for gmsh format 1. Tetrahedra
         are taken if present, else triangles (quads and polygons split into triangles from their
         first vertex): a 2D mesh when every z is 0, otherwise a surface mesh in 3D; triangles with
         a repeated vertex (STL files have them) are left out with a warning. Every point of the
         file is kept, in its order. A file that cannot be read, or holds no mesh snede can use,
-        raises a ValueError naming the file and why.
+        raises a ValueError naming the file and why (for a damaged text gmsh or VTK file, the line
+        and what is wrong with it).
 
         An ``.xdmf`` time series written by ``snede.output.SeriesWriter`` (which meshio cannot
         read) gives the mesh of its last step; use ``snede.output.read_series`` for every step

@@ -1,8 +1,12 @@
 """Reading mesh files for ``Mesh.read``: meshio's reader for the file's suffix first, then gmsh's
-own reader for what meshio cannot read (gmsh format 1, binary VTK, ...), and a reader of VTK
-legacy POLYDATA surfaces, which neither reads. Every reader gives ``(points, blocks)``: (n, 2|3)
-points and {meshio cell type: (m, corners) vertex indices}, quads and polygons split into
-triangles."""
+own reader (in a child process: it crashes on some damaged files) for what meshio cannot read,
+a reader of VTK legacy POLYDATA surfaces, which neither reads, and one of gmsh's format 1, which
+meshio cannot read and gmsh's reader reads without each element's physical group. Every reader
+gives ``(points, blocks)``: (n, 2|3) points and {meshio cell type: (m, corners) vertex indices},
+quads and polygons split into triangles; and the file's named groups.
+
+Text gmsh 2 and VTK legacy files are checked first, where their readers misread or crash: each
+gmsh section has the lines its count announces, each VTK section line its numbers."""
 from __future__ import annotations
 
 import contextlib
@@ -21,24 +25,35 @@ MESHIO_FORMATS = {".msh": "gmsh", ".vtk": "vtk", ".vtu": "vtu", ".mesh": "medit"
 GMSH_SUFFIXES = (".msh", ".vtk", ".stl", ".mesh", ".off")
 
 
+class DamagedFile(ValueError):
+    """A file that contradicts itself (a count and the lines that follow it): no reader is tried
+    on it."""
+
+
 def read_blocks(path: Path) -> tuple[np.ndarray, dict[str, np.ndarray], list]:
     """The points, cell blocks and named groups of the first reader that reads ``path``; a
-    ValueError naming the file and why each reader failed if none does. OSError (permissions, a
-    folder) passes. Groups are (cell type, name, (m, corners) vertex indices) triples: gmsh's
-    physical groups (from meshio's reader or gmsh's), or a VTK file's integer cell data
-    (``"array=value"``)."""
+    ValueError naming the file and why each reader failed if none does, or what is wrong with
+    the file if it is damaged. OSError (permissions, a folder) passes. Groups are (cell type,
+    name, (m, corners) vertex indices) triples: gmsh's physical groups, or a VTK file's integer
+    cell data (``"array=value"``)."""
     reasons = []
-    for name, reader in _readers(path):
-        try:
-            points, blocks, *groups = reader(path)
-        except OSError:
-            raise
-        except Exception as error:  # meshio's parsers fail in many ways
-            reasons.append(f"{name}: {_reason(error)}")
-            continue
-        if len(points):
-            return points, blocks, groups[0] if groups else []
-        reasons.append(f"{name}: no points in it")
+    try:
+        with open(path, "rb") as file:  # a folder or an unreadable file: the OSError says why
+            head = file.read(256)
+        check_counts(path, head)
+        for name, reader in _readers(path, head):
+            try:
+                points, blocks, *groups = reader(path)
+            except (OSError, DamagedFile):
+                raise
+            except Exception as error:  # meshio's parsers fail in many ways
+                reasons.append(f"{name}: {_reason(error)}")
+                continue
+            if len(points):
+                return points, blocks, groups[0] if groups else []
+            reasons.append(f"{name}: no points in it")
+    except DamagedFile as error:
+        raise ValueError(f"{path}: {error}") from None
     raise ValueError(f"{path}: could not read this file as a mesh ({'; '.join(reasons)})")
 
 
@@ -48,10 +63,10 @@ def _reason(error: Exception) -> str:
     return str(error) if kind in ("ValueError", "ReadError") else f"{kind}: {error}"
 
 
-def _readers(path: Path) -> list:
+def _readers(path: Path, head: bytes) -> list:
     suffix = path.suffix.lower()
-    with open(path, "rb") as file:  # a folder or an unreadable file: the OSError says why
-        head = file.read(256)
+    if suffix == ".msh" and head.lstrip().startswith(b"$NOD"):  # gmsh format 1: meshio cannot read it
+        return [("gmsh format 1", read_gmsh_1)]
     readers = [("meshio", _meshio_reader(MESHIO_FORMATS.get(suffix)))]
     if suffix == ".vtk" and head.lstrip().startswith(b"<"):  # an XML (VTU) file named .vtk
         readers.append(("meshio as VTU", _meshio_reader("vtu")))
@@ -113,16 +128,155 @@ def _groups(data) -> list:
     return groups
 
 
+def _physical_groups(tagged: list, names: dict) -> list:
+    """(cell type, name, cells) from (cell type, cells, physical tag): named by ``names``
+    ({(dim, tag): name}), else as ``_gmsh.unnamed_group``."""
+    groups = []
+    for kind, cells, tag in tagged:
+        dim = _GROUP_TYPES.get(kind)
+        if dim:
+            groups.append((kind, names.get((dim, tag)) or _gmsh.unnamed_group(dim, tag), cells))
+    return groups
+
+
+def _unrepeated(cells: np.ndarray) -> np.ndarray:
+    """The cells without the repeats of an earlier one, in their order: gmsh format 1 writes an
+    element once per physical group it is in."""
+    if len(cells) < 2:
+        return cells
+    _, first = np.unique(cells, axis=0, return_index=True)
+    return cells[np.sort(first)]
+
+
 def read_with_gmsh(path: Path):
-    """gmsh's own reader (``gmsh.merge``): every format gmsh reads, gmsh's .msh 1, 2 and 4 among them."""
-    with _gmsh.model("snede-read") as gmsh:
-        try:
-            gmsh.merge(str(path))
-        except Exception as error:
-            raise ValueError("; ".join(_gmsh.errors(gmsh)) or str(error)) from None
-        points, blocks = _gmsh.elements(gmsh)
-        groups = _gmsh.physical_groups(gmsh)
+    """gmsh's own reader, in a child process (``_gmsh.read_file_in_child``)."""
+    points, blocks, groups = _gmsh.read_file_in_child(path)
     return points, collect(blocks), groups
+
+
+# -- gmsh format 1 ------------------------------------------------------------------------------
+def read_gmsh_1(path: Path):
+    """gmsh's format 1 ($NOD and $ELM sections; SOFA's liver.msh): the nodes, the elements of the
+    types in ``_gmsh.TYPES``, and each element's physical group ("physical volume N": the format
+    has no names). An element line is ``number type physical elementary node-count nodes...``."""
+    lines = path.read_text(encoding="utf-8", errors="replace").splitlines()
+    node_lines, element_lines = _counted_section(lines, "$NOD"), _counted_section(lines, "$ELM")
+    if node_lines is None or element_lines is None:
+        raise DamagedFile(f"no {'$NOD' if node_lines is None else '$ELM'} section")
+    numbers, points = _numbered_points(node_lines)
+    if len(numbers) == 0:
+        return points, {}, []
+    elements: dict[str, list] = {}  # cell type → [(line number, physical tag, node numbers)]
+    for number, line in element_lines:
+        try:
+            values = [int(word) for word in line.split()]
+        except ValueError:
+            values = []
+        if len(values) < 5 or len(values) != 5 + values[4]:
+            raise DamagedFile(f"line {number}: an element is 'number type physical elementary node-count nodes...', "
+                              f"found {line.strip()!r}")
+        if values[1] in _gmsh.TYPES:
+            kind, corners = _gmsh.TYPES[values[1]]
+            if values[4] != corners:
+                raise DamagedFile(f"line {number}: a {kind} has {corners} nodes, not {values[4]}")
+            elements.setdefault(kind, []).append((number, values[2], values[5:]))
+    order = np.argsort(numbers)
+    tagged = []  # (cell type, cells, physical tag)
+    blocks = {}
+    for kind, entries in elements.items():
+        nodes = np.array([entry[2] for entry in entries], dtype=np.int64)
+        rows = order[np.minimum(np.searchsorted(numbers, nodes, sorter=order), len(numbers) - 1)]
+        if np.any(unknown := numbers[rows] != nodes):
+            entry = int(np.flatnonzero(unknown.any(axis=1))[0])
+            raise DamagedFile(f"line {entries[entry][0]}: node {nodes[unknown][0]} is not in $NOD")
+        tags = np.array([entry[1] for entry in entries])
+        tagged += [(kind, rows[tags == tag], int(tag)) for tag in np.unique(tags) if tag > 0]
+        blocks[kind] = rows
+    blocks = {kind: _unrepeated(cells) for kind, cells in collect(blocks.items()).items()}
+    return points, blocks, _physical_groups(tagged, {})
+
+
+def _numbered_points(node_lines: list) -> tuple[np.ndarray, np.ndarray]:
+    """The node numbers and (n, 3) points of "number x y z" lines, each number once."""
+    rows = [line.split() for _, line in node_lines]
+    try:
+        values = np.array(rows, dtype=float).reshape(len(rows), 4)
+    except ValueError:
+        number, line = next((n, line) for (n, line), words in zip(node_lines, rows)
+                            if len(words) != 4 or not all(map(_is_number, words)))
+        raise DamagedFile(f"line {number}: a node is 'number x y z', found {line.strip()!r}") from None
+    numbers = values[:, 0].astype(np.int64)
+    distinct, counts = np.unique(numbers, return_counts=True)
+    if np.any(counts > 1):
+        repeated = distinct[counts > 1][0]
+        first, second = [n for (n, _), number in zip(node_lines, numbers) if number == repeated][:2]
+        raise DamagedFile(f"node {repeated} is on lines {first} and {second}")
+    return numbers, values[:, 1:]
+
+
+def _is_number(word: str) -> bool:
+    try:
+        float(word)
+    except ValueError:
+        return False
+    return True
+
+
+# -- counts checked before reading --------------------------------------------------------------
+def _counted_section(lines: list[str], header: str) -> list[tuple[int, str]] | None:
+    """The lines of a gmsh text section (``header``, a count, as many lines, ``$End...``) as
+    (line number, line), blank lines left out; None if the file has no such section. A
+    DamagedFile names the line if the count is not the number of lines: gmsh's reader crashes on
+    one line too many, and meshio's reads one line too few without a word."""
+    end = "$END" + header[1:].upper()  # format 1's are upper case, format 2's "$EndNodes"
+    start = next((k for k, line in enumerate(lines) if line.startswith(header) and line.rstrip() == header), None)
+    if start is None:
+        return None
+    count = lines[start + 1].strip() if start + 1 < len(lines) else ""
+    if not count.isdigit():
+        raise DamagedFile(f"line {start + 2}: {header} is followed by its count, not {count!r}")
+    body = []
+    for number, line in enumerate(lines[start + 2:], start + 3):
+        if line.startswith("$") and line.split()[0].upper() == end:
+            break
+        if line and not line.isspace():
+            body.append((number, line))
+    else:
+        raise DamagedFile(f"line {start + 1}: {header} has no {end if header.isupper() else '$End' + header[1:]} "
+                          "after it")
+    if len(body) != int(count):
+        raise DamagedFile(f"line {start + 2}: {header} announces {int(count)}, but {len(body)} lines follow "
+                          f"before {line.split()[0]}")
+    return body
+
+
+#: a VTK legacy file's section lines and what follows their keyword (the counts, and POINTS' type)
+_CELLS = ("<number of cells>", "<number of values>")
+_VTK_SECTION_LINES = {"POINTS": ("<number of points>", "<type>"), "CELLS": _CELLS, "VERTICES": _CELLS,
+                      "LINES": _CELLS, "POLYGONS": _CELLS, "TRIANGLE_STRIPS": _CELLS,
+                      "CELL_TYPES": ("<number of cells>",), "CELL_DATA": ("<number of cells>",),
+                      "POINT_DATA": ("<number of points>",)}
+
+
+def check_counts(path: Path, head: bytes) -> None:
+    """A DamagedFile if a text gmsh 2 file's $Nodes, $Elements or $PhysicalNames section has not
+    the lines its count announces, or a text VTK legacy file's section line has not its numbers
+    (gmsh's reader crashes, or meshio's misreads, on these)."""
+    gmsh_2 = re.match(rb"\s*\$MeshFormat\s+2(\.\d+)?\s+0\s", head)
+    vtk = re.match(rb"# vtk DataFile[^\n]*\n[^\n]*\n\s*ASCII\s", head, re.I)
+    if not (gmsh_2 or vtk):
+        return
+    lines = path.read_text(encoding="utf-8", errors="replace").splitlines()
+    if gmsh_2:
+        for header in ("$PhysicalNames", "$Nodes", "$Elements"):
+            _counted_section(lines, header)
+        return
+    for number, line in enumerate(lines, 1):
+        words = line.split()
+        form = _VTK_SECTION_LINES.get(words[0]) if words else None
+        if form is not None and (len(words) != 1 + len(form) or not all(
+                word.isdigit() for word, field in zip(words[1:], form) if field.startswith("<number"))):
+            raise DamagedFile(f"line {number}: {line.strip()!r} should be '{words[0]} {' '.join(form)}'")
 
 
 # -- VTK legacy POLYDATA ------------------------------------------------------------------------

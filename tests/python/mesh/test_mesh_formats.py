@@ -63,7 +63,7 @@ def test_gmsh_files_of_every_version_read_as_gmsh_wrote_them(gmsh_files, version
 
 
 def test_gmsh_format_1_is_what_meshio_cannot_read(gmsh_files):
-    """The files the fallback to gmsh's reader is for: SOFA's liver.msh is one ($NOD ... $ELM)."""
+    """The files snede's reader of format 1 is for: SOFA's liver.msh is one ($NOD ... $ELM)."""
     files, _ = gmsh_files
     assert files[1.0, 0].read_text().startswith("$NOD\n")
     with pytest.raises(Exception):
@@ -246,9 +246,10 @@ def test_a_missing_file():
 
 @pytest.mark.parametrize("suffix", [".msh", ".vtk", ".stl", ".obj", ".off", ".ply", ".mesh", ".vtu"])
 def test_a_file_no_reader_takes_says_why_each_failed_and_does_not_exit(tmp_path, suffix, capfd):
-    """meshio calls sys.exit on some of these (it is caught); nothing is printed."""
+    """meshio calls sys.exit on some of these (it is caught); nothing is printed. (Not "$NOD": a
+    gmsh format 1 file goes to snede's reader of that format alone, test_mesh_read_damaged.py.)"""
     path = tmp_path / f"nonsense{suffix}"
-    path.write_text("$NOD\n3\n1 0 0\n")
+    path.write_text("$Nodes\n3\n1 0 0\n")
     message = read_refused(path, "could not read this file as a mesh", "meshio: ")
     assert ("gmsh: " in message) == (suffix in (".msh", ".vtk", ".stl", ".mesh", ".off"))
     assert capfd.readouterr() == ("", "")
@@ -257,7 +258,7 @@ def test_a_file_no_reader_takes_says_why_each_failed_and_does_not_exit(tmp_path,
 @pytest.mark.parametrize("suffix", [".msh", ".vtu", ".ply"])
 def test_where_meshio_exits_mesh_read_raises_with_meshios_reason(tmp_path, suffix):
     path = tmp_path / f"nonsense{suffix}"
-    path.write_text("$NOD\n3\n1 0 0\n")
+    path.write_text("$Nodes\n3\n1 0 0\n")
     with pytest.raises(SystemExit):
         meshio.read(path)
     read_refused(path, "meshio: ")

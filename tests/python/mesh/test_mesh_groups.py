@@ -205,10 +205,10 @@ def test_the_output_series_carries_the_groups(tmp_path):
     assert read_series(writer.xdmf_path)[-1].cell_fields["group:left"].sum() == len(mesh.cell_groups["left"])
 
 
-def test_gmsh_s_own_reader_gives_the_groups_too(tmp_path):
-    """A gmsh format-1 file (which meshio cannot read): its physical regions, unnamed in that
-    format, come as "physical volume <number>" and "physical surface <number>" through gmsh's
-    reader."""
+def test_a_gmsh_format_1_file_gives_the_groups_too(tmp_path):
+    """A gmsh format-1 file (which meshio cannot read; snede's reader of format 1 reads it): its
+    physical regions, unnamed in that format, come as "physical volume <number>" and "physical
+    surface <number>"."""
     import gmsh
 
     path = gmsh_box(tmp_path, size=0.1)
