@@ -34,8 +34,8 @@ def read_blocks(path: Path) -> tuple[np.ndarray, dict[str, np.ndarray], list]:
     """The points, cell blocks and named groups of the first reader that reads ``path``; a
     ValueError naming the file and why each reader failed if none does, or what is wrong with
     the file if it is damaged. OSError (permissions, a folder) passes. Groups are (cell type,
-    name, (m, corners) vertex indices) triples: gmsh's physical groups, or a VTK file's integer
-    cell data (``"array=value"``)."""
+    name, (m, corners) vertex indices) triples, one per cell type and name: gmsh's physical
+    groups (those that share a name joined), or a VTK file's integer cell data (``"array=value"``)."""
     reasons = []
     try:
         with open(path, "rb") as file:  # a folder or an unreadable file: the OSError says why
@@ -50,11 +50,21 @@ def read_blocks(path: Path) -> tuple[np.ndarray, dict[str, np.ndarray], list]:
                 reasons.append(f"{name}: {_reason(error)}")
                 continue
             if len(points):
-                return points, blocks, groups[0] if groups else []
+                return points, blocks, _joined(groups[0] if groups else [])
             reasons.append(f"{name}: no points in it")
     except DamagedFile as error:
         raise ValueError(f"{path}: {error}") from None
     raise ValueError(f"{path}: could not read this file as a mesh ({'; '.join(reasons)})")
+
+
+def _joined(groups: list) -> list:
+    """One group per cell type and name. Physical groups that share a name are one group, as a
+    name is in gmsh (a second ``Physical Volume("a") = ...`` in a .geo file redefines group "a");
+    so are one array value's cells in several blocks."""
+    joined: dict[tuple[str, str], list] = {}
+    for kind, name, cells in groups:
+        joined.setdefault((kind, name), []).append(np.asarray(cells, dtype=np.int64))
+    return [(kind, name, np.concatenate(parts)) for (kind, name), parts in joined.items()]
 
 
 def _reason(error: Exception) -> str:
@@ -90,7 +100,10 @@ def _meshio_reader(file_format: str | None):
         except SystemExit:
             lines = printed.getvalue().strip().splitlines()
             raise ValueError(lines[-1] if lines else "could not parse it") from None
-        return np.asarray(data.points), collect((block.type, block.data) for block in data.cells), _groups(data)
+        blocks = collect((block.type, block.data) for block in data.cells)
+        if file_format == "gmsh":
+            return (np.asarray(data.points),) + _gmsh_groups(path, data, blocks)
+        return np.asarray(data.points), blocks, _cell_data_groups(data)
     return read
 
 
@@ -98,28 +111,20 @@ def _meshio_reader(file_format: str | None):
 _GROUP_TYPES = {"tetra": 3, "triangle": 2, "line": 1}
 
 
-def _groups(data) -> list:
-    """(cell type, name, cells) for each physical group of a gmsh file (named by the file's
-    $PhysicalNames, else as ``_gmsh.unnamed_group``), or each value of an integer cell-data array of other
-    formats with at most 64 values ("array=value")."""
+def _cell_data_groups(data) -> list:
+    """Of a file of another format than gmsh's: the physical groups of gmsh's tags if meshio
+    gives them (a file converted by meshio from gmsh's), named by its field data; else (cell
+    type, "array=value", cells) for each value of an integer cell-data array (of one component:
+    VTK's ``SCALARS region int 1`` comes as (n, 1)) with at most 64 values."""
+    if "gmsh:physical" in data.cell_data:
+        names = {(int(value[1]), int(value[0])): name for name, value in data.field_data.items() if len(value) >= 2}
+        return _physical_groups(_tagged_by_element(data), names)
     groups = []
-    physical = data.cell_data.get("gmsh:physical")
-    if physical is not None:
-        names = {(int(value[0]), int(value[1])): name for name, value in data.field_data.items() if len(value) >= 2}
-        for block, tags in zip(data.cells, physical):
-            dim = _GROUP_TYPES.get(block.type)
-            if dim is None:
-                continue
-            tags = np.asarray(tags)
-            for tag in np.unique(tags):
-                groups.append((block.type, names.get((int(tag), dim), _gmsh.unnamed_group(dim, int(tag))),
-                               block.data[tags == tag]))
-        return groups
     for array_name, arrays in data.cell_data.items():
         if array_name.startswith("gmsh:"):  # gmsh's elementary entities are not groups
             continue
         for block, values in zip(data.cells, arrays):
-            values = np.asarray(values)
+            values = _column(values)
             if block.type not in _GROUP_TYPES or values.ndim != 1 or values.dtype.kind not in "iu":
                 continue
             distinct = np.unique(values)
@@ -128,9 +133,43 @@ def _groups(data) -> list:
     return groups
 
 
+def _gmsh_groups(path: Path, data, blocks: dict) -> tuple[dict, list]:
+    """The cell blocks and physical groups of a gmsh file meshio read. meshio keeps one physical
+    group per element and one per name, so the groups come from the file's own sections: in
+    format 4 each entity's groups ($Entities), in format 2 each element's group, an element in
+    two groups written twice (taken once in the blocks)."""
+    version, names, entity_groups = _gmsh_sections(path)
+    tagged = []  # (cell type, cells, physical tag)
+    if version >= 4:
+        for block, entities in zip(data.cells, data.cell_data.get("gmsh:geometrical", [])):
+            dim = _GROUP_TYPES.get(block.type)
+            for entity in np.unique(entities) if dim else ():
+                tagged += [(block.type, block.data[entities == entity], tag)
+                           for tag in entity_groups.get((dim, int(entity)), ())]
+    else:
+        tagged = _tagged_by_element(data)
+        blocks = {kind: _unrepeated(cells) for kind, cells in blocks.items()}
+    return blocks, _physical_groups(tagged, names)
+
+
+def _tagged_by_element(data) -> list:
+    """(cell type, cells, physical tag) from meshio's physical tag of each element."""
+    tagged = []
+    for block, tags in zip(data.cells, data.cell_data.get("gmsh:physical", [])):
+        tags = _column(tags)
+        tagged += [(block.type, block.data[tags == tag], int(tag)) for tag in np.unique(tags) if tag > 0]
+    return tagged
+
+
+def _column(values) -> np.ndarray:
+    """A cell-data array of one component as (n,)."""
+    values = np.asarray(values)
+    return values[:, 0] if values.ndim == 2 and values.shape[1] == 1 else values
+
+
 def _physical_groups(tagged: list, names: dict) -> list:
-    """(cell type, name, cells) from (cell type, cells, physical tag): named by ``names``
-    ({(dim, tag): name}), else as ``_gmsh.unnamed_group``."""
+    """(cell type, name, cells) from (cell type, cells, physical tag): named by the file's
+    $PhysicalNames ({(dim, tag): name}), else as ``_gmsh.unnamed_group``."""
     groups = []
     for kind, cells, tag in tagged:
         dim = _GROUP_TYPES.get(kind)
@@ -140,8 +179,8 @@ def _physical_groups(tagged: list, names: dict) -> list:
 
 
 def _unrepeated(cells: np.ndarray) -> np.ndarray:
-    """The cells without the repeats of an earlier one, in their order: gmsh format 1 writes an
-    element once per physical group it is in."""
+    """The cells without the repeats of an earlier one, in their order: gmsh formats 1 and 2
+    write an element once per physical group it is in."""
     if len(cells) < 2:
         return cells
     _, first = np.unique(cells, axis=0, return_index=True)
@@ -152,6 +191,75 @@ def read_with_gmsh(path: Path):
     """gmsh's own reader, in a child process (``_gmsh.read_file_in_child``)."""
     points, blocks, groups = _gmsh.read_file_in_child(path)
     return points, collect(blocks), groups
+
+
+# -- gmsh's sections ----------------------------------------------------------------------------
+def _gmsh_sections(path: Path) -> tuple[float, dict, dict]:
+    """A gmsh file's version, its $PhysicalNames as {(dim, tag): name} (every one: meshio keeps
+    one tag per name) and, in format 4, each entity's physical groups from $Entities as
+    {(dim, entity): [tags]} (meshio keeps the first). Both sections come before $Nodes."""
+    head = bytearray()
+    with open(path, "rb") as file:
+        while chunk := file.read(1 << 20):
+            head += chunk
+            if (end := head.find(b"$Nodes", max(len(head) - len(chunk) - 8, 0))) >= 0:
+                del head[end:]
+                break
+    header = re.search(rb"^\$MeshFormat\s+(\S+)\s+(\d+)\s+(\d+)", head, re.M)
+    if header is None:
+        raise ValueError("no $MeshFormat section")
+    version, binary, size = float(header[1]), header[2] == b"1", int(header[3])
+    names = {}
+    section = _gmsh_section(head, b"PhysicalNames")
+    for line in (section or b"").decode("utf-8", "replace").splitlines():
+        if match := re.match(r'\s*(\d+)\s+(\d+)\s+"(.*)"\s*$', line):
+            names[int(match[1]), int(match[2])] = match[3]
+    section = _gmsh_section(head, b"Entities") if version >= 4 else None
+    return version, names, {} if section is None else _entity_groups(section, version, binary, size)
+
+
+def _gmsh_section(head: bytes, name: bytes) -> bytes | None:
+    """The body of a gmsh file's section ``$name`` ... ``$Endname`` (up to the end if it has none)."""
+    start = re.search(rb"^\$" + name + rb"[ \t]*\r?\n", head, re.M)
+    if start is None:
+        return None
+    end = head.find(b"$End" + name, start.end())
+    return bytes(head[start.end():end if end >= 0 else len(head)])
+
+
+def _entity_groups(section: bytes, version: float, binary: bool, size: int) -> dict:
+    """{(dim, entity): physical tags} from the body of a format 4 $Entities section: per
+    dimension a count, then per entity its tag, bounding box (a point's is its position in 4.1),
+    physical tags and (above points) bounding entities, each list after its length."""
+    if binary:
+        types, position = {"size": np.dtype(f"<u{size}"), "int": np.dtype("<i4"), "double": np.dtype("<f8")}, 0
+
+        def take(kind: str, count: int):
+            nonlocal position
+            values = np.frombuffer(section, types[kind], count, position)
+            position += values.nbytes
+            return values
+    else:
+        words, position = section.split(), 0
+
+        def take(kind: str, count: int):
+            nonlocal position
+            position += count
+            if position > len(words):
+                raise ValueError("it ends early")
+            return words[position - count:position] if kind == "double" else [int(w) for w in words[position - count:position]]
+    groups = {}
+    try:
+        for dim, count in enumerate(take("size", 4)):
+            for _ in range(int(count)):
+                entity = int(take("int", 1)[0])
+                take("double", 3 if dim == 0 and version >= 4.1 else 6)
+                groups[dim, entity] = [int(tag) for tag in take("int", int(take("size", 1)[0]))]
+                if dim > 0:
+                    take("int", int(take("size", 1)[0]))
+    except ValueError as error:
+        raise ValueError(f"its $Entities section is damaged ({error})") from None
+    return groups
 
 
 # -- gmsh format 1 ------------------------------------------------------------------------------
