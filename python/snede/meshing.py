@@ -1,6 +1,11 @@
 """Mesh generators: structured boxes and rectangles, unstructured solids (gmsh: a cylinder, an
 ellipsoid, a torus, a lumpy organ-like solid, the inside of any closed surface), and
-surfaces in 3D for cutting (height fields, the Gaussian bell of Figure 5.19, a folded sheet)."""
+surfaces in 3D for cutting (height fields, the Gaussian bell of Figure 5.19, a folded sheet).
+
+The gmsh generators first estimate how many tetrahedra their edge length makes
+(``tetrahedra_estimate``) and refuse more than ``max_cells`` (default ``MAX_CELLS``) with a
+ValueError that gives the number: a length given in the wrong unit (1e-9 for 1e-3) would
+otherwise keep gmsh busy for hours and then exhaust the memory."""
 from __future__ import annotations
 
 import itertools
@@ -77,6 +82,39 @@ def _positive(**values) -> None:
         _checks.positive(value, name)
 
 
+# The gmsh generators' default limit: gmsh takes about 60 µs and 0.6 kB per tetrahedron
+# (measured on a cylinder of 1.3 million), so 10 million take some 10 minutes and 6 GB; a body
+# of that size is beyond what a static solve or an interactive session relaxes in useful time.
+MAX_CELLS = 10_000_000
+_REGULAR_TETRAHEDRON = 1.0 / (6.0 * math.sqrt(2.0))  # volume of the regular tetrahedron of edge 1
+_EQUILATERAL_TRIANGLE = math.sqrt(3.0) / 4.0  # area of the equilateral triangle of side 1
+# gmsh's tetrahedra at target edge h are about twice as large as regular ones of edge h: it made
+# 0.47–0.52 of tetrahedra_estimate's count on a cylinder, a torus and a thin slab at several h
+_GMSH_SHARE = 0.5
+
+
+def tetrahedra_estimate(volume: float, area: float, h: float) -> float:
+    """How many regular tetrahedra of edge ``h`` fill a solid of ``volume`` and boundary ``area``:
+    the volume over that of one, plus one per boundary triangle (the area over that of an
+    equilateral triangle of side h), which a thin solid has more of than it has volume for."""
+    return volume / _REGULAR_TETRAHEDRON / h / h / h + area / _EQUILATERAL_TRIANGLE / h / h
+
+
+def check_cells(estimate: float, max_cells: int, given: str,
+                remedy: str = "give a larger edge length (each halving makes 8 times as many), or raise max_cells "
+                              "if you mean it") -> None:
+    """Refuse ``estimate`` cells beyond ``max_cells`` with a ValueError: ``given`` names the value
+    that asks for them ("h = 1e-09"), ``remedy`` what to do."""
+    if not estimate <= max_cells:
+        about = f"about {estimate:.2g}" if math.isfinite(estimate) else "more than 1e308"
+        raise ValueError(f"{given} would make {about} tetrahedra (limit {max_cells}); {remedy}")
+
+
+def _check_size(volume: float, area: float, h: float, max_cells, name: str = "h") -> None:
+    max_cells = _checks.count(max_cells, "max_cells", 1, None)
+    check_cells(_GMSH_SHARE * tetrahedra_estimate(volume, area, h), max_cells, f"{name} = {h:g}")
+
+
 def _gmsh_tetrahedra(name: str, add_solid, h: float, seed: int | None) -> Mesh:
     """Tetrahedra of the OpenCASCADE solid that ``add_solid(occ)`` adds, meshed by gmsh
     (Delaunay, then optimised) at target edge length ``h``; deterministic for given arguments
@@ -109,21 +147,28 @@ def _gmsh_fill(name: str, add_volume, h: float, seed: int | None) -> Mesh:
     return Mesh(points[used], cells.reshape(-1, 4))
 
 
-def cylinder(length=0.1, radius=0.03, h=0.01, seed: int | None = None) -> Mesh:
+def cylinder(length=0.1, radius=0.03, h=0.01, seed: int | None = None, *, max_cells: int = MAX_CELLS) -> Mesh:
     """Unstructured tetrahedra of the cylinder 0 ≤ x ≤ length, y² + z² ≤ radius², meshed by
     gmsh (Delaunay, then optimised) with target edge length ``h``. Deterministic for given
-    arguments (gmsh's random factor is fixed by ``seed`` when given)."""
+    arguments (gmsh's random factor is fixed by ``seed`` when given). ``max_cells``: see the
+    module."""
     _positive(length=length, radius=radius, h=h)
+    _check_size(math.pi * radius**2 * length, 2 * math.pi * radius * (radius + length), h, max_cells)
     return _gmsh_tetrahedra("cylinder", lambda occ: occ.addCylinder(0, 0, 0, length, 0, 0, radius), h, seed)
 
 
-def ellipsoid(radii=(0.06, 0.04, 0.03), h=0.01, seed: int | None = None) -> Mesh:
+def ellipsoid(radii=(0.06, 0.04, 0.03), h=0.01, seed: int | None = None, *, max_cells: int = MAX_CELLS) -> Mesh:
     """Unstructured tetrahedra (gmsh, edge length ``h``) of the ellipsoid centred at the origin
-    with semi-axes ``radii`` along x, y, z."""
+    with semi-axes ``radii`` along x, y, z. ``max_cells``: see the module."""
     radii = np.asarray(radii, dtype=np.float64)
     if radii.shape != (3,):
         raise ValueError(f"radii must be 3 numbers, got shape {radii.shape}")
     _positive(h=h, **{f"radii[{k}]": r for k, r in enumerate(radii)})
+    a, b, c = radii
+    # the area by Thomsen's formula (within 1.1 %)
+    p = 1.6075
+    area = 4 * math.pi * (((a * b) ** p + (a * c) ** p + (b * c) ** p) / 3) ** (1 / p)
+    _check_size(4 / 3 * math.pi * a * b * c, area, h, max_cells)
 
     def add(occ):
         sphere = occ.addSphere(0, 0, 0, 1.0)
@@ -131,12 +176,14 @@ def ellipsoid(radii=(0.06, 0.04, 0.03), h=0.01, seed: int | None = None) -> Mesh
     return _gmsh_tetrahedra("ellipsoid", add, h, seed)
 
 
-def hollow_sphere(inner=0.5, outer=1.0, h=0.1, seed: int | None = None) -> Mesh:
+def hollow_sphere(inner=0.5, outer=1.0, h=0.1, seed: int | None = None, *, max_cells: int = MAX_CELLS) -> Mesh:
     """Unstructured tetrahedra (gmsh, edge length ``h``) of the shell inner ≤ |x| ≤ outer centred
-    at the origin: the pressurised sphere of Lamé's analytic solution (studies/benchmarks/locking.py)."""
+    at the origin: the pressurised sphere of Lamé's analytic solution (studies/benchmarks/locking.py).
+    ``max_cells``: see the module."""
     _positive(inner=inner, outer=outer, h=h)
     if not inner < outer:
         raise ValueError(f"inner radius must be below the outer one, got inner={inner}, outer={outer}")
+    _check_size(4 / 3 * math.pi * (outer**3 - inner**3), 4 * math.pi * (outer**2 + inner**2), h, max_cells)
 
     def add(occ):
         shell, _ = occ.cut([(3, occ.addSphere(0, 0, 0, outer))], [(3, occ.addSphere(0, 0, 0, inner))])
@@ -144,23 +191,27 @@ def hollow_sphere(inner=0.5, outer=1.0, h=0.1, seed: int | None = None) -> Mesh:
     return _gmsh_tetrahedra("hollow sphere", add, h, seed)
 
 
-def torus(radius=0.05, tube=0.02, h=0.01, seed: int | None = None) -> Mesh:
+def torus(radius=0.05, tube=0.02, h=0.01, seed: int | None = None, *, max_cells: int = MAX_CELLS) -> Mesh:
     """Unstructured tetrahedra (gmsh, edge length ``h``) of the torus around the z axis with
     centre-line ``radius`` and tube radius ``tube`` < ``radius``: a body with a hole, which one
-    cut through its ring leaves in one piece."""
+    cut through its ring leaves in one piece. ``max_cells``: see the module."""
     _positive(radius=radius, tube=tube, h=h)
     if not tube < radius:
         raise ValueError(f"tube ({tube}) must be smaller than radius ({radius})")
+    _check_size(2 * math.pi**2 * radius * tube**2, 4 * math.pi**2 * radius * tube, h, max_cells)
     return _gmsh_tetrahedra("torus", lambda occ: occ.addTorus(0, 0, 0, radius, tube), h, seed)
 
 
-def lumpy(radius=0.04, lumps: int = 6, h=0.01, seed: int = 0) -> Mesh:
+def lumpy(radius=0.04, lumps: int = 6, h=0.01, seed: int = 0, *, max_cells: int = MAX_CELLS) -> Mesh:
     """Unstructured tetrahedra (gmsh, edge length ``h``) of an organ-like lumpy solid: a sphere
     of ``radius`` fused with ``lumps`` smaller spheres (radius 0.45–0.7 × ``radius``) centred
     0.6–0.9 × ``radius`` from its centre in directions drawn from ``seed``: lobes, necks and
-    concave folds a cut can run into."""
+    concave folds a cut can run into. ``max_cells``: see the module (the estimate takes the
+    spheres' volumes and areas as if apart, at most 0.7³ and 0.7² of the big one's per lump)."""
     _positive(radius=radius, h=h)
     lumps = _checks.count(lumps, "lumps", 0)
+    _check_size(4 / 3 * math.pi * radius**3 * (1 + 0.7**3 * lumps), 4 * math.pi * radius**2 * (1 + 0.7**2 * lumps),
+                h, max_cells)
     rng = np.random.default_rng(_checks.count(seed, "seed", 0))
     directions = rng.normal(size=(lumps, 3))
     directions /= np.linalg.norm(directions, axis=1, keepdims=True)
@@ -179,7 +230,8 @@ def _where(point) -> str:
     return "(" + ", ".join(f"{float(x):.4g}" for x in point) + ")"
 
 
-def tetrahedralize(surface, size: float, *, remesh: bool = True, seed: int | None = None) -> Mesh:
+def tetrahedralize(surface, size: float, *, remesh: bool = True, seed: int | None = None,
+                   max_cells: int = MAX_CELLS) -> Mesh:
     """Tetrahedra filling a closed triangle surface: ``surface`` is a surface ``Mesh`` (triangles
     in 3D) or a file ``Mesh.read`` reads as one (STL, OBJ, OFF, PLY, VTK, ...). gmsh fills it
     (Delaunay, then optimised) with edges of about ``size``. With ``remesh`` (default) gmsh first
@@ -187,7 +239,8 @@ def tetrahedralize(surface, size: float, *, remesh: bool = True, seed: int | Non
     than 40°, which stay sharp): a coarser polyhedron, which on a sphere of radius R encloses
     about 0.3·(size/R)² less (1 % at size = R/5.5). ``remesh=False`` keeps the surface's
     triangles as the boundary of the result (the same volume), and the tetrahedra near it take
-    their size from them. ``seed`` fixes gmsh's random factor.
+    their size from them. ``seed`` fixes gmsh's random factor. ``max_cells``: the most tetrahedra
+    to make (see the module), estimated from the volume and area the surface encloses.
 
     A ValueError names what stops it: a mesh that is no surface, a surface that is open (with
     one of its boundary edges), in several pieces, or that crosses itself (with a pair of
@@ -209,6 +262,12 @@ def tetrahedralize(surface, size: float, *, remesh: bool = True, seed: int | Non
     if pieces > 1:
         raise ValueError(f"the surface is in {pieces} separate pieces; tetrahedralize fills one closed surface: "
                          "pass each piece alone")
+    # A surface Mesh's triangles are oriented alike, so the signed volumes of the cones from the
+    # origin add up to ± the enclosed volume.
+    a, b, c = (points[triangles[:, k]] for k in range(3))
+    volume = abs(float(np.einsum("ij,ij->", a, np.cross(b, c)))) / 6
+    area = float(np.linalg.norm(np.cross(b - a, c - a), axis=1).sum()) / 2
+    _check_size(volume, area, size, max_cells, "size")
 
     def add(gmsh):
         entity = gmsh.model.addDiscreteEntity(2)

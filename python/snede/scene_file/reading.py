@@ -37,8 +37,9 @@ def number_kind(what: str, accept: Callable[[float], bool]) -> Kind:
     return Kind(what, lambda v: float(v) if is_number(v) and accept(v) else REFUSED)
 
 
-def integer_kind(what: str, low: int) -> Kind:
-    return Kind(what, lambda v: v if isinstance(v, int) and not isinstance(v, bool) and v >= low else REFUSED)
+def integer_kind(what: str, low: int, high: int | None = None) -> Kind:
+    return Kind(what, lambda v: v if isinstance(v, int) and not isinstance(v, bool) and v >= low
+                and (high is None or v <= high) else REFUSED)
 
 
 def vector_kind(what: str, length: int, item: Kind, accept: Callable[[list], bool] = lambda v: True) -> Kind:

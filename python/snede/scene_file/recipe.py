@@ -86,7 +86,7 @@ def read(path) -> Recipe:
     top.close()
     name = top.get("name", NAME, path.stem)
     description = top.get("description", TEXT, f"scene file {path.name}")
-    mesh = read_mesh(top.table("mesh", NEEDED), path.parent)
+    mesh, max_cells = read_mesh(top.table("mesh", NEEDED), path.parent)
     material = _material(top.table("material", NEEDED))
     holds = [_region_and(t, "displacement", [0.0, 0.0, 0.0]) for t in top.tables("hold")]
     if not holds:
@@ -98,7 +98,7 @@ def read(path) -> Recipe:
               for t in loads.tables("force")]
     loads.close()
     solver = _solver(top.table("solver") or Table({}, "solver", source), material.name)
-    tools = read_tools(top.tables("tool"), solver.method)
+    tools = read_tools(top.tables("tool"), solver.method, max_cells)
     if solver.method == "dynamic" and tools:
         raise SceneFileError(f'{source}: solver.method "dynamic" cannot relax the tools\' steps: take newton, '
                              "ncg or cg")

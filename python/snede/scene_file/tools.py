@@ -4,19 +4,29 @@ steps to ``end``, the body relaxed after each; snede.TetrahedralCutter) and a ne
 (``kind = "needle"``: from where the line through ``entry`` along ``direction`` meets the
 surface, ``depth`` deep in ``steps`` updates; snede.NeedleInsertion). Before anything runs,
 each path is checked against the body's reference shape: a sweep must meet it, a needle must
-start outside it and its tip stay inside."""
+start outside it and its tip stay inside. A sweep takes at most MAX_STEPS moves, an insertion
+as many updates, and a needle's ``h_ref`` may not refine the body beyond ``[mesh] max_cells``."""
 from __future__ import annotations
+
+import math
 
 import numpy as np
 
 import snede
-from snede.scene_file.reading import (COUNT, DIRECTION, POINT, POSITIVE, REFUSED, SEGMENT, Kind, SceneFileError,
-                                      Table, choice, is_number, number_kind)
+from snede import meshing
+from snede.scene_file.reading import (DIRECTION, POINT, POSITIVE, REFUSED, SEGMENT, Kind, SceneFileError, Table,
+                                      choice, integer_kind, is_number, number_kind)
 from snede.scenes import briefly
 
 KINDS = ("scalpel", "needle")
 AIM = np.array([0.31, 0.47, 0.83])  # a direction no mesh lines up with, to tell inside from outside
 SAMPLES_PER_MOVE = 4  # blade positions tried per move when checking that a sweep meets the body
+# Each move or update is a relaxation, a step of the series and a frame of the GIF, which holds
+# the mesh's points, boundary and displacement until the end and takes matplotlib a fraction of
+# a second to draw: 1000 take minutes, a billion would never end.
+MAX_STEPS = 1000
+STEPS = integer_kind(f"a positive integer up to {MAX_STEPS} (each is a relaxation, a step of the series and a "
+                     "frame of the GIF)", 1, MAX_STEPS)
 
 
 def _friction(value):
@@ -67,7 +77,7 @@ class Scalpel:
     def __init__(self, table: Table):
         self.key = table.name
         self.start, self.end = np.array(table.get("start", SEGMENT)), np.array(table.get("end", SEGMENT))
-        self.moves = table.get("moves", COUNT, meaning="how many steps the blade takes from start to end")
+        self.moves = table.get("moves", STEPS, meaning="how many steps the blade takes from start to end")
         self.table = table
 
     def path(self, samples: int) -> np.ndarray:
@@ -106,17 +116,29 @@ class Needle:
 
     methods = ("cg", "newton")
 
-    def __init__(self, table: Table):
+    def __init__(self, table: Table, max_cells: int):
         self.key, self.table = table.name, table
         self.entry = np.array(table.get("entry", POINT, meaning="a point outside the body on the needle's line"))
         direction = np.array(table.get("direction", DIRECTION))
         self.direction = direction / np.linalg.norm(direction)
         self.depth = table.get("depth", POSITIVE, meaning="how far the tip goes in past the surface, in metres")
-        self.steps = table.get("steps", COUNT, meaning="how many updates the insertion takes")
+        self.steps = table.get("steps", STEPS, meaning="how many updates the insertion takes")
         self.radius = table.get("radius", POSITIVE, 1e-3)
         self.friction = table.get("friction", FRICTION, snede.FrictionProfile.figure_6_4())
         self.static_factor = table.get("static_factor", STATIC_FACTOR, 2.0)
         self.h_ref = table.get("h_ref", POSITIVE, None)
+        if self.h_ref is not None:
+            # Bisection refines every element within radius of the shaft, and those up to one
+            # element beyond, to edges of h_ref: the tube around the shaft and the ball at the tip
+            # filled with tetrahedra no larger than regular ones of edge h_ref (fewer than it makes).
+            reach = self.radius + self.h_ref
+            tube = math.pi * reach**2 * self.depth + 4 / 3 * math.pi * reach**3
+            try:
+                meshing.check_cells(meshing.tetrahedra_estimate(tube, 0.0, self.h_ref), max_cells,
+                                    f"{self.h_ref:g} m", "give a larger h_ref (each halving makes 8 times as "
+                                    "many), or raise mesh.max_cells if you mean it")
+            except ValueError as error:
+                table.fail("h_ref", str(error))
 
     def check(self, mesh) -> None:
         hit = mesh.ray_hit(self.entry, self.direction)
@@ -181,13 +203,13 @@ def _span(mesh) -> str:
     return f"{np.round(low, 6).tolist()} to {np.round(high, 6).tolist()}"
 
 
-def read_tools(tables: list[Table], method: str | None) -> list:
+def read_tools(tables: list[Table], method: str | None, max_cells: int) -> list:
     """The tools of the ``[[tool]]`` tables, in order; a needle, which stays in the body, only
-    last. ``method``: the solver's, when the file names one."""
+    last. ``method``: the solver's, when the file names one; ``max_cells``: the body's limit."""
     tools = []
     for table in tables:
         kind = table.get("kind", choice(KINDS))
-        tool = Scalpel(table) if kind == "scalpel" else Needle(table)
+        tool = Scalpel(table) if kind == "scalpel" else Needle(table, max_cells)
         table.close()
         if tools and isinstance(tools[-1], Needle):
             table.fail(None, f"comes after the needle of {tools[-1].key}: a needle stays in the body, so it is "

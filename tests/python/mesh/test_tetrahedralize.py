@@ -207,3 +207,31 @@ def test_the_crossing_search_agrees_with_testing_every_pair():
 def test_a_closed_clean_surface_has_no_crossings():
     points, triangles = torus_surface()
     assert len(_geometry.crossing_triangles(points, triangles)) == 0
+
+
+def test_a_size_that_would_make_too_many_tetrahedra_is_refused_at_once():
+    """Issue 48, item 10: size 1e-9 on a unit box ran without end. The estimate (half the count of
+    regular tetrahedra of edge size that fill the volume, plus the boundary triangles) comes
+    first: about 0.5·(6 / (1e-27/(6√2)) + 22 / (√3/4·1e-18)) = 2.5e28, refused with that number;
+    max_cells raises the limit, and the count gmsh makes where it is allowed is near the estimate."""
+    points, triangles = box_surface((1.0, 2.0, 3.0))
+    surface = snede.Mesh(points, triangles)
+    message = "size = 1e-09 would make about 2.5e+28 tetrahedra (limit 10000000)"
+    with pytest.raises(ValueError, match=re.escape(message)):
+        tetrahedralize(surface, 1e-9)
+    expected = 0.5 * (6.0 / (0.3**3 / (6 * math.sqrt(2))) + 22.0 / (math.sqrt(3) / 4 * 0.3**2))
+    with pytest.raises(ValueError, match=re.escape(f"about {expected:.2g} tetrahedra (limit 100); give a larger")):
+        tetrahedralize(surface, 0.3, max_cells=100)
+    made = tetrahedralize(surface, 0.3, max_cells=round(expected * 2), seed=1).n_cells
+    assert 0.7 * expected < made < 1.4 * expected, (made, expected)
+
+
+@pytest.mark.parametrize("make, count", [
+    (lambda: snede.meshing.cylinder(h=1e-9), "1.2e+24"),  # 0.5·π·0.03²·0.1·6√2/1e-27
+    (lambda: snede.meshing.ellipsoid(h=1e-6), "1.3e+15"),  # 0.5·(4/3)π·0.06·0.04·0.03·6√2/1e-18
+    (lambda: snede.meshing.torus(h=1e-5), "1.7e+12"),  # 0.5·2π²·0.05·0.02²·6√2/1e-15
+    (lambda: snede.meshing.hollow_sphere(0.999999, 1.0, h=1e-3), "2.9e+07"),  # a thin shell: its 2 spheres' triangles
+])
+def test_each_gmsh_shape_refuses_an_edge_length_that_would_make_too_many(make, count):
+    with pytest.raises(ValueError, match=re.escape(f"would make about {count} tetrahedra (limit 10000000)")):
+        make()

@@ -9,7 +9,7 @@ import sys
 import pytest
 
 from snede import scene_file
-from test_scene_files import BOX
+from test_scene_files import BOX, ROOT
 
 GOOD = BOX + """
 [[hold]]
@@ -21,6 +21,7 @@ gravity = [0.0, 0.0, -9.81]
 BOX_SHAPE = 'shape = "box"\nsize = [0.1, 0.04, 0.04]\ndivisions = [10, 4, 4]'
 SCALPEL = '\n[[tool]]\nkind = "scalpel"\nstart = [[0.05, -0.01, 0.03], [0.05, 0.03, 0.03]]\n' \
           'end = [[0.05, -0.01, 0.01], [0.05, 0.03, 0.01]]\nmoves = 3\n'
+LIVER = ROOT / "meshes" / "liver2_surface.obj"
 NEEDLE = '\n[[tool]]\nkind = "needle"\nentry = [0.05, -0.1, 0.01]\ndirection = [0, 1, 0]\ndepth = 0.01\nsteps = 3\n'
 
 
@@ -120,6 +121,28 @@ MISTAKES = {
     "a name that is no folder": (edited(("[mesh]", 'name = "../up"\n\n[mesh]')),
                                  "name must be a name of letters, digits, '-', '_' or '.' (the output folder's), "
                                  'got "../up"'),
+    # one number that would ask for unbounded work (issue 48, item 10)
+    "a billion moves": (edited(SCALPEL.replace("moves = 3", "moves = 1000000000")),
+                        "tool[1].moves must be a positive integer up to 1000 (each is a relaxation, a step of the "
+                        "series and a frame of the GIF), got 1000000000"),
+    "a billion steps": (edited(NEEDLE.replace("steps = 3", "steps = 1000000000")),
+                        "tool[1].steps must be a positive integer up to 1000"),
+    "a needle's h_ref in nanometres": (edited(NEEDLE + "h_ref = 1e-9\n"),
+                                       "tool[1].h_ref 1e-09 m would make about 3e+20 tetrahedra (limit 10000000); "
+                                       "give a larger h_ref (each halving makes 8 times as many), or raise "
+                                       "mesh.max_cells if you mean it"),
+    "a surface filled at a micrometre": (edited((BOX_SHAPE, f'surface = "{LIVER}"\nsize = 1e-6')),
+                                         "mesh.surface could not be filled with tetrahedra: size = 1e-06 would make "
+                                         "about "),
+    "a gmsh shape at a nanometre": (edited((BOX_SHAPE, 'shape = "cylinder"\nh = 1e-9')),
+                                    'mesh.shape "cylinder" could not be made: h = 1e-09 would make about 1.2e+24 '
+                                    "tetrahedra (limit 10000000)"),
+    "a box of a billion cubes": (edited(("[10, 4, 4]", "[1000, 1000, 1000]")),
+                                 "mesh.divisions [1000, 1000, 1000] would make about 6e+09 tetrahedra (limit "
+                                 "10000000); give fewer divisions, or raise mesh.max_cells if you mean it"),
+    "a target beyond the limit": (edited(("[10, 4, 4]", "[10, 4, 4]\ntarget_cells = 20000\nmax_cells = 10000")),
+                                  "mesh.target_cells 20000 would make about 2e+04 tetrahedra (limit 10000); give a "
+                                  "smaller one, or raise mesh.max_cells if you mean it"),
     # missing files, unknown materials and shapes
     "a missing mesh file": (edited((BOX_SHAPE, 'file = "no_such.msh"')), "mesh.file names no file: "),
     "a missing surface": (edited((BOX_SHAPE, 'surface = "liver.stl"\nsize = 0.01')), "mesh.surface names no file: "),
@@ -168,8 +191,18 @@ def test_a_missing_scene_file_is_named(tmp_path):
         scene_file.load(tmp_path / "nothere.toml")
 
 
+def test_max_cells_is_the_limit_a_user_can_raise(tmp_path):
+    path = tmp_path / "fine.toml"
+    path.write_text(edited(("[10, 4, 4]", "[10, 4, 4]\nmax_cells = 959")))  # the box has 960 tetrahedra
+    with pytest.raises(scene_file.SceneFileError, match="about 9.6e.02 tetrahedra .limit 959."):
+        scene_file.load(path)
+    path.write_text(edited(("[10, 4, 4]", "[10, 4, 4]\nmax_cells = 960")))
+    assert scene_file.load(path).body.mesh.n_cells == 960
+
+
 @pytest.mark.parametrize("mistake", ["a negative modulus", "a misspelled section", "a missing mesh file",
-                                     "a needle that comes out the other side", "TOML nested 5 000 deep"])
+                                     "a needle that comes out the other side", "TOML nested 5 000 deep",
+                                     "a needle's h_ref in nanometres", "a billion moves"])
 def test_the_command_line_says_the_line_and_exits_with_status_2(mistake, tmp_path):
     text, message = MISTAKES[mistake]
     (tmp_path / "my_scene.toml").write_text(text)
