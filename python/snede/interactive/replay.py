@@ -52,7 +52,8 @@ def replay(recording, out=None) -> ReplayResult:
             session.tool.write(writer, float(recording["moves"][index]["t"]))
     final = digest(session.body)
     files = {} if folder is None else _picture(session, folder, writer)
-    return ReplayResult(session.name, len(recording["moves"]), final, compare(recording["digest"], final, session.rtol), files)
+    mismatches = compare(recording["digest"], final, session.rtol)
+    return ReplayResult(session.name, len(recording["moves"]), final, mismatches, files)
 
 
 def _picture(session, folder: Path, writer) -> dict:

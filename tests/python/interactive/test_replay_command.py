@@ -35,7 +35,8 @@ def test_a_tampered_digest_fails_the_check(cut_recording):
     recording = json.loads(cut_recording.read_text())
     digest = recording["digest"]
     # twice the sum's tolerance, √n·rtol·|u| (recording.compare)
-    digest["points"]["sum"] += 2 * math.sqrt(digest["points"]["size"]) * recording["rtol"] * digest["displacement"]["norm"]
+    digest["points"]["sum"] += 2 * math.sqrt(digest["points"]["size"]) * recording["rtol"] * \
+        digest["displacement"]["norm"]
     cut_recording.write_text(json.dumps(recording))
     done = snede("replay", cut_recording, "--check")
     assert done.returncode == 1
@@ -87,7 +88,8 @@ def tampered(name, key, value) -> str:
     (tampered("displacement", "sum", math.nan), "digest.displacement.sum must be a finite number, got NaN"),
     (tampered("points", "norm", -math.inf), "digest.points.norm must be a finite number, got -Infinity"),
     (tampered("points", "sum", "32.2"), 'digest.points.sum must be a finite number, got "32.2"'),
-    (tampered("points", "weighted", json.loads("1e999")), "digest.points.weighted must be a finite number, got Infinity"),
+    (tampered("points", "weighted", json.loads("1e999")),
+     "digest.points.weighted must be a finite number, got Infinity"),
     (tampered("points", "weighted", 10**400), "digest.points.weighted must be a finite number"),
     (tampered("points", "size", 3.0), "digest.points.size must be an integer, got 3.0"),
     (tampered("cells", "sum", True), "digest.cells.sum must be an integer, got true"),
