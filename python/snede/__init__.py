@@ -6,6 +6,9 @@ Importing snede initialises PETSc once, through petsc4py (see ``snede._petsc``).
 import importlib
 
 from snede._petsc import PETSc  # noqa: F401  (initialises PETSc before the engine loads)
+from snede._command_line import abort_first_under_mpi4py
+
+abort_first_under_mpi4py()  # after petsc4py's exit handler is registered: see there
 from snede._snede import (  # noqa: F401
     BodyInUse,
     DomainError,

@@ -288,18 +288,6 @@ def _replay(args) -> int:
     return 0
 
 
-def _end_every_rank(code: int) -> None:
-    """Under ``mpirun -n N`` an error on one rank alone (a scene script's, an engine's) would
-    leave the other ranks waiting in a collective call for ever (issue 18): with several ranks,
-    a failed command ends the whole job with MPI_Abort, as ``python -m mpi4py`` does."""
-    from mpi4py import MPI
-
-    if MPI.COMM_WORLD.size > 1:
-        sys.stdout.flush()
-        sys.stderr.flush()
-        MPI.COMM_WORLD.Abort(code)
-
-
 if __name__ == "__main__":
     # Not converged (1, from the collective summary) and bad input every rank finds alike end
     # every rank alike; an error, an interrupt or a script's sys.exit may have happened on this
@@ -318,5 +306,5 @@ if __name__ == "__main__":
         traceback.print_exc()
         exit_code, alone = 1, True
     if exit_code != 0 and alone:
-        _end_every_rank(exit_code)
+        _command_line.end_every_rank(exit_code)
     sys.exit(exit_code)

@@ -2,10 +2,13 @@
 ``python -m snede: error: ...``, and exit status 2; Ctrl-C gives one line, ``interrupted ...``,
 and status 130; never a traceback. ``python -m snede`` imports the package before its
 ``__main__`` runs, so ``snede._petsc`` keeps the promise while the package loads (PETSc's
-start-up, Ctrl-C) and ``snede.__main__`` afterwards, both through this module.
+start-up, Ctrl-C) and ``snede.__main__`` afterwards, both through this module. Under ``mpirun``
+a failure on one rank ends every rank (``end_every_rank``), also for a script run by
+``python -m mpi4py`` (``abort_first_under_mpi4py``).
 """
 from __future__ import annotations
 
+import atexit
 import os
 import signal
 import sys
@@ -32,6 +35,45 @@ def fail(message) -> NoReturn:
     if _rank() == 0:
         print(error_line(message), file=sys.stderr)
     raise AlikeOnEveryRank(BAD_INPUT)
+
+
+def end_every_rank(code: int) -> None:
+    """Under ``mpirun -n N`` an error on one rank alone (a scene script's, an engine's) would
+    leave the other ranks waiting in a collective call for ever (issue 18): with several ranks,
+    a failed command ends the whole job with MPI_Abort, as ``python -m mpi4py`` does."""
+    from mpi4py import MPI
+
+    if MPI.Is_initialized() and not MPI.Is_finalized() and MPI.COMM_WORLD.size > 1:
+        sys.stdout.flush()
+        sys.stderr.flush()
+        MPI.COMM_WORLD.Abort(code)
+
+
+def abort_first_under_mpi4py() -> None:
+    """Under ``python -m mpi4py script.py`` an exception (or a non-zero sys.exit) in the script
+    makes mpi4py record its status and call MPI_Abort at the very end of Python's exit. But
+    petsc4py's exit handler comes before that and frees PETSc's objects collectively
+    (PetscGarbageCleanup duplicates a communicator): the failed rank waited there for the others,
+    which waited for it, for ever (issue 48, item 4). Here mpi4py's runner's status is noted as it
+    is set, and an exit handler that runs before petsc4py's (registered after it: atexit runs
+    the last registered first) aborts at once. Nothing changes without mpi4py's runner."""
+    runner = sys.modules.get("mpi4py.run")
+    if runner is None or getattr(runner.set_abort_status, "_snede", False):
+        return
+    status = [0]
+    record = runner.set_abort_status
+
+    def set_abort_status(code):
+        status[0] = code if isinstance(code, int) else 0 if code is None else 1
+        return record(code)
+
+    def abort_if_failed() -> None:
+        if status[0]:
+            end_every_rank(status[0])
+
+    set_abort_status._snede = True
+    runner.set_abort_status = set_abort_status  # the runner looks it up when the script has failed
+    atexit.register(abort_if_failed)
 
 
 def _rank() -> int:

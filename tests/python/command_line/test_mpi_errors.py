@@ -6,6 +6,7 @@ import shutil
 import subprocess
 import sys
 import textwrap
+import time
 
 import pytest
 
@@ -96,3 +97,38 @@ def test_a_rank_that_skips_a_collective_call_is_ended_only_by_a_time_limit(tmp_p
         """, mpirun_options=("--timeout", "3"))
     assert run.returncode != 0, (run.stdout, run.stderr)
     assert "rank 1 finished" in run.stdout and "rank 0 finished" not in run.stdout, run.stdout
+
+
+@pytest.mark.parametrize("imports", ["import snede", "import petsc4py; petsc4py.init(); from petsc4py import PETSc; "
+                                                     "import snede"])
+@pytest.mark.parametrize("error, status", [("ValueError('rank 1 fails')", 1), ("SystemExit(3)", 3)])
+def test_python_m_mpi4py_ends_the_job_when_a_script_that_imports_snede_fails(tmp_path, imports, error, status):
+    """Issue 48, item 4: ``mpirun -n 2 python -m mpi4py script.py``, the guard the MPI guide
+    recommends, ended the job when rank 1 raised, until the script imported snede: petsc4py's
+    exit handler then waited in a collective call (PetscGarbageCleanup) on rank 1 while rank 0
+    waited in its barrier. The job must end, with mpi4py's status, well within the time limit."""
+    script = tmp_path / "script.py"
+    script.write_text(textwrap.dedent(f"""
+        from mpi4py import MPI
+        {imports}
+        if MPI.COMM_WORLD.rank == 1:
+            raise {error}
+        MPI.COMM_WORLD.Barrier()
+        print("rank 0 went on alone")
+        """))
+    start = time.monotonic()
+    run = subprocess.run(["mpirun", "-n", "2", sys.executable, "-m", "mpi4py", str(script)], capture_output=True,
+                         text=True, timeout=120, env={**os.environ, **MPI_ROOT})
+    assert time.monotonic() - start < 60, "the job ended only by itself, late"
+    assert run.returncode == status, (run.stdout, run.stderr)
+    assert "went on alone" not in run.stdout
+    assert status != 1 or "ValueError: rank 1 fails" in run.stderr, run.stderr
+
+
+def test_python_m_mpi4py_still_exits_cleanly(tmp_path):
+    """The abort is only for a failed script: one that imports snede and ends on both ranks exits 0."""
+    script = tmp_path / "script.py"
+    script.write_text("from mpi4py import MPI\nimport snede\nassert MPI.COMM_WORLD.allreduce(1) == 2\n")
+    run = subprocess.run(["mpirun", "-n", "2", sys.executable, "-m", "mpi4py", str(script)], capture_output=True,
+                         text=True, timeout=120, env={**os.environ, **MPI_ROOT})
+    assert run.returncode == 0, run.stderr
