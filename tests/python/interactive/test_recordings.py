@@ -54,4 +54,4 @@ def longer_push(recording: dict) -> dict:
                                                 ("needle_push", longer_push, ("displacement",))])
 def test_a_wrong_move_does_not_match(name, change, seen):
     mismatches = replay(change(copy.deepcopy(stored(name)))).mismatches
-    assert {line.split(":")[0] for line in mismatches} == set(seen), mismatches
+    assert set(seen) <= {line.split(":")[0] for line in mismatches}, mismatches
