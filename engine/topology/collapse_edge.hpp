@@ -22,7 +22,12 @@ namespace snede {
 //    the collapse would change the topology — Figure 3.10, and in particular an interior
 //    edge joining two boundary vertices;
 //  * a surviving element would be flat or inverted at the new position of keep (exact
-//    signs in 2D and 3D; see orientation_checks.hpp for surfaces).
+//    signs in 2D and 3D; see orientation_checks.hpp for surfaces);
+//  * on a tetrahedral mesh, the collapse would change the body's volume beyond round-off: it
+//    would move the boundary (a boundary vertex off its flat patch), and the cells would no
+//    longer fill the body they filled (the 2D cutters' exit contractions, §5.3.2, may);
+//  * with t = 0, a watcher refuses a cell of gone's star with keep in gone's place that it did
+//    not refuse before (a body: the cell inverted by its displacement, issue 48).
 EditResult collapse_edge(Mesh& mesh, VertexId keep, VertexId gone, double t = 0);
 
 }  // namespace snede
