@@ -42,7 +42,10 @@ if ! cmp -s tools/requirements.txt "$stamp"; then
 fi
 
 # snede itself: rebuilt by scikit-build-core only when sources changed (build dir is kept).
-echo "setup: building snede"
+# SNEDE_NATIVE=OFF builds for the x86-64 baseline instead of this processor, in a build
+# directory of its own, so that switching back and forth rebuilds nothing.
+source tools/build_mode.sh
+echo "setup: building snede (SNEDE_NATIVE=$SNEDE_NATIVE)"
 PETSC_DIR=$PETSC_DIR_DEBIAN $PIP install --no-build-isolation --no-deps -e . \
-    -Cbuild-dir=build/python
+    -Cbuild-dir="build/python$BUILD_SUFFIX" -Ccmake.define.SNEDE_NATIVE="$SNEDE_NATIVE"
 echo "setup: done"
