@@ -381,41 +381,75 @@ def _fans(faces: np.ndarray, mesh: Mesh) -> np.ndarray:
     across a shared edge."""
     n = mesh.n_points
     n_faces = len(faces)
+
+    def fans(half_edge_pairs: np.ndarray) -> np.ndarray:
+        """Corner labels (corner 3 f + k: corner k of face f, labelled by the smallest corner of
+        its fan): across paired half-edges (a → b in one face, b → a in the other) the corners
+        at a and those at b belong to the same fans."""
+        f, k = np.divmod(half_edge_pairs[:, 0], 3)
+        g, m = np.divmod(half_edge_pairs[:, 1], 3)
+        joined = np.concatenate([np.c_[3 * f + k, 3 * g + (m + 1) % 3], np.c_[3 * f + (k + 1) % 3, 3 * g + m]])
+        labels = np.arange(3 * n_faces)
+        while True:  # the smallest corner of each fan spreads through it
+            lowest = np.minimum(labels[joined[:, 0]], labels[joined[:, 1]])
+            updated = labels.copy()
+            np.minimum.at(updated, joined[:, 0], lowest)
+            np.minimum.at(updated, joined[:, 1], lowest)
+            updated = updated[updated]
+            if np.array_equal(updated, labels):
+                return labels
+            labels = updated
+
     # Half-edge k of face f runs from corner k to corner k + 1; an edge's faces are its owners.
     tail, head = faces, np.roll(faces, -1, axis=1)
     keys = _edge_keys(tail, head, n).ravel()
     order = np.argsort(keys, kind="stable")
     _, first, uses = np.unique(keys[order], return_index=True, return_counts=True)
-    # Two faces at an edge follow each other; at an edge where the boundary touches itself
-    # (4, 6, ... faces), those that close the same wedge of solid do.
+    # Two faces at an edge follow each other.
     two = first[uses == 2]
-    half_edge_pairs = [np.c_[order[two], order[two + 1]]]
+    manifold_pairs = np.c_[order[two], order[two + 1]]
     touching = first[uses > 2]
-    if len(touching):
-        half_edges = order[touching]
-        edges = np.c_[tail.ravel()[half_edges], head.ravel()[half_edges]]
-        wedges = _wedge_partners(faces, mesh.cells, edges, n)
-        for f, g in wedges.tolist():
-            shared = set(faces[f]) & set(faces[g])
-            k = next(k for k in range(3) if {faces[f][k], faces[f][(k + 1) % 3]} == shared)
-            m = next(m for m in range(3) if {faces[g][m], faces[g][(m + 1) % 3]} == shared)
-            half_edge_pairs.append(np.array([[3 * f + k, 3 * g + m]]))
-    half_edge_pairs = np.concatenate(half_edge_pairs)
-    # Across paired half-edges (a → b in one face, b → a in the other) the corners at a and
-    # those at b belong to the same fans.
-    f, k = np.divmod(half_edge_pairs[:, 0], 3)
-    g, m = np.divmod(half_edge_pairs[:, 1], 3)
-    joined = np.concatenate([np.c_[3 * f + k, 3 * g + (m + 1) % 3], np.c_[3 * f + (k + 1) % 3, 3 * g + m]])
-    labels = np.arange(3 * n_faces)
-    while True:  # the smallest corner of each fan spreads through it
-        lowest = np.minimum(labels[joined[:, 0]], labels[joined[:, 1]])
-        updated = labels.copy()
-        np.minimum.at(updated, joined[:, 0], lowest)
-        np.minimum.at(updated, joined[:, 1], lowest)
-        updated = updated[updated]
-        if np.array_equal(updated, labels):
+    if not len(touching):
+        return fans(manifold_pairs).reshape(n_faces, 3)
+    # At an edge ab where the boundary touches itself (4, 6, ... faces), those that close the
+    # same wedge of solid do, to begin with: pairs of half-edges, the one running from the
+    # edge's lower vertex a to b first.
+    half_edges = order[touching]
+    edges = np.c_[tail.ravel()[half_edges], head.ravel()[half_edges]]
+    at_edge: dict[tuple[int, int], list[list[int]]] = {}
+    for f, g in _wedge_partners(faces, mesh.cells, edges, n).tolist():
+        shared = set(faces[f]) & set(faces[g])
+        k = next(k for k in range(3) if {faces[f][k], faces[f][(k + 1) % 3]} == shared)
+        m = next(m for m in range(3) if {faces[g][m], faces[g][(m + 1) % 3]} == shared)
+        if faces[f][k] > faces[f][(k + 1) % 3]:
+            f, k, g, m = g, m, f, k
+        at_edge.setdefault((int(faces[f][k]), int(faces[f][(k + 1) % 3])), []).append([3 * f + k, 3 * g + m])
+    while True:
+        wedge_pairs = np.array([pair for pairs in at_edge.values() for pair in pairs]).reshape(-1, 2)
+        labels = fans(np.concatenate([manifold_pairs, wedge_pairs]))
+        # Two pairs of an edge ab whose faces are in one fan round a and one fan round b would
+        # still put four faces on one edge of the surface. That happens where the solid round
+        # each of a and b is connected: the wedges meet again beyond both ends of the edge,
+        # with a gap between them on either side of it (two notches whose tips touch along the
+        # edge; where two of SOFA's ossicles touch). Then the two pairs trade partners, so that
+        # the faces that bound the same gap follow each other. The faces round a follow each
+        # other in a cycle (a permutation's), which passes the edge once per pair; trading
+        # partners between two pairs of one cycle cuts it in two, as a transposition does, and
+        # so round b: each of the two pairs gets its own copy of a and of b. Trades at edges
+        # with no vertex in common are made at once; each splits two fans and merges none, so
+        # this ends.
+        done: set[int] = set()
+        for (a, b), pairs in at_edge.items():
+            if a in done or b in done:
+                continue
+            ends = [(labels[h], labels[h + 1 if h % 3 < 2 else h - 2]) for h, _ in pairs]
+            clash = next(((i, j) for i in range(len(pairs)) for j in range(i) if ends[i] == ends[j]), None)
+            if clash is not None:
+                i, j = clash
+                pairs[i][1], pairs[j][1] = pairs[j][1], pairs[i][1]
+                done.update((a, b))
+        if not done:
             return labels.reshape(n_faces, 3)
-        labels = updated
 
 
 def boundary_surface(mesh: Mesh) -> tuple[Mesh, np.ndarray]:
@@ -425,8 +459,10 @@ def boundary_surface(mesh: Mesh) -> tuple[Mesh, np.ndarray]:
     Where the boundary touches itself — two bones that meet along an edge or at a vertex — the
     surface is split into manifold surfaces: such a vertex becomes one surface vertex per fan of
     boundary triangles around it (along an edge, the two triangles that close the same wedge of
-    solid follow each other), so that every edge is shared by exactly two triangles and a
-    membrane can be built on it. Each copy sits where its vertex is, and ``vertex_ids`` maps
+    solid follow each other; where the wedges meet again beyond both ends of the edge, so that
+    this would leave four triangles on one edge, the two that bound the same gap between them
+    do), so that every edge is shared by exactly two triangles and a membrane can be built on
+    it. Each copy sits where its vertex is, and ``vertex_ids`` maps
     every copy to that same volume vertex. Surface vertices are numbered in ascending order of
     their volume vertex; the extra copies come after them."""
     if mesh.cell_dim != 3:
