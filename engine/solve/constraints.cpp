@@ -154,12 +154,12 @@ void Constraints::projection_block(VertexId v, std::span<double> block) const {
   }
 }
 
-void Constraints::add_complement(std::span<const double> v, std::span<double> out) const {
+void Constraints::add_complement(std::span<const double> v, std::span<double> out, double scale) const {
   std::array<double, 3> complement{};
   for (std::size_t i = 0; i < vertices_.size(); ++i) {
     if (vertices_[i].kind == ConstraintKind::free) continue;
     complement_of(vertices_[i], dim_, v.data() + i * dim_, complement.data());
-    for (int k = 0; k < dim_; ++k) out[i * dim_ + k] += complement[k];
+    for (int k = 0; k < dim_; ++k) out[i * dim_ + k] += scale * complement[k];
   }
 }
 

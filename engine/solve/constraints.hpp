@@ -54,8 +54,8 @@ class Constraints {
   void projection_block(VertexId v, std::span<double> block) const;
   // v ← (I − P) v
   void project_complement(std::span<double> v) const;
-  // out += (I − P) v, touching only the constrained vertices' entries.
-  void add_complement(std::span<const double> v, std::span<double> out) const;
+  // out += scale (I − P) v, touching only the constrained vertices' entries.
+  void add_complement(std::span<const double> v, std::span<double> out, double scale = 1.0) const;
   // u ← P u + (I − P) anchor: the nearest displacement that satisfies the constraints.
   void enforce(std::span<double> u) const;
   // A new vertex inherits its parents' constraint when they agree (one parent: its

@@ -18,16 +18,19 @@ std::vector<double> diagonal_projection(std::span<const std::uint8_t> fixed_loca
 
 DistributedAssembledTangent::DistributedAssembledTangent(const DistributedMesh& part, const ElasticBody& body,
                                                          std::span<const PetscInt> local_rows,
-                                                         std::span<const std::uint8_t> fixed_local, PetscInt n_owned_dofs)
+                                                         std::span<const std::uint8_t> fixed_local, PetscInt n_owned_dofs,
+                                                         double constraint_stiffness)
     : DistributedAssembledTangent(part, body, local_rows, diagonal_projection(fixed_local, part.local->dim()),
-                                  n_owned_dofs) {}
+                                  n_owned_dofs, constraint_stiffness) {}
 
 DistributedAssembledTangent::DistributedAssembledTangent(const DistributedMesh& part, const ElasticBody& body,
                                                          std::span<const PetscInt> local_rows,
-                                                         std::span<const double> projection, PetscInt n_owned_dofs)
+                                                         std::span<const double> projection, PetscInt n_owned_dofs,
+                                                         double constraint_stiffness)
     : part_(part), body_(body), local_rows_(local_rows.begin(), local_rows.end()),
       projection_(projection.begin(), projection.end()),
       complement_(complement_blocks(projection_, part.local->dim())) {
+  for (double& x : complement_) x *= constraint_stiffness;
   const int dim = part.local->dim();
   const std::vector<double> at_rest(local_rows_.size(), 0.0);
   MatHandle sparsity;
@@ -75,8 +78,8 @@ void DistributedAssembledTangent::add_elements(Mat target, std::span<const doubl
     SNEDE_PETSC(MatSetValues(target, static_cast<PetscInt>(n), rows.data(), static_cast<PetscInt>(n), rows.data(), K.data(),
                              ADD_VALUES));
   });
-  // + (I − P) on every owned vertex's diagonal block (zero for a free one), so every owned row
-  // has its diagonal entry and a constrained direction a unit diagonal, as in the shell.
+  // + c (I − P) on every owned vertex's diagonal block (zero for a free one), so every owned row
+  // has its diagonal entry and a constrained direction the stiffness c, as in the shell.
   for (std::size_t v = 0; v < part_.owned.size(); ++v)
     if (part_.owned[v])
       SNEDE_PETSC(MatSetValues(target, static_cast<PetscInt>(dim), &local_rows_[v * dim], static_cast<PetscInt>(dim),

@@ -156,7 +156,13 @@ DistributedStatic::DistributedStatic(DistributedMesh& part, Material material, d
                          sliding_anchors);
     }
   projection_ = projection_blocks(constraints_, constraints_.n_points());
+  // c of the serial Model from the whole body's cells (a cell lives on one rank).
+  double volume = volume_of_cells(*part.local);
+  MPI_Allreduce(MPI_IN_PLACE, &volume, 1, MPI_DOUBLE, MPI_SUM, comm);
+  constraint_stiffness_ = snede::constraint_stiffness(body_.material(), part.local->cell_dim(), body_.thickness(), volume,
+                                                      static_cast<double>(part.n_global_cells));
   complement_ = complement_blocks(projection_, dim_);
+  for (double& x : complement_) x *= constraint_stiffness_;  // c (I − P)
   std::vector<double> load_local(n_dofs, 0.0);
   for (std::size_t k = 0; k < conditions.loaded.size(); ++k)
     if (const auto found = local_of.find(conditions.loaded[k]); found != local_of.end())
@@ -261,7 +267,7 @@ void DistributedStatic::add_to_global(const std::vector<double>& local, Vec glob
 }
 
 ResidualCheck DistributedStatic::residual(Vec u, Vec F) {
-  // F = P(−f_int(u) − f_ext) + (I − P)(u − ū); the fixed rows' −f_int − f_ext are the reactions.
+  // F = P(−f_int(u) − f_ext) + c (I − P)(u − ū); the fixed rows' −f_int − f_ext are the reactions.
   to_local(u, u_local_);
   EvaluationReport report;
   std::vector<double> f(u_local_.size(), 0.0);
@@ -275,14 +281,14 @@ ResidualCheck DistributedStatic::residual(Vec u, Vec F) {
   const ReadView u_view(u);
   const std::span<double> r = F_view.span();
   for (std::size_t k = 0; k < owned_rows_.size(); ++k) r[owned_rows_[k] - start] -= load_owned_[k];
-  // The reactions (I − P)(−f_int − f_ext), then r = P(−f_int − f_ext) + (I − P)(u − ū), as the
+  // The reactions (I − P)(−f_int − f_ext), then r = P(−f_int − f_ext) + c (I − P)(u − ū), as the
   // serial Model has it.
   std::vector<double> reaction(r.begin(), r.end());
   owned_constraints_.project_complement(reaction);
   owned_constraints_.project(r);
   std::vector<double> held(u_view.span().begin(), u_view.span().end());
   owned_constraints_.enforce(held);
-  for (std::size_t i = 0; i < r.size(); ++i) r[i] += u_view.span()[i] - held[i];
+  for (std::size_t i = 0; i < r.size(); ++i) r[i] += constraint_stiffness_ * (u_view.span()[i] - held[i]);
   const bool inverted = !report.inverted.empty() && forbids_inversion(body_.material());
   // Ranks with an inverted element, ranks with a non-finite one, ‖reactions‖².
   double sums[3] = {inverted ? 1.0 : 0.0, report.domain_errors.empty() ? 0.0 : 1.0,
@@ -371,7 +377,7 @@ class AssembledDistributedTangent final : public AssembledProblemTangent {
   explicit AssembledDistributedTangent(DistributedStatic& problem)
       : problem_(problem),
         tangent_(problem.part_, problem.body_, problem.local_rows_, std::span<const double>(problem.projection_),
-                 static_cast<PetscInt>(problem.owned_rows_.size())),
+                 static_cast<PetscInt>(problem.owned_rows_.size()), problem.constraint_stiffness_),
         u_local_(problem.u_local_.size()) {}
   Mat mat() const override { return tangent_.mat(); }
   void assemble(Vec u) override {
@@ -392,7 +398,7 @@ std::unique_ptr<AssembledProblemTangent> DistributedStatic::make_assembled_tange
 }
 
 void DistributedStatic::tangent_mult(Vec d, Vec out) {
-  // (P K P + I − P) d, K at the linearisation point.
+  // (P K P + c (I − P)) d, K at the linearisation point.
   to_local(d, d_local_);
   constraints_.project(d_local_);
   std::fill(out_local_.begin(), out_local_.end(), 0.0);
@@ -404,15 +410,15 @@ void DistributedStatic::tangent_mult(Vec d, Vec out) {
     // P is vertex by vertex: projecting the owners' sums is projecting every rank's share.
     const WriteView y(out);
     owned_constraints_.project(y.span());
-    owned_constraints_.add_complement(ReadView(d).span(), y.span());
+    owned_constraints_.add_complement(ReadView(d).span(), y.span(), constraint_stiffness_);
   }
   if (operator_scale_ != 1) SNEDE_PETSC(VecScale(out, operator_scale_));
 }
 
 void DistributedStatic::tangent_diagonal(Vec diagonal) {
-  // diag(P K P + I − P): the projected element stiffnesses' diagonals on this rank's cells and
-  // the owned vertices' diag(I − P) (1 on a fixed dof, for PCJACOBI), the ghosts' shares added
-  // into their owners.
+  // diag(P K P + c (I − P)): the projected element stiffnesses' diagonals on this rank's cells
+  // and the owned vertices' diag(c (I − P)) (c on a fixed dof, for PCJACOBI), the ghosts' shares
+  // added into their owners.
   std::fill(out_local_.begin(), out_local_.end(), 0.0);
   const auto d = static_cast<std::size_t>(dim_);
   for_each_projected_element_matrix(body_, u_linearization_, projection_, [&](ElementId, std::span<const VertexId> vertices,

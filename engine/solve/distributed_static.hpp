@@ -13,8 +13,9 @@
 // fixed vertices (all components) and their displacements, sliding vertices (each along a line
 // through a given displacement), nodal forces, and gravity. Each rank holds the constraints of
 // its vertices as the serial Model does (constraints.hpp, §3.1, §6.6): P the projection onto
-// the allowed motions, the residual P(−f_int − f_ext) + (I − P)(u − ū), the tangent
-// P K P + I − P.
+// the allowed motions, the residual P(−f_int − f_ext) + c (I − P)(u − ū), the tangent
+// P K P + c (I − P), c the constrained directions' stiffness (projected_stiffness.hpp), from
+// the whole body's cells.
 #pragma once
 
 #include <cstdint>
@@ -68,7 +69,7 @@ class DistributedStatic final : public Problem {
   std::vector<double> local_displacement();
 
   // What the solvers (SNES callbacks, DynamicRelaxation) use. All collective.
-  // F = P(−f_int(u) − f_ext) + (I − P)(u − ū). Not admissible when an element on some rank is
+  // F = P(−f_int(u) − f_ext) + c (I − P)(u − ū). Not admissible when an element on some rank is
   // inverted (for a material that forbids it) or not finite; F is then NaN on every rank.
   ResidualCheck residual(Vec u, Vec F) override;
   // ‖reactions‖ ((I − P)(−f_int − f_ext), the constrained directions') from the latest residual().
@@ -80,6 +81,8 @@ class DistributedStatic final : public Problem {
   double external_force_norm() override;
   // (6.9)'s force scale E·H² (E·t·H in 2D), H the whole body's diameter.
   double force_scale() override;
+  // c of F and J (the serial Model's constraint_stiffness, the same on every rank).
+  double constraint_stiffness() const { return constraint_stiffness_; }
   // 1/m per owned dof from the lumped masses (§2.5) summed over the ranks, 0 without mass.
   void inverse_lumped_mass(Vec out) override;
   // (2.61) on the whole mesh: the smallest over the ranks.
@@ -126,7 +129,8 @@ class DistributedStatic final : public Problem {
   int dim_;
   Constraints constraints_;        // per local vertex (owned and ghost), for the element kernels
   Constraints owned_constraints_;  // per owned vertex in row order, for the rank's entries of a Vec
-  std::vector<double> projection_, complement_;  // P's and I − P's block of each local vertex
+  std::vector<double> projection_, complement_;  // P's and c (I − P)'s block of each local vertex
+  double constraint_stiffness_ = 1;              // c
   std::vector<double> load_owned_;          // per owned dof (forces counted once, at the owner)
   std::vector<PetscInt> local_rows_;        // global row of each local dof (owned and ghost)
   std::vector<PetscInt> owned_rows_;        // global row of each owned dof, in local order

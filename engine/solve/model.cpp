@@ -12,6 +12,7 @@
 #include "core/norms.hpp"
 #include "core/petsc_util.hpp"
 #include "core/predicates.hpp"
+#include "solve/projected_stiffness.hpp"
 #include "solve/stopping.hpp"
 #include "solve/tangent_assembly.hpp"
 
@@ -179,11 +180,12 @@ void Model::residual(Vec u, Vec F, EvaluationReport& report) {
     constraints_.project_complement(reaction);
     last_reaction_norm_ = euclidean_norm(reaction);
     constraints_.project(r.span());
-    // (I − P)(u − anchor): zero while the constraints hold; pulls them back otherwise.
+    // c (I − P)(u − anchor): zero while the constraints hold; pulls them back otherwise.
     std::vector<double> offset(x.span().begin(), x.span().end());
     std::vector<double> held = offset;
     constraints_.enforce(held);
-    for (std::size_t i = 0; i < offset.size(); ++i) r.span()[i] += offset[i] - held[i];
+    const double c = constraint_stiffness();
+    for (std::size_t i = 0; i < offset.size(); ++i) r.span()[i] += c * (offset[i] - held[i]);
   }
   gradient_.valid = report.domain_errors.size() == errors_before;
   gradient_.key = key_of(u);
@@ -225,6 +227,15 @@ double Model::force_scale() const {
   for (int k = 0; k < dim(); ++k) diameter += (hi[k] - lo[k]) * (hi[k] - lo[k]);
   diameter = std::sqrt(diameter);
   return snede::force_scale(young_modulus(body_.material()), body_.mesh().cell_dim(), body_.thickness(), diameter);
+}
+
+double Model::constraint_stiffness() const {
+  if (constraint_stiffness_ == 0) {
+    const Mesh& mesh = body_.mesh();
+    constraint_stiffness_ = snede::constraint_stiffness(body_.material(), mesh.cell_dim(), body_.thickness(),
+                                                        volume_of_cells(mesh), static_cast<double>(mesh.n_cells()));
+  }
+  return constraint_stiffness_;
 }
 
 bool Model::admissible(Vec u, std::string* why) const {
@@ -270,7 +281,7 @@ void Model::tangent_mult(Vec d, Vec out) {
   EvaluationReport report;
   body_.tangent_apply(x.span(), projected_direction_, result.span(), report);
   constraints_.project(result.span());
-  constraints_.add_complement(direction.span(), result.span());  // + (I − P) d
+  constraints_.add_complement(direction.span(), result.span(), constraint_stiffness());  // + c (I − P) d
   if (operator_scale_ != 1)
     for (double& x : result.span()) x *= operator_scale_;
   throw_if_domain_error(report);
@@ -295,6 +306,7 @@ PetscErrorCode Model::tangent_diagonal_callback(Mat A, Vec diagonal) {
 
 void Model::on_change(const Connectivity&, const ConnectivityChange& change) {
   loads_changed();  // gravity follows the element masses
+  constraint_stiffness_ = 0;  // the cells' mean size
   if (change.vertex_events.empty()) return;
   const VertexId n_new = body_.mesh().n_points();
   constraints_.resize(n_new);

@@ -10,9 +10,10 @@
 // count changed, in time proportional to the vertices added (the vectors keep spare room).
 //
 // The static problem is min Π(u) = Π_int(u) − f_extᵀu under the constraints. PETSc sees
-//   F(u) = P ∇Π(u) + (I − P)(u − anchor)      (residual; zero exactly at the solution)
-//   J    = P K(u) P + (I − P)                  (tangent shell, applied matrix-free)
-// so that search directions and tangents are projected onto the allowed motions (6.7).
+//   F(u) = P ∇Π(u) + c (I − P)(u − anchor)    (residual; zero exactly at the solution)
+//   J    = P K(u) P + c (I − P)                (tangent shell, applied matrix-free)
+// so that search directions and tangents are projected onto the allowed motions (6.7); c, the
+// constrained directions' stiffness, is about a diagonal entry of K (constraint_stiffness()).
 #pragma once
 
 #include <petscmat.h>
@@ -98,6 +99,10 @@ class Model : public ConnectivityWatcher {
   double last_reaction_norm() const { return last_reaction_norm_; }
   // E·H² in 3D, E·t·H in 2D (H = diameter of the reference body): the force scale of (6.9).
   double force_scale() const;
+  // c of F and J above, in N/m (projected_stiffness.hpp: (λ + 2μ)·ℓ in 3D, ℓ the mean cell's
+  // size; E/(1 − ν²)·t for sheets and membranes), so that the constrained block is of the
+  // stiffness's size whatever the units. Computed once per mesh (after each change).
+  double constraint_stiffness() const;
   // True if u is finite and has no inverted element under a material that forbids it.
   bool admissible(Vec u, std::string* why = nullptr) const;
 
@@ -148,6 +153,7 @@ class Model : public ConnectivityWatcher {
   ExclusiveUse exclusive_use_;
   double last_reaction_norm_ = 0;
   double operator_scale_ = 1;
+  mutable double constraint_stiffness_ = 0;  // 0 until computed for the current mesh
 };
 
 }  // namespace snede

@@ -1,7 +1,8 @@
 // What the serial and the distributed assembled tangents (tangent_assembly.hpp,
-// distributed_assembly.hpp) share: J = P K P + (I − P) needs each vertex's block of the
-// constraints' projection P and of I − P, the element stiffnesses projected on both sides
-// (P_a K_ab P_b), and, for a preconditioner on a membrane, an element matrix's positive part.
+// distributed_assembly.hpp) share: J = P K P + c (I − P) needs each vertex's block of the
+// constraints' projection P and of I − P, the constrained directions' stiffness c, the element
+// stiffnesses projected on both sides (P_a K_ab P_b), and, for a preconditioner on a membrane,
+// an element matrix's positive part.
 #pragma once
 
 #include <Eigen/Eigenvalues>
@@ -46,6 +47,27 @@ class MembranePositivePart {
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, n, n>> solver_;
   std::array<double, n * n> part_{};
 };
+
+// The stiffness c of the constrained directions (issue 48 item 8): the static problem is
+//   F(u) = P ∇Π(u) + c (I − P)(u − ū),   J = P K(u) P + c (I − P),
+// with c about a diagonal entry of K, in K's units (N/m), so that the constrained block is of
+// the size of the rest whatever the units. With c = 1 (metres in a force residual) the system
+// divided by the force scale E·H² had a constrained block 1/(E·h) times its stiffness: from
+// E = 1e13 Pa a Chebyshev smoother's eigenvalue estimate (Krylov from a noisy right-hand side,
+// Jacobi-scaled: the constrained rows' 1/(c s) dominated it) saw the constrained block alone,
+// and 'mg' became indefinite; GAMG's broke down from E = 1e200 (PETSc error 77, "Computed
+// maximum singular value as zero").
+// c = M ℓ for volume meshes, M = λ + 2μ the material's largest small-strain modulus and
+// ℓ = (|Ω| / cells)^(1/3) the mean cell's size (the mean diagonal entry of a P1 stiffness is
+// 1.5–4 M ℓ on boxes of 240–6 480 tetrahedra, ν = 0.3–0.49); c = M' t for sheets and
+// membranes (plane stress, M' = E/(1 − ν²), t the thickness), whose diagonal entries do not
+// depend on the cell size (1.7 M' t on a plane-stress strip). Scale-invariant in the modulus
+// and, in 3D, in the length unit (c scales with the lengths as K does). 1 when that is not a
+// positive finite number (no cells). Computed once per mesh, never per product.
+// volume: |Ω| (the cells' measures summed; read for volume meshes only), cells: their number.
+double constraint_stiffness(const Material& material, int cell_dim, double thickness, double volume, double cells);
+// |Ω| of a volume mesh: its live cells' volumes summed (0 for a sheet or a membrane).
+double volume_of_cells(const Mesh& mesh);
 
 // The blocks of P (dim × dim, row-major) of vertices 0 .. n_points − 1, one after another.
 std::vector<double> projection_blocks(const Constraints& constraints, VertexId n_points);

@@ -83,6 +83,17 @@ std::string automatic_preconditioner(const Problem& problem, StaticMethod method
   return PCMG;
 }
 
+// GAMG keeps its interpolation when the matrix changes (PETSc 3.18's default), and with it the
+// bounds its Chebyshev smoothers took from the first set-up's smoothed-aggregation estimate.
+// Newton refills the matrix at every iteration, and a tangent that stiffened past those bounds
+// made the V-cycle indefinite (DIVERGED_INDEFINITE_PC, then DIVERGED_LINE_SEARCH: a neo-Hookean
+// cantilever of 30 × 6 × 6 cubes, a box with vertices sliding along oblique lines; issue 48
+// item 8). The smoothers estimate their own bounds instead, again whenever their operator
+// changes (-<prefix>pc_gamg_use_sa_esteig, read afterwards, overrides).
+void configure_gamg(PC pc, const std::string& pc_type) {
+  if (pc_type == PCGAMG) SNEDE_PETSC(PCGAMGSetUseSAEstEig(pc, PETSC_FALSE));
+}
+
 Model* serial_model(Problem& problem) {
   auto* serial = dynamic_cast<ModelProblem*>(&problem);
   return serial ? &serial->model() : nullptr;
@@ -221,6 +232,7 @@ void StaticSolver::create_objects() {
     SNEDE_PETSC(KSPGetPC(ksp_, &pc));
     option_database_.use_for(pc);
     SNEDE_PETSC(PCSetType(pc, pc_type_.c_str()));
+    configure_gamg(pc, pc_type_);
     SNEDE_PETSC(PCSetUseAmat(pc, PETSC_FALSE));  // see the Newton branch
     if (multigrid_) configure_multigrid(pc);
     SNEDE_PETSC(KSPSetOperators(ksp_, problem_.tangent(), preconditioning_matrix()));
@@ -264,6 +276,7 @@ void StaticSolver::create_objects() {
     SNEDE_PETSC(KSPGetPC(inner, &pc));
     option_database_.use_for(pc);
     SNEDE_PETSC(PCSetType(pc, pc_type_.c_str()));
+    configure_gamg(pc, pc_type_);
     // A multigrid PC smooths its finest level with the assembled matrix, not the shell (each
     // shell product costs several assembled ones); -<prefix>pc_use_amat turns it back.
     SNEDE_PETSC(PCSetUseAmat(pc, PETSC_FALSE));
@@ -346,6 +359,7 @@ void StaticSolver::follow_mesh_changes() {
     SNEDE_PETSC(KSPGetPC(ksp(), &pc));
     SNEDE_PETSC(PCSetType(pc, PCNONE));
     SNEDE_PETSC(PCSetType(pc, pc_type_.c_str()));
+    configure_gamg(pc, pc_type_);
     if (multigrid_) configure_multigrid(pc);
     SNEDE_PETSC(PCSetFromOptions(pc));
   }

@@ -160,7 +160,8 @@ void AssembledTangent::assemble(const Model& model, Vec u) {
 void AssembledTangent::add_entries(const Model& model, Vec u, const CsrView& A) const {
   const int d = model.dim();
   const std::vector<double> P = projection_blocks(model);
-  const std::vector<double> complement = complement_blocks(P, d);
+  std::vector<double> complement = complement_blocks(P, d);
+  for (double& x : complement) x *= model.constraint_stiffness();  // c (I − P)
   const bool membrane = model.body().mesh().is_surface() && membranes_ == MembraneTangent::positive_part;
   MembranePositivePart positive_part;
   const double s = model.operator_scale();
@@ -196,7 +197,7 @@ void AssembledTangent::add_entries(const Model& model, Vec u, const CsrView& A) 
         for (int b = 0; b < corners; ++b)
           add_block(vertices[a], ranks[a * corners + b], K.data() + (a * n + b) * D, n);
     });
-    // + (I − P): the constrained directions keep a unit diagonal, as in the shell.
+    // + c (I − P): the constrained directions' stiffness, as in the shell.
     for (std::size_t v = 0; v < self_rank_.size(); ++v)
       add_block(v, self_rank_[v], complement.data() + v * D * D, D);
   };
@@ -234,9 +235,10 @@ void tangent_diagonal(const Model& model, Vec u, Vec diagonal) {
     });
   }
   const std::vector<double> complement = complement_blocks(P, d);
+  const double c = model.constraint_stiffness();
   for (std::size_t dof = 0; dof < values.size(); ++dof) {
     const std::size_t v = dof / d, k = dof % d;
-    values[dof] = model.operator_scale() * (values[dof] + complement[(v * d + k) * d + k]);
+    values[dof] = model.operator_scale() * (values[dof] + c * complement[(v * d + k) * d + k]);
   }
   set_vec_values(diagonal, values);
 }

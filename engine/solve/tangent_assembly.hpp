@@ -1,4 +1,4 @@
-// The tangent J = s·(P K(u) P + (I − P)) of model.hpp, with entries: assembled from the element
+// The tangent J = s·(P K(u) P + c (I − P)) of model.hpp, with entries: assembled from the element
 // stiffness matrices (the same kernels as the shell, ElasticBody::element_stiffness), or only
 // its diagonal. For preconditioners that need entries (Jacobi, GAMG, ILU, ...) and for
 // comparison; the shell stays the operator of every solve, because a cut or a bisection

@@ -1,8 +1,8 @@
 // Fixed and sliding vertices as projections (§3.1, §6.6, (6.7)): against a model of the same
 // body without constraints (F_free = ∇Π, J_free = K) and the tests' own P and anchors,
-//   F(u) = P F_free(u) + (I − P)(u − anchor),   J v = P K P v + (I − P) v,
-//   reactions = (I − P) ∇Π(u),                 enforce(u) = P u + (I − P) anchor,
-// at a random state, in 2D and 3D, for two materials.
+//   F(u) = P F_free(u) + c (I − P)(u − anchor),   J v = P K P v + c (I − P) v,
+//   reactions = (I − P) ∇Π(u),                   enforce(u) = P u + (I − P) anchor,
+// at a random state, in 2D and 3D, for two materials (c: Model::constraint_stiffness).
 #include <gtest/gtest.h>
 
 #include "solve/test_model_cases.hpp"
@@ -46,6 +46,12 @@ std::vector<double> sum(std::vector<double> a, const std::vector<double>& b) {
   return a;
 }
 
+// c a
+std::vector<double> times(double c, std::vector<double> a) {
+  for (double& x : a) x *= c;
+  return a;
+}
+
 }  // namespace
 
 class ModelConstraints : public ::testing::TestWithParam<ModelCase> {};
@@ -56,7 +62,8 @@ TEST_P(ModelConstraints, ResidualRowsAreProjectedAndHoldTheAnchors) {
   ASSERT_GT(m.known.n_sliding, 0u);
   std::vector<double> offset = m.u;
   for (std::size_t k = 0; k < offset.size(); ++k) offset[k] -= m.known.anchor[k];
-  const std::vector<double> expected = sum(m.known.project(m.free_residual()), m.known.complement(offset));
+  const double c = m.constrained.model.constraint_stiffness();
+  const std::vector<double> expected = sum(m.known.project(m.free_residual()), times(c, m.known.complement(offset)));
   VecHandle x = m.constrained.new_vec(), F = m.constrained.new_vec();
   set_vec_values(x, m.u);
   EvaluationReport report;
@@ -73,7 +80,7 @@ TEST_P(ModelConstraints, ReactionsAreTheConstrainedPartOfTheGradient) {
   EXPECT_LT(relative_difference(vec_values(R), expected), 1e-12);
 }
 
-TEST_P(ModelConstraints, TangentIsTheProjectedStiffnessAndTheIdentityOnConstrainedMotions) {
+TEST_P(ModelConstraints, TangentIsTheProjectedStiffnessAndTheConstraintStiffnessOnConstrainedMotions) {
   ConstrainedAndFree m(GetParam());
   VecHandle x = m.constrained.new_vec(), v = m.constrained.new_vec(), Kv = m.constrained.new_vec(),
             Jv = m.constrained.new_vec();
@@ -84,7 +91,8 @@ TEST_P(ModelConstraints, TangentIsTheProjectedStiffnessAndTheIdentityOnConstrain
     const std::vector<double> d = random_values(m.constrained.n_dofs(), 1.0, m.random);
     set_vec_values(v, m.known.project(d));
     SNEDE_PETSC(MatMult(m.free.tangent(), v, Kv));
-    const std::vector<double> expected = sum(m.known.project(vec_values(Kv)), m.known.complement(d));
+    const std::vector<double> expected =
+        sum(m.known.project(vec_values(Kv)), times(m.constrained.model.constraint_stiffness(), m.known.complement(d)));
     set_vec_values(v, d);
     SNEDE_PETSC(MatMult(m.constrained.model.tangent(), v, Jv));
     EXPECT_LT(relative_difference(vec_values(Jv), expected), 1e-12) << "trial " << trial;
