@@ -3,9 +3,10 @@ ellipsoid, a torus, a lumpy organ-like solid, the inside of any closed surface),
 surfaces in 3D for cutting (height fields, the Gaussian bell of Figure 5.19, a folded sheet).
 
 The gmsh generators first estimate how many tetrahedra their edge length makes
-(``tetrahedra_estimate``) and refuse more than ``max_cells`` (default ``MAX_CELLS``) with a
-ValueError that gives the number: a length given in the wrong unit (1e-9 for 1e-3) would
-otherwise keep gmsh busy for hours and then exhaust the memory."""
+(``tetrahedra_estimate``), and the structured box and rectangle count theirs, and refuse more
+than ``max_cells`` (default ``MAX_CELLS``) with a ValueError that gives the number: a length
+given in the wrong unit (1e-9 for 1e-3), or 1000 divisions a side, would otherwise keep gmsh
+or numpy busy for hours and then exhaust the memory."""
 from __future__ import annotations
 
 import itertools
@@ -16,13 +17,18 @@ import numpy as np
 from snede import _checks, _geometry, _gmsh
 from snede.mesh import Mesh
 
+# The generators' default limit: gmsh takes about 60 µs and 0.6 kB per tetrahedron
+# (measured on a cylinder of 1.3 million), so 10 million take some 10 minutes and 6 GB; a body
+# of that size is beyond what a static solve or an interactive session relaxes in useful time.
+MAX_CELLS = 10_000_000
+
 
 def _grid_points(size, divisions) -> np.ndarray:
     axes = [np.linspace(0.0, s, n + 1) for s, n in zip(size, divisions)]
     return np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, len(size))
 
 
-def _check(size, divisions, dim: int, cells_per_box: int):
+def _check(size, divisions, dim: int, cells_per_box: int, max_cells):
     size = tuple(float(s) for s in size)
     divisions = tuple(divisions)
     if len(size) != dim or len(divisions) != dim:
@@ -30,15 +36,19 @@ def _check(size, divisions, dim: int, cells_per_box: int):
     if not all(np.isfinite(s) and s > 0 for s in size):
         raise ValueError(f"size must be positive and finite, got {size}")
     divisions = tuple(_checks.count(n, f"divisions[{k}]", 1, None) for k, n in enumerate(divisions))
+    check_cells(cells_per_box * math.prod(divisions), _checks.count(max_cells, "max_cells", 1, None),
+                f"divisions {divisions}", "give fewer divisions, or raise max_cells if you mean it",
+                "tetrahedra" if dim == 3 else "triangles")
     _checks.size(math.prod(n + 1 for n in divisions), cells_per_box * math.prod(divisions), f"divisions {divisions}")
     return size, divisions
 
 
-def box(size=(1.0, 1.0, 1.0), divisions=(10, 10, 10)) -> Mesh:
+def box(size=(1.0, 1.0, 1.0), divisions=(10, 10, 10), *, max_cells: int = MAX_CELLS) -> Mesh:
     """Structured tetrahedra on [0, size]: each of the nx·ny·nz cubes split into six
     tetrahedra around its main diagonal (the Kuhn split, which conforming bisection needs).
-    Gives 6·nx·ny·nz cells and (nx+1)(ny+1)(nz+1) points."""
-    size, divisions = _check(size, divisions, 3, 6)
+    Gives 6·nx·ny·nz cells and (nx+1)(ny+1)(nz+1) points; more than ``max_cells`` are refused
+    (see the module)."""
+    size, divisions = _check(size, divisions, 3, 6, max_cells)
     nx, ny, nz = divisions
     points = _grid_points(size, divisions)
 
@@ -61,10 +71,11 @@ def box(size=(1.0, 1.0, 1.0), divisions=(10, 10, 10)) -> Mesh:
     return Mesh(points, np.concatenate(cells))
 
 
-def rectangle(size=(1.0, 1.0), divisions=(10, 10)) -> Mesh:
+def rectangle(size=(1.0, 1.0), divisions=(10, 10), *, max_cells: int = MAX_CELLS) -> Mesh:
     """Structured right triangles on [0, size]: each square split along its diagonal from
-    (x, y) to (x + hx, y + hy). Gives 2·nx·ny cells and (nx+1)(ny+1) points."""
-    size, divisions = _check(size, divisions, 2, 2)
+    (x, y) to (x + hx, y + hy). Gives 2·nx·ny cells and (nx+1)(ny+1) points; more than
+    ``max_cells`` are refused (see the module)."""
+    size, divisions = _check(size, divisions, 2, 2, max_cells)
     nx, ny = divisions
     points = _grid_points(size, divisions)
     i, j = (a.ravel() for a in np.meshgrid(np.arange(nx), np.arange(ny), indexing="ij"))
@@ -82,10 +93,6 @@ def _positive(**values) -> None:
         _checks.positive(value, name)
 
 
-# The gmsh generators' default limit: gmsh takes about 60 µs and 0.6 kB per tetrahedron
-# (measured on a cylinder of 1.3 million), so 10 million take some 10 minutes and 6 GB; a body
-# of that size is beyond what a static solve or an interactive session relaxes in useful time.
-MAX_CELLS = 10_000_000
 _REGULAR_TETRAHEDRON = 1.0 / (6.0 * math.sqrt(2.0))  # volume of the regular tetrahedron of edge 1
 _EQUILATERAL_TRIANGLE = math.sqrt(3.0) / 4.0  # area of the equilateral triangle of side 1
 # gmsh's tetrahedra at target edge h are about twice as large as regular ones of edge h: it made
@@ -102,12 +109,12 @@ def tetrahedra_estimate(volume: float, area: float, h: float) -> float:
 
 def check_cells(estimate: float, max_cells: int, given: str,
                 remedy: str = "give a larger edge length (each halving makes 8 times as many), or raise max_cells "
-                              "if you mean it") -> None:
+                              "if you mean it", cells: str = "tetrahedra") -> None:
     """Refuse ``estimate`` cells beyond ``max_cells`` with a ValueError: ``given`` names the value
     that asks for them ("h = 1e-09"), ``remedy`` what to do."""
     if not estimate <= max_cells:
         about = f"about {estimate:.2g}" if math.isfinite(estimate) else "more than 1e308"
-        raise ValueError(f"{given} would make {about} tetrahedra (limit {max_cells}); {remedy}")
+        raise ValueError(f"{given} would make {about} {cells} (limit {max_cells}); {remedy}")
 
 
 def _check_size(volume: float, area: float, h: float, max_cells, name: str = "h") -> None:

@@ -235,3 +235,19 @@ def test_a_size_that_would_make_too_many_tetrahedra_is_refused_at_once():
 def test_each_gmsh_shape_refuses_an_edge_length_that_would_make_too_many(make, count):
     with pytest.raises(ValueError, match=re.escape(f"would make about {count} tetrahedra (limit 10000000)")):
         make()
+
+
+@pytest.mark.parametrize("make, message", [
+    (lambda **limit: snede.meshing.box((1, 1, 1), (1000, 1000, 1000), **limit),
+     "divisions (1000, 1000, 1000) would make about 6e+09 tetrahedra (limit 10000000)"),  # 6·1000³
+    (lambda **limit: snede.meshing.rectangle((1, 1), (10**5, 10**5), **limit),
+     "divisions (100000, 100000) would make about 2e+10 triangles (limit 10000000)"),  # 2·10¹⁰
+])
+def test_a_structured_mesh_of_too_many_cells_is_refused_before_numpy_allocates_it(make, message):
+    """Issue 48, item 10: `run cut --divisions 1000` asked numpy for 375 M cells' arrays. The
+    count (6 tetrahedra a cube, 2 triangles a square) is refused first; max_cells raises it."""
+    with pytest.raises(ValueError, match=re.escape(message)):
+        make()
+    with pytest.raises(ValueError, match=re.escape("(limit 100); give fewer divisions")):
+        snede.meshing.box((1, 1, 1), (3, 3, 3), max_cells=100)  # 162
+    assert snede.meshing.box((1, 1, 1), (3, 3, 3), max_cells=162).n_cells == 162
