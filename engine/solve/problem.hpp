@@ -1,6 +1,8 @@
 // What a solver needs of a static problem, whatever communicator it lives on (issue 36): the
-// state, the residual F(u) = P∇Π(u) + (I − P)(u − ū) and the energy, the lumped masses, the
-// constraints' projection, and the scales of the stopping rule (6.9). The serial Model is the
+// state, the residual F(u) = P∇Π(u) + c (I − P)(u − ū) and the energy (c: a stiffness of the
+// problem's own units for the constrained directions, so that nothing depends on E or the
+// length unit, issue 48), the lumped masses, the constraints' projection, and the scales of
+// the stopping rule (6.9). The serial Model is the
 // one-rank problem (ModelProblem); DistributedStatic is the problem over a distributed mesh.
 // A solver written against Problem runs unchanged on 1 or N ranks, as PETSc's tutorials run
 // the same code on any number of processes. Every member is collective on comm().
@@ -26,7 +28,7 @@ struct ResidualCheck {
 };
 
 // An assembled copy of a problem's tangent, for the preconditioners that need entries (GAMG,
-// ILU, LU, Galerkin multigrid levels): the same J = P K P + I − P as the shell, times the
+// ILU, LU, Galerkin multigrid levels): the same J = P K P + c (I − P) as the shell, times the
 // operator scale, with the rigid-body motions as near null space.
 class AssembledProblemTangent {
  public:
@@ -67,7 +69,7 @@ class Problem {
   virtual double force_scale() = 0;
   virtual std::int64_t n_global_dofs() const = 0;
 
-  // The tangent J = P K P + I − P at the linearisation point, applied matrix-free (a MatShell
+  // The tangent J = P K P + c (I − P) at the linearisation point, applied matrix-free (a MatShell
   // on comm() with MatMult and MatGetDiagonal), times the operator scale.
   virtual Mat tangent() const = 0;
   virtual void set_linearization_point(Vec u) = 0;

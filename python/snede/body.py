@@ -148,9 +148,11 @@ class Body:
         return self._impl.element_stiffness(int(self.mesh.cell_ids[row]), self._field("u", u))
 
     def tangent_operator(self, u=None):
-        """The tangent J = P K(u) P + (I − P) as a petsc4py ``Mat`` applied matrix-free (a
+        """The tangent J = P K(u) P + c (I − P) as a petsc4py ``Mat`` applied matrix-free (a
         ``MatShell`` over the element kernels; P projects out the constrained motions, so a
-        fixed vertex's rows are the identity). ``u``: (n_points, dim), default the current
+        fixed vertex's rows are c times the identity, c a stiffness of the body's units about a
+        diagonal entry of K, which keeps every preconditioner independent of E and the length
+        unit). ``u``: (n_points, dim), default the current
         displacement. The shell is the body's own: a later solve moves its linearisation point,
         and after a cut or refinement the body makes a new one (ask again). It also gives its
         diagonal (``getDiagonal``)."""

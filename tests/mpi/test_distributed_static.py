@@ -173,8 +173,10 @@ def test_solver_arguments_that_differ_between_ranks_raise_everywhere():
 
 def test_parts_touching_at_a_single_vertex():
     """Two tetrahedra sharing only a vertex (one per rank on 2 ranks): the shared vertex is
-    owned once, and a solve with both far faces held and the free corners pulled gives the
-    serial displacement."""
+    owned once, and a solve with each held on two fixed corners and a third sliding along z
+    (two fixed corners alone leave each free to turn about the line through them, both turning
+    together about the shared vertex: issue 48 item 1), the sliding corners and the shared one
+    pulled, gives the serial displacement."""
     points = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1], [-1, 0, 0], [0, -1, 0], [0, 0, -1.0]])
     serial = snede.Mesh(points, [[0, 1, 2, 3], [0, 4, 6, 5]])
     part = snede.distribute(serial if COMM.rank == 0 else None)
@@ -184,11 +186,14 @@ def test_parts_touching_at_a_single_vertex():
         assert COMM.allgather(part.local.n_cells) == [1, 1]  # PETSc's partitioner splits them
     material = snede.LinearElastic(1e5, 0.3)
     fixed, forces = [1, 2, 4, 5], {3: (0.0, 0.0, 10.0), 6: (0.0, 0.0, -10.0), 0: (5.0, 0.0, 0.0)}
-    problem = snede.DistributedStatic(part, material, fixed=fixed, forces=forces)
+    sliding, along_z = [3, 6], [(0.0, 0.0, 1.0)] * 2
+    problem = snede.DistributedStatic(part, material, fixed=fixed, sliding=sliding, sliding_directions=along_z,
+                                      forces=forces)
     result = problem.solve("cg", rtol=1e-12)
     assert result.converged, result
     body = snede.Body(snede.Mesh(points, [[0, 1, 2, 3], [0, 4, 6, 5]]), material)
     body.fix(fixed)
+    body.slide(sliding, along_z[0])
     for vertex, force in forces.items():
         body.add_nodal_force([vertex], force)
     assert snede.StaticSolver(body, "cg", preconditioner="none", rtol=1e-12).solve().converged
