@@ -36,10 +36,11 @@ def _check(size, divisions, dim: int, cells_per_box: int, max_cells):
     if not all(np.isfinite(s) and s > 0 for s in size):
         raise ValueError(f"size must be positive and finite, got {size}")
     divisions = tuple(_checks.count(n, f"divisions[{k}]", 1, None) for k, n in enumerate(divisions))
+    # What the engine cannot number (32-bit ids) first, then what it could but should not build.
+    _checks.size(math.prod(n + 1 for n in divisions), cells_per_box * math.prod(divisions), f"divisions {divisions}")
     check_cells(cells_per_box * math.prod(divisions), _checks.count(max_cells, "max_cells", 1, None),
                 f"divisions {divisions}", "give fewer divisions, or raise max_cells if you mean it",
                 "tetrahedra" if dim == 3 else "triangles")
-    _checks.size(math.prod(n + 1 for n in divisions), cells_per_box * math.prod(divisions), f"divisions {divisions}")
     return size, divisions
 
 
