@@ -44,7 +44,10 @@ def test_iteration_count_and_energy_do_not_depend_on_the_rank_count(precondition
     together, alone = linear_cantilever_problem(COMM), linear_cantilever_problem(MPI.COMM_SELF)
     shared = together.solve("cg", rtol=1e-10, preconditioner=preconditioner)
     single = alone.solve("cg", rtol=1e-10, preconditioner=preconditioner, options_prefix="alone_")
-    assert shared.converged and shared.iterations == single.iterations
+    # CG's iterates on N ranks and on one differ by the order of the dot products' sums; after
+    # it loses orthogonality (163 iterations unpreconditioned) that moves the step where ‖r‖
+    # crosses rtol: 164 against 163 in the portable build. Equal to 2 %.
+    assert shared.converged and abs(shared.iterations - single.iterations) <= max(1, 0.02 * single.iterations)
     assert together.energy() == pytest.approx(alone.energy(), rel=1e-12)
     if preconditioner == "jacobi":
         plain = linear_cantilever_problem(MPI.COMM_SELF).solve("cg", rtol=1e-10, options_prefix="plain_")

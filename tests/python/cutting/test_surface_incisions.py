@@ -8,7 +8,8 @@ import numpy as np
 import pytest
 
 import snede
-from surface_checks import along, bell_normal, check_surface, components, folded, mean_edge, up, vertical_scalpels
+from surface_checks import (PORTABLE_BUILD, PORTABLE_DEFECT, along, bell_normal, check_surface, components, folded,
+                            mean_edge, up, vertical_scalpels)
 
 
 def graph_normal(slope_x):
@@ -39,6 +40,7 @@ def split_by_plane_y(mesh, cutter, y0):
     assert lower.max() <= y0 + slack and upper.min() >= y0 - slack
 
 
+@pytest.mark.xfail(PORTABLE_BUILD, strict=False, reason=PORTABLE_DEFECT)
 def test_folded_sheet_cut_once_gives_two_incisions():
     """A vertical scalpel crossing the fold pierces both layers: two entries at once, two
     incisions, two exits; the lower layer, the upper layer's tail and the rest (joined by the
