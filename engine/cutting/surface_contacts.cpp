@@ -24,6 +24,16 @@ bool in_plane(const Point3& p, const Point3& q, const std::array<Point3, 3>& x) 
          orientation_3d(x[0].data(), x[1].data(), x[2].data(), q.data()) == 0;
 }
 
+// Whether the scalpel slides in the plane of triangle x for the whole step (in it at both ends of
+// the step, so throughout). Decided on the step's given positions, not on a position
+// interpolated at the crossing time: a blade that only passes through the plane, lying in it
+// for an instant (a level blade rising through a level face), enters across the crest, and
+// whether the interpolated blade lands exactly in the plane is rounding (FMA or not).
+bool slides_in_plane(const Point3& head_from, const Point3& tail_from, const Point3& head_to, const Point3& tail_to,
+                     const std::array<Point3, 3>& x) {
+  return in_plane(head_from, tail_from, x) && in_plane(head_to, tail_to, x);
+}
+
 }  // namespace
 
 bool SurfaceCutter::meets_inside(const Segment& scalpel, ElementId triangle, int corner) const {
@@ -78,9 +88,9 @@ std::vector<SurfaceCutter::Contact> SurfaceCutter::first_contacts(const Segment&
       const int far_corner = static_cast<int>(std::find_if(p.begin(), p.begin() + 3, [&](VertexId v) {
                                                 return v != o[i] && v != o[j];
                                               }) - p.begin());
-      const Segment at = scalpel_at(time);
       const std::array<Point3, 3> y{deformed(p[0]), deformed(p[1]), deformed(p[2])};
-      if (in_plane(at.head, at.tail, x) || in_plane(at.head, at.tail, y)) continue;
+      const auto slides = [&](const std::array<Point3, 3>& t) { return slides_in_plane(from.head, from.tail, to.head, to.tail, t); };
+      if (slides(x) || slides(y)) continue;
       const Segment before = scalpel_at(time * (1 - 1e-3));
       if (meets_inside(before, e, k) || meets_inside(before, other, far_corner)) continue;
       if (later(e, k) || later(other, far_corner)) found.push_back({Contact::Way::crest, time, e, triangle, weights});

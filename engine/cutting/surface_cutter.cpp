@@ -55,6 +55,7 @@ SurfaceCutter::SurfaceCutter(Mesh& mesh, DisplacementSource displacement, Surfac
           mesh.connectivity(), incision_vertices_,
           [this](const Connectivity& c, const IncisionWatch::Fates& fates) { settle(c, fates); },
           [this](const VertexEvent& event) { carry_normal(event); }) {
+  watch_.forget_removed_from(ended_);
   if (mesh.cell_dim() != 2 || mesh.space_dim() != 3)
     throw std::invalid_argument("SurfaceCutter: the mesh must be a surface (triangles in 3D), got cell_dim " +
                                 std::to_string(mesh.cell_dim()) + " in " + std::to_string(mesh.space_dim()) + "D");
@@ -359,6 +360,11 @@ PlanarCutReport SurfaceCutter::move(std::span<const double> segment) {
   rebuild_grid_ = rebuild_grid_ || body_displacement_ || grid_revision_ != mesh_.connectivity().revision();
   touched_.clear();
   refused_.clear();
+  // §5.2.2: where incisions ended stays forbidden until the scalpel has moved 2 ε_exit away
+  // (else a scalpel still at an exit enters again through the lips it just made).
+  std::erase_if(ended_, [&](VertexId v) { return segment_point_distance(now.head, now.tail, deformed(v)) > 2 * options_.eps_exit; });
+  for (VertexId v : ended_)
+    for (ElementId e : local_star(mesh_.connectivity(), v).elements) refused_.insert(e);
   {
     // A body hears of the move's edits at once, when it is over.
     ChangeBatch batch(mesh_.connectivity());
@@ -378,6 +384,7 @@ PlanarCutReport SurfaceCutter::move(std::span<const double> segment) {
 
 void SurfaceCutter::lift() {
   incisions_.clear();
+  ended_.clear();
   scalpel_.reset();
   watch_.follow({});
 }
@@ -947,12 +954,14 @@ std::vector<VertexId> SurfaceCutter::join_at(VertexId w, const std::vector<Verte
   incision_vertices_.insert(w);
   touched_.push_back(w);
   // As at an exit in 2D (§5.2.2, forbidden edges): where incisions ended, the scalpel that is
-  // still there enters nothing new in this move.
+  // still there enters nothing new in this move, nor later while it stays near (move()).
   std::vector<VertexId> ended = copies;
   ended.insert(ended.end(), actives.begin(), actives.end());
   ended.push_back(w);
-  for (VertexId v : ended)
+  for (VertexId v : ended) {
+    ended_.insert(v);
     for (ElementId e : local_star(mesh_.connectivity(), v).elements) refused_.insert(e);
+  }
   return copies;
 }
 

@@ -30,7 +30,8 @@
 //    annihilation): a boundary edge (the exit, Figure 5.7) or an edge whose other triangle has
 //    another active node, whose incision then ends there too. A node that separates two active
 //    nodes and is closer than ε_edge to one of them is where both end. Where incisions ended,
-//    nothing new is entered for the rest of the move (2D's forbidden edges, Figure 5.7);
+//    nothing new is entered near them until the scalpel has moved 2 ε_exit away (2D's
+//    forbidden edges, Figure 5.7);
 //  * new incisions begin in one of the three ways of Figure 5.12, on triangles that touch no
 //    active node: the swept scalpel crossing a boundary edge into its triangle, an end of the
 //    scalpel passing through a triangle, or the swept scalpel meeting an interior edge from
@@ -246,6 +247,8 @@ class SurfaceCutter {
   std::unordered_set<VertexId> crease_vertices_;
   std::vector<VertexId> touched_;
   std::unordered_set<ElementId> refused_;  // this move enters none of these (refused, or where an incision ended)
+  // Where incisions ended: no entry into their stars until the scalpel is 2 ε_exit away (§5.2.2).
+  std::unordered_set<VertexId> ended_;
   IncisionWatch watch_;                    // last: it refers to the sets above
 };
 

@@ -41,6 +41,8 @@ ClosestPoints closest_points(const Point3& p, const Point3& q, const Point3& a, 
 
 }  // namespace
 
+double segment_point_distance(const Point3& p, const Point3& q, const Point3& x) { return closest_points(p, q, x, x).distance; }
+
 std::optional<TriangleHit> segment_meets_triangle(const Point3& p, const Point3& q, const Point3& a, const Point3& b,
                                                   const Point3& c, const Point3& near) {
   if (collinear_3d(a.data(), b.data(), c.data())) return std::nullopt;

@@ -24,6 +24,9 @@ struct TriangleHit {
 std::optional<TriangleHit> segment_meets_triangle(const Point3& p, const Point3& q, const Point3& a, const Point3& b,
                                                   const Point3& c, const Point3& near);
 
+// The distance from point x to segment p→q.
+double segment_point_distance(const Point3& p, const Point3& q, const Point3& x);
+
 struct SweptCrossing {
   double time = 0;   // γ: the scalpel is h0 + γ (h1 − h0) → t0 + γ (t1 − t0)
   double along = 0;  // λ: fraction along the scalpel, from its first end

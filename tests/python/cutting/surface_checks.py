@@ -1,6 +1,5 @@
 """Surfaces, scalpel paths and checks shared by the surface cutter's tests."""
 import math
-import os
 
 import numpy as np
 
@@ -113,11 +112,3 @@ def components(mesh):
     """The vertex sets of the pieces the mesh falls into (Mesh.connected_components)."""
     count, label = mesh.connected_components()
     return [np.unique(mesh.cells[label == k]) for k in range(count)]
-
-
-# Built for the x86-64 baseline (SNEDE_NATIVE=OFF make test; tools/build_mode.sh exports it):
-# some surface-cutting paths decide differently there (issue 48, left open): the scalpel's entry
-# on the coarse box and the folded sheet's incisions depend on the rounding of the build.
-PORTABLE_BUILD = os.environ.get("SNEDE_NATIVE") == "OFF"
-PORTABLE_DEFECT = ("the portable build (SNEDE_NATIVE=OFF) decides this cut differently from the native one: "
-                   "a rounding-dependent decision in the surface cutter, open in issue 48")
