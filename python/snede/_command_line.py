@@ -101,11 +101,18 @@ def raise_keyboard_interrupt() -> NoReturn:
 
 
 def on_ctrl_c(react: Callable[[], None]) -> None:
-    """From now on Ctrl-C calls ``react()``, except inside a finalizer (a weakref callback or a
-    ``__del__``, run whenever the garbage collector frees PETSc objects): Python prints and
-    swallows an exception raised there, and the run went on to its end with status 0. There the
-    signal is sent again a moment later, once the finalizer has returned. Where SIGINT is
-    ignored (nohup) or handled by someone else, it stays so."""
+    """From now on Ctrl-C calls ``react()``, except where an exception it raises would be
+    mishandled; there the signal is sent again a moment later, once that code has returned:
+    * inside a finalizer (a weakref callback or a ``__del__``, run whenever the garbage collector
+      frees PETSc objects): Python prints and swallows an exception raised there, and the run
+      went on to its end with status 0;
+    * inside code compiled from a string (``eval``/``exec`` of source, as ``namedtuple`` does
+      while matplotlib is imported for a GIF): CPython 3.11 marks a KeyboardInterrupt leaving such
+      code as unhandled even when it is caught later, and under ``python -m`` the process then
+      kills itself with SIGINT at exit (status −2 instead of 130);
+    * inside an import: it leaves the module half made, and one with C++ state (matplotlib's
+      ft2font) then aborted the process at exit (status −6).
+    Where SIGINT is ignored (nohup) or handled by someone else, it stays so."""
     current = signal.getsignal(signal.SIGINT)
     if current is not signal.default_int_handler and getattr(current, "__module__", None) != __name__:
         return
@@ -113,7 +120,8 @@ def on_ctrl_c(react: Callable[[], None]) -> None:
     def handler(signum, frame) -> None:
         while frame is not None:
             code = frame.f_code
-            if code.co_name == "__del__" or code.co_filename.endswith("weakref.py"):
+            if code.co_name == "__del__" or code.co_filename.endswith("weakref.py") or code.co_filename == "<string>" \
+                    or code.co_filename.startswith("<frozen importlib._bootstrap"):
                 threading.Timer(0.02, os.kill, (os.getpid(), signum)).start()
                 return
             frame = frame.f_back
