@@ -438,6 +438,11 @@ void Connectivity::notify(ConnectivityChange& change, std::span<const FaceId> or
   update_vertex_incidence(change, orphans);
   change.reshaped_elements = reshaped_by(*this, change);
   ++revision_;
+  const bool moves_only =
+      change.removed_elements.empty() && change.added_elements.empty() && change.changed_elements.empty() &&
+      std::all_of(change.vertex_events.begin(), change.vertex_events.end(),
+                  [](const VertexEvent& event) { return event.kind == VertexEventKind::moved; });
+  if (!moves_only) ++topology_revision_;
   for (const auto& [watcher, mode] : watchers_)
     if (!in_batch() || mode == WatchMode::each_operation) watcher->on_change(*this, change);
   if (in_batch()) merge_into_batch(change);

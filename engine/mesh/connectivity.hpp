@@ -140,6 +140,10 @@ class Connectivity {
 
   // Increases with every operation: a cheap "has it changed" test.
   std::uint64_t revision() const { return revision_; }
+  // Increases with every operation that adds, removes or changes an element or adds or removes
+  // a vertex: what sparsities and piece labels depend on. A vertex moved in the reference
+  // configuration (a cut's snap) changes revision() only.
+  std::uint64_t topology_revision() const { return topology_revision_; }
 
   // Bytes held by the element, face and boundary containers (capacity, not just size).
   std::size_t memory_bytes() const;
@@ -178,6 +182,7 @@ class Connectivity {
   std::vector<VertexEvent> staged_vertex_events_;
   std::vector<std::pair<ConnectivityWatcher*, WatchMode>> watchers_;
   std::uint64_t revision_ = 0;
+  std::uint64_t topology_revision_ = 0;
 
   // The open batch: what merged watchers will hear at its end.
   int batch_depth_ = 0;

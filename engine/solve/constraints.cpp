@@ -220,7 +220,7 @@ void PieceHolding::label_pieces() {
   }
   std::sort(hinge_pieces_.begin(), hinge_pieces_.end());
   hinge_pieces_.erase(std::unique(hinge_pieces_.begin(), hinge_pieces_.end()), hinge_pieces_.end());
-  labelled_revision_ = c.revision();
+  labelled_revision_ = c.topology_revision();
   labelled_ = true;
 }
 
@@ -268,7 +268,7 @@ struct RigidMotionGram {
 }  // namespace
 
 std::vector<LoosePiece> PieceHolding::loose_pieces(const Constraints& constraints) {
-  if (!labelled_ || labelled_revision_ != mesh_.connectivity().revision()) label_pieces();
+  if (!labelled_ || labelled_revision_ != mesh_.connectivity().topology_revision()) label_pieces();
   const int pieces = static_cast<int>(piece_cells_.size());
   const int dim = constraints.dim(), n_motions = dim == 3 ? 6 : 3;
   std::vector<RigidMotionGram> grams(pieces, RigidMotionGram{Eigen::MatrixXd::Zero(n_motions, n_motions)});

@@ -97,8 +97,8 @@ struct LoosePiece {
 class PieceHolding {
  public:
   explicit PieceHolding(const Mesh& mesh) : mesh_(mesh) {}
-  // The pieces `constraints` do not hold, by label. The pieces are labelled once per mesh
-  // revision (O(n)); each call then accumulates each piece's constraint rows (one pass).
+  // The pieces `constraints` do not hold, by label. The pieces are labelled once per topology
+  // revision of the mesh (O(n)); each call then accumulates each piece's constraint rows (one pass).
   std::vector<LoosePiece> loose_pieces(const Constraints& constraints);
   // Throws std::invalid_argument naming the first loose piece (its size, a vertex, the rigid
   // motions its constraints stop against those it has) and the remedies.

@@ -20,6 +20,11 @@ class AssembledModelTangent final : public AssembledProblemTangent {
   Mat mat() const override { return tangent_.mat(); }
   void assemble(Vec u) override { tangent_.assemble(model_, u); }
   bool matches() const override { return tangent_.matches(model_); }
+  bool follow_moved_vertices() override {
+    if (!tangent_.follow_moved_vertices(model_)) return false;
+    set_rigid_body_near_null_space(model_, tangent_.mat());  // the rigid motions of the moved vertices
+    return true;
+  }
 
  private:
   const Model& model_;

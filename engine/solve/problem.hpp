@@ -38,6 +38,10 @@ class AssembledProblemTangent {
   virtual void assemble(Vec u) = 0;
   // Whether the sparsity is still the problem's (no edit of the mesh since it was made).
   virtual bool matches() const = 0;
+  // Takes over a mesh whose vertices only moved since (a cut's snap): true, the sparsity kept
+  // and the next assemble() filling the values for the new shapes; false if elements or vertices
+  // were added or removed (a new tangent is needed).
+  virtual bool follow_moved_vertices() { return false; }
 };
 
 // How an assembled tangent stores its entries: AIJ for PETSc's preconditioners, vertex blocks

@@ -334,7 +334,12 @@ void StaticSolver::follow_mesh_changes() {
   }
   generation_ = problem_.generation();
   if (resized) SNEDE_PETSC(VecDuplicate(problem_.state(), residual_.out()));
-  assembled_.reset();  // its sparsity was the old mesh's (a flip or a cut changes it)
+  // A flip or a cut changes the sparsity; vertices moved alone (a cut's snap) keep it, and the
+  // values are filled again for the new reference shapes.
+  if (assembled_ && assembled_->follow_moved_vertices())
+    preconditioner_filled_ = false;
+  else
+    assembled_.reset();
   multigrid_.reset();
   build_multigrid();
   if (ksp_) {
@@ -365,16 +370,22 @@ void StaticSolver::follow_mesh_changes() {
   }
 }
 
+MatrixFormat StaticSolver::assembled_tangent_format() const {
+  // GAMG works on AIJ, Galerkin levels on what their products read.
+  return pc_needs_matrix_ || !multigrid_ ? MatrixFormat::aij : multigrid_->assembled_tangent_format();
+}
+
 Mat StaticSolver::preconditioning_matrix() {
   if (!needs_matrix_) return problem_.tangent();
+  // Levels of another kind (bisection, then grid after a cut) may read another format.
+  if (assembled_ && assembled_format_ != assembled_tangent_format()) assembled_.reset();
   if (!assembled_) {
     static const PetscLogEvent event = log_event("SnedeTangentSparsity");
     ScopedEvent logged(event);
-    // GAMG works on AIJ, Galerkin levels on what their products read; a membrane's compressed
-    // elements must not make the PC indefinite.
-    const MatrixFormat format =
-        pc_needs_matrix_ || !multigrid_ ? MatrixFormat::aij : multigrid_->assembled_tangent_format();
-    assembled_ = problem_.make_assembled_tangent(format);
+    // A membrane's compressed elements must not make the PC indefinite (tangent_assembly.hpp).
+    assembled_format_ = assembled_tangent_format();
+    assembled_ = problem_.make_assembled_tangent(assembled_format_);
+    ++sparsity_builds_;
     preconditioner_filled_ = false;
   }
   return assembled_->mat();

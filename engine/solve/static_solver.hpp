@@ -78,6 +78,9 @@ class StaticSolver {
   // with their interpolations) since the solver was made: after a mesh change, or a change of
   // constraints the levels could not take over in place.
   std::size_t multigrid_builds() const { return multigrid_builds_; }
+  // Times the assembled tangent's sparsity was made since the solver was made: once per change
+  // of the mesh's elements, not for vertices moved alone (a cut's snap).
+  std::size_t sparsity_builds() const { return sparsity_builds_; }
   // The mesh's bisection hierarchy, once it has one (a mesh first refined after the solver was
   // made): the next levels, made after that refinement, coarsen along it.
   void use_hierarchy(const RefinementHierarchy* hierarchy) { hierarchy_ = hierarchy; }
@@ -156,6 +159,8 @@ class StaticSolver {
   bool pc_needs_matrix_ = false;       // the PC type needs entries (not none, jacobi or mg)
   bool needs_matrix_ = false;          // the PC needs an assembled tangent (that, or Galerkin mg)
   std::unique_ptr<AssembledProblemTangent> assembled_;  // that tangent, for the current mesh
+  MatrixFormat assembled_format_ = MatrixFormat::aij;
+  MatrixFormat assembled_tangent_format() const;  // what the PC and the levels read
   const RefinementHierarchy* hierarchy_ = nullptr;
   std::unique_ptr<Multigrid> multigrid_;  // PC "mg": the levels for the current mesh
   std::vector<double> smoother_bounds_;  // mg: Chebyshev's estimates from an earlier set-up, reused
@@ -167,6 +172,7 @@ class StaticSolver {
   bool filled_in_this_solve_ = false;
   std::size_t preconditioner_fills_ = 0;
   std::size_t multigrid_builds_ = 0;
+  std::size_t sparsity_builds_ = 0;
   bool keeps_levels_through_solve_ = false;  // Galerkin levels kept through a solve (solve_nonlinear)
   PreconditionerReuse reuse_;                // ... and through the next ones while they serve
   std::uint64_t generation_ = 0;

@@ -29,7 +29,9 @@ std::vector<double> projection_blocks(const Model& model) {
 }  // namespace
 
 AssembledTangent::AssembledTangent(const Model& model, MatrixFormat format, MembraneTangent membranes)
-    : membranes_(membranes), revision_(model.body().mesh().connectivity().revision()) {
+    : membranes_(membranes),
+      revision_(model.body().mesh().connectivity().revision()),
+      topology_revision_(model.body().mesh().connectivity().topology_revision()) {
   const Mesh& mesh = model.body().mesh();
   const Connectivity& c = mesh.connectivity();
   const int d = model.dim();
@@ -144,6 +146,13 @@ const std::int32_t* AssembledTangent::patch_block_ranks(std::span<const VertexId
 
 bool AssembledTangent::matches(const Model& model) const {
   return model.body().mesh().connectivity().revision() == revision_;
+}
+
+bool AssembledTangent::follow_moved_vertices(const Model& model) {
+  const Connectivity& c = model.body().mesh().connectivity();
+  if (c.topology_revision() != topology_revision_) return false;
+  revision_ = c.revision();
+  return true;
 }
 
 void AssembledTangent::assemble(const Model& model, Vec u) {

@@ -32,6 +32,10 @@ class AssembledTangent {
   AssembledTangent(const Model& model, MatrixFormat format, MembraneTangent membranes = MembraneTangent::exact);
   // Whether the mesh is still the one this matrix was made for (no edit since).
   bool matches(const Model& model) const;
+  // Takes over the mesh as it is now if only vertices moved since (a cut's snap): true, and the
+  // sparsity is kept (assemble() fills the values for the new shapes); false if elements or
+  // vertices were added or removed.
+  bool follow_moved_vertices(const Model& model);
   // Fills the matrix with J at u, scaled by the model's operator scale s as the shell is.
   // Values are added straight into PETSc's value array at offsets found once per mesh (AIJ or
   // BAIJ alike).
@@ -41,6 +45,7 @@ class AssembledTangent {
  private:
   MembraneTangent membranes_;
   std::uint64_t revision_;
+  std::uint64_t topology_revision_;
   MatHandle A_;
   std::vector<std::int32_t> block_rank_;  // per element id and block (a, b): b's place among
                                           // a's sorted neighbours

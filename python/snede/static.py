@@ -192,6 +192,13 @@ class StaticSolver(RunsOnRanks):
         return self._engine.preconditioner_fills
 
     @property
+    def sparsity_builds(self) -> int:
+        """How many times this solver made its assembled tangent's sparsity: once per change of
+        the mesh's elements (a cut, a flip, a refinement), not when vertices only moved (a cut
+        snapping a vertex onto the blade keeps it; its values are filled again)."""
+        return self._engine.sparsity_builds
+
+    @property
     def multigrid_builds(self) -> int:
         """How many times this solver made multigrid levels (a grid, aggregates or a cut through
         the bisection tree, with their interpolations): after a mesh change, or a change of
