@@ -24,16 +24,6 @@ bool in_plane(const Point3& p, const Point3& q, const std::array<Point3, 3>& x) 
          orientation_3d(x[0].data(), x[1].data(), x[2].data(), q.data()) == 0;
 }
 
-// Whether the scalpel slides in the plane of triangle x for the whole step (in it at both ends of
-// the step, so throughout). Decided on the step's given positions, not on a position
-// interpolated at the crossing time: a blade that only passes through the plane, lying in it
-// for an instant (a level blade rising through a level face), enters across the crest, and
-// whether the interpolated blade lands exactly in the plane is rounding (FMA or not).
-bool slides_in_plane(const Point3& head_from, const Point3& tail_from, const Point3& head_to, const Point3& tail_to,
-                     const std::array<Point3, 3>& x) {
-  return in_plane(head_from, tail_from, x) && in_plane(head_to, tail_to, x);
-}
-
 }  // namespace
 
 bool SurfaceCutter::meets_inside(const Segment& scalpel, ElementId triangle, int corner) const {
@@ -89,7 +79,14 @@ std::vector<SurfaceCutter::Contact> SurfaceCutter::first_contacts(const Segment&
                                                 return v != o[i] && v != o[j];
                                               }) - p.begin());
       const std::array<Point3, 3> y{deformed(p[0]), deformed(p[1]), deformed(p[2])};
-      const auto slides = [&](const std::array<Point3, 3>& t) { return slides_in_plane(from.head, from.tail, to.head, to.tail, t); };
+      // Whether the scalpel slides in the plane of triangle t for the whole step (in it at both
+      // ends of the step, so throughout), decided on the step's given positions: a blade that
+      // only passes through the plane (a level blade rising through a level face) enters across
+      // the crest, and whether a blade interpolated at the crossing time lands exactly in the
+      // plane is rounding (FMA or not).
+      const auto slides = [&](const std::array<Point3, 3>& t) {
+        return in_plane(from.head, from.tail, t) && in_plane(to.head, to.tail, t);
+      };
       if (slides(x) || slides(y)) continue;
       const Segment before = scalpel_at(time * (1 - 1e-3));
       if (meets_inside(before, e, k) || meets_inside(before, other, far_corner)) continue;
