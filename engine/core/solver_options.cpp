@@ -1,5 +1,6 @@
 #include "core/solver_options.hpp"
 
+#include <cctype>
 #include <sstream>
 #include <stdexcept>
 
@@ -64,6 +65,16 @@ std::optional<std::string> SolverOptions::string_option(const std::string& name)
   SNEDE_PETSC(PetscOptionsGetString(database_, nullptr, ("-" + name).c_str(), value, sizeof value, &set));
   if (!set) return std::nullopt;
   return std::string(value);
+}
+
+bool SolverOptions::bool_option(const std::string& name, bool fallback) const {
+  const std::optional<std::string> text = string_option(name);
+  if (!text) return fallback;
+  std::string value = *text;
+  for (char& c : value) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  if (value.empty() || value == "1" || value == "true" || value == "yes" || value == "on") return true;
+  if (value == "0" || value == "false" || value == "no" || value == "off") return false;
+  throw std::invalid_argument("-" + name + " must be true or false (1/0, yes/no, on/off), got '" + *text + "'");
 }
 
 void SolverOptions::set_string_option(const std::string& name, const std::string& value) {

@@ -46,6 +46,10 @@ class SolverOptions {
 
   // The value of option `name` (with its prefix, without '-') in this database, if set.
   std::optional<std::string> string_option(const std::string& name) const;
+  // The value of the logical option `name` as PETSc spells it (given without a value: true;
+  // 1/0, true/false, yes/no, on/off in any case), or `fallback` if it is not set;
+  // std::invalid_argument naming the option for any other value.
+  bool bool_option(const std::string& name, bool fallback) const;
   // Sets option `name` (with its prefix, without '-') in this database only.
   void set_string_option(const std::string& name, const std::string& value);
 

@@ -19,10 +19,19 @@ constexpr double chebyshev_lower_fraction = 0.1;
 GalerkinMultigrid::GalerkinMultigrid(Model& fine)
     : fine_(fine),
       revision_(fine.body().mesh().connectivity().revision()),
+      topology_revision_(fine.body().mesh().connectivity().topology_revision()),
       constraints_(fine.constraints().projection_fingerprint()) {}
 
 bool GalerkinMultigrid::matches_mesh(const Model& fine) const {
   return &fine == &fine_ && fine.body().mesh().connectivity().revision() == revision_;
+}
+
+bool GalerkinMultigrid::carry_over_moved_vertices(const Model& fine) {
+  const Connectivity& mesh = fine.body().mesh().connectivity();
+  if (&fine != &fine_ || mesh.topology_revision() != topology_revision_) return false;
+  revision_ = mesh.revision();
+  carried_ = true;
+  return true;
 }
 
 bool GalerkinMultigrid::matches(const Model& fine) const {

@@ -32,6 +32,13 @@ class Multigrid {
   // After the fine constraints changed (not the mesh): the levels take them over. False if
   // they cannot (then the levels must be made anew).
   virtual bool follow_constraints() = 0;
+  // After vertices moved in the reference configuration and no element changed (a cut's snap):
+  // levels that still precondition the mesh take it over and return true, keeping what they
+  // were made with (interpolation, products) for the earlier positions until they are made
+  // anew; false if they must be made anew now.
+  virtual bool carry_over_moved_vertices(const Model&) { return false; }
+  // Whether the levels were carried over moved vertices since they were made.
+  virtual bool made_for_earlier_positions() const { return false; }
   // Levels including the finest.
   virtual int n_levels() const = 0;
   // Per level, coarsest first, the fine mesh last: elements (bisection levels) or nodes
@@ -65,6 +72,10 @@ class GalerkinMultigrid : public Multigrid {
   bool matches(const Model& fine) const override;
   bool matches_mesh(const Model& fine) const override;
   bool follow_constraints() override { return false; }
+  // An interpolation for the earlier positions is still an interpolation of the same vertices,
+  // and the products of the earlier tangent still an SPD preconditioner of the present one.
+  bool carry_over_moved_vertices(const Model& fine) override;
+  bool made_for_earlier_positions() const override { return carried_; }
   bool needs_assembled_tangent() const override { return true; }
   // Recomputes Pᵀ A P level by level from the refilled fine matrix (numeric only while the
   // matrices are those of the first call: the mesh has not changed).
@@ -84,6 +95,8 @@ class GalerkinMultigrid : public Multigrid {
 
  private:
   std::uint64_t revision_;
+  std::uint64_t topology_revision_;
+  bool carried_ = false;  // carried over moved vertices (carry_over_moved_vertices)
   std::uint64_t constraints_;
   PC pc_ = nullptr;                      // the PCMG of the last configure_levels (owned by its KSP)
   std::vector<Mat> interpolations_;      // coarsest first

@@ -132,7 +132,8 @@ StaticSolver::StaticSolver(std::unique_ptr<ModelProblem> owned, Problem* problem
       options_(std::move(options)),
       option_database_(options_.options_prefix, options_.petsc_options),
       hierarchy_(hierarchy),
-      reuse_(number_option("mg_refresh_ratio", PreconditionerReuse::default_refresh_ratio)) {
+      reuse_(number_option("mg_refresh_ratio", PreconditionerReuse::default_refresh_ratio)),
+      rebuild_after_edits_(option_database_.bool_option(options_.options_prefix + "rebuild_after_edits", false)) {
   require_same_options_everywhere(problem_.comm(), options_);
   if (model_) piece_holding_.emplace(model_->body().mesh());
   if (options_.stopping.rtol <= 0 || !std::isfinite(options_.stopping.rtol))
@@ -332,11 +333,27 @@ void StaticSolver::follow_mesh_changes() {
     take_over_constraints();
     return;
   }
+  if (!resized && carry_levels_over_moved_vertices()) return;
+  make_structures_for_mesh(resized);
+}
+
+bool StaticSolver::carry_levels_over_moved_vertices() {
+  // A cut's snap moves a vertex or two onto the blade and changes no element (half of a
+  // scalpel's moves, issue 49): Galerkin levels that Newton keeps across solves keep serving,
+  // with the tangent of the earlier shapes, until they show their age; then solve_nonlinear
+  // makes them anew for the shapes of now. The operator of every solve is the exact tangent.
+  if (rebuild_after_edits_ || !model_ || !assembled_ || !multigrid_ || !lags_constraint_changes()) return false;
+  if (!multigrid_->carry_over_moved_vertices(*model_)) return false;
+  if (!assembled_->follow_moved_vertices()) throw std::logic_error("levels carried over a change of elements");
+  return true;
+}
+
+void StaticSolver::make_structures_for_mesh(bool resized) {
   generation_ = problem_.generation();
   if (resized) SNEDE_PETSC(VecDuplicate(problem_.state(), residual_.out()));
   // A flip or a cut changes the sparsity; vertices moved alone (a cut's snap) keep it, and the
   // values are filled again for the new reference shapes.
-  if (assembled_ && assembled_->follow_moved_vertices())
+  if (assembled_ && !rebuild_after_edits_ && assembled_->follow_moved_vertices())
     preconditioner_filled_ = false;
   else
     assembled_.reset();
@@ -450,13 +467,10 @@ void StaticSolver::build_multigrid() {
     ScopedEvent logged(event);
     multigrid_ = std::make_unique<GridMultigrid>(*model_, number_option("mg_grid_width", GridMultigrid::default_grid_width));
   }
-  const std::string smoothing =
-      option_database_.string_option(options_.options_prefix + "mg_aggregation_smoothing").value_or("false");
-  if (smoothing != "true" && smoothing != "false")
-    throw std::invalid_argument(prefix + "mg_aggregation_smoothing must be true or false, got '" + smoothing + "'");
+  const bool smoothing = option_database_.bool_option(options_.options_prefix + "mg_aggregation_smoothing", false);
   if (!multigrid_)
     multigrid_ = std::make_unique<AggregationMultigrid>(
-        *model_, max_levels, smoothing == "true",
+        *model_, max_levels, smoothing,
         number_option("mg_aggregate_width", AggregationMultigrid::default_aggregate_width));
   // An option for another kind of levels than those made is a mistake the user should hear of,
   // except the grid's width on bisection levels chosen by "auto": grid levels take over after
@@ -744,6 +758,7 @@ SolveResult StaticSolver::solve_nonlinear() {
   keeps_levels_through_solve_ = keeps_galerkin_levels();
   filled_in_this_solve_ = false;
   if (keeps_levels_through_solve_) {
+    if (!reuse_.keep() && multigrid_->made_for_earlier_positions()) make_structures_for_mesh(false);
     const bool reuse = filled_for_current_system() && reuse_.keep();
     if (!reuse_.keep() && !levels_match()) take_over_constraints();
     SNEDE_PETSC(SNESSetLagPreconditioner(snes_, reuse ? -1 : -2));

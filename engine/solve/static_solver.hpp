@@ -96,6 +96,12 @@ class StaticSolver {
   // After a mesh change: new vectors if the size changed (same solver objects, so a user's
   // handle and options survive), a new assembled tangent if its sparsity is out of date.
   void follow_mesh_changes();
+  // After vertices moved alone: the kept levels and assembled tangent take the mesh over
+  // unchanged (true), or nothing is kept (false).
+  bool carry_levels_over_moved_vertices();
+  // New vectors if `resized`, the sparsity kept or made anew, the multigrid levels made anew,
+  // and the solver objects reset onto them.
+  void make_structures_for_mesh(bool resized);
   // "auto" after the mesh grew or shrank past multigrid_from_cells: the other choice, with new
   // solver objects (the old ones left to any handle that holds them).
   void choose_preconditioner_again();
@@ -175,6 +181,9 @@ class StaticSolver {
   std::size_t sparsity_builds_ = 0;
   bool keeps_levels_through_solve_ = false;  // Galerkin levels kept through a solve (solve_nonlinear)
   PreconditionerReuse reuse_;                // ... and through the next ones while they serve
+  // -<prefix>rebuild_after_edits: every structure made from scratch after each mesh change, the
+  // reference the structures that follow the change are compared with (issue 49, item 7).
+  bool rebuild_after_edits_;
   std::uint64_t generation_ = 0;
   StoppingRule rule_;  // the stopping rule of the current solve, scaled to the model
   double external_norm_ = 0;

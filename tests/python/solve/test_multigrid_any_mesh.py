@@ -324,7 +324,7 @@ def test_bad_coarsening_options_are_refused_naming_them(gmsh_cylinder):
     with pytest.raises(ValueError, match="no bisection hierarchy"):
         snede.StaticSolver(body, "cg", preconditioner="mg", petsc_options={"mg_coarsening": "bisection"})
     aggregation = {"mg_coarsening": "aggregation"}
-    for options, message in (({**aggregation, "mg_aggregation_smoothing": "yes"},
+    for options, message in (({**aggregation, "mg_aggregation_smoothing": "maybe"},
                               "mg_aggregation_smoothing must be true or false"),
                              ({**aggregation, "mg_aggregate_width": "wide"}, "mg_aggregate_width must be a number, got 'wide'"),
                              ({**aggregation, "mg_aggregate_width": -1}, "mg_aggregate_width must be positive"),

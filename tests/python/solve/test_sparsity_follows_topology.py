@@ -8,9 +8,9 @@ import pytest
 import snede
 
 
-def sagging_box():
+def sagging_box(E=1e4):
     mesh = snede.meshing.box((4.0, 1.0, 1.0), (8, 2, 2))
-    body = snede.Body(mesh, snede.NeoHookean(E=1e4, nu=0.3), density=1000.0)
+    body = snede.Body(mesh, snede.NeoHookean(E=E, nu=0.3), density=1000.0)
     body.fix(np.isclose(mesh.points[:, 0], 0.0))
     body.add_gravity((0.0, 0.0, -9.81))
     return body
@@ -62,3 +62,68 @@ def test_after_a_moved_vertex_the_kept_sparsity_solves_as_a_new_solver():
                                                                       after_fresh.linear_iterations)
     np.testing.assert_allclose(kept.displacement, fresh.displacement, rtol=0,
                                atol=1e-12 * np.abs(fresh.displacement).max())
+
+
+def interior_vertices(mesh, count):
+    inside = np.flatnonzero(np.all((mesh.points > 1e-9) & (mesh.points < np.array([4.0, 1.0, 1.0]) - 1e-9), axis=1))
+    return [int(inside[k * len(inside) // (count + 1)]) for k in range(1, count + 1)]
+
+
+def grid_levels_solver(body, **options):
+    return snede.StaticSolver(body, "newton", rtol=1e-8, preconditioner="mg",
+                              petsc_options={"mg_coarsening": "grid", **options})
+
+
+def snap_and_solve(**options):
+    """Relax a stiff sagging box (few Newton steps: no failed linear solve refills the levels)
+    with grid levels, then snap three interior vertices one after the other, one solve after
+    each. Returns (solver, results after the snaps, displacement)."""
+    body = sagging_box(E=1e7)
+    solver = grid_levels_solver(body, **options)
+    assert solver.solve().converged
+    results = []
+    for vertex in interior_vertices(body.mesh, 3):
+        snap(body, vertex)
+        results.append(solver.solve())
+    return solver, results, body.displacement.copy()
+
+
+def test_multigrid_levels_kept_through_solves_are_carried_over_moved_vertices():
+    """Galerkin levels that Newton keeps across solves serve after a snap too (issue 49): no new
+    levels, no new fill, while the solves reach the answer of the reference that makes every
+    structure anew after each edit (the operator is the exact tangent; only the preconditioner
+    is older). Levels made anew for every solve (refresh ratio 0) keep the sparsity."""
+    carried, carried_results, carried_state = snap_and_solve()
+    reference, reference_results, reference_state = snap_and_solve(rebuild_after_edits="true")
+    renewed, renewed_results, _ = snap_and_solve(mg_refresh_ratio=0)
+    assert all(r.converged for r in carried_results + reference_results + renewed_results)
+    assert carried.multigrid_source == reference.multigrid_source == renewed.multigrid_source == "grid"
+    assert (carried.multigrid_builds, carried.preconditioner_fills, carried.sparsity_builds) == (1, 1, 1)
+    assert (reference.multigrid_builds, reference.preconditioner_fills, reference.sparsity_builds) == (4, 4, 4)
+    assert (renewed.multigrid_builds, renewed.preconditioner_fills, renewed.sparsity_builds) == (4, 4, 1)
+    # Both stop at rtol 1e-8 of the first residual: the states differ by the remaining error.
+    scale = np.abs(reference_state).max()
+    np.testing.assert_allclose(carried_state, reference_state, rtol=0, atol=1e-6 * scale)
+
+
+def test_a_bad_rebuild_option_is_refused_naming_it():
+    with pytest.raises(ValueError, match="-static_rebuild_after_edits must be true or false.*got 'sometimes'"):
+        grid_levels_solver(sagging_box(), rebuild_after_edits="sometimes")
+
+
+def test_levels_carried_over_moved_vertices_are_made_anew_once_they_show_their_age():
+    """A failed solve (the free end pushed 5 m through the clamped one) ends the reuse: the next solve makes the levels
+    for the vertices' positions of now, not only refills those of the earlier positions."""
+    body = sagging_box(E=1e7)
+    solver = grid_levels_solver(body)
+    assert solver.solve().converged
+    snap(body, interior_vertices(body.mesh, 1)[0])
+    assert solver.solve().converged
+    assert solver.multigrid_builds == 1
+    end = np.isclose(body.mesh.points[:, 0], 4.0)
+    body.fix(end, (-5.0, 0.0, 0.0))
+    assert not solver.solve().converged
+    builds = solver.multigrid_builds
+    body.fix(end, (0.0, 0.0, 0.0))
+    assert solver.solve().converged
+    assert solver.multigrid_builds == builds + 1
