@@ -282,17 +282,7 @@ void StaticSolver::create_objects() {
     // shell product costs several assembled ones); -<prefix>pc_use_amat turns it back.
     SNEDE_PETSC(PCSetUseAmat(pc, PETSC_FALSE));
     if (multigrid_) configure_multigrid(pc);
-    // Truncated Newton (§2.4.3): the inner CG stops early, tightening as the outer converges,
-    // and where the tangent is indefinite (far from the solution of a soft body) CG stops at
-    // the negative curvature and its iterate so far is used as the search direction.
-    // With a PC that is set up anew at every Newton iteration (GAMG on an assembled tangent),
-    // a few accurate Newton steps cost less than many truncated ones: at 98 304 neo-Hookean
-    // tetrahedra 9 iterations (inner rtol 1e-3) against 37–44 with Eisenstat-Walker.
-    if (needs_matrix_ || multigrid_) {
-      SNEDE_PETSC(KSPSetTolerances(inner, 1e-3, PETSC_DEFAULT, PETSC_DEFAULT, PETSC_DEFAULT));
-    } else {
-      SNEDE_PETSC(SNESKSPSetUseEW(snes_, PETSC_TRUE));
-    }
+    choose_forcing(needs_matrix_ || multigrid_);
     SNEDE_PETSC(SNESSetMaxLinearSolveFailures(snes_, options_.max_iterations));
     SNEDE_PETSC(SNESLineSearchSetPreCheck(line_search, descent_direction_callback, this));
   }
@@ -309,6 +299,30 @@ void StaticSolver::create_objects() {
   if (!(std::isfinite(damping) && damping > 0))
     throw std::invalid_argument("-" + options_.options_prefix + "snes_linesearch_damping must be positive and finite, got " +
                                 std::to_string(damping));
+}
+
+void StaticSolver::choose_forcing(bool preconditioned) {
+  // A forcing the user chose is left alone.
+  if (option_database_.string_option(options_.options_prefix + "snes_ksp_ew") ||
+      option_database_.string_option(options_.options_prefix + "ksp_rtol"))
+    return;
+  KSP inner = nullptr;
+  SNEDE_PETSC(SNESGetKSP(snes_, &inner));
+  // Truncated Newton (§2.4.3) without a PC: the inner CG stops early (Eisenstat–Walker),
+  // tightening as the outer converges, and where the tangent is indefinite (far from the
+  // solution of a soft body) CG stops at the negative curvature and its iterate so far is used
+  // as the search direction.
+  SNEDE_PETSC(SNESKSPSetUseEW(snes_, preconditioned ? PETSC_FALSE : PETSC_TRUE));
+  if (!preconditioned) return;
+  // With a PC set up anew at every Newton iteration (GAMG on an assembled tangent, matrix-free
+  // bisection levels), a few accurate Newton steps cost less than many truncated ones: at
+  // 98 304 neo-Hookean tetrahedra 9 iterations (inner rtol 1e-3) against 37–44 with
+  // Eisenstat-Walker. Galerkin levels kept through the solve cost nothing per iteration: there
+  // 1e-2 took as many Newton iterations and a quarter fewer flops in the cut loops, and the same
+  // on the static block (issue 49; docs/results/interactive.md). Eisenstat–Walker took half the
+  // CG in the loops but four times the Newton iterations on the static block.
+  const double inner_rtol = keeps_galerkin_levels() ? kept_levels_inner_rtol : set_up_levels_inner_rtol;
+  SNEDE_PETSC(KSPSetTolerances(inner, inner_rtol, PETSC_DEFAULT, PETSC_DEFAULT, PETSC_DEFAULT));
 }
 
 void StaticSolver::follow_mesh_changes() {
@@ -756,6 +770,7 @@ SolveResult StaticSolver::solve_nonlinear() {
   // the interpolation of the earlier constraints (follow_mesh_changes) until they show their
   // age: then they take the constraints of now over.
   keeps_levels_through_solve_ = keeps_galerkin_levels();
+  if (options_.method == StaticMethod::newton) choose_forcing(needs_matrix_ || multigrid_);
   filled_in_this_solve_ = false;
   if (keeps_levels_through_solve_) {
     if (!reuse_.keep() && multigrid_->made_for_earlier_positions()) make_structures_for_mesh(false);

@@ -96,6 +96,11 @@ class StaticSolver {
   // After a mesh change: new vectors if the size changed (same solver objects, so a user's
   // handle and options survive), a new assembled tangent if its sparsity is out of date.
   void follow_mesh_changes();
+  // Newton's inner tolerance (unless the options choose one): Eisenstat–Walker's forcing without
+  // a PC, else a fixed relative tolerance, looser with Galerkin levels kept through the solve.
+  void choose_forcing(bool preconditioned);
+  static constexpr double set_up_levels_inner_rtol = 1e-3;
+  static constexpr double kept_levels_inner_rtol = 1e-2;
   // After vertices moved alone: the kept levels and assembled tangent take the mesh over
   // unchanged (true), or nothing is kept (false).
   bool carry_levels_over_moved_vertices();
