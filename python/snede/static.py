@@ -57,7 +57,9 @@ class StaticSolver(RunsOnRanks):
       1.5; 0: new levels for every solve) times the CG iterations per Newton iteration of the
       solve that built them, or fails; ``-static_mg_coarsening aggregation`` takes rigid-motion
       aggregates instead. Levels are made anew at the first solve after a mesh change (after a
-      change of constraints alone, Newton's grid or aggregation levels are refilled instead);
+      change of constraints alone, Newton's grid or aggregation levels are refilled instead;
+      after vertices only moved, a cut's snap, they are carried over as they are until they show
+      their age; ``-static_rebuild_after_edits`` makes everything anew after every edit);
       ``follow_seconds`` says what that cost, ``preconditioner_fills`` how often the
       preconditioner was filled, ``multigrid_builds`` how often levels were made. ``multigrid_source`` says which kind is in use
       (``"bisection"``, ``"grid"``, ``"aggregation"``), ``multigrid_levels`` and
