@@ -1,7 +1,8 @@
-"""Issue 49's first step: the assembled tangent's sparsity follows the mesh's elements, not its
-vertices' positions. Half of a cut's moves only snap a vertex or two onto the blade (no element
-added or removed); the solver kept rebuilding its sparsity for those. Now it keeps it, fills the
-values for the new shapes, and solves exactly as a solver made afresh on the same state."""
+"""Issue 49: the solver's structures follow the mesh's elements, not its vertices' positions.
+Half of a cut's moves only snap a vertex or two onto the blade (no element added or removed); the
+solver kept rebuilding everything for those. Now it keeps the assembled tangent's sparsity (and
+solves exactly as a solver made afresh on the same state), and Newton's kept multigrid levels are
+carried over the snap until they show their age."""
 import numpy as np
 import pytest
 
@@ -16,9 +17,14 @@ def sagging_box(E=1e4):
     return body
 
 
+def interior_vertices(mesh, count):
+    """`count` vertices strictly inside the box, spread evenly through its vertex numbering."""
+    inside = np.flatnonzero(np.all((mesh.points > 1e-9) & (mesh.points < np.array([4.0, 1.0, 1.0]) - 1e-9), axis=1))
+    return [int(inside[k * len(inside) // (count + 1)]) for k in range(1, count + 1)]
+
+
 def interior_vertex(mesh):
-    inside = np.all((mesh.points > 1e-9) & (mesh.points < np.array([4.0, 1.0, 1.0]) - 1e-9), axis=1)
-    return int(np.flatnonzero(inside)[len(np.flatnonzero(inside)) // 2])
+    return interior_vertices(mesh, 1)[0]
 
 
 def snap(body, vertex):
@@ -64,11 +70,6 @@ def test_after_a_moved_vertex_the_kept_sparsity_solves_as_a_new_solver():
                                atol=1e-12 * np.abs(fresh.displacement).max())
 
 
-def interior_vertices(mesh, count):
-    inside = np.flatnonzero(np.all((mesh.points > 1e-9) & (mesh.points < np.array([4.0, 1.0, 1.0]) - 1e-9), axis=1))
-    return [int(inside[k * len(inside) // (count + 1)]) for k in range(1, count + 1)]
-
-
 def grid_levels_solver(body, **options):
     return snede.StaticSolver(body, "newton", rtol=1e-8, preconditioner="mg",
                               petsc_options={"mg_coarsening": "grid", **options})
@@ -112,12 +113,13 @@ def test_a_bad_rebuild_option_is_refused_naming_it():
 
 
 def test_levels_carried_over_moved_vertices_are_made_anew_once_they_show_their_age():
-    """A failed solve (the free end pushed 5 m through the clamped one) ends the reuse: the next solve makes the levels
-    for the vertices' positions of now, not only refills those of the earlier positions."""
+    """A failed solve (the free end pushed 5 m through the clamped one) ends the reuse: the next
+    solve makes the levels for the vertices' positions of now, not only refills those of the
+    earlier positions."""
     body = sagging_box(E=1e7)
     solver = grid_levels_solver(body)
     assert solver.solve().converged
-    snap(body, interior_vertices(body.mesh, 1)[0])
+    snap(body, interior_vertex(body.mesh))
     assert solver.solve().converged
     assert solver.multigrid_builds == 1
     end = np.isclose(body.mesh.points[:, 0], 4.0)
