@@ -10,23 +10,31 @@ namespace snede {
 PreconditionerReuse::PreconditionerReuse(double refresh_ratio) : refresh_ratio_(refresh_ratio) {
   if (!(refresh_ratio == 0 || refresh_ratio >= 1) || !std::isfinite(refresh_ratio))
     throw std::invalid_argument("mg_refresh_ratio must be 0 (new levels for every solve) or at least 1 (CG "
-                                "iterations per Newton iteration, over those of the solve that built the levels), got " +
+                                "iterations per Newton iteration, over those of the first Newton iteration "
+                                "after the levels were filled), got " +
                                 std::to_string(refresh_ratio));
 }
 
-void PreconditionerReuse::record(int newton_iterations, int linear_iterations, bool converged, bool built_levels) {
-  if (refresh_ratio_ == 0 || !converged) {
+void PreconditionerReuse::filled(bool new_baseline) {
+  stale_ = false;
+  awaiting_baseline_ = awaiting_baseline_ || new_baseline || baseline_ == 0;
+}
+
+void PreconditionerReuse::record_linear_solve(int iterations, bool converged) {
+  if (!converged) {
     stale_ = true;
     return;
   }
-  if (newton_iterations == 0) return;  // already in equilibrium: nothing learnt about the levels
-  const double per_newton = static_cast<double>(linear_iterations) / newton_iterations;
-  if (built_levels) {
-    baseline_ = std::max(per_newton, 1.0);
-    stale_ = false;
-  } else {
-    stale_ = stale_ || per_newton > refresh_ratio_ * baseline_;
+  if (awaiting_baseline_) {
+    baseline_ = std::max(iterations, 1);
+    awaiting_baseline_ = false;
+    return;
   }
+  if (refresh_ratio_ > 0) stale_ = stale_ || iterations > refresh_ratio_ * baseline_;
+}
+
+void PreconditionerReuse::record_solve(bool converged) {
+  if (refresh_ratio_ == 0 || !converged) stale_ = true;
 }
 
 }  // namespace snede

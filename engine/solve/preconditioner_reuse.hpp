@@ -1,33 +1,44 @@
-// Whether Galerkin multigrid levels built for one static solve serve the next ones (issue 31:
-// reuse across tool moves). In an interactive loop every tool move is followed by one solve
-// from the previous state; while the mesh and the constraints' projections stay the same (a
-// grasper dragging, a blade moving through an incision it already made), the levels of an
-// earlier solve — the assembled tangent at that state, its Galerkin products, the coarse
-// factorisation, the smoothers' bounds — still precondition the tangent well. When only the
-// projections change (a needle's stick-slip), the levels keep their interpolation and are
-// refilled at the new state (static_solver.cpp). They are kept
-// until the preconditioner shows its age: a solve that needed more than `refresh_ratio` times
-// the CG iterations per Newton iteration of the solve that built them, or one that failed.
+// Whether Galerkin multigrid levels filled for one Newton iteration serve the next ones, within
+// a solve and across solves (issue 31: reuse across tool moves; issue 49: ageing within a solve).
+// In an interactive loop every tool move is followed by one solve from the previous state; while
+// the mesh and the constraints' projections stay the same (a grasper dragging, a blade moving
+// through an incision it already made), the levels of an earlier solve — the assembled tangent at
+// that state, its Galerkin products, the coarse factorisation, the smoothers' bounds — still
+// precondition the tangent well. When only the projections change (a needle's stick-slip), the
+// levels keep their interpolation and are refilled at the new state (static_solver.cpp). Within
+// one solve from far away (a body loaded from rest) the tangent changes more from step to step.
+// Levels are kept until they show their age: a Newton iteration whose CG needs more than
+// `refresh_ratio` times the CG iterations of the first Newton iteration the levels served after
+// they were filled, or a linear solve or a solve that failed. Then they are filled at the state
+// of now (static_solver.cpp).
 #pragma once
 
 namespace snede {
 
 class PreconditionerReuse {
  public:
-  // refresh_ratio: ≥ 1, or 0 to build the levels anew for every solve.
+  // refresh_ratio: ≥ 1, or 0 to fill the levels anew at the start of every solve (and keep them
+  // through it).
   explicit PreconditionerReuse(double refresh_ratio);
   // Measured on the interactive loops (docs/results/interactive.md, "Reuse across moves").
   static constexpr double default_refresh_ratio = 1.5;
 
-  // Whether levels filled for an earlier solve (on the same mesh and projections) serve the next.
+  // Whether the levels as filled last still serve the next Newton iteration.
   bool keep() const { return !stale_; }
-  // After a solve: its Newton and CG iterations, whether it converged, and whether it built the
-  // levels it used (then its CG per Newton iteration is the baseline of the ones that reuse them).
-  void record(int newton_iterations, int linear_iterations, bool converged, bool built_levels);
+  // The levels were filled at the current state. `new_baseline`: the next linear solve's CG
+  // iterations are the baseline later ones are compared with — false when they were refilled on
+  // the interpolation of earlier constraints, which keep the baseline of the levels made for those.
+  void filled(bool new_baseline);
+  // After each Newton iteration's linear solve with the levels: its CG iterations, and whether it
+  // converged.
+  void record_linear_solve(int iterations, bool converged);
+  // After a whole solve.
+  void record_solve(bool converged);
 
  private:
   double refresh_ratio_;
-  double baseline_ = 0;  // CG per Newton iteration of the solve that built the levels
+  double baseline_ = 0;  // CG iterations of the first linear solve after the levels were filled
+  bool awaiting_baseline_ = false;
   bool stale_ = true;
 };
 

@@ -610,23 +610,37 @@ void StaticSolver::refill_preconditioner(SNES snes, Vec x) {
   PetscInt lag = 1, iteration = 0;
   SNEDE_PETSC(SNESGetLagPreconditioner(snes, &lag));
   SNEDE_PETSC(SNESGetIterationNumber(snes, &iteration));
-  // Galerkin levels kept through a solve (solve_nonlinear) are rebuilt when the last linear
-  // solve failed with them (of this solve, or of the earlier one whose levels it reuses): kept
-  // levels made Newton's line search fail on the 63k liver.
-  if (keeps_levels_through_solve_ && lag == -1) {
-    KSPConvergedReason last = KSP_CONVERGED_ITERATING;
-    SNEDE_PETSC(KSPGetConvergedReason(ksp(), &last));
-    if (last < 0) {
+  // Galerkin levels kept through a solve (solve_nonlinear) are filled again at the state of now
+  // once they show their age (preconditioner_reuse.hpp): the last linear solve failed with them
+  // (kept levels made Newton's line search fail on the 63k liver), or needed more than the refresh
+  // ratio of CG iterations (on the static 98k block the CG per Newton iteration grew from 3 to 42
+  // over 13 iterations with the levels of the first).
+  if (keeps_levels_through_solve_) {
+    record_last_linear_solve();
+    if (lag == -1 && !reuse_.keep()) {
       SNEDE_PETSC(SNESSetLagPreconditioner(snes, -2));
       lag = -2;
       preconditioner_filled_ = false;
     }
+    linear_solve_pending_ = true;
   }
   // As SNES decides whether to rebuild the PC: -1 never again (-2 becomes -1 once built), k > 1
   // every k-th iteration.
   const bool lagged = (lag == -1 || (lag > 1 && iteration % lag != 0)) && preconditioner_filled_;
   if (lagged) return;
   fill_preconditioner(x);
+  // Levels refilled on an interpolation of earlier constraints do not set a new baseline.
+  if (keeps_levels_through_solve_) reuse_.filled(levels_match());
+}
+
+void StaticSolver::record_last_linear_solve() {
+  if (!linear_solve_pending_) return;
+  linear_solve_pending_ = false;
+  PetscInt iterations = 0;
+  KSPConvergedReason reason = KSP_CONVERGED_ITERATING;
+  SNEDE_PETSC(KSPGetIterationNumber(ksp(), &iterations));
+  SNEDE_PETSC(KSPGetConvergedReason(ksp(), &reason));
+  reuse_.record_linear_solve(static_cast<int>(iterations), reason > 0);
 }
 
 void StaticSolver::fill_preconditioner(Vec u) {
@@ -642,7 +656,6 @@ void StaticSolver::fill_preconditioner(Vec u) {
   }
   ++preconditioner_fills_;
   preconditioner_filled_ = true;
-  filled_in_this_solve_ = true;
   filled_at_scale_ = system_scale_;
   filled_for_constraints_ = problem_.projection_fingerprint();
 }
@@ -762,16 +775,17 @@ SolveResult StaticSolver::solve_nonlinear() {
   PetscInt iterations = 0, linear = 0;
   const ScaledOperator scaled(problem_, system_scale_);
   // Galerkin levels (an assembled tangent, its products with the interpolation, a coarse
-  // factorisation) are built at the first Newton iteration of a solve and kept through its other
-  // iterations, unless the options lag otherwise: rebuilding them cost more than the CG
-  // iterations they save (docs/results/interactive.md). While the mesh and the projections stay
-  // the same, the next solves keep them too, until they show their age (preconditioner_reuse.hpp).
+  // factorisation) are filled at the first Newton iteration of a solve and kept through its other
+  // iterations until they show their age (preconditioner_reuse.hpp), unless the options lag
+  // otherwise: filling them at every iteration cost more than the CG iterations it saves
+  // (docs/results/interactive.md). While the mesh and the projections stay the same, the next
+  // solves keep them too, by the same test.
   // After a change of constraints alone (a needle's stick-slip) the levels are refilled with
   // the interpolation of the earlier constraints (follow_mesh_changes) until they show their
   // age: then they take the constraints of now over.
   keeps_levels_through_solve_ = keeps_galerkin_levels();
   if (options_.method == StaticMethod::newton) choose_forcing(needs_matrix_ || multigrid_);
-  filled_in_this_solve_ = false;
+  linear_solve_pending_ = false;
   if (keeps_levels_through_solve_) {
     if (!reuse_.keep() && multigrid_->made_for_earlier_positions()) make_structures_for_mesh(false);
     const bool reuse = filled_for_current_system() && reuse_.keep();
@@ -787,6 +801,7 @@ SolveResult StaticSolver::solve_nonlinear() {
     SNEDE_PETSC(SNESGetLinearSolveIterations(snes_, &lits));
     iterations += its;
     linear += lits;
+    if (keeps_levels_through_solve_) record_last_linear_solve();
   };
   run();
   // Near the solution the energy decrease of a Newton step falls below the round-off of Π
@@ -822,10 +837,7 @@ SolveResult StaticSolver::solve_nonlinear() {
   result.reason = std::string(SNESConvergedReasons[reason]);
   result.converged = reason > 0;
   finish(result, start, start_flops);
-  if (keeps_levels_through_solve_)
-    // Levels refilled on an interpolation of earlier constraints do not set a new baseline.
-    reuse_.record(result.iterations, result.linear_iterations, result.converged,
-                  filled_in_this_solve_ && levels_match());
+  if (keeps_levels_through_solve_) reuse_.record_solve(result.converged);
   return result;
 }
 

@@ -180,12 +180,14 @@ class StaticSolver {
   bool preconditioner_filled_ = false;  // filled since it was made (for lagging)
   double filled_at_scale_ = 0;          // the system scale it was filled with
   std::uint64_t filled_for_constraints_ = 0;  // ... and the constraints' projection fingerprint
-  bool filled_in_this_solve_ = false;
   std::size_t preconditioner_fills_ = 0;
   std::size_t multigrid_builds_ = 0;
   std::size_t sparsity_builds_ = 0;
   bool keeps_levels_through_solve_ = false;  // Galerkin levels kept through a solve (solve_nonlinear)
   PreconditionerReuse reuse_;                // ... and through the next ones while they serve
+  bool linear_solve_pending_ = false;        // a Newton iteration's CG with kept levels not yet recorded
+  // Tells reuse_ the CG iterations of the last Newton iteration with kept levels, once.
+  void record_last_linear_solve();
   // -<prefix>rebuild_after_edits: every structure made from scratch after each mesh change, the
   // reference the structures that follow the change are compared with (issue 49, item 7).
   bool rebuild_after_edits_;

@@ -51,11 +51,12 @@ class StaticSolver(RunsOnRanks):
       background grid over the reference configuration, with one copy of a grid node per
       connected piece of the fine vertices it reaches (virtual nodes: a cut never ties the
       lips), and a Galerkin coarse operator from the tangent assembled by the element kernels,
-      built at the first Newton iteration of a solve and kept through the next solves while the
-      mesh and the constraints' projections stay the same (a grasper dragging a patch held at a
-      moving displacement), until a solve needs more than ``-static_mg_refresh_ratio`` (default
-      1.5; 0: new levels for every solve) times the CG iterations per Newton iteration of the
-      solve that built them, or fails; ``-static_mg_coarsening aggregation`` takes rigid-motion
+      filled at the first Newton iteration of a solve and kept through its next iterations and
+      the next solves while the mesh and the constraints' projections stay the same (a grasper
+      dragging a patch held at a moving displacement), until a Newton iteration needs more than
+      ``-static_mg_refresh_ratio`` (default 1.5; 0: filled once per solve) times the CG
+      iterations of the first one after they were filled, or a solve fails: then they are filled
+      again at the state of now; ``-static_mg_coarsening aggregation`` takes rigid-motion
       aggregates instead. Levels are made anew at the first solve after a mesh change (after a
       change of constraints alone, Newton's grid or aggregation levels are refilled instead;
       after vertices only moved, a cut's snap, they are carried over as they are until they show

@@ -26,13 +26,18 @@ import argparse
 import json
 import shutil
 import subprocess
+import sys
 import tempfile
 import textwrap
 import time
+from pathlib import Path
 
 import numpy as np
 
 import snede
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from work_units import work_unit_flops, work_unit_seconds  # noqa: E402
 
 BLOCK_DIVISIONS = (64, 16, 16)  # 6 · 64 · 16 · 16 = 98 304 tetrahedra
 
@@ -59,10 +64,11 @@ def block(refined: bool = False):
 
 
 def timed_solve(body, method: str, **options):
+    """(solver, result, seconds) of one solve."""
     solver = snede.StaticSolver(body, method, **options)
     start = time.perf_counter()
     result = solver.solve()
-    return result, time.perf_counter() - start
+    return solver, result, time.perf_counter() - start
 
 
 def cantilever_table(levels) -> None:
@@ -72,7 +78,7 @@ def cantilever_table(levels) -> None:
     for pc in ("none", "jacobi", "icc", "gamg", "mg"):
         for n in levels:
             body = cantilever(n)
-            result, seconds = timed_solve(body, "cg", rtol=1e-8, preconditioner=pc)
+            _, result, seconds = timed_solve(body, "cg", rtol=1e-8, preconditioner=pc)
             counts.setdefault(pc, []).append(result.iterations)
             print(f"{n:>3} {body.mesh.n_cells:>10} {3 * body.mesh.n_points:>8} {pc:<15} {result.iterations:>10} "
                   f"{seconds:>8.3f}  {result.reason}", flush=True)
@@ -149,13 +155,20 @@ def fenicsx_block(mesh=None) -> dict | None:
 
 def block_table() -> None:
     print("\n2. The neo-Hookean block, 98 304 tetrahedra, rtol 1e-6")
-    print(f"{'solver':<44} {'outer':>6} {'CG':>6} {'seconds':>8} {'u_z min [m]':>12}  reason")
+    print("   (fills: the preconditioner's fills; WU: the solve in products of the mesh's assembled AIJ tangent,\n"
+          "    timed in this run; flop WU: its logged flops in the flops of one product, issue 49)")
+    print(f"{'solver':<58} {'outer':>6} {'CG':>6} {'fills':>5} {'seconds':>8} {'WU':>6} {'flop WU':>7} "
+          f"{'u_z min [m]':>12}  reason")
     runs = [
         ("snede newton, mg (bisected mesh)", "newton", {"preconditioner": "mg"}),
         ("snede newton, gamg (bisected mesh)", "newton", {"preconditioner": "gamg"}),
         ("snede newton, mg on a grid (bisected)", "newton", {"preconditioner": "mg", "petsc_options":
                                                              {"mg_coarsening": "grid"}}),
         ("snede newton, mg on a grid (the default)", "newton", {"preconditioner": "mg"}),
+        ("snede newton, mg on a grid, filled once (-static_mg_refresh_ratio 0)", "newton",
+         {"preconditioner": "mg", "petsc_options": {"mg_refresh_ratio": 0}}),
+        ("snede newton, mg on a grid, filled at every step (lag 1)", "newton",
+         {"preconditioner": "mg", "petsc_options": {"snes_lag_preconditioner": 1}}),
         ("snede newton, mg by aggregation", "newton", {"preconditioner": "mg", "petsc_options":
                                                        {"mg_coarsening": "aggregation"}}),
         ("snede newton, no preconditioner", "newton", {"preconditioner": "none"}),
@@ -166,11 +179,17 @@ def block_table() -> None:
         ("snede ncg (Polak-Ribière, secant)", "ncg", {}),
     ]
     seconds_of = {}
+    unit = {}
     for label, method, options in runs:
-        body = block(refined="bisected" in label)
-        result, seconds = timed_solve(body, method, rtol=1e-6, **options)
+        refined = "bisected" in label
+        body = block(refined=refined)
+        if refined not in unit:
+            unit[refined] = (work_unit_seconds(body), work_unit_flops(body))
+        solver, result, seconds = timed_solve(body, method, rtol=1e-6, **options)
         seconds_of[label] = seconds
-        print(f"{label:<44} {result.iterations:>6} {result.linear_iterations:>6} {seconds:>8.2f} "
+        unit_seconds, unit_flops = unit[refined]
+        print(f"{label:<58} {result.iterations:>6} {result.linear_iterations:>6} {solver.preconditioner_fills:>5} "
+              f"{seconds:>8.2f} {seconds / unit_seconds:>6.0f} {result.flops / unit_flops:>7.0f} "
               f"{body.displacement[:, 2].min():>12.6f}  {result.reason}", flush=True)
     peers = {}
     for mesh_label, mesh in (("", None), (" (bisected mesh)", block(refined=True).mesh)):
@@ -180,7 +199,8 @@ def block_table() -> None:
             return
         peers[mesh_label] = peer
         label = f"FEniCSx 0.5.2 newton, CG + gamg{mesh_label}"
-        print(f"{label:<44} {peer['newton']:>6} {peer['linear']:>6} {peer['seconds']:>8.2f} {peer['u_min']:>12.6f}  "
+        print(f"{label:<58} {peer['newton']:>6} {peer['linear']:>6} {'':>5} {peer['seconds']:>8.2f} {'':>6} {'':>7} "
+              f"{peer['u_min']:>12.6f}  "
               f"{'converged' if peer['converged'] else 'NOT converged'} (full steps; {peer['tets']} tetrahedra; "
               f"+ {peer['setup']:.1f} s forms and set-up)", flush=True)
     for label in ("snede newton, mg (bisected mesh)", "snede newton, gamg (bisected mesh)", "snede newton, gamg",

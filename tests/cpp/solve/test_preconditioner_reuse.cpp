@@ -1,6 +1,7 @@
-// The rule that keeps multigrid levels through several solves (preconditioner_reuse.hpp): kept
-// while each solve needs at most refresh_ratio times the CG iterations per Newton iteration of
-// the solve that built them; given up after a failure or a slower solve; never kept at ratio 0.
+// The rule that keeps multigrid levels through Newton iterations and solves
+// (preconditioner_reuse.hpp): kept while each Newton iteration's CG needs at most refresh_ratio
+// times the CG iterations of the first one after the levels were filled; given up after a failed
+// linear solve or solve, or a slower iteration; at ratio 0 kept through one solve only.
 #include <gtest/gtest.h>
 
 #include <stdexcept>
@@ -9,44 +10,69 @@
 
 using namespace snede;
 
-TEST(PreconditionerReuse, NothingToKeepBeforeTheFirstSolve) { EXPECT_FALSE(PreconditionerReuse(1.5).keep()); }
+TEST(PreconditionerReuse, NothingToKeepBeforeTheFirstFill) { EXPECT_FALSE(PreconditionerReuse(1.5).keep()); }
 
-TEST(PreconditionerReuse, KeptWhileSolvesStayWithinTheRatioOfTheBuildingSolve) {
+TEST(PreconditionerReuse, KeptWhileIterationsStayWithinTheRatioOfTheFirstAfterTheFill) {
   PreconditionerReuse reuse(1.5);
-  reuse.record(2, 20, true, true);  // 10 CG per Newton iteration: the baseline
+  reuse.filled(true);
   EXPECT_TRUE(reuse.keep());
-  reuse.record(3, 45, true, false);  // 15 = 1.5 × 10: still kept
+  reuse.record_linear_solve(10, true);  // the baseline
+  reuse.record_linear_solve(15, true);  // 1.5 × 10: still kept
+  reuse.record_solve(true);
   EXPECT_TRUE(reuse.keep());
-  reuse.record(0, 0, true, false);  // already in equilibrium: says nothing
-  EXPECT_TRUE(reuse.keep());
-  reuse.record(2, 31, true, false);  // 15.5 > 15
+  reuse.record_linear_solve(16, true);  // > 15, in the next solve
   EXPECT_FALSE(reuse.keep());
-  reuse.record(1, 9, true, false);  // a faster solve with the old levels does not revive them
+  reuse.record_linear_solve(9, true);  // a faster iteration with the old levels does not revive them
+  reuse.record_solve(true);
   EXPECT_FALSE(reuse.keep());
-  reuse.record(1, 12, true, true);  // new levels: a new baseline
+  reuse.filled(true);  // filled again: a new baseline
+  EXPECT_TRUE(reuse.keep());
+  reuse.record_linear_solve(20, true);
+  reuse.record_linear_solve(30, true);
   EXPECT_TRUE(reuse.keep());
 }
 
-TEST(PreconditionerReuse, AFailedSolveGivesTheLevelsUp) {
+TEST(PreconditionerReuse, LevelsRefilledOnEarlierConstraintsKeepTheirBaseline) {
+  PreconditionerReuse reuse(2.0);
+  reuse.filled(true);
+  reuse.record_linear_solve(5, true);
+  reuse.filled(false);  // the constraints changed; the interpolation is the earlier one
+  reuse.record_linear_solve(10, true);  // 2 × 5: kept
+  EXPECT_TRUE(reuse.keep());
+  reuse.record_linear_solve(11, true);
+  EXPECT_FALSE(reuse.keep());
+}
+
+TEST(PreconditionerReuse, AFailedLinearSolveOrSolveGivesTheLevelsUp) {
   PreconditionerReuse reuse(3.0);
-  reuse.record(1, 5, true, true);
-  reuse.record(1, 5, false, false);
+  reuse.filled(true);
+  reuse.record_linear_solve(5, true);
+  reuse.record_linear_solve(5, false);
   EXPECT_FALSE(reuse.keep());
-  reuse.record(4, 40, false, true);  // levels built in a failed solve are not kept either
+  reuse.filled(true);
+  reuse.record_linear_solve(5, true);
+  reuse.record_solve(false);  // levels filled in a failed solve are not kept either
   EXPECT_FALSE(reuse.keep());
 }
 
-TEST(PreconditionerReuse, RatioZeroNeverKeeps) {
+TEST(PreconditionerReuse, RatioZeroKeepsTheLevelsThroughOneSolveOnly) {
   PreconditionerReuse reuse(0.0);
-  reuse.record(1, 5, true, true);
+  reuse.filled(true);
+  reuse.record_linear_solve(5, true);
+  reuse.record_linear_solve(50, true);
+  EXPECT_TRUE(reuse.keep());
+  reuse.record_solve(true);
   EXPECT_FALSE(reuse.keep());
 }
 
-TEST(PreconditionerReuse, ABuildingSolveWithoutCgIterationsCountsAsOne) {
+TEST(PreconditionerReuse, ABaselineWithoutCgIterationsCountsAsOne) {
   PreconditionerReuse reuse(1.5);
-  reuse.record(1, 0, true, true);
-  reuse.record(1, 1, true, false);
+  reuse.filled(true);
+  reuse.record_linear_solve(0, true);
+  reuse.record_linear_solve(1, true);
   EXPECT_TRUE(reuse.keep());
+  reuse.record_linear_solve(2, true);
+  EXPECT_FALSE(reuse.keep());
 }
 
 TEST(PreconditionerReuse, RatiosBetweenZeroAndOneOrNotFiniteAreRefused) {

@@ -91,7 +91,7 @@ def snap_and_solve(**options):
 
 def test_multigrid_levels_kept_through_solves_are_carried_over_moved_vertices():
     """Galerkin levels that Newton keeps across solves serve after a snap too (issue 49): no new
-    levels, no new fill, while the solves reach the answer of the reference that makes every
+    levels or sparsity, fewer fills, while the solves reach the answer of the reference that makes every
     structure anew after each edit (the operator is the exact tangent; only the preconditioner
     is older). Levels made anew for every solve (refresh ratio 0) keep the sparsity."""
     carried, carried_results, carried_state = snap_and_solve()
@@ -99,8 +99,12 @@ def test_multigrid_levels_kept_through_solves_are_carried_over_moved_vertices():
     renewed, renewed_results, _ = snap_and_solve(mg_refresh_ratio=0)
     assert all(r.converged for r in carried_results + reference_results + renewed_results)
     assert carried.multigrid_source == reference.multigrid_source == renewed.multigrid_source == "grid"
-    assert (carried.multigrid_builds, carried.preconditioner_fills, carried.sparsity_builds) == (1, 1, 1)
-    assert (reference.multigrid_builds, reference.preconditioner_fills, reference.sparsity_builds) == (4, 4, 4)
+    assert (carried.multigrid_builds, carried.sparsity_builds) == (1, 1)
+    assert (reference.multigrid_builds, reference.sparsity_builds) == (4, 4)
+    # The reference fills at every solve, and again within one as its levels age; the carried
+    # levels only as they age (2 fills for 4 solves against 5 when this was written).
+    assert reference.preconditioner_fills >= 4
+    assert carried.preconditioner_fills < reference.preconditioner_fills
     assert (renewed.multigrid_builds, renewed.preconditioner_fills, renewed.sparsity_builds) == (4, 4, 1)
     # Both stop at rtol 1e-8 of the first residual: the states differ by the remaining error.
     scale = np.abs(reference_state).max()
