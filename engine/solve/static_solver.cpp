@@ -611,13 +611,15 @@ void StaticSolver::refill_preconditioner(SNES snes, Vec x) {
   SNEDE_PETSC(SNESGetLagPreconditioner(snes, &lag));
   SNEDE_PETSC(SNESGetIterationNumber(snes, &iteration));
   // Galerkin levels kept through a solve (solve_nonlinear) are filled again at the state of now
-  // once they show their age (preconditioner_reuse.hpp): the last linear solve failed with them
-  // (kept levels made Newton's line search fail on the 63k liver), or needed more than the refresh
-  // ratio of CG iterations (on the static 98k block the CG per Newton iteration grew from 3 to 42
-  // over 13 iterations with the levels of the first).
+  // when the last linear solve failed with them (kept levels made Newton's line search fail on
+  // the 63k liver), or when they show their age (preconditioner_reuse.hpp: on the static 98k block
+  // the CG per Newton iteration grew from 3 to 42 over 13 iterations with the levels of the
+  // first). Aged levels that lag a change of constraints (a needle's stick-slip) take the
+  // constraints over at the next solve instead: refilled on their earlier interpolation they keep
+  // the old baseline (preconditioner_reuse.hpp), and would be refilled at every later iteration.
   if (keeps_levels_through_solve_) {
-    record_last_linear_solve();
-    if (lag == -1 && !reuse_.keep()) {
+    const bool failed = record_last_linear_solve();
+    if (lag == -1 && (failed || (!reuse_.keep() && levels_match()))) {
       SNEDE_PETSC(SNESSetLagPreconditioner(snes, -2));
       lag = -2;
       preconditioner_filled_ = false;
@@ -633,14 +635,15 @@ void StaticSolver::refill_preconditioner(SNES snes, Vec x) {
   if (keeps_levels_through_solve_) reuse_.filled(levels_match());
 }
 
-void StaticSolver::record_last_linear_solve() {
-  if (!linear_solve_pending_) return;
+bool StaticSolver::record_last_linear_solve() {
+  if (!linear_solve_pending_) return false;
   linear_solve_pending_ = false;
   PetscInt iterations = 0;
   KSPConvergedReason reason = KSP_CONVERGED_ITERATING;
   SNEDE_PETSC(KSPGetIterationNumber(ksp(), &iterations));
   SNEDE_PETSC(KSPGetConvergedReason(ksp(), &reason));
   reuse_.record_linear_solve(static_cast<int>(iterations), reason > 0);
+  return reason < 0;
 }
 
 void StaticSolver::fill_preconditioner(Vec u) {

@@ -186,8 +186,9 @@ class StaticSolver {
   bool keeps_levels_through_solve_ = false;  // Galerkin levels kept through a solve (solve_nonlinear)
   PreconditionerReuse reuse_;                // ... and through the next ones while they serve
   bool linear_solve_pending_ = false;        // a Newton iteration's CG with kept levels not yet recorded
-  // Tells reuse_ the CG iterations of the last Newton iteration with kept levels, once.
-  void record_last_linear_solve();
+  // Tells reuse_ the CG iterations of the last Newton iteration with kept levels, once; whether
+  // that linear solve failed.
+  bool record_last_linear_solve();
   // -<prefix>rebuild_after_edits: every structure made from scratch after each mesh change, the
   // reference the structures that follow the change are compared with (issue 49, item 7).
   bool rebuild_after_edits_;

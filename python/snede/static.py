@@ -54,7 +54,7 @@ class StaticSolver(RunsOnRanks):
       filled at the first Newton iteration of a solve and kept through its next iterations and
       the next solves while the mesh and the constraints' projections stay the same (a grasper
       dragging a patch held at a moving displacement), until a Newton iteration needs more than
-      ``-static_mg_refresh_ratio`` (default 1.5; 0: filled once per solve) times the CG
+      ``-static_mg_refresh_ratio`` (default 2; 0: filled once per solve) times the CG
       iterations of the first one after they were filled, or a solve fails: then they are filled
       again at the state of now; ``-static_mg_coarsening aggregation`` takes rigid-motion
       aggregates instead. Levels are made anew at the first solve after a mesh change (after a

@@ -134,7 +134,7 @@ def test_bad_refresh_ratios_are_refused_naming_the_option():
 def test_levels_that_age_within_a_solve_are_filled_again_and_reach_the_same_state():
     """Relaxing from rest, the tangent changes from Newton step to step: levels filled at the
     first step need more and more CG iterations (issue 49). The default refresh ratio fills them
-    again within the solve once a step needs more than 1.5 times the first step's CG; ratio 0
+    again within the solve once a step needs more than twice the first step's CG; ratio 0
     keeps the first step's levels through the solve. Both reach the plain answer."""
     states, results, fills = {}, {}, {}
     for ratio in (None, 0):
