@@ -23,7 +23,7 @@ class PreconditionerReuse {
   // docs/results/interactive.md, "Levels that age within a solve": 1.5, 2 and 3 cost the same
   // on the cut loops; on the static 98k block 2 took as few CG iterations as 1.5 (38) with one
   // fill fewer, 3 took 50; the needle into the 10k liver filled 196 times with 2, 246 with 1.5 and
-  // 176 with 3 (as before fills within a solve), for the same CG iterations.
+  // 176 with 3 and 175 before levels were refilled within a solve, for the same CG iterations.
   static constexpr double default_refresh_ratio = 2.0;
 
   // Whether the levels as filled last still serve the next Newton iteration.
