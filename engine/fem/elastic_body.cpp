@@ -181,16 +181,20 @@ template <int D, class M>
 // Calls visit(e, vertices, K_e) for every live element with its stiffness at u
 // (fem/block_stiffness.hpp), leaving out inverted elements of a material that forbids
 // inversion. Flattened like the loops above: the block's kernels inlined into one body.
+// `wanted`, if given, holds one mask of wanted lanes per block (the others are not computed).
 template <int D, class M>
 [[gnu::flatten]] void visit_block_stiffness(const ElementStream<D>& stream, const M& material, std::span<const double> u,
-                                            const ElasticBody::StiffnessVisitor& visit) {
+                                            const ElasticBody::StiffnessVisitor& visit,
+                                            const std::vector<LaneMask>* wanted = nullptr) {
   const M m = material;  // a local copy, as in accumulate_blocks
   const std::span<const ElementBlock<D>> blocks = stream.blocks();
   LaneStiffness<D> K;
   for (std::size_t b = 0; b < blocks.size(); ++b) {
+    if (wanted && !(*wanted)[b]) continue;
     prefetch_ahead<D>(blocks, b);
     const ElementBlock<D>& block = blocks[b];
     LaneMask lanes = ElementStream<D>::live_lanes(block);
+    if (wanted) lanes &= (*wanted)[b];
     Tensor<Batch, D> U;
     if constexpr (!is_linear_elastic<M>) U = gather_differences<D>(u, block);
     if constexpr (M::forbids_inversion) lanes &= ~inverted_lanes<D>(block, U);
@@ -479,6 +483,30 @@ void ElasticBody::for_each_element_stiffness(std::span<const double> u, const St
                       : smoothed_for_each_patch_stiffness<3>(stream_3d_, patches<3>(), material_, u, visit);
   with_material_and_dimension(material_, dim(), [&](const auto& m, auto dimension) {
     visit_block_stiffness<decltype(dimension)::value>(stream<decltype(dimension)::value>(), m, u, visit);
+  });
+}
+
+void ElasticBody::for_each_element_stiffness(std::span<const double> u, std::span<const ElementId> elements,
+                                             const StiffnessVisitor& visit) const {
+  check_size("displacement", u);
+  if (formulation_ != Formulation::p1)
+    throw std::invalid_argument("the stiffness of chosen elements is a P1 element's; under formulation '" +
+                                std::string(name_of(formulation_)) + "' stiffness belongs to strain patches");
+  const Connectivity& c = mesh_.connectivity();
+  for (ElementId e : elements)
+    if (!c.is_element(e)) throw std::invalid_argument("element " + std::to_string(e) + " does not exist");
+  if (is_membrane()) {
+    const std::vector<ElementId> only(elements.begin(), elements.end());
+    return membrane_for_each_element_stiffness(membranes_, material_, u, visit, &only);
+  }
+  // The blocks' kernels compute batch_width elements at once: only blocks holding a chosen one.
+  const auto capacity = static_cast<std::size_t>(c.element_capacity());
+  std::vector<LaneMask> wanted((capacity + batch_width - 1) / batch_width, 0);
+  for (ElementId e : elements) wanted[e / batch_width] |= LaneMask{1} << (e % batch_width);
+  with_material_and_dimension(material_, dim(), [&](const auto& m, auto dimension) {
+    constexpr int D = decltype(dimension)::value;
+    wanted.resize(stream<D>().blocks().size(), 0);
+    visit_block_stiffness<D>(stream<D>(), m, u, visit, &wanted);
   });
 }
 

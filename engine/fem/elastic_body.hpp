@@ -78,6 +78,16 @@ class ElasticBody : public ConnectivityWatcher {
   // patch's first element): J is their sum all the same.
   using StiffnessVisitor = std::function<void(ElementId, std::span<const VertexId>, std::span<const double>)>;
   void for_each_element_stiffness(std::span<const double> u, const StiffnessVisitor& visit) const;
+  // The same for the live P1 elements `elements` only (volume or membrane; each once): an edited
+  // mesh's few changed cells (tangent_assembly.hpp). Throws
+  // std::invalid_argument for a dead element or a smoothed formulation.
+  void for_each_element_stiffness(std::span<const double> u, std::span<const ElementId> elements,
+                                  const StiffnessVisitor& visit) const;
+  // Whether K(u) depends on u: for every material but LinearElastic, and on membranes (whose
+  // kinematics are nonlinear whatever the material).
+  bool tangent_depends_on_state() const {
+    return is_membrane() || !std::holds_alternative<LinearElastic>(material_);
+  }
   // Lumped mass per vertex: an equal share of each incident element's mass (§2.5).
   std::vector<double> lumped_mass() const;
   // Consistent gravity load for linear elements: ρ|τ|g/(corners) per vertex and element.

@@ -142,16 +142,19 @@ std::vector<double> membrane_element_stiffness(const MembraneElements& elements,
 
 void membrane_for_each_element_stiffness(
     const MembraneElements& elements, const Material& material, std::span<const double> u,
-    const std::function<void(ElementId, std::span<const VertexId>, std::span<const double>)>& visit) {
+    const std::function<void(ElementId, std::span<const VertexId>, std::span<const double>)>& visit,
+    const std::vector<ElementId>* only) {
   std::array<double, 81> K;
   std::visit(
       [&](const auto& m) {
-        elements.for_each_live([&](ElementId e, const Vertices& v, const MembraneReference& ref) {
+        auto visit_element = [&](ElementId e, const Vertices& v, const MembraneReference& ref) {
           const MembraneColumns<double> U = gather_differences<3>(u, v);
           if (m.forbids_inversion && membrane_collapsed(ref, U)) return;
           fill_stiffness(m, ref, U, K);
           visit(e, std::span<const VertexId>(v), std::span<const double>(K));
-        });
+        };
+        if (!only) return elements.for_each_live(visit_element);
+        for (ElementId e : *only) visit_element(e, elements.vertices(e), elements.reference(e));
       },
       material);
 }

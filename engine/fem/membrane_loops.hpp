@@ -32,11 +32,12 @@ std::vector<double> membrane_element_stress(const MembraneElements& elements, co
 // Element e's 9 × 9 stiffness at u (corners in oriented order, then x, y, z).
 std::vector<double> membrane_element_stiffness(const MembraneElements& elements, const Material& material,
                                                ElementId e, std::span<const double> u);
-// visit(e, vertices, K) for every live element but the collapsed ones of a material that
-// forbids inversion.
+// visit(e, vertices, K) for every live element (or, given `only`, for those live elements) but
+// the collapsed ones of a material that forbids inversion.
 void membrane_for_each_element_stiffness(
     const MembraneElements& elements, const Material& material, std::span<const double> u,
-    const std::function<void(ElementId, std::span<const VertexId>, std::span<const double>)>& visit);
+    const std::function<void(ElementId, std::span<const VertexId>, std::span<const double>)>& visit,
+    const std::vector<ElementId>* only = nullptr);
 KernelFlops membrane_kernel_flops(const Material& material);
 
 }  // namespace snede

@@ -13,8 +13,13 @@ namespace {
 
 class AssembledModelTangent final : public AssembledProblemTangent {
  public:
-  AssembledModelTangent(const Model& model, MatrixFormat format)
-      : model_(model), tangent_(model, format, MembraneTangent::positive_part) {
+  AssembledModelTangent(Model& model, MatrixFormat format)
+      : model_(model), edits_(model.body().mesh().connectivity()), tangent_(model, format, MembraneTangent::positive_part) {
+    set_rigid_body_near_null_space(model, tangent_.mat());
+  }
+  // The tangent of the edited mesh from `earlier`'s (tangent_assembly.hpp).
+  AssembledModelTangent(Model& model, const AssembledModelTangent& earlier, Vec u)
+      : model_(model), edits_(model.body().mesh().connectivity()), tangent_(model, earlier.tangent_, earlier.edits_, u) {
     set_rigid_body_near_null_space(model, tangent_.mat());
   }
   Mat mat() const override { return tangent_.mat(); }
@@ -25,9 +30,14 @@ class AssembledModelTangent final : public AssembledProblemTangent {
     set_rigid_body_near_null_space(model_, tangent_.mat());  // the rigid motions of the moved vertices
     return true;
   }
+  std::unique_ptr<AssembledProblemTangent> follow_edits(Vec u) override {
+    if (model_.body().tangent_depends_on_state() || !tangent_.can_follow_edits(model_)) return nullptr;
+    return std::make_unique<AssembledModelTangent>(model_, *this, u);
+  }
 
  private:
-  const Model& model_;
+  Model& model_;
+  EditFootprint edits_;  // since this tangent was made
   AssembledTangent tangent_;
 };
 

@@ -42,6 +42,11 @@ class AssembledProblemTangent {
   // and the next assemble() filling the values for the new shapes; false if elements or vertices
   // were added or removed (a new tangent is needed).
   virtual bool follow_moved_vertices() { return false; }
+  // The tangent of the mesh as edited since this one was made (a cut, a refinement), made from
+  // this one, filled: this one's values where no edit reached, J at u in the blocks of the
+  // vertices the edits touched (tangent_assembly.hpp). Only where that is J exactly (a tangent
+  // that does not depend on the state); null elsewhere (then a new tangent is made and assembled).
+  virtual std::unique_ptr<AssembledProblemTangent> follow_edits(Vec /*u*/) { return nullptr; }
 };
 
 // How an assembled tangent stores its entries: AIJ for PETSc's preconditioners, vertex blocks

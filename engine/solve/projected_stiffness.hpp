@@ -80,10 +80,10 @@ std::vector<double> complement_blocks(const std::vector<double>& P, int d);
 // and columns ordered by the element's oriented vertices, then by component
 // (ElasticBody::element_stiffness's order). An element whose vertices are all free (P = I)
 // passes its stiffness as it is. Inverted elements of a material that forbids inversion are left
-// out, as the shell leaves them out.
+// out, as the shell leaves them out. Given `only` (P1), for those elements alone.
 template <class Visit>
 void for_each_projected_element_matrix(const ElasticBody& body, std::span<const double> u, std::span<const double> P,
-                                       Visit&& visit) {
+                                       Visit&& visit, const std::vector<ElementId>* only = nullptr) {
   const int d = body.dim();
   std::vector<bool> free(body.mesh().n_points());
   for (std::size_t v = 0; v < free.size(); ++v) {
@@ -91,7 +91,7 @@ void for_each_projected_element_matrix(const ElasticBody& body, std::span<const 
     for (int i = 0; i < d * d; ++i) free[v] = free[v] && P[v * d * d + i] == (i % (d + 1) == 0 ? 1.0 : 0.0);
   }
   std::vector<double> left, projected;
-  body.for_each_element_stiffness(u, [&](ElementId e, std::span<const VertexId> vertices, std::span<const double> K) {
+  auto project = [&](ElementId e, std::span<const VertexId> vertices, std::span<const double> K) {
     if (std::all_of(vertices.begin(), vertices.end(), [&](VertexId v) { return free[v]; })) {
       visit(e, vertices, K);
       return;
@@ -118,7 +118,12 @@ void for_each_projected_element_matrix(const ElasticBody& body, std::span<const 
           projected[static_cast<std::size_t>(row) * n + b * d + j] = sum;
         }
     visit(e, vertices, std::span<const double>(projected));
-  });
+  };
+  if (only) {
+    body.for_each_element_stiffness(u, *only, project);
+  } else {
+    body.for_each_element_stiffness(u, project);
+  }
 }
 
 }  // namespace snede

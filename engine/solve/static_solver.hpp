@@ -81,6 +81,11 @@ class StaticSolver {
   // Times the assembled tangent's sparsity was made since the solver was made: once per change
   // of the mesh's elements, not for vertices moved alone (a cut's snap).
   std::size_t sparsity_builds() const { return sparsity_builds_; }
+  // Times every element's matrix was assembled into the tangent since the solver was made. After a
+  // cut or a refinement, Newton's kept Galerkin levels on a tangent that does not depend on the
+  // state (a linear material) take one made from the earlier one instead, with only the blocks
+  // the edit touched computed (tangent_assembly.hpp).
+  std::size_t tangent_assemblies() const { return tangent_assemblies_; }
   // The mesh's bisection hierarchy, once it has one (a mesh first refined after the solver was
   // made): the next levels, made after that refinement, coarsen along it.
   void use_hierarchy(const RefinementHierarchy* hierarchy) { hierarchy_ = hierarchy; }
@@ -183,6 +188,14 @@ class StaticSolver {
   std::size_t preconditioner_fills_ = 0;
   std::size_t multigrid_builds_ = 0;
   std::size_t sparsity_builds_ = 0;
+  std::size_t tangent_assemblies_ = 0;
+  // The assembled tangent was made from the earlier one after an edit, its values already filled:
+  // the next fill does not assemble it again.
+  bool tangent_follows_edits_ = false;
+  double tangent_edited_at_scale_ = 0;  // ... in the system scale of then
+  // After an edit of the mesh's elements: the tangent made from the earlier one, when the levels
+  // are kept across solves; false if a new one must be made.
+  bool tangent_follows_edits();
   bool keeps_levels_through_solve_ = false;  // Galerkin levels kept through a solve (solve_nonlinear)
   PreconditionerReuse reuse_;                // ... and through the next ones while they serve
   bool linear_solve_pending_ = false;        // a Newton iteration's CG with kept levels not yet recorded

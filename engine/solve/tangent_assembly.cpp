@@ -26,10 +26,22 @@ std::vector<double> projection_blocks(const Model& model) {
   return projection_blocks(model.constraints(), model.body().mesh().n_points());
 }
 
+// The live elements with a corner v for which marked[v] holds.
+std::vector<ElementId> elements_with_a_corner(const Connectivity& c, const std::vector<bool>& marked) {
+  std::vector<ElementId> found;
+  for (ElementId e = 0; e < c.element_capacity(); ++e) {
+    if (!c.is_element(e)) continue;
+    const std::span<const VertexId> corners = c.element(e).simplex.vertices();
+    if (std::any_of(corners.begin(), corners.end(), [&](VertexId v) { return marked[v]; })) found.push_back(e);
+  }
+  return found;
+}
+
 }  // namespace
 
 AssembledTangent::AssembledTangent(const Model& model, MatrixFormat format, MembraneTangent membranes)
     : membranes_(membranes),
+      format_(format),
       revision_(model.body().mesh().connectivity().revision()),
       topology_revision_(model.body().mesh().connectivity().topology_revision()) {
   const Mesh& mesh = model.body().mesh();
@@ -158,23 +170,113 @@ bool AssembledTangent::follow_moved_vertices(const Model& model) {
 void AssembledTangent::assemble(const Model& model, Vec u) {
   if (!matches(model))
     throw std::logic_error("the assembled tangent was made for another mesh: the mesh changed since");
+  std::vector<double> P = projection_blocks(model);
   {
     const CsrView A(A_);  // given back before assembling
-    add_entries(model, u, A);
+    const int d = model.dim();
+    std::fill(A.value, A.value + static_cast<std::size_t>(A.start[A.rows]) * (A.blocked ? d * d : 1), 0.0);
+    add_entries(model, u, A, P);
   }
   SNEDE_PETSC(MatAssemblyBegin(A_, MAT_FINAL_ASSEMBLY));
   SNEDE_PETSC(MatAssemblyEnd(A_, MAT_FINAL_ASSEMBLY));
+  record_fill(model, std::move(P));
 }
 
-void AssembledTangent::add_entries(const Model& model, Vec u, const CsrView& A) const {
+void AssembledTangent::record_fill(const Model& model, std::vector<double> projections) {
+  filled_ = true;
+  filled_scale_ = model.operator_scale();
+  filled_constraint_stiffness_ = model.constraint_stiffness();
+  filled_projections_ = std::move(projections);
+}
+
+AssembledTangent::AssembledTangent(const Model& model, const AssembledTangent& earlier, const EditFootprint& edits, Vec u)
+    : AssembledTangent(model, earlier.format_, earlier.membranes_) {
+  take_values(model, earlier, edits, u);
+}
+
+bool AssembledTangent::can_follow_edits(const Model& model) const {
+  return filled_ && !patches_ && filled_scale_ == model.operator_scale() &&
+         static_cast<std::size_t>(model.body().mesh().n_points()) >= self_rank_.size();
+}
+
+void AssembledTangent::take_values(const Model& model, const AssembledTangent& earlier, const EditFootprint& edits,
+                                   Vec u) {
+  if (!earlier.can_follow_edits(model)) throw std::logic_error("this assembled tangent cannot follow the edits");
+  const int d = model.dim(), dd = d * d;
+  const std::size_t n = self_rank_.size(), n_earlier = earlier.self_rank_.size();
+  std::vector<double> P = projection_blocks(model);
+  // Fresh: the vertices an edit touched, those added since, and those whose constraints changed.
+  std::vector<bool> fresh(n, false), constraint_changed(n, false);
+  for (VertexId v : edits.vertices())
+    if (static_cast<std::size_t>(v) < n) fresh[v] = true;
+  for (std::size_t v = 0; v < n; ++v) {
+    constraint_changed[v] = v < n_earlier && !std::equal(P.begin() + v * dd, P.begin() + (v + 1) * dd,
+                                                         earlier.filled_projections_.begin() + v * dd);
+    fresh[v] = fresh[v] || v >= n_earlier || constraint_changed[v];
+  }
+  const Connectivity& c = model.body().mesh().connectivity();
+  if (model.body().mesh().is_surface() && membranes_ == MembraneTangent::positive_part) {
+    // A membrane element's positive part mixes all its blocks: a corner's new projection
+    // changes the element's every block.
+    for (ElementId e : elements_with_a_corner(c, constraint_changed))
+      for (VertexId v : c.element(e).simplex.vertices()) fresh[v] = true;
+  }
+  const double s = model.operator_scale();
+  const std::vector<double> complement = complement_blocks(P, d);
+  const double stiffness_change = model.constraint_stiffness() - earlier.filled_constraint_stiffness_;
+  {
+    const CsrView from(earlier.A_);
+    const CsrView to(A_);
+    // Values per block row (BAIJ) or per scalar row (AIJ, d rows per vertex).
+    const std::size_t rows_per_vertex = to.blocked ? 1 : d, entries_per_column = to.blocked ? dd : d;
+    const std::size_t column_stride = to.blocked ? 1 : d;  // a vertex's columns in a row's column list
+    for (std::size_t v = 0; v < n; ++v)
+      for (std::size_t r = v * rows_per_vertex; r < (v + 1) * rows_per_vertex; ++r) {
+        const std::size_t length = to.start[r + 1] - to.start[r];
+        PetscScalar* row = to.value + to.start[r] * (to.blocked ? dd : 1);
+        const std::size_t entries = length * (to.blocked ? dd : 1);
+        if (fresh[v]) {
+          std::fill_n(row, entries, 0.0);
+          continue;
+        }
+        // An untouched vertex has the elements around it it had: the same neighbours.
+        if (static_cast<std::size_t>(from.start[r + 1] - from.start[r]) != length)
+          throw std::logic_error("vertex " + std::to_string(v) + " has other neighbours, but no edit touched it");
+        std::copy_n(from.value + from.start[r] * (to.blocked ? dd : 1), entries, row);
+        for (std::size_t k = 0; k < length / column_stride; ++k)
+          if (fresh[to.column[to.start[r] + k * column_stride] / column_stride])
+            std::fill_n(row + k * entries_per_column, entries_per_column, 0.0);
+      }
+    // c (I − P) of the untouched rows, for the c of now (it follows the cells' mean size).
+    for (std::size_t v = 0; v < n && stiffness_change != 0; ++v) {
+      if (fresh[v]) continue;
+      for (int i = 0; i < d; ++i)
+        for (int j = 0; j < d; ++j) {
+          const double change = s * stiffness_change * complement[v * dd + i * d + j];
+          if (change == 0) continue;
+          if (to.blocked)
+            to.value[(static_cast<std::size_t>(to.start[v]) + self_rank_[v]) * dd + j * d + i] += change;
+          else
+            to.value[to.start[v * d + i] + static_cast<std::size_t>(d) * self_rank_[v] + j] += change;
+        }
+    }
+    // Every element with a fresh corner adds its blocks that have a fresh row or column.
+    const std::vector<ElementId> reached = elements_with_a_corner(c, fresh);
+    add_entries(model, u, to, P, &fresh, &reached);
+  }
+  SNEDE_PETSC(MatAssemblyBegin(A_, MAT_FINAL_ASSEMBLY));
+  SNEDE_PETSC(MatAssemblyEnd(A_, MAT_FINAL_ASSEMBLY));
+  record_fill(model, std::move(P));
+}
+
+void AssembledTangent::add_entries(const Model& model, Vec u, const CsrView& A, const std::vector<double>& P,
+                                   const std::vector<bool>* fresh, const std::vector<ElementId>* only) const {
   const int d = model.dim();
-  const std::vector<double> P = projection_blocks(model);
   std::vector<double> complement = complement_blocks(P, d);
   for (double& x : complement) x *= model.constraint_stiffness();  // c (I − P)
   const bool membrane = model.body().mesh().is_surface() && membranes_ == MembraneTangent::positive_part;
   MembranePositivePart positive_part;
   const double s = model.operator_scale();
-  std::fill(A.value, A.value + static_cast<std::size_t>(A.start[A.rows]) * (A.blocked ? d * d : 1), 0.0);
   ReadView x(u);
   std::vector<std::int32_t> patch_ranks;
   // The dimension known at compile time, so that the block loops unroll: 7.3 → 5.9 ms per
@@ -204,11 +306,12 @@ void AssembledTangent::add_entries(const Model& model, Vec u, const CsrView& A) 
                                            : block_rank_.data() + static_cast<std::size_t>(e) * corners * corners;
       for (int a = 0; a < corners; ++a)
         for (int b = 0; b < corners; ++b)
-          add_block(vertices[a], ranks[a * corners + b], K.data() + (a * n + b) * D, n);
-    });
+          if (!fresh || (*fresh)[vertices[a]] || (*fresh)[vertices[b]])
+            add_block(vertices[a], ranks[a * corners + b], K.data() + (a * n + b) * D, n);
+    }, only);
     // + c (I − P): the constrained directions' stiffness, as in the shell.
     for (std::size_t v = 0; v < self_rank_.size(); ++v)
-      add_block(v, self_rank_[v], complement.data() + v * D * D, D);
+      if (!fresh || (*fresh)[v]) add_block(v, self_rank_[v], complement.data() + v * D * D, D);
   };
   if (d == 3) {
     add_all(std::integral_constant<int, 3>{});

@@ -13,6 +13,7 @@
 
 #include "core/csr_matrix.hpp"
 #include "core/petsc_handle.hpp"
+#include "mesh/edit_footprint.hpp"
 #include "solve/model.hpp"
 #include "solve/problem.hpp"
 
@@ -30,6 +31,17 @@ enum class MembraneTangent { exact, positive_part };
 class AssembledTangent {
  public:
   AssembledTangent(const Model& model, MatrixFormat format, MembraneTangent membranes = MembraneTangent::exact);
+  // The tangent of the mesh as it is now, made from `earlier` (filled, for the mesh before the
+  // edits `edits` recorded since it was made): its values are earlier's where no edit reached,
+  // and J's at u in every block whose row or column vertex an edit touched or whose constraints
+  // changed (the few hundred blocks around a cut, instead of every element's matrix again). Where
+  // the state moved since earlier was filled, the kept blocks are of that state: a preconditioner's
+  // matrix, lagged as kept levels are. Check can_follow_edits first.
+  AssembledTangent(const Model& model, const AssembledTangent& earlier, const EditFootprint& edits, Vec u);
+  // Whether this tangent can make the next one that way: filled, P1 (a smoothed formulation's
+  // patches reach two edges: not done), for the model's operator scale, and no vertex removed
+  // from the id range.
+  bool can_follow_edits(const Model& model) const;
   // Whether the mesh is still the one this matrix was made for (no edit since).
   bool matches(const Model& model) const;
   // Takes over the mesh as it is now if only vertices moved since (a cut's snap): true, and the
@@ -44,6 +56,7 @@ class AssembledTangent {
 
  private:
   MembraneTangent membranes_;
+  MatrixFormat format_;
   std::uint64_t revision_;
   std::uint64_t topology_revision_;
   MatHandle A_;
@@ -53,8 +66,20 @@ class AssembledTangent {
   bool patches_ = false;                  // a smoothed formulation's patches: blocks to two edges
   std::vector<std::size_t> neighbour_start_;  // patches only: each vertex's sorted neighbours (CSR)
   std::vector<VertexId> neighbours_;
-  // J's entries at u, scaled, added into A_'s arrays (zeroed first).
-  void add_entries(const Model& model, Vec u, const CsrView& A) const;
+  // What the last assemble() filled the values with: the operator scale, the constrained
+  // directions' stiffness c and every vertex's block of P (follow_edits compares them).
+  bool filled_ = false;
+  double filled_scale_ = 0;
+  double filled_constraint_stiffness_ = 0;
+  std::vector<double> filled_projections_;
+  void record_fill(const Model& model, std::vector<double> projections);
+  // J's entries at u, scaled, added into A_'s arrays (P: every vertex's block): every element's;
+  // or, given `fresh` (per vertex) and `only`, those of the elements `only` in the blocks with a
+  // fresh row or column vertex, and c (I − P) on the fresh rows.
+  void add_entries(const Model& model, Vec u, const CsrView& A, const std::vector<double>& P,
+                   const std::vector<bool>* fresh = nullptr, const std::vector<ElementId>* only = nullptr) const;
+  // The edit of the constructor above: earlier's values copied where fresh is false, J's added.
+  void take_values(const Model& model, const AssembledTangent& earlier, const EditFootprint& edits, Vec u);
   // Each block's place among its row's neighbours, for a patch's sorted vertices (count²).
   const std::int32_t* patch_block_ranks(std::span<const VertexId> vertices, std::vector<std::int32_t>& ranks) const;
 };

@@ -60,9 +60,11 @@ class StaticSolver(RunsOnRanks):
       aggregates instead. Levels are made anew at the first solve after a mesh change (after a
       change of constraints alone, Newton's grid or aggregation levels are refilled instead;
       after vertices only moved, a cut's snap, they are carried over as they are until they show
-      their age; ``-static_rebuild_after_edits`` makes everything anew after every edit);
-      ``follow_seconds`` says what that cost, ``preconditioner_fills`` how often the
-      preconditioner was filled, ``multigrid_builds`` how often levels were made. ``multigrid_source`` says which kind is in use
+      their age; after elements changed, a linear material's assembled tangent is made from the
+      earlier one, only the blocks the edit touched computed; ``-static_rebuild_after_edits``
+      makes everything anew after every edit); ``follow_seconds`` says what that cost,
+      ``preconditioner_fills`` how often the preconditioner was filled, ``multigrid_builds`` how
+      often levels were made, ``tangent_assemblies`` how often every element's matrix was assembled. ``multigrid_source`` says which kind is in use
       (``"bisection"``, ``"grid"``, ``"aggregation"``), ``multigrid_levels`` and
       ``multigrid_unknowns`` the levels' sizes; ``-static_mg_coarsening`` chooses (default
       ``auto``: bisection when it applies and its coarsest level is at most a sixteenth of
@@ -200,6 +202,15 @@ class StaticSolver(RunsOnRanks):
         the mesh's elements (a cut, a flip, a refinement), not when vertices only moved (a cut
         snapping a vertex onto the blade keeps it; its values are filled again)."""
         return self._engine.sparsity_builds
+
+    @property
+    def tangent_assemblies(self) -> int:
+        """How many times this solver assembled every element's matrix into its tangent. After a
+        cut or a refinement of a body whose tangent does not depend on the state (a linear
+        material, not a membrane), Newton with Galerkin levels kept across solves makes the new
+        tangent from the earlier one instead: only the blocks the edit touched are computed, the
+        others keep their (exact) values (``-static_rebuild_after_edits`` assembles anew)."""
+        return self._engine.tangent_assemblies
 
     @property
     def multigrid_builds(self) -> int:

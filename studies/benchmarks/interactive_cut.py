@@ -5,10 +5,10 @@ by gmsh (no bisection history).
     .venv/bin/python studies/benchmarks/interactive_cut.py [--quick] [--meshes block24k organ20k ...]
                                                    [--preconditioners none mg gamg] [--moves 24]
 
-Scene (issue 31): neo-Hookean tissue under gravity, held on one side; a vertical blade, taller
-than the body, crosses it in the middle in ``--moves`` equal moves of a snede.TetrahedralCutter,
-and after every move one Newton solve (rtol 1e-4, criterion (6.9)) relaxes the body from where
-it was. Meshes:
+Scene (issue 31): neo-Hookean tissue (``--material linear``: linear, the same moduli) under
+gravity, held on one side; a vertical blade, taller than the body, crosses it in the middle in
+``--moves`` equal moves of a snede.TetrahedralCutter, and after every move one Newton solve (rtol
+1e-4, criterion (6.9)) relaxes the body from where it was. Meshes:
 
 * block24k / block98k: the 4 × 1 × 1 Kuhn block 0.12 × 0.03 × 0.03 m bisected to 24 576 /
   98 304 tetrahedra, E = 30 kPa, ν = 0.3, clamped at x = 0; the blade at x = 0.061 m moves
@@ -46,10 +46,10 @@ from work_units import work_unit_flops, work_unit_seconds  # noqa: E402
 RTOL = 1e-4
 
 
-def block(refinements: int):
+def block(refinements: int, material=snede.NeoHookean):
     mesh = snede.meshing.box((0.12, 0.03, 0.03), (4, 1, 1))
     mesh.refine_uniform(refinements)
-    body = snede.Body(mesh, snede.NeoHookean(E=3e4, nu=0.3), density=1000.0)
+    body = snede.Body(mesh, material(E=3e4, nu=0.3), density=1000.0)
     body.fix(np.isclose(mesh.points[:, 0], 0.0))
     body.add_gravity((0.0, 0.0, -9.81))
     x = 0.061
@@ -57,11 +57,11 @@ def block(refinements: int):
     return body, lambda y: [(x, y, -0.02), (x, y, 0.05)], (-0.004, 0.034), (grasped, (0.0, 0.0, 1e-3))
 
 
-def organ(target: int):
+def organ(target: int, material=snede.NeoHookean):
     from organ_meshes import organ_mesh
 
     mesh = organ_mesh("liver", target)
-    body = snede.Body(mesh, snede.NeoHookean(E=5e3, nu=0.45), density=1000.0)
+    body = snede.Body(mesh, material(E=5e3, nu=0.45), density=1000.0)
     z = mesh.points[:, 2]
     body.fix(z >= z.max() - 0.1 * np.ptp(z))
     body.add_gravity((0.0, 0.0, -9.81))
@@ -76,15 +76,16 @@ def organ(target: int):
 
 
 MESHES = {
-    "block24k": lambda: block(10),
-    "block98k": lambda: block(12),
-    "organ20k": lambda: organ(20000),
-    "organ60k": lambda: organ(60000),
+    "block24k": lambda material: block(10, material),
+    "block98k": lambda material: block(12, material),
+    "organ20k": lambda material: organ(20000, material),
+    "organ60k": lambda material: organ(60000, material),
 }
+MATERIALS = {"neo-hookean": snede.NeoHookean, "linear": snede.LinearElastic}
 
 
-def run(make, preconditioner: str, moves: int, tool: str) -> dict:
-    body, blade, (start, stop), (grasped, drag) = make()
+def run(make, preconditioner: str, moves: int, tool: str, material=snede.NeoHookean) -> dict:
+    body, blade, (start, stop), (grasped, drag) = make(material)
     # "mg:aggregation" forces aggregation levels on a mesh that has a bisection hierarchy;
     # "mg/0" builds the levels anew for every solve (-static_mg_refresh_ratio 0); a suffix
     # "@rebuild" makes every structure anew after each mesh change (-static_rebuild_after_edits).
@@ -156,6 +157,9 @@ def main() -> None:
                         help="scalpel: the blade cuts through the body; grasper: a patch of the body (the block's "
                              "free end, the liver's lowest tenth) is dragged 1 mm per move (up, sideways)")
     parser.add_argument("--quick", action="store_true", help="block24k and organ20k, 8 moves, none and mg")
+    parser.add_argument("--material", choices=sorted(MATERIALS), default="neo-hookean",
+                        help="the tissue's material (the same moduli): a linear one's tangent does not depend on "
+                             "the state, so after a cut it is made from the earlier one (issue 49)")
     # Options starting with a single '-' are PETSc's (-static_snes_lag_preconditioner 2, -log_view).
     arguments, petsc_arguments = parser.parse_known_args()
     if any(not a.startswith("-") or a.startswith("--") for a in petsc_arguments[:1]):
@@ -165,7 +169,7 @@ def main() -> None:
     meshes, preconditioners, moves = arguments.meshes, arguments.preconditioners, arguments.moves
     if arguments.quick:
         meshes, preconditioners, moves = ["block24k", "organ20k"], ["none", "mg"], 8
-    print(f"{arguments.tool}: Newton rtol {RTOL:g} after each of {moves} moves; ms are medians per move; "
+    print(f"{arguments.tool}, {arguments.material} tissue: Newton rtol {RTOL:g} after each of {moves} moves; ms are medians per move; "
           "Hz = moves / (cut + solve); WU/move = median (cut + solve) in work units, mean = their mean, "
           "worst = the worst move, flop WU = the solve's median flops in products' flops, "
           "follow = following the mesh change (issue 49's goals: <= 40, <= 120, <= 2)")
@@ -178,7 +182,7 @@ def main() -> None:
         print(header)
         print("-" * len(header))
         for preconditioner in preconditioners:
-            row = run(MESHES[name], preconditioner, moves, arguments.tool)
+            row = run(MESHES[name], preconditioner, moves, arguments.tool, MATERIALS[arguments.material])
             source = row["source"] if row["source"] == row["source_after"] else f"{row['source']}>{row['source_after']}"
             print(f"{row['pc']:>14} {source or '-':>21} {row['cells_after']:>7} | {row['cut_ms']:>7.1f} "
                   f"{row['follow_ms']:>9.1f} {row['solve_ms']:>8.1f} {row['worst_ms']:>8.1f} | {row['newton']:>6g} "

@@ -13,11 +13,13 @@
 #include "core/error.hpp"
 #include "core/petsc_util.hpp"
 #include "fem/material_fixtures.hpp"
+#include "solve/tangent_checks.hpp"
 #include "solve/tangent_assembly.hpp"
 #include "topology/edit_checks.hpp"
 #include "topology/refinement_checks.hpp"
 
 using namespace snede;
+using snede::testing::relative_difference;
 
 namespace {
 
@@ -40,26 +42,6 @@ Mesh mesh_of(Body body) {
     case Body::membrane: return snede::testing::bumpy_surface(4, 0.1, 0.2, 7);
   }
   throw std::logic_error("unknown body");
-}
-
-// The largest difference between two matrices' entries over the largest entry of the second.
-double relative_difference(Mat X, Mat Y) {
-  MatHandle x, y;
-  SNEDE_PETSC(MatConvert(X, MATSEQDENSE, MAT_INITIAL_MATRIX, x.out()));
-  SNEDE_PETSC(MatConvert(Y, MATSEQDENSE, MAT_INITIAL_MATRIX, y.out()));
-  PetscInt rows = 0, columns = 0;
-  SNEDE_PETSC(MatGetSize(x, &rows, &columns));
-  const PetscScalar *a = nullptr, *b = nullptr;
-  SNEDE_PETSC(MatDenseGetArrayRead(x, &a));
-  SNEDE_PETSC(MatDenseGetArrayRead(y, &b));
-  double largest = 0, difference = 0;
-  for (PetscInt k = 0; k < rows * columns; ++k) {
-    largest = std::max(largest, std::abs(b[k]));
-    difference = std::max(difference, std::abs(a[k] - b[k]));
-  }
-  SNEDE_PETSC(MatDenseRestoreArrayRead(x, &a));
-  SNEDE_PETSC(MatDenseRestoreArrayRead(y, &b));
-  return difference / largest;
 }
 
 // The largest relative difference between A x and the shell's J x over a few random x.
@@ -97,15 +79,7 @@ TEST_P(AssembledTangentFormats, BlockAndScalarMatricesEqualTheShell) {
     const int d = mesh.dim();
     ElasticBody body(mesh, material, 1000.0, mesh.is_surface() || d == 2 ? 0.01 : 0.0, c.formulation);
     Model model(body);
-    // Fixed on x = 0, sliding along y on x = 1.
-    std::vector<VertexId> fixed, sliding;
-    for (VertexId v = 0; v < mesh.n_points(); ++v) {
-      if (mesh.point(v)[0] == 0) fixed.push_back(v);
-      if (mesh.point(v)[0] == 1) sliding.push_back(v);
-    }
-    model.fix(fixed, {});
-    const std::vector<double> along_y{0.0, 1.0, 0.0};
-    model.slide(sliding, std::span<const double>(along_y.data(), d));
+    snede::testing::fix_left_slide_right(model);
     model.set_operator_scale(0.37);
     std::mt19937 random(11);
     std::uniform_real_distribution<double> offset(-0.02, 0.02);
