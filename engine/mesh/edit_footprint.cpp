@@ -20,7 +20,6 @@ void EditFootprint::touch_all(const Simplex& cell) {
 }
 
 void EditFootprint::on_change(const Connectivity& connectivity, const ConnectivityChange& change) {
-  ++edits_;
   for (const auto& [e, simplex] : change.removed_elements) touch_all(simplex);
   for (ElementId e : change.added_elements) touch_all(connectivity.element(e).simplex);
   for (const auto& [e, before] : change.changed_elements) {

@@ -5,7 +5,6 @@
 // it, with the same shapes, as then.
 #pragma once
 
-#include <cstdint>
 #include <span>
 #include <vector>
 
@@ -23,9 +22,6 @@ class EditFootprint final : public ConnectivityWatcher {
 
   // The vertices edits touched since construction, each once, in the order first touched.
   std::span<const VertexId> vertices() const { return vertices_; }
-  bool touched(VertexId v) const { return static_cast<std::size_t>(v) < marked_.size() && marked_[v]; }
-  // The number of edits (merged batches) recorded.
-  std::uint64_t edits() const { return edits_; }
 
   void init(const Connectivity&) override {}
   void on_change(const Connectivity& connectivity, const ConnectivityChange& change) override;
@@ -36,8 +32,7 @@ class EditFootprint final : public ConnectivityWatcher {
 
   Connectivity& connectivity_;
   std::vector<VertexId> vertices_;
-  std::vector<bool> marked_;  // by vertex id
-  std::uint64_t edits_ = 0;
+  std::vector<bool> marked_;  // by vertex id: in vertices_
 };
 
 }  // namespace snede

@@ -828,7 +828,7 @@ SolveResult StaticSolver::solve_nonlinear() {
     SNEDE_PETSC(SNESGetLinearSolveIterations(snes_, &lits));
     iterations += its;
     linear += lits;
-    if (keeps_levels_through_solve_) record_last_linear_solve();
+    record_last_linear_solve();  // pending only with levels kept through the solve
   };
   run();
   // Near the solution the energy decrease of a Newton step falls below the round-off of Π
