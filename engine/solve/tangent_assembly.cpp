@@ -44,14 +44,17 @@ AssembledTangent::AssembledTangent(const Model& model, MatrixFormat format, Memb
       format_(format),
       revision_(model.body().mesh().connectivity().revision()),
       topology_revision_(model.body().mesh().connectivity().topology_revision()) {
+  find_neighbours(model);
+  make_matrix(model.dim());
+}
+
+void AssembledTangent::find_neighbours(const Model& model) {
   const Mesh& mesh = model.body().mesh();
   const Connectivity& c = mesh.connectivity();
-  const int d = model.dim();
   const VertexId n = mesh.n_points();
   // Each vertex's neighbours (itself included), sorted, in one flat array (CSR), and every
-  // element block's place among them: a cut or a refinement rebuilds this for every solve that
-  // follows, so it is made vertex by vertex from the elements around each (one small sort per
-  // vertex, a scratch array for the places) rather than by searching sorted lists.
+  // element block's place among them, made vertex by vertex from the elements around each (one
+  // small sort per vertex, a scratch array for the places) rather than by searching sorted lists.
   const VertexStars stars = all_vertex_stars(c, n);
   const int corners = corners_per_cell(model);
   // A smoothed formulation's vertex patch joins every pair of its vertex's neighbours: blocks
@@ -61,27 +64,27 @@ AssembledTangent::AssembledTangent(const Model& model, MatrixFormat format, Memb
     for (std::size_t s = stars.start[v]; s < stars.start[v + 1]; ++s)
       for (VertexId w : std::span(stars.vertices[stars.element_of(stars.entries[s])]).first(corners)) add(w);
   };
-  std::vector<std::size_t> row(static_cast<std::size_t>(n) + 1, 0);
-  std::vector<VertexId> neighbour_list;
-  neighbour_list.reserve(stars.entries.size() * 2 + n);
+  neighbour_start_.assign(static_cast<std::size_t>(n) + 1, 0);
+  neighbours_.clear();
+  neighbours_.reserve(stars.entries.size() * 2 + n);
   std::vector<std::int32_t> place(n, -1);
   if (!patches_) block_rank_.assign(static_cast<std::size_t>(c.element_capacity()) * corners * corners, 0);
   self_rank_.resize(n);
   for (VertexId v = 0; v < n; ++v) {
-    const std::size_t first = neighbour_list.size();
-    neighbour_list.push_back(v);
+    const std::size_t first = neighbours_.size();
+    neighbours_.push_back(v);
     place[v] = 0;
     auto add = [&](VertexId w) {
       if (place[w] < 0) {
         place[w] = 0;
-        neighbour_list.push_back(w);
+        neighbours_.push_back(w);
       }
     };
     add_star(v, add);
     if (patches_)
-      for (std::size_t k = first + 1, end = neighbour_list.size(); k < end; ++k) add_star(neighbour_list[k], add);
-    std::sort(neighbour_list.begin() + static_cast<std::ptrdiff_t>(first), neighbour_list.end());
-    for (std::size_t k = first; k < neighbour_list.size(); ++k) place[neighbour_list[k]] = static_cast<std::int32_t>(k - first);
+      for (std::size_t k = first + 1, end = neighbours_.size(); k < end; ++k) add_star(neighbours_[k], add);
+    std::sort(neighbours_.begin() + static_cast<std::ptrdiff_t>(first), neighbours_.end());
+    for (std::size_t k = first; k < neighbours_.size(); ++k) place[neighbours_[k]] = static_cast<std::int32_t>(k - first);
     self_rank_[v] = place[v];
     for (std::size_t s = stars.start[v]; s < stars.start[v + 1] && !patches_; ++s) {
       const std::size_t k = stars.element_of(stars.entries[s]);
@@ -89,27 +92,83 @@ AssembledTangent::AssembledTangent(const Model& model, MatrixFormat format, Memb
       std::int32_t* ranks = block_rank_.data() + (static_cast<std::size_t>(stars.elements[k]) * corners + a) * corners;
       for (int b = 0; b < corners; ++b) ranks[b] = place[stars.vertices[k][b]];
     }
-    for (std::size_t k = first; k < neighbour_list.size(); ++k) place[neighbour_list[k]] = -1;
-    row[v + 1] = neighbour_list.size();
+    for (std::size_t k = first; k < neighbours_.size(); ++k) place[neighbours_[k]] = -1;
+    neighbour_start_[v + 1] = neighbours_.size();
   }
-  if (patches_) {
-    neighbour_start_ = row;
-    neighbours_ = neighbour_list;
-  }
-  auto neighbours = [&](VertexId v) {
-    return std::span<const VertexId>(neighbour_list.data() + row[v], row[v + 1] - row[v]);
-  };
+}
 
+void AssembledTangent::follow_neighbours(const Model& model, const AssembledTangent& earlier,
+                                         const std::vector<bool>& touched) {
+  const Connectivity& c = model.body().mesh().connectivity();
+  const int corners = corners_per_cell(model);
+  const std::size_t n = touched.size();
+  // The touched vertices' neighbours come from the elements around them, all of which have a
+  // touched corner; every other vertex has the elements, and so the neighbours, it had.
+  const std::vector<ElementId> reached = elements_with_a_corner(c, touched);
+  std::vector<std::size_t> star_start(n + 1, 0);
+  for (ElementId e : reached)
+    for (VertexId v : c.element(e).simplex.vertices())
+      if (touched[v]) ++star_start[v + 1];
+  std::partial_sum(star_start.begin(), star_start.end(), star_start.begin());
+  std::vector<ElementId> star(star_start.back());
+  std::vector<std::size_t> next(star_start.begin(), star_start.end() - 1);
+  for (ElementId e : reached)
+    for (VertexId v : c.element(e).simplex.vertices())
+      if (touched[v]) star[next[v]++] = e;
+
+  neighbour_start_.assign(n + 1, 0);
+  neighbours_.clear();
+  neighbours_.reserve(earlier.neighbours_.size() + (star.size() + n - earlier.self_rank_.size()) * corners);
+  self_rank_.resize(n);
+  for (std::size_t v = 0; v < n; ++v) {
+    const std::size_t first = neighbours_.size();
+    if (touched[v]) {
+      neighbours_.push_back(static_cast<VertexId>(v));
+      for (std::size_t s = star_start[v]; s < star_start[v + 1]; ++s)
+        for (VertexId w : c.element(star[s]).simplex.vertices()) neighbours_.push_back(w);
+      const auto row = neighbours_.begin() + static_cast<std::ptrdiff_t>(first);
+      std::sort(row, neighbours_.end());
+      neighbours_.erase(std::unique(row, neighbours_.end()), neighbours_.end());
+      self_rank_[v] = static_cast<std::int32_t>(std::lower_bound(row, neighbours_.end(), static_cast<VertexId>(v)) - row);
+    } else {
+      neighbours_.insert(neighbours_.end(), earlier.neighbours_.begin() + static_cast<std::ptrdiff_t>(earlier.neighbour_start_[v]),
+                         earlier.neighbours_.begin() + static_cast<std::ptrdiff_t>(earlier.neighbour_start_[v + 1]));
+      self_rank_[v] = earlier.self_rank_[v];
+    }
+    neighbour_start_[v + 1] = neighbours_.size();
+  }
+  // An element without a touched corner is one the earlier mesh had, under the same id, with the
+  // same ranks; the reached ones are looked up in their corners' rows.
+  block_rank_.assign(static_cast<std::size_t>(c.element_capacity()) * corners * corners, 0);
+  std::copy_n(earlier.block_rank_.begin(), std::min(earlier.block_rank_.size(), block_rank_.size()), block_rank_.begin());
+  for (ElementId e : reached) {
+    // In the corner order of the element matrices (all_vertex_stars, add_entries).
+    const auto vertices = c.element(e).simplex.oriented_vertices();
+    std::int32_t* ranks = block_rank_.data() + static_cast<std::size_t>(e) * corners * corners;
+    for (int a = 0; a < corners; ++a) {
+      const auto row = neighbours_.begin() + static_cast<std::ptrdiff_t>(neighbour_start_[vertices[a]]);
+      const auto row_end = neighbours_.begin() + static_cast<std::ptrdiff_t>(neighbour_start_[vertices[a] + 1]);
+      for (int b = 0; b < corners; ++b)
+        ranks[a * corners + b] = static_cast<std::int32_t>(std::lower_bound(row, row_end, vertices[b]) - row);
+    }
+  }
+}
+
+void AssembledTangent::make_matrix(int d) {
+  const std::size_t n = self_rank_.size();
+  auto neighbours = [&](std::size_t v) {
+    return std::span<const VertexId>(neighbours_.data() + neighbour_start_[v], neighbour_start_[v + 1] - neighbour_start_[v]);
+  };
   // Each row's columns are sorted, so that an element block (a, b) lies at a's row start plus
   // b's rank among a's neighbours (assemble()). Neither format inserts the structure row by row:
   // that (MatSeqAIJSetPreallocationCSR) took two thirds of this constructor's time (8.5 → 2.7 ms
   // at 24k tetrahedra, event SnedeTangentSparsity).
   const PetscInt rows = static_cast<PetscInt>(n) * d;
-  if (format == MatrixFormat::baij) {
+  if (format_ == MatrixFormat::baij) {
     // A d × d block per pair of neighbours: the vertex CSR as it is, its columns copied in
     // (PETSc 3.18 takes no block CSR arrays of its own, MatCreateSeqBAIJWithArrays: block size 1).
-    std::vector<PetscInt> blocks_per_row(n), block_columns(neighbour_list.begin(), neighbour_list.end());
-    for (VertexId v = 0; v < n; ++v) blocks_per_row[v] = static_cast<PetscInt>(row[v + 1] - row[v]);
+    std::vector<PetscInt> blocks_per_row(n), block_columns(neighbours_.begin(), neighbours_.end());
+    for (std::size_t v = 0; v < n; ++v) blocks_per_row[v] = static_cast<PetscInt>(neighbour_start_[v + 1] - neighbour_start_[v]);
     SNEDE_PETSC(MatCreate(PETSC_COMM_SELF, A_.out()));
     SNEDE_PETSC(MatSetSizes(A_, rows, rows, rows, rows));
     SNEDE_PETSC(MatSetType(A_, MATSEQBAIJ));
@@ -121,11 +180,11 @@ AssembledTangent::AssembledTangent(const Model& model, MatrixFormat format, Memb
     // Scalar rows: (row 3a + i, column 3b + j) lies at row_start[3a + i] + 3·rank(a, b) + j.
     auto csr = std::make_unique<CsrArrays>();
     csr->row_start.resize(static_cast<std::size_t>(rows) + 1);
-    csr->columns.resize(neighbour_list.size() * d * d);
+    csr->columns.resize(neighbours_.size() * d * d);
     std::size_t at = 0;
-    for (VertexId v = 0; v < n; ++v)
+    for (std::size_t v = 0; v < n; ++v)
       for (int i = 0; i < d; ++i) {
-        csr->row_start[static_cast<std::size_t>(v) * d + i] = static_cast<PetscInt>(at);
+        csr->row_start[v * d + i] = static_cast<PetscInt>(at);
         for (VertexId w : neighbours(v))
           for (int j = 0; j < d; ++j) csr->columns[at++] = static_cast<PetscInt>(w) * d + j;
       }
@@ -190,8 +249,19 @@ void AssembledTangent::record_fill(const Model& model, std::vector<double> proje
 }
 
 AssembledTangent::AssembledTangent(const Model& model, const AssembledTangent& earlier, const EditFootprint& edits, Vec u)
-    : AssembledTangent(model, earlier.format_, earlier.membranes_) {
-  take_values(model, earlier, edits, u);
+    : membranes_(earlier.membranes_),
+      format_(earlier.format_),
+      revision_(model.body().mesh().connectivity().revision()),
+      topology_revision_(model.body().mesh().connectivity().topology_revision()) {
+  if (!earlier.can_follow_edits(model)) throw std::logic_error("this assembled tangent cannot follow the edits");
+  const std::size_t n = static_cast<std::size_t>(model.body().mesh().n_points());
+  std::vector<bool> touched(n, false);
+  for (VertexId v : edits.vertices())
+    if (static_cast<std::size_t>(v) < n) touched[v] = true;
+  for (std::size_t v = earlier.self_rank_.size(); v < n; ++v) touched[v] = true;  // added since
+  follow_neighbours(model, earlier, touched);
+  make_matrix(model.dim());
+  take_values(model, earlier, std::move(touched), u);
 }
 
 bool AssembledTangent::can_follow_edits(const Model& model) const {
@@ -199,20 +269,16 @@ bool AssembledTangent::can_follow_edits(const Model& model) const {
          static_cast<std::size_t>(model.body().mesh().n_points()) >= self_rank_.size();
 }
 
-void AssembledTangent::take_values(const Model& model, const AssembledTangent& earlier, const EditFootprint& edits,
-                                   Vec u) {
-  if (!earlier.can_follow_edits(model)) throw std::logic_error("this assembled tangent cannot follow the edits");
+void AssembledTangent::take_values(const Model& model, const AssembledTangent& earlier, std::vector<bool> fresh, Vec u) {
   const int d = model.dim(), dd = d * d;
   const std::size_t n = self_rank_.size(), n_earlier = earlier.self_rank_.size();
   std::vector<double> P = projection_blocks(model);
-  // Fresh: the vertices an edit touched, those added since, and those whose constraints changed.
-  std::vector<bool> fresh(n, false), constraint_changed(n, false);
-  for (VertexId v : edits.vertices())
-    if (static_cast<std::size_t>(v) < n) fresh[v] = true;
-  for (std::size_t v = 0; v < n; ++v) {
-    constraint_changed[v] = v < n_earlier && !std::equal(P.begin() + v * dd, P.begin() + (v + 1) * dd,
-                                                         earlier.filled_projections_.begin() + v * dd);
-    fresh[v] = fresh[v] || v >= n_earlier || constraint_changed[v];
+  // Fresh: the vertices the edits touched or added (given), and those whose constraints changed.
+  std::vector<bool> constraint_changed(n, false);
+  for (std::size_t v = 0; v < n_earlier; ++v) {
+    constraint_changed[v] = !std::equal(P.begin() + v * dd, P.begin() + (v + 1) * dd,
+                                        earlier.filled_projections_.begin() + v * dd);
+    fresh[v] = fresh[v] || constraint_changed[v];
   }
   const Connectivity& c = model.body().mesh().connectivity();
   if (model.body().mesh().is_surface() && membranes_ == MembraneTangent::positive_part) {
@@ -239,9 +305,7 @@ void AssembledTangent::take_values(const Model& model, const AssembledTangent& e
           std::fill_n(row, entries, 0.0);
           continue;
         }
-        // An untouched vertex has the elements around it it had: the same neighbours.
-        if (static_cast<std::size_t>(from.start[r + 1] - from.start[r]) != length)
-          throw std::logic_error("vertex " + std::to_string(v) + " has other neighbours, but no edit touched it");
+        // An untouched vertex's row has the columns it had (follow_neighbours).
         std::copy_n(from.value + from.start[r] * (to.blocked ? dd : 1), entries, row);
         for (std::size_t k = 0; k < length / column_stride; ++k)
           if (fresh[to.column[to.start[r] + k * column_stride] / column_stride])

@@ -32,9 +32,11 @@ class AssembledTangent {
  public:
   AssembledTangent(const Model& model, MatrixFormat format, MembraneTangent membranes = MembraneTangent::exact);
   // The tangent of the mesh as it is now, made from `earlier` (filled, for the mesh before the
-  // edits `edits` recorded since it was made): its values are earlier's where no edit reached,
-  // and J's at u in every block whose row or column vertex an edit touched or whose constraints
-  // changed (the few hundred blocks around a cut, instead of every element's matrix again). Where
+  // edits `edits` recorded since it was made): the rows of vertices no edit touched keep their
+  // columns, the others' come from the elements around them; its values are earlier's where no
+  // edit reached, and J's at u in every block whose row or column vertex an edit touched or whose
+  // constraints changed (the few hundred blocks around a cut, instead of every element's matrix
+  // and the whole mesh's vertex stars again). Where
   // the state moved since earlier was filled, the kept blocks are of that state: a preconditioner's
   // matrix, lagged as kept levels are. Check can_follow_edits first.
   AssembledTangent(const Model& model, const AssembledTangent& earlier, const EditFootprint& edits, Vec u);
@@ -64,8 +66,16 @@ class AssembledTangent {
                                           // a's sorted neighbours
   std::vector<std::int32_t> self_rank_;   // per vertex: its own place among its neighbours
   bool patches_ = false;                  // a smoothed formulation's patches: blocks to two edges
-  std::vector<std::size_t> neighbour_start_;  // patches only: each vertex's sorted neighbours (CSR)
+  std::vector<std::size_t> neighbour_start_;  // each vertex's sorted neighbours, itself included (CSR)
   std::vector<VertexId> neighbours_;
+  // The sparsity from the whole mesh's vertex stars: neighbours, block and self ranks.
+  void find_neighbours(const Model& model);
+  // The same after edits, from `earlier`'s: the rows of the vertices `touched` (by the edits, or
+  // added since) from the elements around them, the others' copied, and the ranks of the
+  // elements with a touched corner found anew (the rest copied: the same elements, the same ids).
+  void follow_neighbours(const Model& model, const AssembledTangent& earlier, const std::vector<bool>& touched);
+  // A_ with the sparsity of the neighbours, zero values.
+  void make_matrix(int d);
   // What the last assemble() filled the values with: the operator scale, the constrained
   // directions' stiffness c and every vertex's block of P (follow_edits compares them).
   bool filled_ = false;
@@ -78,8 +88,9 @@ class AssembledTangent {
   // fresh row or column vertex, and c (I − P) on the fresh rows.
   void add_entries(const Model& model, Vec u, const CsrView& A, const std::vector<double>& P,
                    const std::vector<bool>* fresh = nullptr, const std::vector<ElementId>* only = nullptr) const;
-  // The edit of the constructor above: earlier's values copied where fresh is false, J's added.
-  void take_values(const Model& model, const AssembledTangent& earlier, const EditFootprint& edits, Vec u);
+  // The edit of the constructor above: earlier's values copied for the vertices neither `fresh`
+  // (touched by the edits or added) nor with changed constraints, J's added on the others.
+  void take_values(const Model& model, const AssembledTangent& earlier, std::vector<bool> fresh, Vec u);
   // Each block's place among its row's neighbours, for a patch's sorted vertices (count²).
   const std::int32_t* patch_block_ranks(std::span<const VertexId> vertices, std::vector<std::int32_t>& ranks) const;
 };
