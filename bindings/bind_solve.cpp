@@ -135,6 +135,7 @@ void bind_solve(py::module_& m) {
       .def_property_readonly("follow_seconds", &StaticSolver::follow_seconds)
       .def_property_readonly("preconditioner_fills", &StaticSolver::preconditioner_fills)
       .def_property_readonly("multigrid_builds", &StaticSolver::multigrid_builds)
+      .def_property_readonly("multigrid_edits", &StaticSolver::multigrid_edits)
       .def_property_readonly("sparsity_builds", &StaticSolver::sparsity_builds)
       .def_property_readonly("tangent_assemblies", &StaticSolver::tangent_assemblies)
       // Without the GIL (other Python threads run); the interrupt check and petsc4py's callbacks take it.

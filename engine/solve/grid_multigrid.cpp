@@ -9,6 +9,7 @@
 #include <span>
 #include <stdexcept>
 #include <string>
+#include <unordered_set>
 
 #include "core/csr_matrix.hpp"
 #include "core/error.hpp"
@@ -34,8 +35,8 @@ struct GridWeights {
 // interpolation is continuous.
 class KuhnGrid {
  public:
-  KuhnGrid(int dim, std::array<double, 3> low, std::array<double, 3> high, double width) : dim_(dim), low_(low), width_(width) {
-    for (int k = 0; k < dim; ++k) nodes_[k] = static_cast<std::int64_t>(std::floor((high[k] - low[k]) / width)) + 2;
+  explicit KuhnGrid(const GridGeometry& g) : dim_(g.dim), low_(g.low), width_(g.width) {
+    for (int k = 0; k < dim_; ++k) nodes_[k] = static_cast<std::int64_t>(std::floor((g.high[k] - g.low[k]) / width_)) + 2;
   }
   GridWeights locate(std::span<const double> x) const {
     std::array<std::int64_t, 3> cell{};
@@ -79,73 +80,159 @@ void GridMultigrid::require_valid_width(double grid_width) {
                                 "than the mesh), got " + std::to_string(grid_width));
 }
 
-GridMultigrid::GridMultigrid(Model& fine, double grid_width)
-    : GalerkinMultigrid(fine) {
-  const Mesh& mesh = fine.body().mesh();
+GridGeometry GridMultigrid::geometry_for(const Mesh& mesh, double grid_width) {
   require_valid_width(grid_width);
-  // A fine vertex uses the d + 1 nodes of its grid simplex (its slots); a cell has cell_dim + 1
-  // corners (3 on a membrane in 3D).
-  const int d = mesh.dim(), slots = d + 1, corners = mesh.cell_dim() + 1;
-  const auto n = static_cast<std::size_t>(mesh.n_points());
-  std::array<double, 3> low{}, high{};
-  low.fill(std::numeric_limits<double>::infinity());
-  high.fill(-std::numeric_limits<double>::infinity());
+  GridGeometry g;
+  g.dim = mesh.dim();
+  g.low.fill(std::numeric_limits<double>::infinity());
+  g.high.fill(-std::numeric_limits<double>::infinity());
   for (VertexId v = 0; v < mesh.n_points(); ++v)
     if (mesh.is_vertex(v))
-      for (int k = 0; k < d; ++k) {
-        low[k] = std::min(low[k], mesh.point(v)[k]);
-        high[k] = std::max(high[k], mesh.point(v)[k]);
+      for (int k = 0; k < g.dim; ++k) {
+        g.low[k] = std::min(g.low[k], mesh.point(v)[k]);
+        g.high[k] = std::max(g.high[k], mesh.point(v)[k]);
       }
-  // The stars list every cell once: the spacing reads them rather than the mesh again.
   const VertexStars stars = all_vertex_stars(mesh.connectivity(), mesh.n_points());
-  double width = grid_width * vertex_spacing(mesh, stars);
-  for (int k = 0; k < d; ++k) width = std::max(width, (high[k] - low[k]) / 1e6);  // at most 10⁶ nodes a side
-  const KuhnGrid grid(d, low, high, width);
-  std::vector<GridWeights> weights(n);
-  // The node of each (vertex, slot) pair the vertex uses, -1 for the others.
-  std::vector<std::int64_t> used_node(n * slots, -1);
-  for (VertexId v = 0; v < mesh.n_points(); ++v)
-    if (mesh.is_vertex(v)) {
-      weights[v] = grid.locate(mesh.point(v));
-      for (int s = 0; s < slots; ++s)
-        if (weights[v].node[s] >= 0 && weights[v].weight[s] > negligible_weight) used_node[v * slots + s] = weights[v].node[s];
-    }
+  g.width = grid_width * vertex_spacing(mesh, stars);
+  for (int k = 0; k < g.dim; ++k) g.width = std::max(g.width, (g.high[k] - g.low[k]) / 1e6);  // at most 10⁶ nodes a side
+  return g;
+}
 
+GridMultigrid::GridMultigrid(Model& fine, double grid_width)
+    : GridMultigrid(fine, geometry_for(fine.body().mesh(), grid_width)) {}
+
+GridMultigrid::GridMultigrid(Model& fine, const GridGeometry& geometry)
+    : GalerkinMultigrid(fine),
+      geometry_(geometry),
+      edits_(std::make_unique<EditFootprint>(fine.body().mesh().connectivity())) {
+  const Mesh& mesh = fine.body().mesh();
+  const std::size_t slots = static_cast<std::size_t>(geometry_.dim) + 1;
+  const auto n = static_cast<std::size_t>(mesh.n_points());
+  pair_node_.assign(n * slots, -1);
+  pair_weight_.assign(n * slots, 0.0);
+  for (VertexId v = 0; v < mesh.n_points(); ++v) locate(v);
+  DisjointSets copies(n * slots);
+  join_linked_pairs(copies, nullptr);
+  std::vector<std::int32_t> label(n * slots, -1);
+  for (std::size_t i = 0; i < n * slots; ++i)
+    if (pair_node_[i] >= 0) label[i] = copies.find(static_cast<std::int32_t>(i));
+  make_levels(label);
+}
+
+std::unique_ptr<Multigrid> GridMultigrid::follow_edits() {
+  const std::size_t slots = static_cast<std::size_t>(geometry_.dim) + 1;
+  if (static_cast<std::size_t>(fine_.body().mesh().n_points()) * slots < pair_node_.size()) return nullptr;
+  return std::unique_ptr<Multigrid>(new GridMultigrid(fine_, *this));
+}
+
+GridMultigrid::GridMultigrid(Model& fine, const GridMultigrid& earlier)
+    : GalerkinMultigrid(fine),
+      geometry_(earlier.geometry_),
+      edits_(std::make_unique<EditFootprint>(fine.body().mesh().connectivity())) {
+  const std::size_t slots = static_cast<std::size_t>(geometry_.dim) + 1;
+  const auto n = static_cast<std::size_t>(fine.body().mesh().n_points());
+  const std::size_t n_earlier = earlier.pair_node_.size() / slots;
+  // The vertices the edits touched or added are located again; a grid node one of them uses or
+  // used is dirty: its copies are found again. Every other node's users and their edges are
+  // those of the earlier mesh, and so are its copies.
+  std::vector<bool> touched(n, false);
+  for (VertexId v : earlier.edits_->vertices())
+    if (static_cast<std::size_t>(v) < n) touched[v] = true;
+  for (std::size_t v = n_earlier; v < n; ++v) touched[v] = true;
+  pair_node_ = earlier.pair_node_;
+  pair_weight_ = earlier.pair_weight_;
+  pair_node_.resize(n * slots, -1);
+  pair_weight_.resize(n * slots, 0.0);
+  std::unordered_set<std::int64_t> dirty_nodes;
+  for (std::size_t v = 0; v < n; ++v) {
+    if (!touched[v]) continue;
+    for (std::size_t s = 0; s < slots && v < n_earlier; ++s)
+      if (earlier.pair_node_[v * slots + s] >= 0) dirty_nodes.insert(earlier.pair_node_[v * slots + s]);
+    locate(static_cast<VertexId>(v));
+    for (std::size_t s = 0; s < slots; ++s)
+      if (pair_node_[v * slots + s] >= 0) dirty_nodes.insert(pair_node_[v * slots + s]);
+  }
+  std::vector<bool> dirty_copy(earlier.copy_node_.size());
+  for (std::size_t k = 0; k < dirty_copy.size(); ++k) dirty_copy[k] = dirty_nodes.count(earlier.copy_node_[k]) > 0;
+  // A pair on a dirty node: a touched vertex's, or an untouched one's whose copy was dirty.
+  std::vector<bool> on_dirty_node(n, false);
+  std::vector<std::int32_t> label(n * slots, -1);
+  const auto kept_labels = static_cast<std::int32_t>(earlier.copy_node_.size());
+  for (std::size_t i = 0; i < n * slots; ++i) {
+    if (pair_node_[i] < 0) continue;
+    const std::size_t v = i / slots;
+    if (touched[v] || dirty_copy[earlier.pair_copy_[i]]) {
+      on_dirty_node[v] = true;
+    } else {
+      label[i] = earlier.pair_copy_[i];
+    }
+  }
+  DisjointSets copies(n * slots);
+  join_linked_pairs(copies, &on_dirty_node);
+  for (std::size_t i = 0; i < n * slots; ++i)
+    if (pair_node_[i] >= 0 && label[i] < 0) label[i] = kept_labels + copies.find(static_cast<std::int32_t>(i));
+  make_levels(label);
+}
+
+void GridMultigrid::locate(VertexId v) {
+  const Mesh& mesh = fine_.body().mesh();
+  const std::size_t slots = static_cast<std::size_t>(geometry_.dim) + 1;
+  std::fill_n(pair_node_.begin() + static_cast<std::ptrdiff_t>(v * slots), slots, -1);
+  std::fill_n(pair_weight_.begin() + static_cast<std::ptrdiff_t>(v * slots), slots, 0.0);
+  if (!mesh.is_vertex(v)) return;
+  const GridWeights weights = KuhnGrid(geometry_).locate(mesh.point(v));
+  for (std::size_t s = 0; s < slots; ++s)
+    if (weights.node[s] >= 0 && weights.weight[s] > negligible_weight) {
+      pair_node_[v * slots + s] = weights.node[s];
+      pair_weight_[v * slots + s] = weights.weight[s];
+    }
+}
+
+void GridMultigrid::join_linked_pairs(DisjointSets& copies, const std::vector<bool>* marked) const {
   // Virtual nodes: (vertex, slot) pairs on the same grid node are one copy of it when a fine
   // edge joins them, so that each copy spans one connected piece of the node's fine vertices.
-  DisjointSets copies(n * slots);
+  // Every edge lies in an element; an edge shared by several is joined once per element.
+  const Connectivity& c = fine_.body().mesh().connectivity();
+  const std::size_t slots = static_cast<std::size_t>(geometry_.dim) + 1;
   auto join = [&](VertexId i, VertexId j) {
-    for (int s = 0; s < slots; ++s) {
-      const std::int64_t node = used_node[i * slots + s];
+    for (std::size_t s = 0; s < slots; ++s) {
+      const std::int64_t node = pair_node_[i * slots + s];
       if (node < 0) continue;
-      for (int t = 0; t < slots; ++t)
-        if (used_node[j * slots + t] == node)
+      for (std::size_t t = 0; t < slots; ++t)
+        if (pair_node_[j * slots + t] == node)
           copies.unite(static_cast<std::int32_t>(i * slots + s), static_cast<std::int32_t>(j * slots + t));
     }
   };
-  // Each edge once (from its lower end), found in the vertex stars: an edge lies in about five
-  // tetrahedra, and this runs after every edit.
-  std::vector<VertexId> last_seen_from(n, no_id);
-  for (VertexId i = 0; i < mesh.n_points(); ++i)
-    for (std::size_t e = stars.start[i]; e < stars.start[i + 1]; ++e)
-      for (VertexId j : std::span(stars.vertices[stars.element_of(stars.entries[e])]).first(corners))
-        if (j > i && last_seen_from[j] != i) {
-          last_seen_from[j] = i;
-          join(i, j);
-        }
-  // Members of each copy, in vertex order.
-  std::vector<std::int32_t> copy_of(n * slots, -1);
+  for (ElementId e = 0; e < c.element_capacity(); ++e) {
+    if (!c.is_element(e)) continue;
+    const std::span<const VertexId> corners = c.element(e).simplex.vertices();
+    if (marked && std::none_of(corners.begin(), corners.end(), [&](VertexId v) { return (*marked)[v]; })) continue;
+    for (std::size_t a = 0; a < corners.size(); ++a)
+      for (std::size_t b = a + 1; b < corners.size(); ++b) join(corners[a], corners[b]);
+  }
+}
+
+void GridMultigrid::make_levels(const std::vector<std::int32_t>& label) {
+  const int d = geometry_.dim;
+  const std::size_t slots = static_cast<std::size_t>(d) + 1;
+  const std::size_t n = pair_node_.size() / slots;
+  // Each label's copy number, in the order of the copies' first pairs, and their members.
+  std::vector<std::int32_t> copy_of_label(*std::max_element(label.begin(), label.end()) + 1, -1);
+  pair_copy_.assign(n * slots, -1);
+  copy_node_.clear();
   std::vector<std::size_t> count;
   for (std::size_t i = 0; i < n * slots; ++i) {
-    if (used_node[i] < 0) continue;
-    const std::int32_t root = copies.find(static_cast<std::int32_t>(i));
-    if (copy_of[root] < 0) {
-      copy_of[root] = static_cast<std::int32_t>(count.size());
+    if (label[i] < 0) continue;
+    std::int32_t& copy = copy_of_label[label[i]];
+    if (copy < 0) {
+      copy = static_cast<std::int32_t>(count.size());
       count.push_back(0);
+      copy_node_.push_back(pair_node_[i]);
     }
-    copy_of[i] = copy_of[root];
-    ++count[copy_of[root]];
+    pair_copy_[i] = copy;
+    ++count[copy];
   }
+  const std::vector<std::int32_t>& copy_of = pair_copy_;
   const std::size_t n_copies = count.size();
   std::vector<std::size_t> start(n_copies + 1, 0);
   for (std::size_t k = 0; k < n_copies; ++k) start[k + 1] = start[k] + count[k];
@@ -164,7 +251,7 @@ GridMultigrid::GridMultigrid(Model& fine, double grid_width)
     bool all_free = true;
     for (std::size_t m = start[k]; m < start[k + 1]; ++m) {
       const std::span<double> P(projections.data() + m * dd, dd);
-      fine.constraints().projection_block(static_cast<VertexId>(members[m] / slots), P);
+      fine_.constraints().projection_block(static_cast<VertexId>(members[m] / slots), P);
       for (int i = 0; i < d; ++i)
         for (int j = 0; j < d; ++j) all_free = all_free && P[i * d + j] == (i == j ? 1.0 : 0.0);
     }
@@ -173,13 +260,13 @@ GridMultigrid::GridMultigrid(Model& fine, double grid_width)
     // without the zeros (which leave its sums unchanged).
     double sum_of_squares = 0;
     for (std::size_t m = start[k]; all_free && m < start[k + 1]; ++m) {
-      const double w = weights[members[m] / slots].weight[members[m] % slots];
+      const double w = pair_weight_[members[m]];
       sum_of_squares += w * w;
     }
     if (all_free && sum_of_squares > 0) {
       const double norm = std::sqrt(sum_of_squares);
       for (std::size_t m = start[k]; m < start[k + 1]; ++m) {
-        const double q = weights[members[m] / slots].weight[members[m] % slots] / norm;
+        const double q = pair_weight_[members[m]] / norm;
         for (int i = 0; i < d; ++i) member_block[m * dd + i * d + i] = q;
       }
       first_column[k + 1] = first_column[k] + d;
@@ -188,7 +275,7 @@ GridMultigrid::GridMultigrid(Model& fine, double grid_width)
     const std::size_t rows = (start[k + 1] - start[k]) * d;
     block.assign(rows * d, 0.0);
     for (std::size_t m = start[k]; m < start[k + 1]; ++m) {
-      const double w = weights[members[m] / slots].weight[members[m] % slots];
+      const double w = pair_weight_[members[m]];
       const std::size_t row = (m - start[k]) * d;
       for (int i = 0; i < d; ++i)
         for (int j = 0; j < d; ++j) block[static_cast<std::size_t>(j) * rows + row + i] = w * projections[m * dd + i * d + j];

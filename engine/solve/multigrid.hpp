@@ -37,6 +37,9 @@ class Multigrid {
   // were made with (interpolation, products) for the earlier positions until they are made
   // anew; false if they must be made anew now.
   virtual bool carry_over_moved_vertices(const Model&) { return false; }
+  // After edits of elements: levels for the mesh as it is now made from these, equal to levels
+  // made anew, or null where they are made anew only (the default).
+  virtual std::unique_ptr<Multigrid> follow_edits() { return nullptr; }
   // Whether the levels were carried over moved vertices since they were made.
   virtual bool made_for_earlier_positions() const { return false; }
   // Levels including the finest.

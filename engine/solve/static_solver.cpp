@@ -391,8 +391,8 @@ void StaticSolver::make_structures_for_mesh(bool resized) {
     preconditioner_filled_ = false;
   else if (!tangent_follows_edits())
     assembled_.reset();
-  multigrid_.reset();
-  build_multigrid();
+  const std::unique_ptr<Multigrid> earlier = std::move(multigrid_);
+  build_multigrid(earlier.get());
   if (ksp_) {
     SNEDE_PETSC(KSPReset(ksp_));
     SNEDE_PETSC(KSPSetOperators(ksp_, problem_.tangent(), preconditioning_matrix()));
@@ -443,7 +443,7 @@ Mat StaticSolver::preconditioning_matrix() {
   return assembled_->mat();
 }
 
-void StaticSolver::build_multigrid() {
+void StaticSolver::build_multigrid(Multigrid* earlier) {
   if (pc_type_ != PCMG) return;
   const std::string prefix = "-" + options_.options_prefix;
   const std::optional<std::string> galerkin = option_database_.string_option(options_.options_prefix + "pc_mg_galerkin");
@@ -500,7 +500,16 @@ void StaticSolver::build_multigrid() {
     if (max_levels > 2) throw std::invalid_argument(prefix + "pc_mg_levels: grid coarsening gives 2 levels");
     static const PetscLogEvent event = log_event("SnedeGridLevels");
     ScopedEvent logged(event);
-    multigrid_ = std::make_unique<GridMultigrid>(*model_, number_option("mg_grid_width", GridMultigrid::default_grid_width));
+    if (earlier && !rebuild_after_edits_) multigrid_ = earlier->follow_edits();
+    if (multigrid_) {
+      ++multigrid_edits_;
+    } else {
+      auto grid = grid_geometry_
+          ? std::make_unique<GridMultigrid>(*model_, *grid_geometry_)
+          : std::make_unique<GridMultigrid>(*model_, number_option("mg_grid_width", GridMultigrid::default_grid_width));
+      grid_geometry_ = grid->geometry();
+      multigrid_ = std::move(grid);
+    }
   }
   const bool smoothing = option_database_.bool_option(options_.options_prefix + "mg_aggregation_smoothing", false);
   if (!multigrid_)

@@ -23,6 +23,7 @@
 #include "core/solver_options.hpp"
 #include "solve/model.hpp"
 #include "solve/model_problem.hpp"
+#include "solve/grid_multigrid.hpp"
 #include "solve/multigrid.hpp"
 #include "solve/preconditioner_reuse.hpp"
 #include "solve/problem.hpp"
@@ -78,6 +79,9 @@ class StaticSolver {
   // with their interpolations) since the solver was made: after a mesh change, or a change of
   // constraints the levels could not take over in place.
   std::size_t multigrid_builds() const { return multigrid_builds_; }
+  // How many of those were grid levels made from the earlier ones after an edit (on the grid of
+  // the first build, only the node copies the edit reached found again: grid_multigrid.hpp).
+  std::size_t multigrid_edits() const { return multigrid_edits_; }
   // Times the assembled tangent's sparsity was made since the solver was made: once per change
   // of the mesh's elements, not for vertices moved alone (a cut's snap).
   std::size_t sparsity_builds() const { return sparsity_builds_; }
@@ -120,8 +124,9 @@ class StaticSolver {
   // The matrix the PC is built from: the shell, or an assembled tangent for the current mesh.
   Mat preconditioning_matrix();
   // PC "mg": the levels for the current mesh (bisection when the hierarchy gives them, else a
-  // grid or aggregation), and whether the PC then needs the assembled tangent.
-  void build_multigrid();
+  // grid or aggregation), and whether the PC then needs the assembled tangent. Grid levels are
+  // made from `earlier` (the levels of the mesh before an edit) when they can follow the edit.
+  void build_multigrid(Multigrid* earlier = nullptr);
   // "mg" on a distributed problem: aggregation levels on each rank's vertices.
   void build_rank_multigrid(const std::string& coarsening, int max_levels);
   // The levels built anew and configured on `pc`.
@@ -187,6 +192,10 @@ class StaticSolver {
   std::uint64_t filled_for_constraints_ = 0;  // ... and the constraints' projection fingerprint
   std::size_t preconditioner_fills_ = 0;
   std::size_t multigrid_builds_ = 0;
+  std::size_t multigrid_edits_ = 0;
+  // The grid of the first grid levels: every later grid level lies on it (the edited ones must,
+  // and the reference rebuild_after_edits makes the same levels from scratch).
+  std::optional<GridGeometry> grid_geometry_;
   std::size_t sparsity_builds_ = 0;
   std::size_t tangent_assemblies_ = 0;
   // The assembled tangent was made from the earlier one after an edit, its values already filled:

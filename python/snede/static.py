@@ -64,7 +64,7 @@ class StaticSolver(RunsOnRanks):
       earlier one, only the blocks the edit touched computed; ``-static_rebuild_after_edits``
       makes everything anew after every edit); ``follow_seconds`` says what that cost,
       ``preconditioner_fills`` how often the preconditioner was filled, ``multigrid_builds`` how
-      often levels were made, ``tangent_assemblies`` how often every element's matrix was assembled. ``multigrid_source`` says which kind is in use
+      often levels were made (``multigrid_edits`` of them from the earlier ones), ``tangent_assemblies`` how often every element's matrix was assembled. ``multigrid_source`` says which kind is in use
       (``"bisection"``, ``"grid"``, ``"aggregation"``), ``multigrid_levels`` and
       ``multigrid_unknowns`` the levels' sizes; ``-static_mg_coarsening`` chooses (default
       ``auto``: bisection when it applies and its coarsest level is at most a sixteenth of
@@ -220,6 +220,14 @@ class StaticSolver(RunsOnRanks):
         interpolation through changes of constraints alone (a needle's stick-slip) and are only
         refilled, until they show their age (``-static_mg_refresh_ratio``)."""
         return self._engine.multigrid_builds
+
+    @property
+    def multigrid_edits(self) -> int:
+        """How many of :attr:`multigrid_builds` were grid levels made from the earlier ones after
+        a cut or a refinement: on the grid of the first build, only the node copies the edit
+        reached are found again (``-static_rebuild_after_edits`` makes them from scratch, on the
+        same grid)."""
+        return self._engine.multigrid_edits
 
     @property
     def ksp(self):

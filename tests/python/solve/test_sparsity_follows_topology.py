@@ -177,3 +177,22 @@ def test_a_tangent_that_depends_on_the_state_is_assembled_anew_after_new_element
     cut loops that older preconditioner cost more CG than the assembly saves, so it is assembled."""
     followed, _, _ = split_and_solve(snede.NeoHookean)
     assert followed.tangent_assemblies >= 4
+
+
+@pytest.mark.parametrize("material", [snede.LinearElastic, snede.NeoHookean])
+def test_after_new_elements_grid_levels_are_made_from_the_earlier_ones(material):
+    """After an edit of elements, grid levels are made from the earlier ones on the grid of the
+    first build (issue 49): only the node copies the edit reached are found again. They are the
+    levels the reference makes from scratch on that grid, so both take the same Newton
+    iterations and CG (± 1 for round-off) to the same answer. (Entry by entry after random edits:
+    tests/cpp/solve/test_grid_levels_follow_edits.cpp.)"""
+    followed, followed_results, followed_state = split_and_solve(material)
+    reference, reference_results, reference_state = split_and_solve(material, rebuild_after_edits="true")
+    assert all(r.converged for r in followed_results + reference_results)
+    assert followed.multigrid_builds == reference.multigrid_builds == 4
+    assert (followed.multigrid_edits, reference.multigrid_edits) == (3, 0)
+    for ours, theirs in zip(followed_results, reference_results):
+        assert ours.iterations == theirs.iterations
+        assert abs(ours.linear_iterations - theirs.linear_iterations) <= 1
+    scale = np.abs(reference_state).max()
+    np.testing.assert_allclose(followed_state, reference_state, rtol=0, atol=1e-6 * scale)
