@@ -191,24 +191,23 @@ void GridMultigrid::locate(VertexId v) {
 void GridMultigrid::join_linked_pairs(DisjointSets& copies, const std::vector<bool>* marked) const {
   // Virtual nodes: (vertex, slot) pairs on the same grid node are one copy of it when a fine
   // edge joins them, so that each copy spans one connected piece of the node's fine vertices.
-  // Every edge lies in an element; an edge shared by several is joined once per element.
+  // An element's corners are joined pairwise by its edges: its pairs on one node are joined
+  // (sorted by node, each to the next on the same node).
   const Connectivity& c = fine_.body().mesh().connectivity();
   const std::size_t slots = static_cast<std::size_t>(geometry_.dim) + 1;
-  auto join = [&](VertexId i, VertexId j) {
-    for (std::size_t s = 0; s < slots; ++s) {
-      const std::int64_t node = pair_node_[i * slots + s];
-      if (node < 0) continue;
-      for (std::size_t t = 0; t < slots; ++t)
-        if (pair_node_[j * slots + t] == node)
-          copies.unite(static_cast<std::int32_t>(i * slots + s), static_cast<std::int32_t>(j * slots + t));
-    }
-  };
+  std::array<std::pair<std::int64_t, std::int32_t>, (max_dimension + 1) * (max_dimension + 1)> on_node{};
   for (ElementId e = 0; e < c.element_capacity(); ++e) {
     if (!c.is_element(e)) continue;
     const std::span<const VertexId> corners = c.element(e).simplex.vertices();
     if (marked && std::none_of(corners.begin(), corners.end(), [&](VertexId v) { return (*marked)[v]; })) continue;
-    for (std::size_t a = 0; a < corners.size(); ++a)
-      for (std::size_t b = a + 1; b < corners.size(); ++b) join(corners[a], corners[b]);
+    std::size_t count = 0;
+    for (VertexId v : corners)
+      for (std::size_t s = 0; s < slots; ++s)
+        if (pair_node_[v * slots + s] >= 0)
+          on_node[count++] = {pair_node_[v * slots + s], static_cast<std::int32_t>(v * slots + s)};
+    std::sort(on_node.begin(), on_node.begin() + static_cast<std::ptrdiff_t>(count));
+    for (std::size_t k = 1; k < count; ++k)
+      if (on_node[k].first == on_node[k - 1].first) copies.unite(on_node[k].second, on_node[k - 1].second);
   }
 }
 
@@ -247,14 +246,12 @@ void GridMultigrid::make_levels(const std::vector<std::int32_t>& label) {
   std::vector<double> member_block(members.size() * dd, 0.0);
   std::vector<PetscInt> first_column(n_copies + 1, 0);
   std::vector<double> projections(members.size() * dd), block, Q;
+  const Constraints& constraints = fine_.constraints();
+  if (constraints.n_points() < static_cast<VertexId>(n)) throw std::logic_error("grid levels: constraints for fewer vertices than the mesh's");
   for (std::size_t k = 0; k < n_copies; ++k) {
-    bool all_free = true;
-    for (std::size_t m = start[k]; m < start[k + 1]; ++m) {
-      const std::span<double> P(projections.data() + m * dd, dd);
-      fine_.constraints().projection_block(static_cast<VertexId>(members[m] / slots), P);
-      for (int i = 0; i < d; ++i)
-        for (int j = 0; j < d; ++j) all_free = all_free && P[i * d + j] == (i == j ? 1.0 : 0.0);
-    }
+    bool all_free = true;  // P = I at every member
+    for (std::size_t m = start[k]; m < start[k + 1] && all_free; ++m)
+      all_free = constraints[static_cast<VertexId>(members[m] / slots)].kind == ConstraintKind::free;
     // Free vertices only: column j is the weights on the j components, orthogonal to the
     // others, so Gram-Schmidt only divides it by its norm — the same operations, done here
     // without the zeros (which leave its sums unchanged).
@@ -274,6 +271,8 @@ void GridMultigrid::make_levels(const std::vector<std::int32_t>& label) {
     }
     const std::size_t rows = (start[k + 1] - start[k]) * d;
     block.assign(rows * d, 0.0);
+    for (std::size_t m = start[k]; m < start[k + 1]; ++m)
+      constraints.projection_block(static_cast<VertexId>(members[m] / slots), std::span<double>(projections.data() + m * dd, dd));
     for (std::size_t m = start[k]; m < start[k + 1]; ++m) {
       const double w = pair_weight_[members[m]];
       const std::size_t row = (m - start[k]) * d;
