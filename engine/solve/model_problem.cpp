@@ -17,7 +17,7 @@ class AssembledModelTangent final : public AssembledProblemTangent {
       : model_(model), edits_(model.body().mesh().connectivity()), tangent_(model, format, MembraneTangent::positive_part) {
     set_rigid_body_near_null_space(model, tangent_.mat());
   }
-  // The tangent of the edited mesh from `earlier`'s (tangent_assembly.hpp).
+  // The tangent of the edited mesh from `earlier`'s, its values too given u (tangent_assembly.hpp).
   AssembledModelTangent(Model& model, const AssembledModelTangent& earlier, Vec u)
       : model_(model), edits_(model.body().mesh().connectivity()), tangent_(model, earlier.tangent_, earlier.edits_, u) {
     set_rigid_body_near_null_space(model, tangent_.mat());
@@ -31,9 +31,11 @@ class AssembledModelTangent final : public AssembledProblemTangent {
     return true;
   }
   std::unique_ptr<AssembledProblemTangent> follow_edits(Vec u) override {
-    if (model_.body().tangent_depends_on_state() || !tangent_.can_follow_edits(model_)) return nullptr;
-    return std::make_unique<AssembledModelTangent>(model_, *this, u);
+    if (!tangent_.can_follow_edits(model_)) return nullptr;
+    const bool values = u && !model_.body().tangent_depends_on_state() && tangent_.values_can_follow_edits(model_);
+    return std::make_unique<AssembledModelTangent>(model_, *this, values ? u : nullptr);
   }
+  bool filled() const override { return tangent_.filled(); }
 
  private:
   Model& model_;

@@ -43,10 +43,13 @@ class AssembledProblemTangent {
   // were added or removed (a new tangent is needed).
   virtual bool follow_moved_vertices() { return false; }
   // The tangent of the mesh as edited since this one was made (a cut, a refinement), made from
-  // this one, filled: this one's values where no edit reached, J at u in the blocks of the
-  // vertices the edits touched (tangent_assembly.hpp). Only where that is J exactly (a tangent
-  // that does not depend on the state); null elsewhere (then a new tangent is made and assembled).
+  // this one: its sparsity, and, given u and where that is J exactly (a tangent that does not
+  // depend on the state), its values: this one's where no edit reached, J at u in the blocks of
+  // the vertices the edits touched (tangent_assembly.hpp); else zero values, for assemble().
+  // Null where it cannot be made so (then a new tangent is made and assembled).
   virtual std::unique_ptr<AssembledProblemTangent> follow_edits(Vec /*u*/) { return nullptr; }
+  // Whether the values are J's at some state (a tangent follow_edits made with its values).
+  virtual bool filled() const { return false; }
 };
 
 // How an assembled tangent stores its entries: AIJ for PETSc's preconditioners, vertex blocks

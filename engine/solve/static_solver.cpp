@@ -352,21 +352,25 @@ void StaticSolver::follow_mesh_changes() {
 }
 
 bool StaticSolver::tangent_follows_edits() {
-  // Where the tangent does not depend on the state (problem.hpp), the blocks an edit did not
-  // touch keep their values exactly and only those it did (a cut's few hundred, of 10⁵) are
-  // computed, instead of every element's matrix (11–30 ms at 20–25k tetrahedra against 3–5).
-  // Elsewhere the kept blocks would be of the earlier fill's state: measured on the cut loops
-  // (docs/results/interactive.md), the older preconditioner cost more CG than the assembly saved.
-  if (!assembled_ || rebuild_after_edits_ || !lags_constraint_changes()) return false;
+  // The sparsity follows the edit: the rows of the vertices it touched are made again, the others
+  // copied. Where the tangent does not depend on the state (problem.hpp) and Newton keeps its
+  // levels, the values do too: the blocks an edit did not touch keep their values exactly and only
+  // those it did (a cut's few hundred, of 10⁵) are computed, instead of every element's matrix
+  // (11–30 ms at 20–25k tetrahedra against 3–5). Elsewhere the kept blocks would be of the earlier
+  // fill's state: measured on the cut loops (docs/results/interactive.md), the older
+  // preconditioner cost more CG than the assembly saved.
+  if (!assembled_ || rebuild_after_edits_) return false;
   static const PetscLogEvent event = log_event("SnedeTangentSparsity");
   ScopedEvent logged(event);
   // In the scale of the last solve's system, which the earlier tangent was filled in.
   const ScaledOperator scaled(problem_, system_scale_);
-  std::unique_ptr<AssembledProblemTangent> edited = assembled_->follow_edits(problem_.state());
+  std::unique_ptr<AssembledProblemTangent> edited =
+      assembled_->follow_edits(lags_constraint_changes() ? problem_.state() : nullptr);
   if (!edited) return false;
   assembled_ = std::move(edited);
   ++sparsity_builds_;
-  tangent_follows_edits_ = true;
+  preconditioner_filled_ = false;  // the PC is made for the new matrix
+  tangent_follows_edits_ = assembled_->filled();
   tangent_edited_at_scale_ = system_scale_;
   return true;
 }

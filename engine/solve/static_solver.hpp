@@ -202,8 +202,9 @@ class StaticSolver {
   // the next fill does not assemble it again.
   bool tangent_follows_edits_ = false;
   double tangent_edited_at_scale_ = 0;  // ... in the system scale of then
-  // After an edit of the mesh's elements: the tangent made from the earlier one, when the levels
-  // are kept across solves; false if a new one must be made.
+  // After an edit of the mesh's elements: the tangent made from the earlier one (its sparsity;
+  // its values too when the levels are kept across solves and the tangent does not depend on the
+  // state); false if a new one must be made.
   bool tangent_follows_edits();
   bool keeps_levels_through_solve_ = false;  // Galerkin levels kept through a solve (solve_nonlinear)
   PreconditionerReuse reuse_;                // ... and through the next ones while they serve

@@ -253,7 +253,8 @@ AssembledTangent::AssembledTangent(const Model& model, const AssembledTangent& e
       format_(earlier.format_),
       revision_(model.body().mesh().connectivity().revision()),
       topology_revision_(model.body().mesh().connectivity().topology_revision()) {
-  if (!earlier.can_follow_edits(model)) throw std::logic_error("this assembled tangent cannot follow the edits");
+  if (!earlier.can_follow_edits(model) || (u && !earlier.values_can_follow_edits(model)))
+    throw std::logic_error("this assembled tangent cannot follow the edits");
   const std::size_t n = static_cast<std::size_t>(model.body().mesh().n_points());
   std::vector<bool> touched(n, false);
   for (VertexId v : edits.vertices())
@@ -261,12 +262,15 @@ AssembledTangent::AssembledTangent(const Model& model, const AssembledTangent& e
   for (std::size_t v = earlier.self_rank_.size(); v < n; ++v) touched[v] = true;  // added since
   follow_neighbours(model, earlier, touched);
   make_matrix(model.dim());
-  take_values(model, earlier, std::move(touched), u);
+  if (u) take_values(model, earlier, std::move(touched), u);
 }
 
 bool AssembledTangent::can_follow_edits(const Model& model) const {
-  return filled_ && !patches_ && filled_scale_ == model.operator_scale() &&
-         static_cast<std::size_t>(model.body().mesh().n_points()) >= self_rank_.size();
+  return !patches_ && static_cast<std::size_t>(model.body().mesh().n_points()) >= self_rank_.size();
+}
+
+bool AssembledTangent::values_can_follow_edits(const Model& model) const {
+  return can_follow_edits(model) && filled_ && filled_scale_ == model.operator_scale();
 }
 
 void AssembledTangent::take_values(const Model& model, const AssembledTangent& earlier, std::vector<bool> fresh, Vec u) {

@@ -38,12 +38,16 @@ class AssembledTangent {
   // constraints changed (the few hundred blocks around a cut, instead of every element's matrix
   // and the whole mesh's vertex stars again). Where
   // the state moved since earlier was filled, the kept blocks are of that state: a preconditioner's
-  // matrix, lagged as kept levels are. Check can_follow_edits first.
+  // matrix, lagged as kept levels are. With u null, the sparsity alone (values zero, for
+  // assemble()). Check can_follow_edits (and, with u, values_can_follow_edits) first.
   AssembledTangent(const Model& model, const AssembledTangent& earlier, const EditFootprint& edits, Vec u);
-  // Whether this tangent can make the next one that way: filled, P1 (a smoothed formulation's
-  // patches reach two edges: not done), for the model's operator scale, and no vertex removed
-  // from the id range.
+  // Whether this tangent's sparsity can make the next one's that way: P1 (a smoothed
+  // formulation's patches reach two edges: not done) and no vertex removed from the id range.
   bool can_follow_edits(const Model& model) const;
+  // ... and its values too: filled, for the model's operator scale.
+  bool values_can_follow_edits(const Model& model) const;
+  // Whether the values are J's at some state (assembled, or made from a filled earlier one).
+  bool filled() const { return filled_; }
   // Whether the mesh is still the one this matrix was made for (no edit since).
   bool matches(const Model& model) const;
   // Takes over the mesh as it is now if only vertices moved since (a cut's snap): true, and the

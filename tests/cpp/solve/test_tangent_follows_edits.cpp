@@ -3,7 +3,8 @@
 // flips, vertex removals, dissections and bisections (topology/random_editor.hpp) on a 2D
 // square, a cube and a membrane, for every material and both formats, with fixed and sliding
 // vertices and a vertex fixed between edits, the sparsity is the same exactly and the values
-// agree to round-off. The state is the earlier fill's at every vertex the edits did not add, so
+// agree to round-off (also for the sparsity made alone and then assembled: the path of a
+// tangent that depends on the state). The state is the earlier fill's at every vertex the edits did not add, so
 // the kept blocks are exact (once a solve moves the state they lag, as kept levels do).
 #include <gtest/gtest.h>
 
@@ -83,14 +84,19 @@ TEST_P(TangentFollowsEdits, EqualsTheTangentAssembledAnew) {
           model.constraints().fix(std::vector<VertexId>{v}, {});
         }
         edited_vertices += static_cast<int>(edits->vertices().size());
-        ASSERT_TRUE(earlier->can_follow_edits(model));
+        ASSERT_TRUE(earlier->values_can_follow_edits(model));
         auto next_edits = std::make_unique<EditFootprint>(mesh.connectivity());
         auto edited = std::make_unique<AssembledTangent>(model, *earlier, *edits, model.displacement());
+        AssembledTangent sparsity_only(model, *earlier, *edits, nullptr);
+        EXPECT_FALSE(sparsity_only.filled());
+        sparsity_only.assemble(model, model.displacement());
         AssembledTangent anew(model, format, MembraneTangent::positive_part);
         anew.assemble(model, model.displacement());
         SCOPED_TRACE("round " + std::to_string(round));
         EXPECT_TRUE(same_sparsity(edited->mat(), anew.mat()));
         EXPECT_LT(snede::testing::relative_difference(edited->mat(), anew.mat()), 1e-12);
+        EXPECT_TRUE(same_sparsity(sparsity_only.mat(), anew.mat()));
+        EXPECT_LT(snede::testing::relative_difference(sparsity_only.mat(), anew.mat()), 1e-12);
         earlier = std::move(edited);
         edits = std::move(next_edits);
       }
@@ -105,7 +111,7 @@ std::string shape_name(const ::testing::TestParamInfo<Shape>& info) {
 INSTANTIATE_TEST_SUITE_P(Shapes, TangentFollowsEdits, ::testing::Values(Shape::square, Shape::cube, Shape::membrane),
                          shape_name);
 
-TEST(TangentFollowsEdits, NotUnderTheSmoothedFormulationNorBeforeAFill) {
+TEST(TangentFollowsEdits, NotUnderTheSmoothedFormulationAndItsValuesNotBeforeAFill) {
   Mesh mesh = mesh_of(Shape::cube);
   ElasticBody body(mesh, LinearElastic(1e4, 0.3), 1000.0, 0.0, Formulation::smoothed);
   Model model(body);
@@ -113,13 +119,16 @@ TEST(TangentFollowsEdits, NotUnderTheSmoothedFormulationNorBeforeAFill) {
   EXPECT_FALSE(patches.can_follow_edits(model));
   patches.assemble(model, model.displacement());
   EXPECT_FALSE(patches.can_follow_edits(model));  // its blocks reach two edges
+  EXPECT_FALSE(patches.values_can_follow_edits(model));
   Mesh other = mesh_of(Shape::cube);
   ElasticBody p1_body(other, LinearElastic(1e4, 0.3), 1000.0, 0.0);
   Model p1_model(p1_body);
   AssembledTangent p1(p1_model, MatrixFormat::baij);
-  EXPECT_FALSE(p1.can_follow_edits(p1_model));  // not filled
+  EXPECT_TRUE(p1.can_follow_edits(p1_model));          // its sparsity
+  EXPECT_FALSE(p1.values_can_follow_edits(p1_model));  // not filled
   p1.assemble(p1_model, p1_model.displacement());
-  EXPECT_TRUE(p1.can_follow_edits(p1_model));
+  EXPECT_TRUE(p1.values_can_follow_edits(p1_model));
   p1_model.set_operator_scale(2.0);
-  EXPECT_FALSE(p1.can_follow_edits(p1_model));  // filled for another scale
+  EXPECT_FALSE(p1.values_can_follow_edits(p1_model));  // filled for another scale
+  EXPECT_TRUE(p1.can_follow_edits(p1_model));
 }
