@@ -65,6 +65,7 @@ void bind_needle(py::module_& m) {
       .def_property_readonly("surface_depth", &NeedleInsertion::surface_depth)
       .def_property_readonly("preconditioner_fills", [](NeedleInsertion& n) { return n.solver().preconditioner_fills(); })
       .def_property_readonly("multigrid_builds", [](NeedleInsertion& n) { return n.solver().multigrid_builds(); })
+      .def_property_readonly("multigrid_edits", [](NeedleInsertion& n) { return n.solver().multigrid_edits(); })
       .def_property_readonly("multigrid_source", [](NeedleInsertion& n) { return n.solver().multigrid_source(); })
       .def_property_readonly("multigrid_unknowns", [](NeedleInsertion& n) { return n.solver().multigrid_unknowns(); })
       .def_property_readonly("tip", [](const NeedleInsertion& n) { return point_vector(n.tip(), n.dim()); })

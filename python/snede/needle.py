@@ -203,6 +203,9 @@ class NeedleInsertion:
         "multigrid_builds", """How many times the needle's solver made multigrid levels (see
         :attr:`snede.StaticSolver.multigrid_builds`): after refinements, not after stick-slip
         changes, which refill the levels it has.""")
+    multigrid_edits = engine_property(
+        "multigrid_edits", """How many of :attr:`multigrid_builds` were grid levels made from the earlier ones
+        after a refinement (see :attr:`snede.StaticSolver.multigrid_edits`).""")
     multigrid_source = engine_property(
         "multigrid_source", """What made the needle solver's ``"mg"`` levels at its last solve (see
         :attr:`snede.StaticSolver.multigrid_source`).""")

@@ -62,6 +62,12 @@ def test_the_needle_takes_grid_levels_unless_told_otherwise(coarsening):
     for _ in range(3):
         assert needle.advance(0.01).converged
     assert needle.multigrid_source == (coarsening or "grid")
+    # Grid levels after a refinement are made from the earlier ones (issue 49); bisection
+    # levels are made anew.
+    if coarsening is None:
+        assert 0 < needle.multigrid_edits < needle.multigrid_builds
+    else:
+        assert needle.multigrid_edits == 0
 
 
 def test_stick_slip_changes_refill_the_levels_instead_of_making_new_ones(cylinder):
