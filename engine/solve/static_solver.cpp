@@ -487,7 +487,9 @@ void StaticSolver::build_multigrid(Multigrid* earlier) {
   // 21k-tetrahedron liver took 1.6 s per factorisation). Its roots tell before the levels are made.
   const bool small_roots =
       hierarchy_ && small_coarsest_level(hierarchy_->roots().size(), model_->body().mesh().n_cells());
-  if (coarsening != "aggregation" && coarsening != "grid" && hierarchy_ && (small_roots || coarsening == "bisection")) {
+  const bool refused_before = coarsening == "auto" && hierarchy_ && bisection_refused_at_nodes_ == hierarchy_->n_nodes();
+  if (coarsening != "aggregation" && coarsening != "grid" && hierarchy_ && (small_roots || coarsening == "bisection") &&
+      !refused_before) {
     try {
       static const PetscLogEvent event = log_event("SnedeBisectionLevels");
       ScopedEvent logged(event);
@@ -498,6 +500,11 @@ void StaticSolver::build_multigrid(Multigrid* earlier) {
       // No conforming coarser cut (a mesh never refined, or one that was cut or flipped since):
       // any mesh can be coarsened on its own.
       if (coarsening == "bisection") throw;
+    }
+    if (multigrid_) {
+      bisection_refused_at_nodes_.reset();
+    } else {
+      bisection_refused_at_nodes_ = hierarchy_->n_nodes();
     }
   }
   if (!multigrid_ && coarsening != "aggregation") {
