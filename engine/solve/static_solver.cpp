@@ -487,7 +487,7 @@ void StaticSolver::build_multigrid(Multigrid* earlier) {
   // 21k-tetrahedron liver took 1.6 s per factorisation). Its roots tell before the levels are made.
   const bool small_roots =
       hierarchy_ && small_coarsest_level(hierarchy_->roots().size(), model_->body().mesh().n_cells());
-  const bool refused_before = coarsening == "auto" && hierarchy_ && bisection_refused_at_nodes_ == hierarchy_->n_nodes();
+  const bool refused_before = coarsening == "auto" && hierarchy_ && bisection_refused_at_splits_ == hierarchy_->n_splits();
   if (coarsening != "aggregation" && coarsening != "grid" && hierarchy_ && (small_roots || coarsening == "bisection") &&
       !refused_before) {
     try {
@@ -502,9 +502,9 @@ void StaticSolver::build_multigrid(Multigrid* earlier) {
       if (coarsening == "bisection") throw;
     }
     if (multigrid_) {
-      bisection_refused_at_nodes_.reset();
+      bisection_refused_at_splits_.reset();
     } else {
-      bisection_refused_at_nodes_ = hierarchy_->n_nodes();
+      bisection_refused_at_splits_ = hierarchy_->n_splits();
     }
   }
   if (!multigrid_ && coarsening != "aggregation") {

@@ -37,6 +37,9 @@ class RefinementHierarchy : public ConnectivityWatcher {
   RefinementHierarchy& operator=(const RefinementHierarchy&) = delete;
 
   std::size_t n_nodes() const { return nodes_.size(); }
+  // Bisections recorded (each adds two children; other edits add roots): only a refinement
+  // changes it.
+  std::size_t n_splits() const { return (nodes_.size() - roots_.size()) / 2; }
   const RefinementNode& node(NodeId n) const { return nodes_[n]; }
   const std::vector<NodeId>& roots() const { return roots_; }
   NodeId node_of(ElementId e) const;
