@@ -224,8 +224,8 @@ class StaticSolver(RunsOnRanks):
     @property
     def multigrid_edits(self) -> int:
         """How many of :attr:`multigrid_builds` were grid levels made from the earlier ones after
-        a cut or a refinement: on the grid of the first build, only the node copies the edit
-        reached are found again (``-static_rebuild_after_edits`` makes them from scratch, on the
+        a cut or a refinement of a volume mesh: on the grid of the first build, only the node
+        copies the edit reached are found again (``-static_rebuild_after_edits`` makes them from scratch, on the
         same grid)."""
         return self._engine.multigrid_edits
 
