@@ -13,11 +13,11 @@
 #include <algorithm>
 #include <array>
 #include <cstdio>
-#include <cstdlib>
 #include <set>
 #include <vector>
 
 #include "best_seconds.hpp"
+#include "bisection_levels_argument.hpp"
 #include "core/petsc_session.hpp"
 #include "core/petsc_util.hpp"
 #include "fem/elastic_body.hpp"
@@ -94,9 +94,7 @@ void run_block(int levels) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::vector<int> levels;
-  for (int i = 1; i < argc; ++i) levels.push_back(std::atoi(argv[i]));
-  if (levels.empty()) levels = {0, 2};
+  const std::vector<int> levels = benchmarks::bisection_levels_argument(argc, argv);
   int petsc_argc = 1;
   PetscSession petsc(&petsc_argc, &argv);
   std::printf("| tetrahedra | vertices touched | faces cut | WU ms | tangent anew ms | edited ms | anew WU | edited WU "

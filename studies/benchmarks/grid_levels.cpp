@@ -10,11 +10,11 @@
 // that can be timed alone (mean edge length, vertex stars).
 #include <algorithm>
 #include <cstdio>
-#include <cstdlib>
 #include <string>
 #include <vector>
 
 #include "best_seconds.hpp"
+#include "bisection_levels_argument.hpp"
 #include "core/petsc_session.hpp"
 #include "fem/elastic_body.hpp"
 #include "mesh/traversal.hpp"
@@ -66,9 +66,7 @@ void run_block(int levels) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::vector<int> levels;
-  for (int i = 1; i < argc; ++i) levels.push_back(std::atoi(argv[i]));
-  if (levels.empty()) levels = {0, 2};
+  const std::vector<int> levels = benchmarks::bisection_levels_argument(argc, argv);
   int petsc_argc = 1;
   PetscSession petsc(&petsc_argc, &argv);
   std::printf("| tetrahedra | vertices | copies | ms per construction | mean edge ms | share | vertex stars ms | share |\n");
