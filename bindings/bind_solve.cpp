@@ -4,6 +4,7 @@
 #include "petsc4py_interop.hpp"
 #include "record_binding.hpp"
 #include "solve/model.hpp"
+#include "solve/piece_holding.hpp"
 #include "solve/problem.hpp"
 #include "solve/solve_result.hpp"
 #include "solve/static_solver.hpp"

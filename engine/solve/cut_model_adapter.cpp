@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "core/petsc_util.hpp"
+#include "solve/piece_holding.hpp"
 
 namespace snede {
 

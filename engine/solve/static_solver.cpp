@@ -135,7 +135,7 @@ StaticSolver::StaticSolver(std::unique_ptr<ModelProblem> owned, Problem* problem
       reuse_(number_option("mg_refresh_ratio", PreconditionerReuse::default_refresh_ratio)),
       rebuild_after_edits_(option_database_.bool_option(options_.options_prefix + "rebuild_after_edits", false)) {
   require_same_options_everywhere(problem_.comm(), options_);
-  if (model_) piece_holding_.emplace(model_->body().mesh());
+  if (model_) piece_holding_.emplace(model_->body().mesh(), PieceHolding::FollowEdits{});
   if (options_.stopping.rtol <= 0 || !std::isfinite(options_.stopping.rtol))
     throw std::invalid_argument("rtol must be positive, got " + std::to_string(options_.stopping.rtol));
   if (!(options_.stopping.round_tolerance >= 0) || !std::isfinite(options_.stopping.round_tolerance))

@@ -25,6 +25,7 @@
 #include "solve/model_problem.hpp"
 #include "solve/grid_multigrid.hpp"
 #include "solve/multigrid.hpp"
+#include "solve/piece_holding.hpp"
 #include "solve/preconditioner_reuse.hpp"
 #include "solve/problem.hpp"
 #include "solve/tangent_assembly.hpp"

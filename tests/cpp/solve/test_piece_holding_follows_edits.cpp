@@ -1,0 +1,164 @@
+// The solver's check that constraints hold every piece, following the mesh's edits (issue 49:
+// labels changed only where the mesh changed), against the same check made from scratch on the
+// edited mesh (connected_components): after random splits, collapses, snaps, insertions, flips,
+// removals, dissections and bisections (random_editor.hpp) on a square, a cube and a membrane,
+// both give the same verdict and the same report, for constraints that hold the body and for
+// constraints that do not; and a notch is settled without labelling the whole mesh, while a cut
+// through the body is found to free a piece.
+#include <gtest/gtest.h>
+
+#include <string>
+#include <vector>
+
+#include "mesh/traversal.hpp"
+#include "solve/piece_holding.hpp"
+#include "topology/dissect.hpp"
+#include "topology/edit_checks.hpp"
+#include "topology/random_editor.hpp"
+#include "topology/refinement_checks.hpp"
+
+using namespace snede;
+
+namespace {
+
+enum class Shape { square, cube, membrane };
+
+Mesh mesh_of(Shape shape) {
+  switch (shape) {
+    case Shape::square: return snede::testing::jittered_square(6, 0.2, 3);
+    case Shape::cube: return snede::testing::shuffled_jittered_cube(4, 0.2, 5);
+    case Shape::membrane: return snede::testing::bumpy_surface(6, 0.1, 0.2, 7);
+  }
+  throw std::logic_error("unknown shape");
+}
+
+// Vertices of cells on the plane x = 0 (the squares', cubes' and membranes' left side).
+std::vector<VertexId> left_side(const Mesh& mesh) {
+  std::vector<VertexId> left;
+  for (ElementId e : mesh.cell_ids())
+    for (VertexId v : mesh.connectivity().element(e).simplex.vertices())
+      if (mesh.point(v)[0] == 0) left.push_back(v);
+  std::sort(left.begin(), left.end());
+  left.erase(std::unique(left.begin(), left.end()), left.end());
+  return left;
+}
+
+// The corners of a cell around the vertex of highest id in a cell (the newest an edit added).
+std::vector<VertexId> corners_at_newest_vertex(const Mesh& mesh) {
+  const Connectivity& c = mesh.connectivity();
+  for (VertexId v = mesh.n_points() - 1; v >= 0; --v)
+    if (c.n_vertex_uses(v) > 0) {
+      const auto corners = c.element(c.vertex_element(v)).simplex.vertices();
+      return {corners.begin(), corners.end()};
+    }
+  throw std::logic_error("no vertex in a cell");
+}
+
+Constraints fixed(const Mesh& mesh, const std::vector<VertexId>& vertices) {
+  Constraints constraints(mesh.dim());
+  constraints.resize(mesh.n_points());
+  constraints.fix(vertices, {});
+  return constraints;
+}
+
+void expect_same(const std::vector<LoosePiece>& followed, const std::vector<LoosePiece>& anew) {
+  ASSERT_EQ(followed.size(), anew.size());
+  for (std::size_t i = 0; i < anew.size(); ++i) {
+    EXPECT_EQ(followed[i].piece, anew[i].piece);
+    EXPECT_EQ(followed[i].pieces, anew[i].pieces);
+    EXPECT_EQ(followed[i].cells, anew[i].cells);
+    EXPECT_EQ(followed[i].first_cell, anew[i].first_cell);
+    EXPECT_EQ(followed[i].constrained_components, anew[i].constrained_components);
+    EXPECT_EQ(followed[i].rigid_motions_stopped, anew[i].rigid_motions_stopped);
+  }
+}
+
+// Interior faces (one of each mate pair) whose vertices all have x = value.
+std::vector<FaceId> interior_faces_at_x(const Mesh& mesh, double value) {
+  const Connectivity& c = mesh.connectivity();
+  std::vector<FaceId> faces;
+  for (FaceId f = 0; f < c.face_capacity(); ++f) {
+    if (!c.is_face(f) || c.face(f).mate == no_id || c.face(f).mate < f) continue;
+    bool in = true;
+    for (VertexId v : c.face(f).simplex.vertices()) in = in && mesh.point(v)[0] == value;
+    if (in) faces.push_back(f);
+  }
+  return faces;
+}
+
+void dissect_faces(Mesh& mesh, const std::vector<FaceId>& faces) {
+  dissect(mesh.connectivity(), faces, [&mesh](VertexId v) { return mesh.add_vertex(VertexParents::copy_of(v)); });
+}
+
+}  // namespace
+
+class PieceHoldingFollowsEdits : public ::testing::TestWithParam<Shape> {};
+
+TEST_P(PieceHoldingFollowsEdits, GivesTheVerdictAndReportOfACheckFromScratch) {
+  Mesh mesh = mesh_of(GetParam());
+  PieceHolding followed(mesh, PieceHolding::FollowEdits{});
+  snede::testing::RandomEditor editor(mesh, 31);
+  const double cells = static_cast<double>(mesh.n_cells());
+  const std::vector<VertexId> left = left_side(mesh);
+  ASSERT_GE(left.size(), 3u);
+  std::size_t loose_seen = 0;
+  int pieces_before = 1;
+  EXPECT_TRUE(followed.loose_pieces(fixed(mesh, left)).empty());  // labels every piece, once
+  for (int round = 0; round < 10; ++round) {
+    SCOPED_TRACE("round " + std::to_string(round));
+    for (int step = 0; step < 5; ++step) editor.edit(editor.choose(static_cast<double>(mesh.n_cells()) / cells));
+    if (round % 3 == 2)
+      for (int cut = 0; cut < 4; ++cut) editor.edit(snede::testing::dissection);  // interior faces opened
+    // The left side held (the body is held unless an edit freed a part), the corners of a cell at
+    // the newest vertex held (which only its piece found again can credit), and one vertex held
+    // (no piece is: it can turn about the vertex).
+    for (const Constraints& constraints :
+         {fixed(mesh, left_side(mesh)), fixed(mesh, corners_at_newest_vertex(mesh)), fixed(mesh, {left.front()})}) {
+      const std::vector<LoosePiece> anew = PieceHolding(mesh).loose_pieces(constraints);
+      loose_seen += anew.size();
+      const int pieces = connected_components(mesh.connectivity()).second;
+      const std::size_t labellings = followed.whole_labellings();
+      expect_same(followed.loose_pieces(constraints), anew);
+      // Held, and no piece split since the last question: settled where the edits were.
+      if (anew.empty() && pieces == pieces_before) EXPECT_EQ(followed.whole_labellings(), labellings);
+      pieces_before = pieces;
+    }
+  }
+  EXPECT_GE(loose_seen, 10u);  // the one-vertex constraints left something loose in every round
+}
+
+std::string shape_name(const ::testing::TestParamInfo<Shape>& info) {
+  return info.param == Shape::square ? "square" : info.param == Shape::cube ? "cube" : "membrane";
+}
+
+INSTANTIATE_TEST_SUITE_P(Shapes, PieceHoldingFollowsEdits, ::testing::Values(Shape::square, Shape::cube, Shape::membrane),
+                         shape_name);
+
+TEST(PieceHoldingFollowsEdits, ANotchKeepsTheLabelsAndACutThroughFreesAPiece) {
+  Mesh mesh = snede::testing::kuhn_cube(8, 8.0);
+  PieceHolding followed(mesh, PieceHolding::FollowEdits{});
+  const Constraints left = fixed(mesh, left_side(mesh));
+  EXPECT_TRUE(followed.loose_pieces(left).empty());
+  EXPECT_EQ(followed.whole_labellings(), 1u);
+  // A notch: the section x = 4 opened within one cell of the edge y = z = 0.
+  std::vector<FaceId> notch, rest;
+  for (FaceId f : interior_faces_at_x(mesh, 4)) {
+    bool near = true;
+    for (VertexId v : mesh.connectivity().face(f).simplex.vertices())
+      near = near && mesh.point(v)[1] <= 1 && mesh.point(v)[2] <= 1;
+    (near ? notch : rest).push_back(f);
+  }
+  ASSERT_FALSE(notch.empty());
+  dissect_faces(mesh, notch);
+  EXPECT_TRUE(followed.loose_pieces(fixed(mesh, left_side(mesh))).empty());
+  EXPECT_EQ(followed.whole_labellings(), 1u) << "a notch labelled every piece again";
+  // The rest of the section: the half x ≥ 4 is free.
+  dissect_faces(mesh, rest);
+  const Constraints still_left = fixed(mesh, left_side(mesh));
+  const std::vector<LoosePiece> anew = PieceHolding(mesh).loose_pieces(still_left);
+  ASSERT_EQ(anew.size(), 1u);
+  EXPECT_EQ(anew.front().pieces, 2);
+  EXPECT_EQ(anew.front().cells, mesh.n_cells() / 2);
+  expect_same(followed.loose_pieces(still_left), anew);
+  EXPECT_GT(followed.whole_labellings(), 1u);
+}
