@@ -138,7 +138,9 @@ void bind_solve(py::module_& m) {
       .def_property_readonly("multigrid_builds", &StaticSolver::multigrid_builds)
       .def_property_readonly("multigrid_edits", &StaticSolver::multigrid_edits)
       .def_property_readonly("sparsity_builds", &StaticSolver::sparsity_builds)
+      .def_property_readonly("sparsity_edits", &StaticSolver::sparsity_edits)
       .def_property_readonly("tangent_assemblies", &StaticSolver::tangent_assemblies)
+      .def_property_readonly("piece_labellings", &StaticSolver::piece_labellings)
       // Without the GIL (other Python threads run); the interrupt check and petsc4py's callbacks take it.
       .def("solve", &StaticSolver::solve, py::call_guard<py::gil_scoped_release>())
       .def(

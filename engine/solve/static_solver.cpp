@@ -135,7 +135,11 @@ StaticSolver::StaticSolver(std::unique_ptr<ModelProblem> owned, Problem* problem
       reuse_(number_option("mg_refresh_ratio", PreconditionerReuse::default_refresh_ratio)),
       rebuild_after_edits_(option_database_.bool_option(options_.options_prefix + "rebuild_after_edits", false)) {
   require_same_options_everywhere(problem_.comm(), options_);
-  if (model_) piece_holding_.emplace(model_->body().mesh(), PieceHolding::FollowEdits{});
+  if (model_) {
+    // The reference (-static_rebuild_after_edits) labels the pieces from scratch after each edit too.
+    if (rebuild_after_edits_) piece_holding_.emplace(model_->body().mesh());
+    else piece_holding_.emplace(model_->body().mesh(), PieceHolding::FollowEdits{});
+  }
   if (options_.stopping.rtol <= 0 || !std::isfinite(options_.stopping.rtol))
     throw std::invalid_argument("rtol must be positive, got " + std::to_string(options_.stopping.rtol));
   if (!(options_.stopping.round_tolerance >= 0) || !std::isfinite(options_.stopping.round_tolerance))
@@ -369,6 +373,7 @@ bool StaticSolver::tangent_follows_edits() {
   if (!edited) return false;
   assembled_ = std::move(edited);
   ++sparsity_builds_;
+  ++sparsity_edits_;
   preconditioner_filled_ = false;  // the PC is made for the new matrix
   tangent_follows_edits_ = assembled_->filled();
   tangent_edited_at_scale_ = system_scale_;

@@ -86,11 +86,17 @@ class StaticSolver {
   // Times the assembled tangent's sparsity was made since the solver was made: once per change
   // of the mesh's elements, not for vertices moved alone (a cut's snap).
   std::size_t sparsity_builds() const { return sparsity_builds_; }
+  // How many of those were made from the earlier sparsity after an edit (only the touched
+  // vertices' rows found again: tangent_assembly.hpp).
+  std::size_t sparsity_edits() const { return sparsity_edits_; }
   // Times every element's matrix was assembled into the tangent since the solver was made. After a
   // cut or a refinement, Newton's kept Galerkin levels on a tangent that does not depend on the
   // state (a linear material) take one made from the earlier one instead, with only the blocks
   // the edit touched computed (tangent_assembly.hpp).
   std::size_t tangent_assemblies() const { return tangent_assemblies_; }
+  // Times every piece of the mesh was labelled for the check that constraints hold each one
+  // (piece_holding.hpp): once, then after edits only when a piece split or is loose.
+  std::size_t piece_labellings() const { return piece_holding_ ? piece_holding_->whole_labellings() : 0; }
   // The mesh's bisection hierarchy, once it has one (a mesh first refined after the solver was
   // made): the next levels, made after that refinement, coarsen along it.
   void use_hierarchy(const RefinementHierarchy* hierarchy) {
@@ -206,6 +212,7 @@ class StaticSolver {
   // and the reference rebuild_after_edits makes the same levels from scratch).
   std::optional<GridGeometry> grid_geometry_;
   std::size_t sparsity_builds_ = 0;
+  std::size_t sparsity_edits_ = 0;
   std::size_t tangent_assemblies_ = 0;
   // The assembled tangent was made from the earlier one after an edit, its values already filled:
   // the next fill does not assemble it again.

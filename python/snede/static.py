@@ -204,6 +204,13 @@ class StaticSolver(RunsOnRanks):
         return self._engine.sparsity_builds
 
     @property
+    def sparsity_edits(self) -> int:
+        """How many of :attr:`sparsity_builds` were made from the earlier sparsity after a cut or
+        a refinement: only the rows of the vertices the edit touched are found again
+        (``-static_rebuild_after_edits`` makes them from scratch)."""
+        return self._engine.sparsity_edits
+
+    @property
     def tangent_assemblies(self) -> int:
         """How many times this solver assembled every element's matrix into its tangent. After a
         cut or a refinement of a body whose tangent does not depend on the state (a linear
@@ -211,6 +218,14 @@ class StaticSolver(RunsOnRanks):
         tangent from the earlier one instead: only the blocks the edit touched are computed, the
         others keep their (exact) values (``-static_rebuild_after_edits`` assembles anew)."""
         return self._engine.tangent_assemblies
+
+    @property
+    def piece_labellings(self) -> int:
+        """How many times this solver labelled every piece of the mesh for its check that the
+        constraints hold each one (a solve refuses a piece a cut freed): at the first solve, and
+        after a cut only when a piece split off or is not held; otherwise only the pieces of the
+        vertices the edit touched are found again."""
+        return self._engine.piece_labellings
 
     @property
     def multigrid_builds(self) -> int:
