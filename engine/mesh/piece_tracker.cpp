@@ -46,11 +46,24 @@ void PieceTracker::on_change(const Connectivity& c, const ConnectivityChange& ch
     unlabelled = std::move(still);
   }
   if (!unlabelled.empty()) stale_ = true;  // a new element with no old neighbour: start over
+  // A changed element may now meet another piece through a face it took over (an edge
+  // collapse): pieces joined, so the labels start over.
+  for (const auto& [e, simplex] : change.changed_elements)
+    for (int j = 0; j <= c.dim() && !stale_; ++j) {
+      const ElementId n = c.neighbor(e, j);
+      if (n != no_id && label_[n] >= 0 && label_[e] >= 0 && label_[n] != label_[e]) stale_ = true;
+    }
 
   changed_.insert(changed_.end(), change.added_elements.begin(), change.added_elements.end());
   for (const auto& [e, simplex] : change.changed_elements) changed_.push_back(e);
   for (FaceId f : change.boundary_added)
     if (c.is_face(f)) changed_.push_back(c.face(f).element);
+  // Changes heard for long without an update (a solver that stopped asking): counting again will
+  // cost no more than searching from all of them.
+  if (changed_.size() > static_cast<std::size_t>(c.element_capacity())) {
+    stale_ = true;
+    changed_.clear();
+  }
 }
 
 bool PieceTracker::update(const Connectivity& c) {

@@ -72,6 +72,7 @@ class PieceHolding::EditWatcher final : public ConnectivityWatcher {
 
   void init(const Connectivity&) override {}
   void on_change(const Connectivity& c, const ConnectivityChange& change) override {
+    ++changes_heard_;
     tracker_.on_change(c, change);
     for (const auto& [e, simplex] : change.removed_elements) touch_all(simplex);
     for (ElementId e : change.added_elements) touch_all(c.element(e).simplex);
@@ -89,6 +90,10 @@ class PieceHolding::EditWatcher final : public ConnectivityWatcher {
     settled();
   }
   std::span<const VertexId> touched() const { return touched_; }
+  bool touched(VertexId v) const { return static_cast<std::size_t>(v) < marked_.size() && marked_[v]; }
+  // Changes heard since attached: a question asked within a batch (whose change is heard at its
+  // end) is not answered with labels that pretend to know it.
+  std::uint64_t changes_heard() const { return changes_heard_; }
   void settled() {
     for (VertexId v : touched_) marked_[v] = false;
     touched_.clear();
@@ -109,12 +114,12 @@ class PieceHolding::EditWatcher final : public ConnectivityWatcher {
   PieceTracker tracker_;
   std::vector<VertexId> touched_;
   std::vector<bool> marked_;  // by vertex id: in touched_
+  std::uint64_t changes_heard_ = 0;
 };
 
 PieceHolding::PieceHolding(const Mesh& mesh) : mesh_(mesh) {}
 
-PieceHolding::PieceHolding(Mesh& mesh, FollowEdits)
-    : mesh_(mesh), watcher_(std::make_unique<EditWatcher>(mesh.connectivity())) {}
+PieceHolding::PieceHolding(Mesh& mesh, FollowEdits) : mesh_(mesh), followed_(&mesh.connectivity()) {}
 
 PieceHolding::~PieceHolding() = default;
 
@@ -135,23 +140,30 @@ void PieceHolding::label_vertices(Label label, int pieces) {
       else if (vertex_piece_[v] != piece) hinge_pieces_.emplace_back(v, piece);
     }
   }
-  std::sort(hinge_pieces_.begin(), hinge_pieces_.end());
-  hinge_pieces_.erase(std::unique(hinge_pieces_.begin(), hinge_pieces_.end()), hinge_pieces_.end());
+  sort_hinges();
   labels_from_scratch_ = true;
   ++whole_labellings_;
 }
 
+void PieceHolding::sort_hinges() {
+  std::sort(hinge_pieces_.begin(), hinge_pieces_.end());
+  hinge_pieces_.erase(std::unique(hinge_pieces_.begin(), hinge_pieces_.end()), hinge_pieces_.end());
+}
+
 void PieceHolding::label_from_scratch() {
   const Connectivity& c = mesh_.connectivity();
-  if (watcher_) {
-    watcher_->relabel();
+  if (followed_) {
+    // The watcher's tracker labels the elements as connected_components numbers them.
+    if (watcher_) watcher_->relabel();
+    else watcher_ = std::make_unique<EditWatcher>(*followed_);
     const PieceTracker& tracker = watcher_->tracker();
     label_vertices([&](ElementId e) { return tracker.label(e); }, tracker.pieces());
+    labelled_changes_ = watcher_->changes_heard();
   } else {
     const auto [label, pieces] = connected_components(c);
     label_vertices([&](ElementId e) { return label[e]; }, pieces);
+    labelled_revision_ = c.topology_revision();
   }
-  labelled_revision_ = c.topology_revision();
   labelled_ = true;
 }
 
@@ -178,24 +190,20 @@ void PieceHolding::follow_edits() {
   const Connectivity& c = mesh_.connectivity();
   labels_from_scratch_ = false;
   if (watcher_->tracker().update(c)) {
-    // A piece split: the tracker labelled every element again.
+    // A piece split, or the labels could not follow locally (pieces joined): the tracker
+    // labelled every element again.
     const PieceTracker& tracker = watcher_->tracker();
     label_vertices([&](ElementId e) { return tracker.label(e); }, tracker.pieces());
-    watcher_->settled();
   } else {
     vertex_piece_.resize(mesh_.n_points(), -1);
-    std::vector<bool> touched(vertex_piece_.size(), false);
+    std::erase_if(hinge_pieces_, [&](const auto& hinge) { return watcher_->touched(hinge.first); });
     for (VertexId v : watcher_->touched())
-      if (static_cast<std::size_t>(v) < touched.size()) touched[v] = true;
-    std::erase_if(hinge_pieces_, [&](const auto& hinge) { return touched[hinge.first]; });
-    for (VertexId v : watcher_->touched())
-      if (static_cast<std::size_t>(v) < touched.size()) label_vertex(v);
-    std::sort(hinge_pieces_.begin(), hinge_pieces_.end());
-    hinge_pieces_.erase(std::unique(hinge_pieces_.begin(), hinge_pieces_.end()), hinge_pieces_.end());
+      if (static_cast<std::size_t>(v) < vertex_piece_.size()) label_vertex(v);
+    sort_hinges();
     pieces_ = watcher_->tracker().pieces();
-    watcher_->settled();
   }
-  labelled_revision_ = c.topology_revision();
+  watcher_->settled();
+  labelled_changes_ = watcher_->changes_heard();
 }
 
 std::vector<PieceHolding::Gram> PieceHolding::grams(const Constraints& constraints) const {
@@ -242,11 +250,12 @@ std::vector<LoosePiece> PieceHolding::loose_of(const std::vector<Gram>& grams, b
 }
 
 std::vector<LoosePiece> PieceHolding::loose_pieces(const Constraints& constraints) {
-  const std::uint64_t revision = mesh_.connectivity().topology_revision();
-  if (!labelled_ || (labelled_revision_ != revision && !watcher_)) {
+  if (!labelled_) {
     label_from_scratch();
-  } else if (labelled_revision_ != revision) {
-    follow_edits();
+  } else if (followed_) {
+    if (watcher_->changes_heard() != labelled_changes_) follow_edits();
+  } else if (labelled_revision_ != mesh_.connectivity().topology_revision()) {
+    label_from_scratch();
   }
   // A membrane has no bending stiffness: tension holds it, not the rank of its supports (a
   // sheet hung from a straight rod is a membrane scene), so it keeps the count.

@@ -40,11 +40,12 @@ class PieceHolding {
   // For a question or two: the pieces are labelled from scratch (O(n)) once per topology
   // revision of the mesh.
   explicit PieceHolding(const Mesh& mesh);
-  // For a solver asked before every solve (issue 49): follows the mesh's edits, so that after a
-  // cut the labels change only where the mesh did (mesh/piece_tracker.hpp: a search local to
-  // the edit) and only the touched vertices' pieces are found again. Every piece is labelled
-  // from scratch only when a piece split, or when a piece is loose (so that its report does not
-  // depend on the history of edits).
+  // For a solver asked before every solve (issue 49): follows the mesh's edits from the first
+  // question on, so that after a cut the labels change only where the mesh did
+  // (mesh/piece_tracker.hpp: a search local to the edit) and only the touched vertices' pieces
+  // are found again. Every piece is labelled from scratch only when a piece split off or pieces
+  // were joined, or when a piece is loose (so that its report does not depend on the history of
+  // edits). `mesh` must outlive this.
   struct FollowEdits {};
   PieceHolding(Mesh& mesh, FollowEdits);
   ~PieceHolding();
@@ -66,6 +67,7 @@ class PieceHolding {
   struct Gram;
 
   void label_from_scratch();
+  void sort_hinges();
   template <class Label>
   void label_vertices(Label label, int pieces);
   void follow_edits();
@@ -74,9 +76,11 @@ class PieceHolding {
   std::vector<LoosePiece> loose_of(const std::vector<Gram>& grams, bool by_count) const;
 
   const Mesh& mesh_;
-  std::unique_ptr<EditWatcher> watcher_;  // null: labelled from scratch at each topology revision
+  Connectivity* followed_ = nullptr;      // null: labelled from scratch at each topology revision
+  std::unique_ptr<EditWatcher> watcher_;  // attached at the first labelling of a followed mesh
   bool labelled_ = false;
-  std::uint64_t labelled_revision_ = 0;
+  std::uint64_t labelled_revision_ = 0;   // the mesh's topology revision, when not followed
+  std::uint64_t labelled_changes_ = 0;    // the watcher's changes heard, when followed
   bool labels_from_scratch_ = false;  // piece_cells_ and piece_first_cell_ are those of now
   int pieces_ = 0;
   std::vector<int> vertex_piece_;                       // per vertex id: a piece of its cells; -1 in none

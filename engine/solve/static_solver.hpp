@@ -95,7 +95,8 @@ class StaticSolver {
   // the edit touched computed (tangent_assembly.hpp).
   std::size_t tangent_assemblies() const { return tangent_assemblies_; }
   // Times every piece of the mesh was labelled for the check that constraints hold each one
-  // (piece_holding.hpp): once, then after edits only when a piece split or is loose.
+  // (piece_holding.hpp): once, then after edits only when a piece split off, pieces were joined
+  // or a piece is loose (-static_rebuild_after_edits: after every change of the elements).
   std::size_t piece_labellings() const { return piece_holding_ ? piece_holding_->whole_labellings() : 0; }
   // The mesh's bisection hierarchy, once it has one (a mesh first refined after the solver was
   // made): the next levels, made after that refinement, coarsen along it.

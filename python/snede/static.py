@@ -223,8 +223,9 @@ class StaticSolver(RunsOnRanks):
     def piece_labellings(self) -> int:
         """How many times this solver labelled every piece of the mesh for its check that the
         constraints hold each one (a solve refuses a piece a cut freed): at the first solve, and
-        after a cut only when a piece split off or is not held; otherwise only the pieces of the
-        vertices the edit touched are found again."""
+        after a cut only when a piece split off, pieces were joined or a piece is not held;
+        otherwise only the pieces of the vertices the edit touched are found again
+        (``-static_rebuild_after_edits`` labels them after every change of the elements)."""
         return self._engine.piece_labellings
 
     @property

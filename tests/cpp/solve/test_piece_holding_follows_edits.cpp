@@ -3,8 +3,8 @@
 // edited mesh (connected_components): after random splits, collapses, snaps, insertions, flips,
 // removals, dissections and bisections (random_editor.hpp) on a square, a cube and a membrane,
 // both give the same verdict and the same report, for constraints that hold the body and for
-// constraints that do not; and a notch is settled without labelling the whole mesh, while a cut
-// through the body is found to free a piece.
+// constraints that do not; a hinge counts for both pieces it joins; and a notch is settled
+// without labelling the whole mesh, while a cut through the body is found to free a piece.
 #include <gtest/gtest.h>
 
 #include <string>
@@ -16,6 +16,7 @@
 #include "topology/edit_checks.hpp"
 #include "topology/random_editor.hpp"
 #include "topology/refinement_checks.hpp"
+#include "topology/split_edge.hpp"
 
 using namespace snede;
 
@@ -96,35 +97,57 @@ class PieceHoldingFollowsEdits : public ::testing::TestWithParam<Shape> {};
 
 TEST_P(PieceHoldingFollowsEdits, GivesTheVerdictAndReportOfACheckFromScratch) {
   Mesh mesh = mesh_of(GetParam());
-  PieceHolding followed(mesh, PieceHolding::FollowEdits{});
+  // `followed` is also asked about constraints that hold nothing, which makes it label every piece
+  // again; `kept` only about constraints that hold the body, so its labels follow every round's
+  // edits from the first question on.
+  PieceHolding followed(mesh, PieceHolding::FollowEdits{}), kept(mesh, PieceHolding::FollowEdits{});
   snede::testing::RandomEditor editor(mesh, 31);
   const double cells = static_cast<double>(mesh.n_cells());
   const std::vector<VertexId> left = left_side(mesh);
   ASSERT_GE(left.size(), 3u);
-  std::size_t loose_seen = 0;
   int pieces_before = 1;
-  EXPECT_TRUE(followed.loose_pieces(fixed(mesh, left)).empty());  // labels every piece, once
+  for (PieceHolding* holding : {&followed, &kept})
+    EXPECT_TRUE(holding->loose_pieces(fixed(mesh, left)).empty());  // labels every piece, once
   for (int round = 0; round < 10; ++round) {
     SCOPED_TRACE("round " + std::to_string(round));
     for (int step = 0; step < 5; ++step) editor.edit(editor.choose(static_cast<double>(mesh.n_cells()) / cells));
     if (round % 3 == 2)
       for (int cut = 0; cut < 4; ++cut) editor.edit(snede::testing::dissection);  // interior faces opened
+    const int pieces = connected_components(mesh.connectivity()).second;
     // The left side held (the body is held unless an edit freed a part), the corners of a cell at
     // the newest vertex held (which only its piece found again can credit), and one vertex held
     // (no piece is: it can turn about the vertex).
-    for (const Constraints& constraints :
-         {fixed(mesh, left_side(mesh)), fixed(mesh, corners_at_newest_vertex(mesh)), fixed(mesh, {left.front()})}) {
+    const std::vector<Constraints> holding_constraints{fixed(mesh, left_side(mesh)),
+                                                       fixed(mesh, corners_at_newest_vertex(mesh))};
+    for (const Constraints& constraints : holding_constraints) {
       const std::vector<LoosePiece> anew = PieceHolding(mesh).loose_pieces(constraints);
-      loose_seen += anew.size();
-      const int pieces = connected_components(mesh.connectivity()).second;
-      const std::size_t labellings = followed.whole_labellings();
+      const std::size_t labellings = kept.whole_labellings();
+      expect_same(kept.loose_pieces(constraints), anew);
       expect_same(followed.loose_pieces(constraints), anew);
-      // Held, and no piece split since the last question: settled where the edits were.
-      if (anew.empty() && pieces == pieces_before) EXPECT_EQ(followed.whole_labellings(), labellings);
-      pieces_before = pieces;
+      // Held, and no piece split off since the last question: settled where the edits were.
+      if (anew.empty() && pieces == pieces_before) EXPECT_EQ(kept.whole_labellings(), labellings);
     }
+    const Constraints one_vertex = fixed(mesh, {left.front()});
+    expect_same(followed.loose_pieces(one_vertex), PieceHolding(mesh).loose_pieces(one_vertex));
+    pieces_before = pieces;
   }
-  EXPECT_GE(loose_seen, 10u);  // the one-vertex constraints left something loose in every round
+}
+
+// A triangle and a pair of triangles that share only vertex 2 (a hinge): the fixed hinge counts
+// for both pieces, also after an edit that changes the hinge's star.
+TEST(PieceHoldingFollowsEdits, AHingeCountsForBothPiecesAfterAnEditAroundIt) {
+  Mesh mesh = snede::testing::mesh_of(2, {0, 0, 1, 0, 1, 1, 2, 1, 2, 2, 3, 2}, {{0, 1, 2}, {2, 3, 4}, {3, 5, 4}});
+  PieceHolding followed(mesh, PieceHolding::FollowEdits{});
+  // Two fixed points stop a plane body's three rigid motions: the hinge and vertex 0 hold the
+  // piece {0, 1, 2}, the hinge and vertex 4 the piece {2, 3, 4, 5}; without 4 the second turns.
+  EXPECT_TRUE(followed.loose_pieces(fixed(mesh, {0, 2, 4})).empty());
+  EXPECT_EQ(followed.loose_pieces(fixed(mesh, {0, 2})).size(), 1u);
+  const std::size_t labellings = followed.whole_labellings();
+  split_edge(mesh, 2, 3, 0.5);  // the second piece's triangles around the hinge change
+  const Constraints hinge_and_ends = fixed(mesh, {0, 2, 4});
+  expect_same(followed.loose_pieces(hinge_and_ends), PieceHolding(mesh).loose_pieces(hinge_and_ends));
+  EXPECT_TRUE(followed.loose_pieces(hinge_and_ends).empty());
+  EXPECT_EQ(followed.whole_labellings(), labellings) << "the hinge was not credited to both pieces";
 }
 
 std::string shape_name(const ::testing::TestParamInfo<Shape>& info) {
