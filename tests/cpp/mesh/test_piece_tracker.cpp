@@ -13,7 +13,7 @@
 #include "mesh/piece_tracker.hpp"
 #include "mesh/traversal.hpp"
 #include "mesh/validate.hpp"
-#include "topology/dissect.hpp"
+#include "topology/section_cuts.hpp"
 #include "topology/split_edge.hpp"
 
 namespace snede::testing {
@@ -33,23 +33,6 @@ Mesh kuhn_mesh(int n) {
   std::vector<std::int64_t> cells;
   for (const auto& cell : kuhn_box(n)) cells.insert(cells.end(), cell.begin(), cell.end());
   return Mesh(3, std::move(points), cells);
-}
-
-// Interior faces (one of each mate pair) whose three vertices have coordinate `axis` = value.
-std::vector<FaceId> faces_in_plane(const Mesh& mesh, int axis, double value) {
-  const Connectivity& c = mesh.connectivity();
-  std::vector<FaceId> faces;
-  for (FaceId f = 0; f < c.face_capacity(); ++f) {
-    if (!c.is_face(f) || c.face(f).mate == no_id || c.face(f).mate < f) continue;
-    bool in = true;
-    for (VertexId v : c.face(f).simplex.vertices()) in = in && mesh.point(v)[axis] == value;
-    if (in) faces.push_back(f);
-  }
-  return faces;
-}
-
-void dissect_faces(Mesh& mesh, const std::vector<FaceId>& faces) {
-  dissect(mesh.connectivity(), faces, [&mesh](VertexId v) { return mesh.add_vertex(VertexParents::copy_of(v)); });
 }
 
 // The tracker's labels define the same partition of the elements as the full count.
@@ -106,13 +89,7 @@ TEST(PieceTracker, ANotchIsSettledNearTheCutAndASeparationIsFound) {
   watcher.tracker = &tracker;
   mesh.connectivity().add_watcher(&watcher);
   // A notch: the faces of the section x = 6 within one cell of the corner y = z = 0.
-  std::vector<FaceId> notch, rest;
-  for (FaceId f : faces_in_plane(mesh, 0, 6)) {
-    bool near = true;
-    for (VertexId v : mesh.connectivity().face(f).simplex.vertices())
-      near = near && mesh.point(v)[1] <= 1 && mesh.point(v)[2] <= 1;
-    (near ? notch : rest).push_back(f);
-  }
+  const auto [notch, rest] = notch_and_rest(mesh, 6);
   ASSERT_FALSE(notch.empty());
   dissect_faces(mesh, notch);
   EXPECT_FALSE(tracker.update(mesh.connectivity()));

@@ -15,23 +15,13 @@
 #include "solve/grid_multigrid.hpp"
 #include "solve/tangent_checks.hpp"
 #include "topology/edit_checks.hpp"
+#include "topology/edited_shapes.hpp"
 #include "topology/random_editor.hpp"
 #include "topology/refinement_checks.hpp"
 
 using namespace snede;
 
 namespace {
-
-enum class Shape { square, cube, membrane };
-
-Mesh mesh_of(Shape shape) {
-  switch (shape) {
-    case Shape::square: return snede::testing::jittered_square(6, 0.2, 3);
-    case Shape::cube: return snede::testing::shuffled_jittered_cube(4, 0.2, 5);
-    case Shape::membrane: return snede::testing::bumpy_surface(6, 0.1, 0.2, 7);
-  }
-  throw std::logic_error("unknown shape");
-}
 
 // The interpolation the levels give a PCMG.
 class Interpolation {
@@ -64,10 +54,10 @@ bool identical(Mat X, Mat Y) {
 
 }  // namespace
 
-class GridLevelsFollowEdits : public ::testing::TestWithParam<Shape> {};
+class GridLevelsFollowEdits : public ::testing::TestWithParam<snede::testing::EditedShape> {};
 
 TEST_P(GridLevelsFollowEdits, EqualTheLevelsMadeAnewOnTheSameGrid) {
-  Mesh mesh = mesh_of(GetParam());
+  Mesh mesh = snede::testing::edited_shape_mesh(GetParam(), 6, 4);
   ElasticBody body(mesh, LinearElastic(3e3, 0.3), 1000.0, mesh.is_surface() || mesh.dim() == 2 ? 0.01 : 0.0);
   Model model(body);
   snede::testing::fix_left_slide_right(model);
@@ -96,9 +86,5 @@ TEST_P(GridLevelsFollowEdits, EqualTheLevelsMadeAnewOnTheSameGrid) {
   EXPECT_GT(most_copies, 4u);  // a coarse level with several node copies
 }
 
-std::string shape_name(const ::testing::TestParamInfo<Shape>& info) {
-  return info.param == Shape::square ? "square" : info.param == Shape::cube ? "cube" : "membrane";
-}
-
-INSTANTIATE_TEST_SUITE_P(Shapes, GridLevelsFollowEdits, ::testing::Values(Shape::square, Shape::cube, Shape::membrane),
-                         shape_name);
+INSTANTIATE_TEST_SUITE_P(Shapes, GridLevelsFollowEdits, snede::testing::all_edited_shapes(),
+                         snede::testing::edited_shape_name);

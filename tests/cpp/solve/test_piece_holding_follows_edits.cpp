@@ -12,26 +12,15 @@
 
 #include "mesh/traversal.hpp"
 #include "solve/piece_holding.hpp"
-#include "topology/dissect.hpp"
-#include "topology/edit_checks.hpp"
+#include "topology/edited_shapes.hpp"
 #include "topology/random_editor.hpp"
 #include "topology/refinement_checks.hpp"
+#include "topology/section_cuts.hpp"
 #include "topology/split_edge.hpp"
 
 using namespace snede;
 
 namespace {
-
-enum class Shape { square, cube, membrane };
-
-Mesh mesh_of(Shape shape) {
-  switch (shape) {
-    case Shape::square: return snede::testing::jittered_square(6, 0.2, 3);
-    case Shape::cube: return snede::testing::shuffled_jittered_cube(4, 0.2, 5);
-    case Shape::membrane: return snede::testing::bumpy_surface(6, 0.1, 0.2, 7);
-  }
-  throw std::logic_error("unknown shape");
-}
 
 // Vertices of cells on the plane x = 0 (the squares', cubes' and membranes' left side).
 std::vector<VertexId> left_side(const Mesh& mesh) {
@@ -74,29 +63,12 @@ void expect_same(const std::vector<LoosePiece>& followed, const std::vector<Loos
   }
 }
 
-// Interior faces (one of each mate pair) whose vertices all have x = value.
-std::vector<FaceId> interior_faces_at_x(const Mesh& mesh, double value) {
-  const Connectivity& c = mesh.connectivity();
-  std::vector<FaceId> faces;
-  for (FaceId f = 0; f < c.face_capacity(); ++f) {
-    if (!c.is_face(f) || c.face(f).mate == no_id || c.face(f).mate < f) continue;
-    bool in = true;
-    for (VertexId v : c.face(f).simplex.vertices()) in = in && mesh.point(v)[0] == value;
-    if (in) faces.push_back(f);
-  }
-  return faces;
-}
-
-void dissect_faces(Mesh& mesh, const std::vector<FaceId>& faces) {
-  dissect(mesh.connectivity(), faces, [&mesh](VertexId v) { return mesh.add_vertex(VertexParents::copy_of(v)); });
-}
-
 }  // namespace
 
-class PieceHoldingFollowsEdits : public ::testing::TestWithParam<Shape> {};
+class PieceHoldingFollowsEdits : public ::testing::TestWithParam<snede::testing::EditedShape> {};
 
 TEST_P(PieceHoldingFollowsEdits, GivesTheVerdictAndReportOfACheckFromScratch) {
-  Mesh mesh = mesh_of(GetParam());
+  Mesh mesh = snede::testing::edited_shape_mesh(GetParam(), 6, 4);
   // `followed` is also asked about constraints that hold nothing, which makes it label every piece
   // again; `kept` only about constraints that hold the body, so its labels follow every round's
   // edits from the first question on.
@@ -150,12 +122,8 @@ TEST(PieceHoldingFollowsEdits, AHingeCountsForBothPiecesAfterAnEditAroundIt) {
   EXPECT_EQ(followed.whole_labellings(), labellings) << "the hinge was not credited to both pieces";
 }
 
-std::string shape_name(const ::testing::TestParamInfo<Shape>& info) {
-  return info.param == Shape::square ? "square" : info.param == Shape::cube ? "cube" : "membrane";
-}
-
-INSTANTIATE_TEST_SUITE_P(Shapes, PieceHoldingFollowsEdits, ::testing::Values(Shape::square, Shape::cube, Shape::membrane),
-                         shape_name);
+INSTANTIATE_TEST_SUITE_P(Shapes, PieceHoldingFollowsEdits, snede::testing::all_edited_shapes(),
+                         snede::testing::edited_shape_name);
 
 TEST(PieceHoldingFollowsEdits, ANotchKeepsTheLabelsAndACutThroughFreesAPiece) {
   Mesh mesh = snede::testing::kuhn_cube(8, 8.0);
@@ -164,19 +132,13 @@ TEST(PieceHoldingFollowsEdits, ANotchKeepsTheLabelsAndACutThroughFreesAPiece) {
   EXPECT_TRUE(followed.loose_pieces(left).empty());
   EXPECT_EQ(followed.whole_labellings(), 1u);
   // A notch: the section x = 4 opened within one cell of the edge y = z = 0.
-  std::vector<FaceId> notch, rest;
-  for (FaceId f : interior_faces_at_x(mesh, 4)) {
-    bool near = true;
-    for (VertexId v : mesh.connectivity().face(f).simplex.vertices())
-      near = near && mesh.point(v)[1] <= 1 && mesh.point(v)[2] <= 1;
-    (near ? notch : rest).push_back(f);
-  }
+  const auto [notch, rest] = snede::testing::notch_and_rest(mesh, 4);
   ASSERT_FALSE(notch.empty());
-  dissect_faces(mesh, notch);
+  snede::testing::dissect_faces(mesh, notch);
   EXPECT_TRUE(followed.loose_pieces(fixed(mesh, left_side(mesh))).empty());
   EXPECT_EQ(followed.whole_labellings(), 1u) << "a notch labelled every piece again";
   // The rest of the section: the half x ≥ 4 is free.
-  dissect_faces(mesh, rest);
+  snede::testing::dissect_faces(mesh, rest);
   const Constraints still_left = fixed(mesh, left_side(mesh));
   const std::vector<LoosePiece> anew = PieceHolding(mesh).loose_pieces(still_left);
   ASSERT_EQ(anew.size(), 1u);

@@ -20,23 +20,13 @@
 #include "solve/tangent_checks.hpp"
 #include "solve/tangent_assembly.hpp"
 #include "topology/edit_checks.hpp"
+#include "topology/edited_shapes.hpp"
 #include "topology/random_editor.hpp"
 #include "topology/refinement_checks.hpp"
 
 using namespace snede;
 
 namespace {
-
-enum class Shape { square, cube, membrane };
-
-Mesh mesh_of(Shape shape) {
-  switch (shape) {
-    case Shape::square: return snede::testing::jittered_square(5, 0.2, 3);
-    case Shape::cube: return snede::testing::shuffled_jittered_cube(3, 0.2, 5);
-    case Shape::membrane: return snede::testing::bumpy_surface(5, 0.1, 0.2, 7);
-  }
-  throw std::logic_error("unknown shape");
-}
 
 // Whether both matrices store the same entries (rows' starts and columns).
 bool same_sparsity(Mat X, Mat Y) {
@@ -55,13 +45,13 @@ void set_random_state(Model& model, std::mt19937& random) {
 
 }  // namespace
 
-class TangentFollowsEdits : public ::testing::TestWithParam<Shape> {};
+class TangentFollowsEdits : public ::testing::TestWithParam<snede::testing::EditedShape> {};
 
 TEST_P(TangentFollowsEdits, EqualsTheTangentAssembledAnew) {
   for (const Material& material : snede::testing::all_materials())
     for (MatrixFormat format : {MatrixFormat::aij, MatrixFormat::baij}) {
       SCOPED_TRACE(std::string(snede::testing::name_of(material)) + (format == MatrixFormat::aij ? " aij" : " baij"));
-      Mesh mesh = mesh_of(GetParam());
+      Mesh mesh = snede::testing::edited_shape_mesh(GetParam(), 5, 3);
       ElasticBody body(mesh, material, 1000.0, mesh.is_surface() || mesh.dim() == 2 ? 0.01 : 0.0);
       Model model(body);
       snede::testing::fix_left_slide_right(model);
@@ -104,15 +94,11 @@ TEST_P(TangentFollowsEdits, EqualsTheTangentAssembledAnew) {
     }
 }
 
-std::string shape_name(const ::testing::TestParamInfo<Shape>& info) {
-  return info.param == Shape::square ? "square" : info.param == Shape::cube ? "cube" : "membrane";
-}
-
-INSTANTIATE_TEST_SUITE_P(Shapes, TangentFollowsEdits, ::testing::Values(Shape::square, Shape::cube, Shape::membrane),
-                         shape_name);
+INSTANTIATE_TEST_SUITE_P(Shapes, TangentFollowsEdits, snede::testing::all_edited_shapes(),
+                         snede::testing::edited_shape_name);
 
 TEST(TangentFollowsEdits, NotUnderTheSmoothedFormulationAndItsValuesNotBeforeAFill) {
-  Mesh mesh = mesh_of(Shape::cube);
+  Mesh mesh = snede::testing::edited_shape_mesh(snede::testing::EditedShape::cube, 5, 3);
   ElasticBody body(mesh, LinearElastic(1e4, 0.3), 1000.0, 0.0, Formulation::smoothed);
   Model model(body);
   AssembledTangent patches(model, MatrixFormat::baij);
@@ -120,7 +106,7 @@ TEST(TangentFollowsEdits, NotUnderTheSmoothedFormulationAndItsValuesNotBeforeAFi
   patches.assemble(model, model.displacement());
   EXPECT_FALSE(patches.can_follow_edits(model));  // its blocks reach two edges
   EXPECT_FALSE(patches.values_can_follow_edits(model));
-  Mesh other = mesh_of(Shape::cube);
+  Mesh other = snede::testing::edited_shape_mesh(snede::testing::EditedShape::cube, 5, 3);
   ElasticBody p1_body(other, LinearElastic(1e4, 0.3), 1000.0, 0.0);
   Model p1_model(p1_body);
   AssembledTangent p1(p1_model, MatrixFormat::baij);
