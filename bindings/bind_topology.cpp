@@ -42,6 +42,12 @@ void bind_topology(py::module_& m) {
       .def("level", [](const Bisection& b, ElementId e) { return b.hierarchy().level(e); }, py::arg("element"))
       .def_property_readonly("n_nodes", [](const Bisection& b) { return b.hierarchy().n_nodes(); })
       .def_property_readonly("n_forced_splits", &Bisection::n_forced_splits)
+      .def_property_readonly(
+          "rule",
+          [](const Bisection& b) {
+            return b.hierarchy().rule() == BisectionRule::longest_edge ? "longest_edge" : "newest_vertex";
+          },
+          "3D labelling rule: 'newest_vertex' (Maubach, the Kuhn box) or 'longest_edge' (any other mesh)")
       .def("memory_bytes", &Bisection::memory_bytes);
 }
 

@@ -5,43 +5,13 @@
 #include <vector>
 
 #include "core/predicates.hpp"
+#include "core/segment_distance.hpp"
 
 namespace snede {
-namespace {
 
-struct ClosestPoints {
-  double s, t, distance;  // p + s (q − p) and a + t (b − a), both clamped to [0, 1]
-};
-
-// The nearest points of segments p→q and a→b.
-ClosestPoints closest_points(const Point3& p, const Point3& q, const Point3& a, const Point3& b) {
-  const Point3 d1 = minus(q, p), d2 = minus(b, a), r = minus(p, a);
-  const double A = dot(d1, d1), E = dot(d2, d2), F = dot(d2, r);
-  double s = 0, t = 0;
-  if (A <= 0 && E <= 0) {
-  } else if (A <= 0) {
-    t = std::clamp(F / E, 0.0, 1.0);
-  } else {
-    const double C = dot(d1, r);
-    if (E <= 0) {
-      s = std::clamp(-C / A, 0.0, 1.0);
-    } else {
-      const double B = dot(d1, d2), denominator = A * E - B * B;
-      s = denominator > 0 ? std::clamp((B * F - C * E) / denominator, 0.0, 1.0) : 0.0;
-      t = (B * s + F) / E;
-      if (t < 0) {
-        t = 0, s = std::clamp(-C / A, 0.0, 1.0);
-      } else if (t > 1) {
-        t = 1, s = std::clamp((B - C) / A, 0.0, 1.0);
-      }
-    }
-  }
-  return {s, t, norm(minus(plus_scaled(p, s, d1), plus_scaled(a, t, d2)))};
+double segment_point_distance(const Point3& p, const Point3& q, const Point3& x) {
+  return segment_segment_distance(p, q, x, x);
 }
-
-}  // namespace
-
-double segment_point_distance(const Point3& p, const Point3& q, const Point3& x) { return closest_points(p, q, x, x).distance; }
 
 std::optional<TriangleHit> segment_meets_triangle(const Point3& p, const Point3& q, const Point3& a, const Point3& b,
                                                   const Point3& c, const Point3& near) {
@@ -132,7 +102,7 @@ std::optional<SweptCrossing> swept_segment_meets_edge(const Point3& h0, const Po
                                  norm(minus(t1, t0)), norm(minus(a, h0))});
   const double tolerance = 1e-9 * scale;
   const auto meeting = [&](double g) -> std::optional<SweptCrossing> {
-    const ClosestPoints closest = closest_points(head(g), tail(g), a, b);
+    const ClosestPoints closest = segment_closest_points(head(g), tail(g), a, b);
     if (closest.distance > tolerance) return std::nullopt;
     return SweptCrossing{g, closest.s, closest.t};
   };
@@ -180,7 +150,7 @@ std::optional<SweptCrossing> swept_segment_meets_edge(const Point3& h0, const Po
 double line_distance(const Point3& p, const Point3& q, const Point3& a, const Point3& b) {
   const Point3 n = cross(minus(q, p), minus(b, a));
   const double length = norm(n);
-  if (length <= 1e-12 * norm(minus(q, p)) * norm(minus(b, a))) return closest_points(p, q, a, b).distance;
+  if (length <= 1e-12 * norm(minus(q, p)) * norm(minus(b, a))) return segment_closest_points(p, q, a, b).distance;
   return std::abs(dot(minus(a, p), n)) / length;
 }
 

@@ -73,14 +73,13 @@ BisectionMultigrid::BisectionMultigrid(Model& fine, const RefinementHierarchy& h
   std::vector<int> depth(hierarchy.n_nodes(), 0);
   for (std::size_t n = 0; n < depth.size(); ++n)
     if (hierarchy.node(static_cast<NodeId>(n)).parent != no_id) depth[n] = depth[hierarchy.node(static_cast<NodeId>(n)).parent] + 1;
-  // Every split's midpoint, with the ends of the edge it bisected (Maubach: the child keeping
-  // x0 has the midpoint where its parent had xk).
+  // Every split's midpoint, with the ends of the edge it bisected.
   midpoint_of_.assign(mesh.n_points(), {no_id, no_id});
   for (std::size_t n = 0; n < depth.size(); ++n) {
     const RefinementNode& node = hierarchy.node(static_cast<NodeId>(n));
     if (node.is_leaf()) continue;
     const TaggedSimplex& label = node.label;
-    const VertexId midpoint = hierarchy.node(node.children[0]).label.vertex[label.tag];
+    const VertexId midpoint = hierarchy.midpoint(static_cast<NodeId>(n));
     if (midpoint >= 0 && midpoint < mesh.n_points())
       midpoint_of_[midpoint] = {label.refinement_start(), label.refinement_end()};
   }

@@ -34,7 +34,7 @@ std::size_t Bisection::simple_bisect(VertexId a, VertexId b, const std::vector<E
     // Substituting one endpoint keeps the orientation, so both halves stay positive.
     halves.push_back(whole.substituted(label.refinement_end(), midpoint));
     halves.push_back(whole.substituted(label.refinement_start(), midpoint));
-    hierarchy_.expect_split(e, label.children(midpoint));
+    hierarchy_.expect_split(e, labels_of_halves(mesh_, label, midpoint, hierarchy_.rule()));
   }
   mesh_.connectivity().replace_elements(around, halves);
   return around.size();

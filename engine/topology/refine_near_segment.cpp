@@ -7,37 +7,27 @@
 #include <stdexcept>
 #include <vector>
 
-#include "core/vec3.hpp"
+#include "core/segment_distance.hpp"
 #include "mesh/element_quality.hpp"
 
 namespace snede {
 namespace {
 
-// A segment in the mesh's space (2D points padded with z = 0).
-struct Segment {
-  Point3 a{}, b{};
-  double distance_to(const Point3& x) const {
-    const Point3 ab = minus(b, a);
-    const double ab2 = dot(ab, ab);
-    const double t = ab2 > 0 ? std::clamp(dot(minus(x, a), ab) / ab2, 0.0, 1.0) : 0.0;
-    return distance(plus_scaled(a, t, ab), x);
-  }
-};
-
-// Whether the simplex with these reference corners may come within radius of the segment:
-// its bounding ball (centroid, farthest corner) does.
-bool may_be_near(const Mesh& mesh, std::span<const VertexId> corners, const Segment& segment, double radius) {
-  const int d = mesh.dim();
+// Whether the simplex with these reference corners comes within radius of the segment a–b
+// (points of 2D meshes padded with z = 0): first its bounding ball (centroid, farthest
+// corner), which rejects most of the tree cheaply, then the exact distance.
+bool is_near(const Mesh& mesh, std::span<const VertexId> corners, const Point3& a, const Point3& b, double radius) {
+  std::array<Point3, max_dimension + 1> points{};
   Point3 centre{};
-  for (VertexId v : corners)
-    for (int k = 0; k < d; ++k) centre[k] += mesh.point(v)[k] / static_cast<double>(corners.size());
+  for (std::size_t i = 0; i < corners.size(); ++i)
+    for (int k = 0; k < mesh.dim(); ++k) {
+      points[i][k] = mesh.point(corners[i])[k];
+      centre[k] += points[i][k] / static_cast<double>(corners.size());
+    }
   double reach = 0;
-  for (VertexId v : corners) {
-    double d2 = 0;
-    for (int k = 0; k < d; ++k) d2 += (mesh.point(v)[k] - centre[k]) * (mesh.point(v)[k] - centre[k]);
-    reach = std::max(reach, std::sqrt(d2));
-  }
-  return segment.distance_to(centre) <= radius + reach;
+  for (std::size_t i = 0; i < corners.size(); ++i) reach = std::max(reach, distance(points[i], centre));
+  if (segment_segment_distance(a, b, centre, centre) > radius + reach) return false;
+  return segment_simplex_distance(a, b, std::span<const Point3>(points.data(), corners.size())) <= radius;
 }
 
 void check_point(std::span<const double> x, int dim, const char* name) {
@@ -61,9 +51,9 @@ std::size_t refine_near_segment(Bisection& bisection, std::span<const double> a,
                                 std::to_string(radius));
   check_point(a, d, "a");
   check_point(b, d, "b");
-  Segment segment;
-  std::copy(a.begin(), a.end(), segment.a.begin());
-  std::copy(b.begin(), b.end(), segment.b.begin());
+  Point3 from{}, to{};
+  std::copy(a.begin(), a.end(), from.begin());
+  std::copy(b.begin(), b.end(), to.begin());
   const RefinementHierarchy& tree = bisection.hierarchy();
   ChangeBatch batch(bisection.mesh().connectivity());  // one change for the watchers (§7.4)
   std::size_t n_split = 0;
@@ -79,10 +69,10 @@ std::size_t refine_near_segment(Bisection& bisection, std::span<const double> a,
       stack.pop_back();
       const std::span<const VertexId> corners(node.label.vertex.data(), static_cast<std::size_t>(d) + 1);
       if (!node.is_leaf()) {
-        if (may_be_near(mesh, corners, segment, radius)) stack.insert(stack.end(), node.children.begin(), node.children.end());
+        if (is_near(mesh, corners, from, to, radius)) stack.insert(stack.end(), node.children.begin(), node.children.end());
         continue;
       }
-      if (node.element == no_id || !may_be_near(mesh, corners, segment, radius)) continue;
+      if (node.element == no_id || !is_near(mesh, corners, from, to, radius)) continue;
       any_near = true;
       const double longest = longest_edge(d, mesh.corners(node.element));
       if (h < 1e-12 * longest) {
@@ -103,7 +93,7 @@ std::size_t refine_near_segment(Bisection& bisection, std::span<const double> a,
       const Simplex& simplex = mesh.connectivity().element(e).simplex;
       std::vector<VertexId> corners(static_cast<std::size_t>(d) + 1);
       for (int i = 0; i <= d; ++i) corners[i] = simplex.vertex(i);
-      if (longest_edge(d, mesh.corners(e)) > h && may_be_near(mesh, corners, segment, radius))
+      if (longest_edge(d, mesh.corners(e)) > h && is_near(mesh, corners, from, to, radius))
         n_split += bisection.bisect(e);
     }
   }

@@ -12,9 +12,9 @@
 namespace snede {
 
 // a, b: (dim,) reference coordinates (a = b refines around a point, like refine_around, but
-// with a radius). "Comes within radius" is decided conservatively on the element's bounding
-// ball (centroid, farthest corner), so elements up to one element size beyond the radius may
-// be refined too. Returns the number of elements split. Throws std::invalid_argument for h not
+// with a radius). "Comes within radius" is the exact distance between the segment and the
+// closed element (segment_distance.hpp), so only elements the tube meets are split for their
+// size; neighbours are split only as conformity needs. Returns the number of elements split. Throws std::invalid_argument for h not
 // positive and finite, radius negative or not finite, points of the wrong dimension or not
 // finite, h below 1e-12 of a nearby edge length (beyond round-off), or a segment that does not
 // come within radius of any element.

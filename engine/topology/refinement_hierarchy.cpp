@@ -25,7 +25,9 @@ void RefinementHierarchy::init(const Connectivity& connectivity) {
   roots_.clear();
   root_grid_.clear();
   node_of_element_.assign(connectivity.element_capacity(), no_id);
-  for (ElementId e : connectivity.element_ids()) add_root(initial_labelling(mesh_, connectivity.element(e).simplex), e);
+  rule_ = bisection_rule_for(mesh_);
+  for (ElementId e : connectivity.element_ids())
+    add_root(initial_labelling(mesh_, connectivity.element(e).simplex, rule_), e);
   n_points_seen_ = mesh_.n_points();
 }
 
@@ -54,6 +56,14 @@ NodeId RefinementHierarchy::node_of(ElementId e) const {
   if (e < 0 || static_cast<std::size_t>(e) >= node_of_element_.size() || node_of_element_[e] == no_id)
     throw std::invalid_argument("refinement hierarchy: element " + std::to_string(e) + " is not a live element");
   return node_of_element_[e];
+}
+
+VertexId RefinementHierarchy::midpoint(NodeId split) const {
+  const RefinementNode& parent = nodes_[split];
+  const TaggedSimplex& half = nodes_[parent.children[0]].label;
+  for (int i = 0; i <= half.dim; ++i)
+    if (!parent.label.contains(half.vertex[i])) return half.vertex[i];
+  throw std::logic_error("refinement hierarchy: node " + std::to_string(split) + " has no midpoint");
 }
 
 int RefinementHierarchy::level(ElementId e) const {
@@ -88,7 +98,7 @@ TaggedSimplex RefinementHierarchy::relabelled(const TaggedSimplex& old_label, co
         if (parents.count() == 1 && parents.vertex[0] == *g) image = w;
       }
     }
-    if (image == no_id) return initial_labelling(mesh_, new_simplex);
+    if (image == no_id) return initial_labelling(mesh_, new_simplex, rule_);
     label.vertex[i] = image;
   }
   return label;
@@ -110,7 +120,7 @@ void RefinementHierarchy::on_change(const Connectivity& connectivity, const Conn
     }
     expected_.clear();
   } else {
-    for (ElementId e : change.added_elements) add_root(initial_labelling(mesh_, connectivity.element(e).simplex), e);
+    for (ElementId e : change.added_elements) add_root(initial_labelling(mesh_, connectivity.element(e).simplex, rule_), e);
   }
   for (const auto& [e, old_simplex] : change.changed_elements) {
     const NodeId old_node = node_of_element_[e];

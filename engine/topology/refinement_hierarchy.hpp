@@ -3,7 +3,7 @@
 // the refinement edge) usable for point location and, later, for multilevel solvers.
 //
 // It also keeps the bisection labelling (TaggedSimplex) of every live element, keyed by
-// element id. As a connectivity watcher (§7.4) it follows every change: splits announced by
+// element id, and the labelling rule (initial_labelling.hpp), chosen from the starting mesh. As a connectivity watcher (§7.4) it follows every change: splits announced by
 // expect_split become children; elements removed by another operation leave their node as a
 // dead leaf; elements added by another operation start new roots, labelled afresh; elements
 // changed by a vertex substitution (a cut) start new roots keeping their labelling with the
@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "mesh/mesh.hpp"
+#include "topology/initial_labelling.hpp"
 #include "topology/root_grid.hpp"
 #include "topology/tagged_simplex.hpp"
 
@@ -23,7 +24,7 @@ namespace snede {
 struct RefinementNode {
   TaggedSimplex label;
   NodeId parent = no_id;
-  std::array<NodeId, 2> children{no_id, no_id};  // children[0] keeps x0, children[1] keeps xk
+  std::array<NodeId, 2> children{no_id, no_id};  // children[0] keeps x0, children[1] keeps xk (of label)
   ElementId element = no_id;  // the live element of a leaf; no_id once split or removed
   bool is_leaf() const { return children[0] == no_id; }
 };
@@ -46,6 +47,11 @@ class RefinementHierarchy : public ConnectivityWatcher {
   const TaggedSimplex& label(ElementId e) const { return nodes_[node_of(e)].label; }
   // Number of bisections between the element's root and it.
   int level(ElementId e) const;
+  // The vertex that bisected a split node's refinement edge (the one corner of its halves it
+  // lacks; the halves' labels may order their corners by another rule than Maubach's).
+  VertexId midpoint(NodeId split) const;
+  // The labelling rule of this mesh's 3D bisection, chosen when the hierarchy starts.
+  BisectionRule rule() const { return rule_; }
 
   // The next replace_elements removes `parent` and adds `children` (in this order among its
   // new simplexes); called once per split element before that replace_elements.
@@ -90,7 +96,8 @@ class RefinementHierarchy : public ConnectivityWatcher {
   std::vector<NodeId> node_of_element_;  // indexed by element id
   std::vector<ExpectedSplit> expected_;
   mutable RootGrid root_grid_;
-  VertexId n_points_seen_ = 0;  // ids below this may be in roots' labels: reusing one moves a root
+  VertexId n_points_seen_ = 0;
+  BisectionRule rule_ = BisectionRule::newest_vertex;  // ids below this may be in roots' labels: reusing one moves a root
 };
 
 }  // namespace snede

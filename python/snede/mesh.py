@@ -348,14 +348,15 @@ class Mesh(MeshEdits):
     @serial_only
     def refine_uniform(self, levels: int | None = None, *, target_cells: int | None = None) -> int:
         """Bisect every cell ``levels`` times (default 1) by conforming bisection (§6.5:
-        newest-vertex in 2D, Maubach's in 3D); or, given ``target_cells`` instead, level after
+        newest-vertex in 2D; in 3D Maubach's on ``meshing.box``, longest-edge on any other
+        mesh); or, given ``target_cells`` instead, level after
         level until the mesh has at least ``target_cells`` cells (the fewest levels that reach
         it, so it may overshoot by a level's growth). Returns how many cells were split.
 
         Growth per level: on ``meshing.rectangle`` and ``meshing.box`` each level doubles the
         cell count exactly; on unstructured meshes conformity splits more, about 3.3× per level
-        in 3D over the first four levels (3.5–4× at the first, 2.9× at the fourth: 596 → 72 050
-        tetrahedra on SOFA's liver.msh, 1125 → 115 374 on meshes/cylinder_small.msh) and 2.2× in
+        in 3D after the first (3.9–4.5× at the first: 1125 → 4427 → 14 443 → 46 977 tetrahedra
+        in three levels on meshes/cylinder_small.msh, 596 → 31 597 on SOFA's liver.msh) and 2.2× in
         2D (a gmsh disk: 757 → 41 220 in five levels). ``levels`` is at most what keeps the
         cell count within the engine's 32-bit ids (each level at least doubles it)."""
         if target_cells is not None:

@@ -4,9 +4,10 @@
 
 ``organ_mesh(name, target_tets, seed=1)`` returns a ``snede.Mesh`` of about ``target_tets``
 tetrahedra (within ±10 % when gmsh allows, always within ±30 %) filling the closed surface
-``name`` of ``ORGANS``. The surfaces are SOFA's liver models (``meshes/README.md`` gives their
-source and licence), turned so that z points up (cranially) and scaled so that the liver is
-0.2 m wide (largest bounding-box side), centred at the origin. Results are cached in
+``name`` of ``ORGANS`` ("liver", "liver2", "heart"). The surfaces are SOFA's two liver models and
+its heart (``meshes/README.md`` gives their source and licence), the livers turned so that z points
+up (cranially), and all scaled so that the organ is 0.2 m wide (largest bounding-box side; a
+liver's width, too large for a heart), centred at the origin. Results are cached in
 ``out/organ_meshes/`` keyed by name, target, seed and a hash of the surface, this file and
 gmsh's version, so a second call only reads an ``.npz``. Run as a script, it prints size and
 quality of every organ at 20000 and 60000 tetrahedra (``--refresh`` regenerates them).
@@ -34,6 +35,8 @@ WIDTH = 0.2  #: largest bounding-box side (m): an adult liver is about 0.2 m acr
 _SURFACES = {
     "liver": ("liver_surface.obj", np.array([[1.0, 0, 0], [0, 0, -1], [0, 1, 0]])),
     "liver2": ("liver2_surface.obj", np.eye(3)),
+    # SOFA's heart (coeur1.trian) has no documented orientation and no obvious long axis: as is.
+    "heart": ("heart_surface.obj", np.eye(3)),
 }
 ORGANS = tuple(_SURFACES)
 

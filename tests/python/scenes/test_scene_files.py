@@ -56,7 +56,7 @@ def test_the_example_scene_files_run_and_write_into_the_out_folder(example, name
         assert summary["incision_faces"] > 50 and summary["value"] > 0.01 and summary["components"] == 1
         assert steps[-1].cell_fields["incision"].sum() > 50
     else:  # 20 updates, the mesh refined along the shaft
-        assert summary["updates"] == 20 and summary["needle_nodes"] > 10 and summary["cells"] > 10000
+        assert summary["updates"] == 20 and summary["needle_nodes"] > 10 and summary["cells"] > 6000
         assert (steps[-1].point_fields["needle_state"] > 0).sum() == summary["needle_nodes"]
 
 
