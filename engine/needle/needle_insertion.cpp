@@ -9,6 +9,7 @@
 
 #include "core/log_event.hpp"
 #include "core/petsc_util.hpp"
+#include "needle/move_extension.hpp"
 #include "topology/refine_around.hpp"
 #include "topology/refine_near_segment.hpp"
 
@@ -103,6 +104,22 @@ void NeedleInsertion::create_predictor_vectors() {
   model_.add_carried_field(start_.slot());
 }
 
+void NeedleInsertion::extend_move(double distance) {
+  std::vector<VertexId> sticking;
+  for (const NeedleNode& node : nodes_)
+    if (node.sticking) sticking.push_back(node.vertex);
+  // Twice as many Jacobi sweeps as rings: enough to smooth the first guess's kinks at the rings.
+  const int sweeps = 2 * options_.extension_rings;
+  const auto weights =
+      move_extension_weights(model_.body().mesh(), model_.constraints(), sticking, options_.extension_rings, sweeps);
+  {
+    WriteView u(model_.displacement());
+    for (const auto& [v, w] : weights)
+      for (int k = 0; k < dim_; ++k) u.span()[at(v) + k] += w * distance * direction_[k];
+  }
+  model_.enforce_constraints(model_.displacement());
+}
+
 void NeedleInsertion::predict(double distance) {
   Vec u = model_.displacement();
   SNEDE_PETSC(VecCopy(u, start_));
@@ -174,16 +191,26 @@ void NeedleInsertion::move_needle(double distance) {
 }
 
 NeedleStepReport NeedleInsertion::advance_in_steps(double distance, int halvings) {
+  SNEDE_PETSC(VecCopy(model_.displacement(), start_));
   move_needle(distance);
   // A move that drags sticking nodes across their neighbours would start the solve from
-  // inverted elements, which a material forbidding inversion cannot relax: move in halves.
+  // inverted elements, which a material forbidding inversion cannot relax: carry the move into
+  // the tissue around them, else move in halves.
+  bool extended = false;
+  if (distance > 0 && !model_.admissible(model_.displacement()) && options_.extension_rings > 0) {
+    extend_move(distance);
+    extended = true;
+  }
   if (distance > 0 && halvings < max_halvings && !model_.admissible(model_.displacement())) {
     move_needle(-distance);
+    SNEDE_PETSC(VecCopy(start_, model_.displacement()));
     NeedleStepReport first = advance_in_steps(0.5 * distance, halvings + 1);
+    first.halvings += 1;
     if (!first.converged) return first;
     return merged(first, advance_in_steps(0.5 * distance, halvings + 1));
   }
   NeedleStepReport report;
+  report.extensions = extended ? 1 : 0;
   predict(distance);
   const std::size_t cells_before = model_.body().mesh().n_cells();
   refine_at_tip();
@@ -202,6 +229,8 @@ NeedleStepReport NeedleInsertion::merged(const NeedleStepReport& a, const Needle
   m.released += a.released;
   m.intercepted += a.intercepted;
   m.cells_split += a.cells_split;
+  m.extensions += a.extensions;
+  m.halvings += a.halvings;
   m.solver_iterations += a.solver_iterations;
   m.max_solver_iterations = std::max(a.max_solver_iterations, b.max_solver_iterations);
   m.settled = b.settled;

@@ -67,6 +67,10 @@ struct NeedleOptions {
   // Start each update's solve from the last state plus the last update's displacement change
   // per unit of needle travel (a linear predictor) instead of from the last state.
   bool extrapolate = false;
+  // A move that would invert elements is first carried into the tissue over this many rings of
+  // vertices around the sticking nodes (move_extension.hpp); halved only if that is not
+  // enough. 0: halve at once (the behaviour before issue 50).
+  int extension_rings = 3;
   std::string friction_channel = "friction";
 
   // Every field with its name: the one list that bindings and printing read.
@@ -78,6 +82,7 @@ struct NeedleOptions {
     visit("max_rearrangements", &NeedleOptions::max_rearrangements);
     visit("solves_per_update", &NeedleOptions::solves_per_update);
     visit("extrapolate", &NeedleOptions::extrapolate);
+    visit("extension_rings", &NeedleOptions::extension_rings);
     visit("friction_channel", &NeedleOptions::friction_channel);
   }
 };
@@ -86,6 +91,8 @@ struct NeedleStepReport {
   int rearrangements = 0;        // solves in this update (each followed by a rearrangement)
   int slipped = 0, stuck = 0, released = 0, intercepted = 0;  // state changes in this update
   int cells_split = 0;
+  int extensions = 0;            // moves carried into the tissue (NeedleOptions::extension_rings)
+  int halvings = 0;              // moves halved because they would start the solve inverted
   int solver_iterations = 0;     // total over the solves
   int max_solver_iterations = 0;
   bool converged = true;         // every solve converged and the rearrangements settled
@@ -104,6 +111,8 @@ struct NeedleStepReport {
     visit("released", &NeedleStepReport::released);
     visit("intercepted", &NeedleStepReport::intercepted);
     visit("cells_split", &NeedleStepReport::cells_split);
+    visit("extensions", &NeedleStepReport::extensions);
+    visit("halvings", &NeedleStepReport::halvings);
     visit("converged", &NeedleStepReport::converged);
     visit("settled", &NeedleStepReport::settled);
     visit("reason", &NeedleStepReport::reason);
@@ -160,6 +169,8 @@ class NeedleInsertion : public ConnectivityWatcher {
   // Fixes v at its current displacement (u: the state).
   void fix_where_it_is(VertexId v, std::span<const double> u);
   void refine_at_tip();
+  // Carries a move of the sticking nodes into the vertices around them (move_extension.hpp).
+  void extend_move(double distance);
   int intercept_nodes();
   // Makes v a sticking needle node if it is free, not one already and the tip has passed it.
   int catch_node(VertexId v, std::span<const double> u);

@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 import snede
+from needle_checks import check_thresholds, threshold_tolerance
 
 SIZE = 0.1  # the thesis's 10 cm cube, fixed at the bottom, needle from the left
 RADIUS = 0.002
@@ -82,17 +83,8 @@ def test_after_every_update_thresholds_hold_and_the_needle_balances_the_support(
         step = needle.advance(0.5 * H_REF)
         assert step.converged, step
         u = body.displacement
-        g = -body.internal_forces(u) - body.external_forces()
-        along = g[needle.needle_nodes] @ needle.direction
-        elastic = -along - needle.friction
-        stick = needle.sticking
-        reactions = body.reaction_forces()
-        reactions[needle.needle_nodes] = needle.needle_forces()
-        floor = 34e3 * SIZE ** 2 * np.sqrt(3) / np.sqrt(u.size) * 1e-8  # E·H²/√n·ε_round
-        tolerance = 2 * (rtol * np.sqrt(np.sum(body.external_forces() ** 2) + np.sum(reactions ** 2)) + floor)
-        assert np.all(np.abs(along[stick]) <= needle.static_thresholds[stick] + tolerance)
-        np.testing.assert_allclose(np.abs(elastic[~stick]), needle.dynamic_thresholds[~stick], atol=tolerance)
-        n_slipping += (~stick).sum()
+        tolerance = threshold_tolerance(body, needle, rtol, 34e3, SIZE)
+        n_slipping += check_thresholds(body, needle, tolerance)
         # The needle's forces balance the reactions of the fixed bottom face.
         total = needle.needle_forces().sum(axis=0) + body.reaction_forces()[bottom(body)].sum(axis=0)
         assert np.abs(total).max() <= np.sqrt(u.size) * tolerance
