@@ -87,7 +87,7 @@ def thesis_size_table() -> None:
               f"{seconds:.2f} s, {report.updates / seconds:.1f} updates/s", flush=True)
 
 
-ORGAN_BODIES = ("liver 10k", "liver 20k", "liver2 20k")  #: gmsh-filled public surfaces (organ_meshes.py)
+ORGAN_BODIES = ("liver 10k", "liver 20k", "liver2 20k", "heart 10k", "heart 20k")  #: gmsh-filled public surfaces (organ_meshes.py)
 
 
 def organ(name: str, material):
