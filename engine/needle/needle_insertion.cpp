@@ -191,19 +191,19 @@ void NeedleInsertion::move_needle(double distance) {
 }
 
 NeedleStepReport NeedleInsertion::advance_in_steps(double distance, int halvings) {
-  SNEDE_PETSC(VecCopy(model_.displacement(), start_));
   move_needle(distance);
   // A move that drags sticking nodes across their neighbours would start the solve from
   // inverted elements, which a material forbidding inversion cannot relax: carry the move into
   // the tissue around them, else move in halves.
   bool extended = false;
   if (distance > 0 && !model_.admissible(model_.displacement()) && options_.extension_rings > 0) {
+    SNEDE_PETSC(VecCopy(model_.displacement(), start_));  // the move without its extension
     extend_move(distance);
     extended = true;
   }
   if (distance > 0 && halvings < max_halvings && !model_.admissible(model_.displacement())) {
+    if (extended) SNEDE_PETSC(VecCopy(start_, model_.displacement()));
     move_needle(-distance);
-    SNEDE_PETSC(VecCopy(start_, model_.displacement()));
     NeedleStepReport first = advance_in_steps(0.5 * distance, halvings + 1);
     first.halvings += 1;
     if (!first.converged) return first;
