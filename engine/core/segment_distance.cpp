@@ -101,9 +101,8 @@ double segment_simplex_distance(const Point3& a, const Point3& b, std::span<cons
     throw std::invalid_argument("segment_simplex_distance: a simplex has 3 or 4 corners, got " +
                                 std::to_string(corners.size()));
   if (tetrahedron_contains(a, corners) || tetrahedron_contains(b, corners)) return 0;
-  const std::span<const Point3>& t = corners;
-  return std::min({segment_triangle_distance(a, b, t[1], t[2], t[3]), segment_triangle_distance(a, b, t[0], t[2], t[3]),
-                   segment_triangle_distance(a, b, t[0], t[1], t[3]), segment_triangle_distance(a, b, t[0], t[1], t[2])});
+  const auto face = [&](int i, int j, int k) { return segment_triangle_distance(a, b, corners[i], corners[j], corners[k]); };
+  return std::min({face(1, 2, 3), face(0, 2, 3), face(0, 1, 3), face(0, 1, 2)});
 }
 
 }  // namespace snede

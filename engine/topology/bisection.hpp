@@ -2,9 +2,9 @@
 // simplexes ([62]), which in 2D on right triangles is the thesis's hypotenuse (longest-edge,
 // newest-vertex) bisection and in 3D on the Kuhn box keeps every element in one of 3
 // similarity classes; other 3D meshes get longest-edge bisection (initial_labelling.hpp),
-// whose closure stays near the refined region. Every change goes through Connectivity::replace_elements; new
-// midpoints are added with Mesh::add_vertex first, so watchers (the model) carry the state
-// over to them (§7.4).
+// whose closure stays near the refined region. Every change goes through
+// Connectivity::replace_elements; new midpoints are added with Mesh::add_vertex first, so
+// watchers (the model) carry the state over to them (§7.4).
 #pragma once
 
 #include <cstddef>
