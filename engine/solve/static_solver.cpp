@@ -94,6 +94,31 @@ void configure_gamg(PC pc, const std::string& pc_type) {
   if (pc_type == PCGAMG) SNEDE_PETSC(PCGAMGSetUseSAEstEig(pc, PETSC_FALSE));
 }
 
+// KSPReset and SNESReset keep a KSP's initial-guess object (-<prefix>ksp_guess_type fischer or
+// pod) with the vectors of the mesh before a change: the first solve after a needle's
+// refinement failed with PETSc error 75 ("Incompatible vector local lengths"). An empty guess of
+// the same type, read from the solver's options again, replaces it.
+void renew_initial_guess(KSP ksp, const SolverOptions& options) {
+  const char* prefix = nullptr;
+  SNEDE_PETSC(KSPGetOptionsPrefix(ksp, &prefix));
+  // KSPGetGuess would give a KSP without one an empty guess, which KSPSolve then consults.
+  if (!options.string_option(std::string(prefix ? prefix : "") + "ksp_guess_type")) return;
+  KSPGuess kept = nullptr;
+  SNEDE_PETSC(KSPGetGuess(ksp, &kept));
+  KSPGuessType type = nullptr;
+  SNEDE_PETSC(KSPGuessGetType(kept, &type));
+  if (!type) return;
+  const std::string kept_type = type;
+  KSPGuess fresh = nullptr;
+  SNEDE_PETSC(KSPGuessCreate(PetscObjectComm(reinterpret_cast<PetscObject>(ksp)), &fresh));
+  options.use_for(fresh);
+  SNEDE_PETSC(PetscObjectSetOptionsPrefix(reinterpret_cast<PetscObject>(fresh), prefix));
+  SNEDE_PETSC(KSPGuessSetType(fresh, kept_type.c_str()));
+  SNEDE_PETSC(KSPGuessSetFromOptions(fresh));
+  SNEDE_PETSC(KSPSetGuess(ksp, fresh));  // the KSP holds its own reference
+  SNEDE_PETSC(KSPGuessDestroy(&fresh));
+}
+
 Model* serial_model(Problem& problem) {
   auto* serial = dynamic_cast<ModelProblem*>(&problem);
   return serial ? &serial->model() : nullptr;
@@ -417,6 +442,7 @@ void StaticSolver::make_structures_for_mesh(bool resized) {
     SNEDE_PETSC(SNESSetFunction(snes_, residual_, residual_callback, this));
     SNEDE_PETSC(SNESSetJacobian(snes_, problem_.tangent(), preconditioning_matrix(), jacobian_callback, this));
   }
+  renew_initial_guess(ksp(), option_database_);
   if (needs_matrix_ || pc_type_ == PCMG) {
     // A reset PCGAMG keeps its levels' sizes ("Cannot change local size of Amat after use"):
     // a fresh implementation of the same type, configured from the options again.
