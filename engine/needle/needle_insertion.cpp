@@ -83,6 +83,14 @@ NeedleInsertion::NeedleInsertion(Model& model, Bisection* bisection, const Point
   const OptionList& given = solver_options.petsc_options;
   if (std::none_of(given.begin(), given.end(), [](const auto& option) { return option.first == "mg_coarsening"; }))
     solver_options.petsc_options.emplace_back("mg_coarsening", "grid");
+  // A planar needle's linear CG solves a small correction per update (20–40 iterations without a
+  // preconditioner at ε = 1e-3 on the §6.8.1 slab, 170–1 300 from rest), while refinement and
+  // stick-slip change its system at nearly every update, and multigrid's levels with it: no
+  // preconditioner was 1.25–2.4× faster up to 4 000 triangles, the two even (0.96–1.06) at
+  // 10 000–12 500 (studies/benchmarks/needle_rates.py --crossover). Newton keeps its levels
+  // across stick-slip and gained from them at 1 300 triangles already: its default stays.
+  if (dim_ == 2 && solver_options.method == StaticMethod::linear_cg)
+    solver_options.multigrid_from_cells = planar_linear_multigrid_from_cells;
   solver_ = std::make_unique<StaticSolver>(model_, std::move(solver_options),
                                            bisection_ ? &bisection_->hierarchy() : nullptr);
   node_of_vertex_.assign(mesh.n_points(), -1);

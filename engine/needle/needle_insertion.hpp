@@ -32,6 +32,7 @@
 
 #include <petscvec.h>
 
+#include <cstdint>
 #include <memory>
 #include <optional>
 #include <string>
@@ -129,6 +130,8 @@ class NeedleInsertion : public ConnectivityWatcher {
   // not positive in 3D or not 0 in 2D, or bad options.
   NeedleInsertion(Model& model, Bisection* bisection, const Point& entry, const Point& direction,
                   FrictionProfile friction, NeedleOptions options, StaticOptions solver_options);
+  // Where "auto" starts multigrid for a 2D needle solved by linear CG (the constructor says why).
+  static constexpr std::int64_t planar_linear_multigrid_from_cells = 10000;
   ~NeedleInsertion() override;
   NeedleInsertion(const NeedleInsertion&) = delete;
   NeedleInsertion& operator=(const NeedleInsertion&) = delete;

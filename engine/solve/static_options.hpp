@@ -2,6 +2,7 @@
 // iteration cap, the options prefix, the preconditioner and the solver's own PETSc options.
 #pragma once
 
+#include <cstdint>
 #include <string>
 
 #include "core/enum_names.hpp"
@@ -37,9 +38,16 @@ struct StaticOptions {
   // background grid with virtual nodes or by aggregation, Galerkin levels from an assembled
   // tangent; -<prefix>mg_coarsening auto|bisection|grid|aggregation chooses) or any PETSc PC
   // that works on an assembled matrix ("ilu", "icc", ...).
-  // "auto": "mg" for cg and newton on volume meshes of 1 000 cells or more, else "none".
+  // "auto": "mg" for cg and newton from multigrid_from_cells cells on, else "none".
   // Empty: -<prefix>pc_type if given, else "auto". -<prefix>pc_type on the command line wins.
   std::string preconditioner;
+  // Where "auto" starts multigrid. A solve from rest: on the cantilever block
+  // (studies/benchmarks/static_solve_scaling.py, docs/results/interactive.md) mg and no
+  // preconditioner cost the same at about 650 cells, mg is 1.3× faster at 1 500, 2–3× at
+  // 5 000–40 000; membranes 1.3–5× faster from 1 000 triangles on sheets and organ skins (a slack
+  // sheet loaded across its plane excepted), mixed below. A loop of small corrections whose
+  // system changes at most solves sets its own (needle_insertion.cpp).
+  std::int64_t multigrid_from_cells = 1000;
   OptionList petsc_options;  // this solver's PETSc options, without the prefix
 
   // Every setting with its name (the stopping rule's by theirs; force_scale and n_dofs are the

@@ -61,14 +61,6 @@ constexpr PetscInt newton_finish_steps = 10;
 // ‖F‖ changed by less than this fraction over a Newton iteration: a stalled line search.
 constexpr double newton_stall = 1e-6;
 
-// "auto": multigrid where it pays. On the cantilever block (studies/benchmarks/static_solve_scaling.py
-// and docs/results/interactive.md) mg and no preconditioner cost the same at about 650 cells,
-// mg is 1.3× faster at 1 500, 2–3× at 5 000–40 000. Membranes (docs/results/interactive.md):
-// 1.3–5× faster from 1 000 triangles on sheets and organ skins (a slack sheet loaded across its
-// plane excepted); below, mixed (2× faster on a box's skin of 144, 2× slower on organ skins of
-// 600–700). Nonlinear CG takes none.
-constexpr std::size_t multigrid_from_cells = 1000;
-
 // Whether "mg" has levels for the problem: serially on any mesh; on ranks on volume meshes only
 // (rank_aggregation.hpp aggregates no membrane).
 bool has_multigrid(const Problem& problem) {
@@ -76,9 +68,10 @@ bool has_multigrid(const Problem& problem) {
   return !distributed || distributed->part().local->cell_dim() == problem.dim();
 }
 
-std::string automatic_preconditioner(const Problem& problem, StaticMethod method) {
-  if (method == StaticMethod::nonlinear_cg ||
-      problem.n_global_cells() < static_cast<std::int64_t>(multigrid_from_cells) || !has_multigrid(problem))
+// "auto": multigrid from options.multigrid_from_cells (static_options.hpp), never for nonlinear CG.
+std::string automatic_preconditioner(const Problem& problem, const StaticOptions& options) {
+  if (options.method == StaticMethod::nonlinear_cg || problem.n_global_cells() < options.multigrid_from_cells ||
+      !has_multigrid(problem))
     return PCNONE;
   return PCMG;
 }
@@ -183,7 +176,7 @@ StaticSolver::StaticSolver(std::unique_ptr<ModelProblem> owned, Problem* problem
                  .value_or(options_.preconditioner.empty() ? std::string("auto") : options_.preconditioner);
   if (pc_type_ == "auto") {
     automatic_ = true;
-    pc_type_ = automatic_preconditioner(problem_, options_.method);
+    pc_type_ = automatic_preconditioner(problem_, options_);
     // -<prefix>pc_type auto is snede's: PETSc, which reads the option again, must see the choice.
     if (option_database_.string_option(options_.options_prefix + "pc_type"))
       option_database_.set_string_option(options_.options_prefix + "pc_type", pc_type_);
@@ -358,7 +351,7 @@ void StaticSolver::follow_mesh_changes() {
   // A needle's refinement grows a mesh of a few hundred cells, where "auto" chose no
   // preconditioner, past the size where multigrid pays (and collapses or removed pieces may
   // shrink one): choose again, with solver objects made afresh for the new choice.
-  if (automatic_ && automatic_preconditioner(problem_, options_.method) != pc_type_) {
+  if (automatic_ && automatic_preconditioner(problem_, options_) != pc_type_) {
     choose_preconditioner_again();
     return;
   }
@@ -621,7 +614,7 @@ Model& StaticSolver::model() {
 
 void StaticSolver::choose_preconditioner_again() {
   const std::string previous = pc_type_;
-  pc_type_ = automatic_preconditioner(problem_, options_.method);
+  pc_type_ = automatic_preconditioner(problem_, options_);
   // The levels are made before the solver's objects are replaced: an option they refuse (the
   // -<prefix>mg_ options are checked only once mg is chosen) leaves the solver as it was, and
   // the next solve refuses it again.

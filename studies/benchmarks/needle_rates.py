@@ -1,7 +1,7 @@
 """Benchmark: Table 6.5 — update rates of an automated needle insertion (§6.8.5).
 
     .venv/bin/python studies/benchmarks/needle_rates.py [--quick] [--rtol 1e-3,0.03] [--method cg|ncg|newton]
-                                                [--loop thesis|settle] [--scan] [--markdown]
+                                                [--loop thesis|settle] [--scan] [--crossover] [--markdown]
                                                 [PETSc options, e.g. -log_view]
 
 The §6.8.1 slab (h_start = h3, scenes/needle_slab.py) with the needle inserted to 70 mm at
@@ -18,7 +18,8 @@ against issue 33's goals (≥ 50× in every row at ε = 1e-3, ≥ 1 kHz at h7).
 The relaxation tolerance ε of (6.9): the table is timed at ε = 1e-3 (the issue's) and at
 ε = 0.03, where our CG counts are the thesis's (the thesis states neither; --rtol takes a
 list). --scan finds that ε: the geometric mean over the 12 rows of our mean CG iterations over
-the thesis's, for several ε. --markdown writes the rows (and needle_rates.png) into
+the thesis's, for several ε. --crossover times the insertion with no preconditioner and with
+multigrid on slabs refined to 1 300–12 500 triangles: where the needle's "auto" starts multigrid. --markdown writes the rows (and needle_rates.png) into
 docs/results/needle.md's Table 6.5 section, the one studies.experiments.needle generates.
 
 Then one row (h6, 0.1 h_ref per update, the first ε) again with PETSc's event log, to show
@@ -87,6 +88,34 @@ def scan(args):
         print(f"{rtol:>6g} {cg_ratio(rows):>9.2f}   " + " ".join(f"{r['mean_iterations']:.1f}" for r in rows), flush=True)
 
 
+# Slab h_start, h_ref and speed (h_ref per update) of the crossover rows: the meshes grow from
+# about 1 300 to 12 500 triangles.
+CROSSOVER_ROWS = ((3, 7, 1.0), (3, 8, 1.0), (3, 8, 0.3), (5, 8, 1.0), (6, 8, 1.0), (6, 9, 1.0))
+
+
+def crossover(args):
+    """Where multigrid starts to pay in the planar needle's loop (NeedleInsertion's
+    planar_linear_multigrid_from_cells): the insertion to 70 mm with no preconditioner and with
+    multigrid, CPU µs per solve, on slabs refined to growing sizes."""
+    rtol = args.tolerances[0]
+    print(f"Linear CG, ε = {rtol:g}, one solve per update: no preconditioner against multigrid")
+    print(f"{'slab':>6} {'h_ref':>5} {'speed':>5} {'cells':>6} | {'none µs/solve':>13} {'CG':>6} | "
+          f"{'mg µs/solve':>11} {'CG':>5} | {'mg/none':>7}")
+    for h_start, h_ref, speed in CROSSOVER_ROWS:
+        measured = {}
+        for pc in ("none", "mg"):
+            body = slab_body(h_start)
+            needle = needle_for(body, h_ref, rtol=rtol, solves_per_update=1, petsc_options={"pc_type": pc})
+            cpu = time.process_time()
+            report = needle.insert(DEPTH, speed * h(h_ref))
+            cpu = time.process_time() - cpu
+            state = "" if report.converged else f" NOT converged: {report.reason}"
+            measured[pc] = (1e6 * cpu / report.rearrangements, report.mean_iterations, body.mesh.n_cells, state)
+        (none, none_cg, cells, none_state), (mg, mg_cg, _, mg_state) = measured["none"], measured["mg"]
+        print(f"{'h' + str(h_start):>6} {'h' + str(h_ref):>5} {speed:>5.1f} {cells:>6} | {none:>13.0f} {none_cg:>6.1f} | "
+              f"{mg:>11.0f} {mg_cg:>5.1f} | {mg / none:>7.2f}{none_state}{mg_state}", flush=True)
+
+
 def event_seconds(name: str) -> float:
     return PETSc.Log.Event(name).getPerfInfo()["time"]
 
@@ -127,6 +156,8 @@ def main():
     parser.add_argument("--loop", choices=("thesis", "settle"), default="thesis",
                         help="thesis: one solve per update (§6.7); settle: relax until no node changes (default thesis)")
     parser.add_argument("--scan", action="store_true", help="find the ε whose CG counts are the thesis's")
+    parser.add_argument("--crossover", action="store_true",
+                        help="no preconditioner against multigrid on slabs refined to 1 300-12 500 triangles")
     parser.add_argument("--markdown", action="store_true",
                         help="write the rows into docs/results/needle.md's Table 6.5 section and needle_rates.png")
     args, _ = parser.parse_known_args()  # the rest is PETSc's (-log_view)
@@ -139,6 +170,9 @@ def main():
           f"loop: {args.loop}")
     if args.scan:
         scan(args)
+        return
+    if args.crossover:
+        crossover(args)
         return
     print(f"{'ε':<6} {'':>4} {'speed':>5} {'updates':>7} {'cells':>6} {'CPU s':>7} {'rearr.':>7} {'Hz':>7} "
           f"{'CG avg':>7} {'max':>6} | {'thesis':>6} {'rearr.':>7} {'Hz':>7} {'CG avg':>7} {'max':>6} | "

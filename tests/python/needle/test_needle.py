@@ -190,3 +190,23 @@ def test_every_nonlinear_material_inserts_with_newton_and_keeps_the_thresholds(m
     stick = needle.sticking
     assert np.all(np.abs(along[stick]) <= needle.static_thresholds[stick] * (1 + 1e-4))
     assert len(body.inverted_elements(body.displacement)) == 0
+
+
+def test_a_planar_needle_by_linear_cg_takes_no_multigrid_below_ten_thousand_triangles():
+    # Its small corrections per update were faster without multigrid's levels, made again at
+    # nearly every update, up to 4 000 triangles (studies/benchmarks/needle_rates.py --crossover);
+    # Newton keeps its levels across stick-slip and a solve from rest gains from them: both
+    # take multigrid on the same 2 048 triangles.
+    sources = {}
+    for method, material in (("cg", None), ("newton", snede.NeoHookean(34e3, 0.34))):
+        body = slab_body(5, material)
+        assert 1000 < body.mesh.n_cells < 10000
+        needle = needle_for(body, 6, method=method)
+        for _ in range(3):
+            assert needle.advance(h(6)).converged
+        sources[method] = needle.multigrid_source
+    body = slab_body(5)
+    body.add_gravity((0.0, -9.81))
+    solver = snede.StaticSolver(body, "cg")
+    assert solver.solve().converged
+    assert sources == {"cg": "", "newton": "grid"} and solver.multigrid_source == "grid"
