@@ -1,7 +1,7 @@
 #include "bindings.hpp"
 #include "record_binding.hpp"
 #include "cutting/tetrahedral_cutter.hpp"
-#include "solve/cut_model_adapter.hpp"
+#include "cut_model_adapter.hpp"
 
 #include <pybind11/stl.h>
 

@@ -1,9 +1,9 @@
 #include "bindings.hpp"
 #include "core/rank_agreement.hpp"
 #include "mesh/distributed_mesh.hpp"
-#include "solve/dynamic_relaxation.hpp"
-#include "solve/distributed_static.hpp"
-#include "solve/model.hpp"
+#include "solvers/dynamic_relaxation.hpp"
+#include "problem/distributed_static.hpp"
+#include "problem/model.hpp"
 
 #include <pybind11/stl.h>
 

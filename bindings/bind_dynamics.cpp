@@ -1,8 +1,8 @@
 #include "bindings.hpp"
 #include "petsc4py_interop.hpp"
 #include "record_binding.hpp"
-#include "solve/distributed_static.hpp"
-#include "solve/dynamic_relaxation.hpp"
+#include "problem/distributed_static.hpp"
+#include "solvers/dynamic_relaxation.hpp"
 
 #include <pybind11/stl.h>
 

@@ -1,7 +1,7 @@
 #include "bindings.hpp"
 #include "record_binding.hpp"
 #include "cutting/delaunay_cutter.hpp"
-#include "solve/cut_model_adapter.hpp"
+#include "cut_model_adapter.hpp"
 
 namespace snede::bindings {
 

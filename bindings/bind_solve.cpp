@@ -3,12 +3,12 @@
 #include "core/petsc_util.hpp"
 #include "petsc4py_interop.hpp"
 #include "record_binding.hpp"
-#include "solve/model.hpp"
-#include "solve/piece_holding.hpp"
-#include "solve/problem.hpp"
-#include "solve/solve_result.hpp"
-#include "solve/static_solver.hpp"
-#include "solve/tangent_assembly.hpp"
+#include "problem/model.hpp"
+#include "problem/piece_holding.hpp"
+#include "problem/problem.hpp"
+#include "solvers/solve_result.hpp"
+#include "solvers/static_solver.hpp"
+#include "problem/tangent_assembly.hpp"
 #include "topology/bisection.hpp"
 
 #include <pybind11/stl.h>

@@ -1,6 +1,6 @@
 #include "bindings.hpp"
 #include "cutting/surface_cutter.hpp"
-#include "solve/cut_model_adapter.hpp"
+#include "cut_model_adapter.hpp"
 
 namespace snede::bindings {
 

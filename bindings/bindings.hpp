@@ -11,7 +11,7 @@
 #include "core/solver_options.hpp"
 #include "fem/material.hpp"
 #include "mesh/vertex_parents.hpp"
-#include "solve/static_solver.hpp"
+#include "solvers/static_solver.hpp"
 
 namespace snede::bindings {
 

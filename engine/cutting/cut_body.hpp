@@ -1,6 +1,6 @@
 // What a cutter asks of the simulation running on the mesh it cuts. The cutters sit below the
 // solvers: they see the body only through these calls, which a caller with a model fills
-// (the solve layer's cut_model_adapter) and a bare mesh leaves empty (cut as it is, no supports).
+// (bindings/cut_model_adapter, where the two layers meet) and a bare mesh leaves empty (cut as it is, no supports).
 #pragma once
 
 #include <functional>

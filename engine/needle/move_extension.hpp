@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "mesh/mesh.hpp"
-#include "solve/constraints.hpp"
+#include "problem/constraints.hpp"
 
 namespace snede {
 

@@ -40,7 +40,7 @@
 
 #include "needle/deformed_queries.hpp"
 #include "needle/friction_profile.hpp"
-#include "solve/static_solver.hpp"
+#include "solvers/static_solver.hpp"
 #include "topology/bisection.hpp"
 
 namespace snede {

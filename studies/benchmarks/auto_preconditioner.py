@@ -6,7 +6,7 @@ The cantilever block 0.4 × 0.1 × 0.1 m (Kuhn boxes 4n × n × n, no bisection 
 coarsens by aggregation), clamped at x = 0, gravity, rtol 1e-6, solved from rest: linear CG on
 LinearElastic (E = 100 kPa, ν = 0.3) and Newton on NeoHookean (E = 30 kPa, ν = 0.3), each with
 no preconditioner and with mg, best of 3 runs. The last column is none's time over mg's: above 1
-mg is faster. "auto" picks mg from 1 000 cells (StaticOptions::multigrid_from_cells, engine/solve/static_options.hpp).
+mg is faster. "auto" picks mg from 1 000 cells (StaticOptions::multigrid_from_cells, engine/solvers/static_options.hpp).
 """
 import time
 import warnings

@@ -16,7 +16,7 @@
 #include "fem/linear_elastic.hpp"
 #include "mesh/fixtures.hpp"
 #include "mesh/mesh.hpp"
-#include "solve/model.hpp"
+#include "problem/model.hpp"
 #include "topology/local_star.hpp"
 #include "topology/refinement_checks.hpp"
 

@@ -3,7 +3,7 @@ the first solve. The assembled tangent's sparsity, the grid levels and the piece
 each cut (only what the cut touched is found again), and a linear material's tangent is made from
 the earlier one; the reference (``-static_rebuild_after_edits``) makes all of them anew after
 every cut. Both reach the same state. (Each structure against its rebuild, entry by entry, after
-random edits: tests/cpp/solve/test_tangent_follows_edits.cpp, test_grid_levels_follow_edits.cpp,
+random edits: tests/cpp/problem/test_tangent_follows_edits.cpp, test_grid_levels_follow_edits.cpp,
 test_piece_holding_follows_edits.cpp.)"""
 import numpy as np
 import pytest

@@ -158,7 +158,7 @@ def test_after_new_elements_a_linear_tangent_is_made_from_the_earlier_one():
     element's matrix is assembled once; the levels made from it are those of the reference that
     assembles anew after each edit (the same CG iterations, ± 1 for round-off) and reach its
     answer. (The made tangent against one assembled anew, entry by entry and for every material:
-    tests/cpp/solve/test_tangent_follows_edits.cpp.)"""
+    tests/cpp/problem/test_tangent_follows_edits.cpp.)"""
     followed, followed_results, followed_state = split_and_solve(snede.LinearElastic)
     reference, reference_results, reference_state = split_and_solve(snede.LinearElastic, rebuild_after_edits="true")
     assert all(r.converged for r in followed_results + reference_results)
@@ -185,7 +185,7 @@ def test_after_new_elements_grid_levels_are_made_from_the_earlier_ones(material)
     first build (issue 49): only the node copies the edit reached are found again. They are the
     levels the reference makes from scratch on that grid, so both take the same Newton
     iterations and CG (± 1 for round-off) to the same answer. (Entry by entry after random edits:
-    tests/cpp/solve/test_grid_levels_follow_edits.cpp.)"""
+    tests/cpp/multigrid/test_grid_levels_follow_edits.cpp.)"""
     followed, followed_results, followed_state = split_and_solve(material)
     reference, reference_results, reference_state = split_and_solve(material, rebuild_after_edits="true")
     assert all(r.converged for r in followed_results + reference_results)

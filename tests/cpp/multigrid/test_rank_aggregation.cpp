@@ -1,0 +1,329 @@
+// rank_aggregation_levels' interpolations by their invariants, on boxes distributed over
+// MPI_COMM_WORLD: one rank in the discovered tests, 2 and 3 in rank_aggregation_mpi2/3
+// (CMakeLists.txt). On every rank: its rows of each interpolation reach only its own columns,
+// every rigid motion restricted to the free dofs is the interpolation of some coarse vector
+// (to round-off) from every level, fixed dofs' rows are zero, the columns are independent, and
+// the levels shrink. Then CG preconditioned by PCMG on these levels against Jacobi's CG on an
+// elastic box's assembled tangent. Every check reduces over the ranks first, so all ranks
+// reach the same verdict and make the same collective calls.
+#include <gtest/gtest.h>
+
+#include <Eigen/Dense>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <limits>
+#include <string>
+#include <tuple>
+#include <vector>
+
+#include "core/error.hpp"
+#include "fem/elastic_body.hpp"
+#include "fem/linear_elastic.hpp"
+#include "mesh/distributed_mesh.hpp"
+#include "mesh/fixtures.hpp"
+#include "problem/distributed_assembly.hpp"
+#include "multigrid/rank_aggregation.hpp"
+
+using namespace snede;
+
+namespace {
+
+using Matrix = Eigen::MatrixXd;
+
+int world_rank() {
+  int rank = 0;
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  return rank;
+}
+
+// The unit square (n × n squares, two triangles each) or cube (n³ Kuhn-split cubes).
+Mesh unit_box(int dim, int n) {
+  const std::vector<std::vector<VertexId>> cells = dim == 2 ? snede::testing::grid_triangles(n, n) : snede::testing::kuhn_box(n);
+  std::vector<double> points;
+  for (int i = 0; i <= n; ++i)
+    for (int j = 0; j <= n; ++j) {
+      if (dim == 2) {
+        points.insert(points.end(), {double(i) / n, double(j) / n});
+        continue;
+      }
+      for (int k = 0; k <= n; ++k) points.insert(points.end(), {double(i) / n, double(j) / n, double(k) / n});
+    }
+  std::vector<std::int64_t> flat;
+  for (const auto& cell : cells) flat.insert(flat.end(), cell.begin(), cell.end());
+  return Mesh(dim, dim, std::move(points), flat);
+}
+
+// Collective: the box distributed over MPI_COMM_WORLD.
+DistributedMesh distributed_box(int dim, int n) {
+  const Mesh serial = unit_box(dim, n);
+  return distribute_mesh(MPI_COMM_WORLD, world_rank() == 0 ? &serial : nullptr);
+}
+
+// 1 on every dof of the local vertices on the face y = 0.
+std::vector<std::uint8_t> bottom_fixed(const DistributedMesh& part) {
+  const int d = part.local->dim();
+  std::vector<std::uint8_t> fixed(static_cast<std::size_t>(part.local->n_points()) * d, 0);
+  for (VertexId v = 0; v < part.local->n_points(); ++v)
+    if (part.local->point(v)[1] == 0)
+      for (int k = 0; k < d; ++k) fixed[static_cast<std::size_t>(v) * d + k] = 1;
+  return fixed;
+}
+
+// This rank's rows and columns of P, dense; entries in other ranks' columns are counted.
+Matrix local_block(Mat P, std::size_t& off_rank_entries) {
+  PetscInt row_start = 0, row_end = 0, column_start = 0, column_end = 0;
+  SNEDE_PETSC(MatGetOwnershipRange(P, &row_start, &row_end));
+  SNEDE_PETSC(MatGetOwnershipRangeColumn(P, &column_start, &column_end));
+  Matrix block = Matrix::Zero(row_end - row_start, column_end - column_start);
+  for (PetscInt r = row_start; r < row_end; ++r) {
+    PetscInt n_entries = 0;
+    const PetscInt* columns = nullptr;
+    const PetscScalar* values = nullptr;
+    SNEDE_PETSC(MatGetRow(P, r, &n_entries, &columns, &values));
+    for (PetscInt e = 0; e < n_entries; ++e) {
+      if (columns[e] < column_start || columns[e] >= column_end) {
+        ++off_rank_entries;
+        continue;
+      }
+      block(r - row_start, columns[e] - column_start) = values[e];
+    }
+    SNEDE_PETSC(MatRestoreRow(P, r, &n_entries, &columns, &values));
+  }
+  return block;
+}
+
+// The body's rigid motions (translations, then rotations about the origin) at this rank's
+// rows of the fine level (owned vertex v's dof k at global_number[v]·dim + k), zero on fixed dofs.
+Matrix free_rigid_modes(const DistributedMesh& part, const std::vector<std::uint8_t>& fixed, PetscInt row_start) {
+  const int d = part.local->dim(), n_modes = d == 3 ? 6 : 3;
+  std::size_t n_owned = 0;
+  for (std::uint8_t owned : part.owned) n_owned += owned;
+  Matrix modes = Matrix::Zero(static_cast<Eigen::Index>(n_owned) * d, n_modes);
+  for (VertexId v = 0; v < part.local->n_points(); ++v) {
+    if (!part.owned[v]) continue;
+    const auto x = part.local->point(v);
+    Eigen::Matrix<double, 3, 6> motion = Eigen::Matrix<double, 3, 6>::Zero();
+    motion.leftCols(3).setIdentity();
+    if (d == 3) {
+      // ω × x for ω = e_0, e_1, e_2.
+      motion.col(3) << 0, -x[2], x[1];
+      motion.col(4) << x[2], 0, -x[0];
+      motion.col(5) << -x[1], x[0], 0;
+    } else {
+      motion(0, 2) = -x[1];
+      motion(1, 2) = x[0];
+    }
+    for (int k = 0; k < d; ++k) {
+      if (fixed[static_cast<std::size_t>(v) * d + k]) continue;
+      const Eigen::Index row = part.global_number[v] * d + k - row_start;
+      for (int m = 0; m < n_modes; ++m) modes(row, m) = motion(k, m);
+    }
+  }
+  return modes;
+}
+
+// What examine() finds over all ranks.
+struct Findings {
+  double worst_rigid_residual = 0;          // ‖C c − r‖ / ‖r‖ at the least-squares c, any level and mode
+  double smallest_gram_eigenvalue = std::numeric_limits<double>::infinity();  // of CᵀC over the levels
+  double largest_fixed_row_entry = 0;
+  std::uint64_t off_rank_entries = 0;
+  std::uint64_t layout_mismatches = 0;      // a level's columns on a rank that are not the coarser level's rows
+};
+
+// Collective. C_l, the interpolation from level l to the fine one, restricted to this rank's
+// rows and columns (the product of the ranks' diagonal blocks, which is all of it when no
+// entry is off the rank), checked level by level and reduced over the ranks.
+Findings examine(const DistributedMesh& part, const std::vector<std::uint8_t>& fixed, const RankAggregationLevels& levels) {
+  Findings local;
+  const int d = part.local->dim();
+  PetscInt row_start = 0, row_end = 0;
+  SNEDE_PETSC(MatGetOwnershipRange(levels.interpolations.back(), &row_start, &row_end));
+  const Matrix modes = free_rigid_modes(part, fixed, row_start);
+  local.layout_mismatches += modes.rows() != row_end - row_start;
+  Matrix C = Matrix::Identity(row_end - row_start, row_end - row_start);
+  for (auto P = levels.interpolations.rbegin(); P != levels.interpolations.rend(); ++P) {
+    std::size_t off_rank = 0;
+    const Matrix block = local_block(*P, off_rank);
+    local.off_rank_entries += off_rank;
+    if (block.rows() != C.cols()) {
+      ++local.layout_mismatches;
+      break;
+    }
+    C = C * block;
+    if (C.cols() == 0) continue;
+    const Eigen::ColPivHouseholderQR<Matrix> least_squares(C);
+    for (Eigen::Index m = 0; m < modes.cols(); ++m) {
+      if (modes.col(m).norm() == 0) continue;
+      const Eigen::VectorXd c = least_squares.solve(modes.col(m));
+      local.worst_rigid_residual = std::max(local.worst_rigid_residual, (C * c - modes.col(m)).norm() / modes.col(m).norm());
+    }
+    const Eigen::SelfAdjointEigenSolver<Matrix> gram(C.transpose() * C, Eigen::EigenvaluesOnly);
+    local.smallest_gram_eigenvalue = std::min(local.smallest_gram_eigenvalue, gram.eigenvalues().minCoeff());
+    for (VertexId v = 0; v < part.local->n_points(); ++v)
+      for (int k = 0; k < d; ++k)
+        if (part.owned[v] && fixed[static_cast<std::size_t>(v) * d + k])
+          local.largest_fixed_row_entry = std::max(local.largest_fixed_row_entry,
+                                                   C.row(part.global_number[v] * d + k - row_start).cwiseAbs().maxCoeff());
+  }
+  Findings all;
+  MPI_Allreduce(&local.worst_rigid_residual, &all.worst_rigid_residual, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
+  MPI_Allreduce(&local.smallest_gram_eigenvalue, &all.smallest_gram_eigenvalue, 1, MPI_DOUBLE, MPI_MIN, MPI_COMM_WORLD);
+  MPI_Allreduce(&local.largest_fixed_row_entry, &all.largest_fixed_row_entry, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
+  MPI_Allreduce(&local.off_rank_entries, &all.off_rank_entries, 1, MPI_UINT64_T, MPI_SUM, MPI_COMM_WORLD);
+  MPI_Allreduce(&local.layout_mismatches, &all.layout_mismatches, 1, MPI_UINT64_T, MPI_SUM, MPI_COMM_WORLD);
+  return all;
+}
+
+void expect_sound_levels(const DistributedMesh& part, const std::vector<std::uint8_t>& fixed,
+                         const RankAggregationLevels& levels) {
+  ASSERT_FALSE(levels.interpolations.empty());
+  ASSERT_EQ(levels.global_unknowns.size(), levels.interpolations.size() + 1);
+  EXPECT_EQ(levels.global_unknowns.back(), part.n_global_vertices * part.local->dim());
+  for (std::size_t l = 0; l < levels.interpolations.size(); ++l) {
+    PetscInt rows = 0, columns = 0;
+    SNEDE_PETSC(MatGetSize(levels.interpolations[l], &rows, &columns));
+    EXPECT_EQ(columns, levels.global_unknowns[l]);
+    EXPECT_EQ(rows, levels.global_unknowns[l + 1]);
+    EXPECT_LT(levels.global_unknowns[l], levels.global_unknowns[l + 1]) << "level " << l << " does not shrink";
+    EXPECT_GT(levels.global_unknowns[l], 0);
+  }
+  const Findings found = examine(part, fixed, levels);
+  EXPECT_EQ(found.layout_mismatches, 0u);
+  EXPECT_EQ(found.off_rank_entries, 0u);
+  EXPECT_LT(found.worst_rigid_residual, 1e-12);
+  EXPECT_GT(found.smallest_gram_eigenvalue, 1e-8);  // full column rank
+  EXPECT_EQ(found.largest_fixed_row_entry, 0.0);
+}
+
+TEST(RankAggregation, LevelsOfABoxReproduceEveryRigidMotionOnEveryRank) {
+  // Few direct unknowns, so that aggregates are aggregated again.
+  for (const auto& [dim, n, direct_unknowns] : {std::tuple{2, 24, PetscInt{40}}, std::tuple{3, 8, PetscInt{100}}}) {
+    SCOPED_TRACE("dim " + std::to_string(dim));
+    const DistributedMesh part = distributed_box(dim, n);
+    const std::vector<std::uint8_t> fixed = bottom_fixed(part);
+    const RankAggregationLevels levels = rank_aggregation_levels(part, fixed, 2.5, 0, direct_unknowns);
+    EXPECT_GE(levels.interpolations.size(), 2u);
+    expect_sound_levels(part, fixed, levels);
+  }
+}
+
+TEST(RankAggregation, FreeBoxAndCoarserWidths) {
+  // No fixed dof: every aggregate keeps all its rigid motions.
+  const DistributedMesh part = distributed_box(3, 6);
+  const std::vector<std::uint8_t> free(static_cast<std::size_t>(part.local->n_points()) * 3, 0);
+  for (double width : {1.5, 4.0}) {
+    SCOPED_TRACE("width " + std::to_string(width));
+    const RankAggregationLevels levels = rank_aggregation_levels(part, free, width, 0, 30);
+    expect_sound_levels(part, free, levels);
+    EXPECT_EQ(levels.global_unknowns.front() % 6, 0) << "a free aggregate has 6 rigid motions";
+  }
+}
+
+TEST(RankAggregation, StopsAtTheDirectLimitOrAtMaxLevels) {
+  const DistributedMesh part = distributed_box(3, 8);
+  const std::vector<std::uint8_t> fixed = bottom_fixed(part);
+  const RankAggregationLevels by_default = rank_aggregation_levels(part, fixed, 2.5);
+  EXPECT_LE(by_default.global_unknowns.front(), default_direct_unknowns);
+  const RankAggregationLevels two = rank_aggregation_levels(part, fixed, 2.5, 2, 1);
+  EXPECT_EQ(two.interpolations.size(), 1u);
+  expect_sound_levels(part, fixed, two);
+}
+
+TEST(RankAggregation, AMeshSmallerThanTheRanksLeavesSomeWithoutUnknowns) {
+  // Two triangles: on 3 ranks one has no cell, no vertex and no coarse unknown, yet takes part.
+  const DistributedMesh part = distributed_box(2, 1);
+  const std::vector<std::uint8_t> free(static_cast<std::size_t>(part.local->n_points()) * 2, 0);
+  const RankAggregationLevels levels = rank_aggregation_levels(part, free, 2.5);
+  expect_sound_levels(part, free, levels);
+}
+
+TEST(RankAggregation, BadInputsThrowOnEveryRank) {
+  const DistributedMesh part = distributed_box(2, 4);
+  const std::vector<std::uint8_t> fixed = bottom_fixed(part);
+  for (double width : {0.0, -1.0, std::numeric_limits<double>::quiet_NaN()})
+    EXPECT_THROW(rank_aggregation_levels(part, fixed, width), std::invalid_argument) << width;
+  for (int max_levels : {1, -2}) EXPECT_THROW(rank_aggregation_levels(part, fixed, 2.5, max_levels), std::invalid_argument);
+  const std::vector<std::uint8_t> short_by_one(fixed.begin(), fixed.end() - 1);
+  EXPECT_THROW(rank_aggregation_levels(part, short_by_one, 2.5), std::invalid_argument);
+}
+
+// Collective: CG's iterations to a relative residual of 1e-8 on A x = A x_true, with `pc`
+// set up by `set_up`; the relative error of x.
+template <class SetUp>
+PetscInt cg_iterations(Mat A, Vec x_true, double& relative_error, SetUp&& set_up) {
+  PetscHandle<KSP, KSPDestroy> cg;
+  SNEDE_PETSC(KSPCreate(MPI_COMM_WORLD, cg.out()));
+  SNEDE_PETSC(KSPSetOperators(cg, A, A));
+  SNEDE_PETSC(KSPSetType(cg, KSPCG));
+  SNEDE_PETSC(KSPSetTolerances(cg, 1e-8, 0.0, PETSC_DEFAULT, 5000));
+  PC pc = nullptr;
+  SNEDE_PETSC(KSPGetPC(cg, &pc));
+  set_up(pc);
+  VecHandle b, x;
+  SNEDE_PETSC(VecDuplicate(x_true, b.out()));
+  SNEDE_PETSC(VecDuplicate(x_true, x.out()));
+  SNEDE_PETSC(MatMult(A, x_true, b));
+  SNEDE_PETSC(KSPSolve(cg, b, x));
+  KSPConvergedReason reason;
+  SNEDE_PETSC(KSPGetConvergedReason(cg, &reason));
+  EXPECT_GT(reason, 0) << KSPConvergedReasons[reason];
+  PetscInt iterations = 0;
+  SNEDE_PETSC(KSPGetIterationNumber(cg, &iterations));
+  double true_norm = 0, error_norm = 0;
+  SNEDE_PETSC(VecNorm(x_true, NORM_2, &true_norm));
+  SNEDE_PETSC(VecAXPY(x, -1.0, x_true));
+  SNEDE_PETSC(VecNorm(x, NORM_2, &error_norm));
+  relative_error = error_norm / true_norm;
+  return iterations;
+}
+
+TEST(RankAggregation, MultigridCgNeedsFarFewerIterationsThanJacobiCg) {
+  const DistributedMesh part = distributed_box(3, 12);
+  const int d = 3;
+  const std::vector<std::uint8_t> fixed = bottom_fixed(part);
+  ElasticBody body(*part.local, LinearElastic(3e3, 0.3), 1000.0, 0.0);
+  std::vector<PetscInt> rows(fixed.size());
+  PetscInt n_owned_dofs = 0;
+  for (VertexId v = 0; v < part.local->n_points(); ++v) {
+    for (int k = 0; k < d; ++k) rows[static_cast<std::size_t>(v) * d + k] = static_cast<PetscInt>(part.global_number[v] * d + k);
+    n_owned_dofs += part.owned[v] ? d : 0;
+  }
+  DistributedAssembledTangent tangent(part, body, rows, fixed, n_owned_dofs);
+  tangent.assemble(std::vector<double>(fixed.size(), 0.0));
+  const RankAggregationLevels levels = rank_aggregation_levels(part, fixed, 2.5);
+
+  // x_true(row) = sin(row) + 1: smooth and rough components alike.
+  VecHandle x_true;
+  SNEDE_PETSC(MatCreateVecs(tangent.mat(), x_true.out(), nullptr));
+  PetscInt start = 0, end = 0;
+  SNEDE_PETSC(VecGetOwnershipRange(x_true, &start, &end));
+  for (PetscInt row = start; row < end; ++row) SNEDE_PETSC(VecSetValue(x_true, row, std::sin(double(row)) + 1.0, INSERT_VALUES));
+  SNEDE_PETSC(VecAssemblyBegin(x_true));
+  SNEDE_PETSC(VecAssemblyEnd(x_true));
+
+  double jacobi_error = 0, multigrid_error = 0;
+  const PetscInt jacobi = cg_iterations(tangent.mat(), x_true, jacobi_error, [](PC pc) { SNEDE_PETSC(PCSetType(pc, PCJACOBI)); });
+  const PetscInt multigrid = cg_iterations(tangent.mat(), x_true, multigrid_error, [&](PC pc) {
+    const auto n_levels = static_cast<PetscInt>(levels.interpolations.size()) + 1;
+    SNEDE_PETSC(PCSetType(pc, PCMG));
+    SNEDE_PETSC(PCMGSetLevels(pc, n_levels, nullptr));
+    SNEDE_PETSC(PCMGSetGalerkin(pc, PC_MG_GALERKIN_BOTH));
+    for (PetscInt l = 1; l < n_levels; ++l) {
+      SNEDE_PETSC(PCMGSetInterpolation(pc, l, levels.interpolations[l - 1]));
+      KSP smoother = nullptr;
+      PC jacobi_pc = nullptr;
+      SNEDE_PETSC(PCMGGetSmoother(pc, l, &smoother));
+      SNEDE_PETSC(KSPSetType(smoother, KSPCHEBYSHEV));
+      SNEDE_PETSC(KSPGetPC(smoother, &jacobi_pc));
+      SNEDE_PETSC(PCSetType(jacobi_pc, PCJACOBI));
+    }
+  });
+  if (world_rank() == 0) std::printf("CG iterations: Jacobi %d, multigrid %d\n", int(jacobi), int(multigrid));
+  EXPECT_LT(jacobi_error, 1e-5);
+  EXPECT_LT(multigrid_error, 1e-5);
+  EXPECT_LT(3 * multigrid, jacobi);
+}
+
+}  // namespace
