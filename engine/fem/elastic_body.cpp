@@ -210,13 +210,15 @@ template <int D, class M>
 }
 
 template <int D>
-[[gnu::flatten]] std::vector<ElementId> find_inverted(const ElementStream<D>& stream, std::span<const double> u) {
+[[gnu::flatten]] std::vector<ElementId> find_inverted(const ElementStream<D>& stream, std::span<const double> u,
+                                                      double floor) {
   std::vector<ElementId> inverted;
   const std::span<const ElementBlock<D>> blocks = stream.blocks();
   for (std::size_t b = 0; b < blocks.size(); ++b) {
     prefetch_ahead<D>(blocks, b);
     const ElementBlock<D>& block = blocks[b];
-    const LaneMask lanes = ElementStream<D>::live_lanes(block) & inverted_lanes<D>(block, gather_differences<D>(u, block));
+    const Batch det = deformation_gradient<Batch, D>(block.reference, gather_differences<D>(u, block)).determinant();
+    const LaneMask lanes = ElementStream<D>::live_lanes(block) & non_positive_lanes(det - floor);
     for (int lane = 0; lane < batch_width; ++lane)
       if (lanes >> lane & 1) inverted.push_back(static_cast<ElementId>(b * batch_width + lane));
   }
@@ -432,10 +434,10 @@ void ElasticBody::tangent_apply(std::span<const double> u, std::span<const doubl
   });
 }
 
-std::vector<ElementId> ElasticBody::inverted_elements(std::span<const double> u) const {
+std::vector<ElementId> ElasticBody::inverted_elements(std::span<const double> u, double floor) const {
   check_size("displacement", u);
   if (is_membrane()) return membrane_collapsed_elements(membranes_, u);
-  return dim() == 2 ? find_inverted<2>(stream<2>(), u) : find_inverted<3>(stream<3>(), u);
+  return dim() == 2 ? find_inverted<2>(stream<2>(), u, floor) : find_inverted<3>(stream<3>(), u, floor);
 }
 
 std::vector<double> ElasticBody::element_stress(std::span<const double> u) const {

@@ -60,8 +60,9 @@ class ElasticBody : public ConnectivityWatcher {
   // reported by energy, internal_forces and inverted_elements, which the solvers consult).
   void tangent_apply(std::span<const double> u, std::span<const double> d, std::span<double> out,
                      EvaluationReport& report) const;
-  // Ids of the elements with det F ≤ 0 at u.
-  std::vector<ElementId> inverted_elements(std::span<const double> u) const;
+  // Ids of the elements with det F ≤ floor at u (0: inverted or flat; a membrane's: collapsed,
+  // whatever the floor).
+  std::vector<ElementId> inverted_elements(std::span<const double> u, double floor = 0.0) const;
   // Second Piola-Kirchhoff stress per live element (σ for LinearElastic): (n_cells, dim, dim);
   // for a membrane the in-plane (n_cells, 2, 2), in each element's reference tangent frame
   // (t₁ along its first oriented edge, t₂ = n × t₁).

@@ -198,18 +198,30 @@ void NeedleInsertion::move_needle(double distance) {
   if (!moved.empty()) model_.fix(moved, anchors);
 }
 
+bool NeedleInsertion::move_admissible() const {
+  // A sticking node moved by exactly the spacing of the needle nodes lands on the next one (the
+  // 2D slab's shaft on a grid line of the h7 mesh, 1 h_ref per update): their cells are flat to
+  // round-off, det F of 1e-13, which the inversion test (det F ≤ 0) does not count, and their
+  // neo-Hookean forces (4e14 N) stopped Newton (DIVERGED_LINE_SEARCH at the third update). Such
+  // a move is carried into the tissue or halved, as one that inverts.
+  if (!model_.admissible(model_.displacement())) return false;
+  if (!forbids_inversion(model_.body().material())) return true;
+  const ReadView u(model_.displacement());
+  return model_.body().inverted_elements(u.span(), collapse_floor).empty();
+}
+
 NeedleStepReport NeedleInsertion::advance_in_steps(double distance, int halvings) {
   move_needle(distance);
   // A move that drags sticking nodes across their neighbours would start the solve from
   // inverted elements, which a material forbidding inversion cannot relax: carry the move into
   // the tissue around them, else move in halves.
   bool extended = false;
-  if (distance > 0 && !model_.admissible(model_.displacement()) && options_.extension_rings > 0) {
+  if (distance > 0 && !move_admissible() && options_.extension_rings > 0) {
     SNEDE_PETSC(VecCopy(model_.displacement(), start_));  // the move without its extension
     extend_move(distance);
     extended = true;
   }
-  if (distance > 0 && halvings < max_halvings && !model_.admissible(model_.displacement())) {
+  if (distance > 0 && halvings < max_halvings && !move_admissible()) {
     if (extended) SNEDE_PETSC(VecCopy(start_, model_.displacement()));
     move_needle(-distance);
     NeedleStepReport first = advance_in_steps(0.5 * distance, halvings + 1);

@@ -174,6 +174,10 @@ class NeedleInsertion : public ConnectivityWatcher {
   void refine_at_tip();
   // Carries a move of the sticking nodes into the vertices around them (move_extension.hpp).
   void extend_move(double distance);
+  // Whether the moved state may start a solve: admissible to the model, and no element of a
+  // material that forbids inversion flattened to det F ≤ collapse_floor.
+  bool move_admissible() const;
+  static constexpr double collapse_floor = 1e-6;
   int intercept_nodes();
   // Makes v a sticking needle node if it is free, not one already and the tip has passed it.
   int catch_node(VertexId v, std::span<const double> u);

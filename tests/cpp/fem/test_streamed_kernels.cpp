@@ -27,6 +27,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/SVD>
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <random>
@@ -34,6 +35,7 @@
 
 #include "fem/elastic_body.hpp"
 #include "fem/material_fixtures.hpp"
+#include "mesh/element_quality.hpp"
 #include "topology/edit_checks.hpp"
 #include "topology/random_editor.hpp"
 
@@ -335,6 +337,42 @@ TEST(StreamedKernels, RoughStatesInvertElements) {
   const std::size_t n_inverted = body.inverted_elements(u).size();
   EXPECT_GT(n_inverted, 0u);
   EXPECT_LT(n_inverted, mesh.n_cells());
+}
+
+// inverted_elements(u, floor) lists the elements whose det F — here their deformed over their
+// reference volume — is at or below the floor: the needle refuses a move that flattens cells
+// (det F ≤ 1e-6) as one that inverts them. Floors midway between two elements' det F, so that
+// the two ways of computing it cannot disagree at the floor.
+TEST(StreamedKernels, ElementsAtOrBelowADeterminantFloor) {
+  for (int dim : {2, 3}) {
+    Mesh mesh = dim == 2 ? jittered_square(6, 0.25, 3) : shuffled_jittered_cube(3, 0.25, 3);
+    const ElasticBody body(mesh, NeoHookean(3e3, 0.45), 1000.0, dim == 2 ? 0.01 : 0.0);
+    std::mt19937 rng(3);
+    const std::vector<double> u = random_field(mesh, 0.6 * shortest_edge(mesh), rng);
+    const std::vector<VertexId> cells = mesh.cells();
+    std::vector<double> det_f;
+    for (std::size_t e = 0; e < mesh.n_cells(); ++e) {
+      std::vector<double> reference, deformed;
+      for (int a = 0; a <= dim; ++a)
+        for (int k = 0; k < dim; ++k) {
+          const std::size_t i = static_cast<std::size_t>(cells[e * (dim + 1) + a]) * dim + k;
+          reference.push_back(mesh.points()[i]);
+          deformed.push_back(mesh.points()[i] + u[i]);
+        }
+      det_f.push_back(signed_volume(dim, deformed) / signed_volume(dim, reference));
+    }
+    std::vector<double> sorted = det_f;
+    std::sort(sorted.begin(), sorted.end());
+    ASSERT_LT(sorted.front(), 0.0) << "the state should invert some elements";
+    for (std::size_t k : {std::size_t{0}, sorted.size() / 4, sorted.size() / 2}) {
+      ASSERT_GT(sorted[k + 1] - sorted[k], 1e-9);
+      const double floor = 0.5 * (sorted[k] + sorted[k + 1]);
+      std::vector<ElementId> expected;
+      for (std::size_t e = 0; e < det_f.size(); ++e)
+        if (det_f[e] <= floor) expected.push_back(static_cast<ElementId>(e));
+      EXPECT_EQ(body.inverted_elements(u, floor), expected) << dim << "D, floor " << floor;
+    }
+  }
 }
 
 // Veronda-Westmann's exponential overflows around one vertex pulled far away: those elements

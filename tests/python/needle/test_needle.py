@@ -210,3 +210,25 @@ def test_a_planar_needle_by_linear_cg_takes_no_multigrid_below_ten_thousand_tria
     solver = snede.StaticSolver(body, "cg")
     assert solver.solve().converged
     assert sources == {"cg": "", "newton": "grid"} and solver.multigrid_source == "grid"
+
+
+def test_a_move_of_one_node_spacing_never_starts_a_solve_from_flat_cells():
+    # The shaft runs on a grid line of the h7 mesh and each update moves it by h_ref, the spacing
+    # of the needle nodes: a sticking node moved by one step landed exactly on the next needle
+    # node, its cells flat to round-off (det F ≈ 1e-13, which no inversion test counts), and
+    # Newton stopped at the third update (DIVERGED_LINE_SEARCH, forces of 4e14 N). The move is
+    # carried into the tissue or halved instead, and every update converges.
+    body = slab_body(3, snede.NeoHookean(34e3, 0.34))
+    needle = needle_for(body, 7, method="newton", rtol=1e-3, solves_per_update=1)
+    helped = 0
+    for _ in range(12):
+        step = needle.advance(h(7))
+        assert step.converged, step
+        helped += step.extensions + step.halvings
+        x = body.mesh.points + body.displacement
+        a, b, c = (x[body.mesh.cells[:, k]] for k in range(3))
+        deformed = np.cross(b - a, c - a)
+        reference = np.cross(*(body.mesh.points[body.mesh.cells[:, k]] - body.mesh.points[body.mesh.cells[:, 0]]
+                               for k in (1, 2)))
+        assert (deformed / reference).min() > 1e-3  # J of every cell, far from flat
+    assert helped > 0, "the test should see a move that needed help"
