@@ -97,9 +97,10 @@ CountedLanes count_lanes(LaneMask live, LaneMask inverted, LaneMask finite, bool
   return count_exceptional_lanes(live, inverted, finite, forbids_inversion, first, report);
 }
 
+// Lanes with det F ≤ floor (x − 0.0 folds to x in the flattened loops that pass no floor).
 template <int D>
-LaneMask inverted_lanes(const ElementBlock<D>& block, const Tensor<Batch, D>& U) {
-  return non_positive_lanes(deformation_gradient<Batch, D>(block.reference, U).determinant());
+LaneMask inverted_lanes(const ElementBlock<D>& block, const Tensor<Batch, D>& U, double floor = 0.0) {
+  return non_positive_lanes(deformation_gradient<Batch, D>(block.reference, U).determinant() - floor);
 }
 
 // The block loops are flattened: every kernel, Eigen expression and Batch operation inlined
@@ -217,8 +218,8 @@ template <int D>
   for (std::size_t b = 0; b < blocks.size(); ++b) {
     prefetch_ahead<D>(blocks, b);
     const ElementBlock<D>& block = blocks[b];
-    const Batch det = deformation_gradient<Batch, D>(block.reference, gather_differences<D>(u, block)).determinant();
-    const LaneMask lanes = ElementStream<D>::live_lanes(block) & non_positive_lanes(det - floor);
+    const LaneMask lanes =
+        ElementStream<D>::live_lanes(block) & inverted_lanes<D>(block, gather_differences<D>(u, block), floor);
     for (int lane = 0; lane < batch_width; ++lane)
       if (lanes >> lane & 1) inverted.push_back(static_cast<ElementId>(b * batch_width + lane));
   }

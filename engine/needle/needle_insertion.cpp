@@ -204,10 +204,7 @@ bool NeedleInsertion::move_admissible() const {
   // round-off, det F of 1e-13, which the inversion test (det F ≤ 0) does not count, and their
   // neo-Hookean forces (4e14 N) stopped Newton (DIVERGED_LINE_SEARCH at the third update). Such
   // a move is carried into the tissue or halved, as one that inverts.
-  if (!model_.admissible(model_.displacement())) return false;
-  if (!forbids_inversion(model_.body().material())) return true;
-  const ReadView u(model_.displacement());
-  return model_.body().inverted_elements(u.span(), collapse_floor).empty();
+  return model_.admissible(model_.displacement(), nullptr, collapse_floor);
 }
 
 NeedleStepReport NeedleInsertion::advance_in_steps(double distance, int halvings) {
@@ -216,12 +213,14 @@ NeedleStepReport NeedleInsertion::advance_in_steps(double distance, int halvings
   // inverted elements, which a material forbidding inversion cannot relax: carry the move into
   // the tissue around them, else move in halves.
   bool extended = false;
-  if (distance > 0 && !move_admissible() && options_.extension_rings > 0) {
+  bool admissible = distance <= 0 || move_admissible();
+  if (!admissible && options_.extension_rings > 0) {
     SNEDE_PETSC(VecCopy(model_.displacement(), start_));  // the move without its extension
     extend_move(distance);
     extended = true;
+    admissible = move_admissible();
   }
-  if (distance > 0 && halvings < max_halvings && !move_admissible()) {
+  if (!admissible && halvings < max_halvings) {
     if (extended) SNEDE_PETSC(VecCopy(start_, model_.displacement()));
     move_needle(-distance);
     NeedleStepReport first = advance_in_steps(0.5 * distance, halvings + 1);

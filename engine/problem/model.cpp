@@ -238,7 +238,7 @@ double Model::constraint_stiffness() const {
   return constraint_stiffness_;
 }
 
-bool Model::admissible(Vec u, std::string* why) const {
+bool Model::admissible(Vec u, std::string* why, double det_floor) const {
   PetscReal norm = 0;
   SNEDE_PETSC(VecNorm(u, NORM_2, &norm));
   if (!std::isfinite(norm)) {
@@ -247,7 +247,7 @@ bool Model::admissible(Vec u, std::string* why) const {
   }
   if (forbids_inversion(body_.material())) {
     ReadView x(u);
-    if (!body_.inverted_elements(x.span()).empty()) {
+    if (!body_.inverted_elements(x.span(), det_floor).empty()) {
       if (why) *why = "DIVERGED_INVERTED_ELEMENTS";
       return false;
     }

@@ -103,8 +103,9 @@ class Model : public ConnectivityWatcher {
   // size; E/(1 − ν²)·t for sheets and membranes), so that the constrained block is of the
   // stiffness's size whatever the units. Computed once per mesh (after each change).
   double constraint_stiffness() const;
-  // True if u is finite and has no inverted element under a material that forbids it.
-  bool admissible(Vec u, std::string* why = nullptr) const;
+  // True if u is finite and, under a material that forbids inversion, has no element with
+  // det F ≤ det_floor (0: none inverted or flat).
+  bool admissible(Vec u, std::string* why = nullptr, double det_floor = 0.0) const;
 
   void init(const Connectivity&) override {}
   void on_change(const Connectivity& connectivity, const ConnectivityChange& change) override;
