@@ -8,7 +8,7 @@ import numpy as np
 
 import snede
 from snede.output import SeriesWriter
-from snede.plotting import plot_body
+from snede.app.plotting import plot_body
 
 mesh = snede.meshing.box((0.10, 0.02, 0.02), (20, 4, 4))
 body = snede.Body(mesh, snede.NeoHookean(E=3e4, nu=0.3), density=1000.0)

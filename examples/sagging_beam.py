@@ -8,7 +8,7 @@ import numpy as np
 
 import snede
 from snede.output import SeriesWriter
-from snede.plotting import plot_body
+from snede.app.plotting import plot_body
 
 # 1. Mesh: 10 cm × 2 cm × 2 cm, Kuhn-split cubes.
 mesh = snede.meshing.box((0.10, 0.02, 0.02), (20, 4, 4))

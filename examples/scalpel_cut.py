@@ -11,7 +11,7 @@ import numpy as np
 
 import snede
 from snede.output import SeriesWriter
-from snede.plotting import plot_body
+from snede.app.plotting import plot_body
 
 # 1. A 10 × 4 × 2 cm block of 5 mm Kuhn-split cubes, neo-Hookean (E = 30 kPa, ν = 0.3),
 #    clamped at x = 0 and pulled along +x by 3 N spread over the end x = 10 cm.

@@ -1,7 +1,9 @@
 """snede: soft deformable objects whose meshes change (cuts, bisection, needle insertion).
 
 Importing snede initialises PETSc once, through petsc4py (see ``snede._petsc``).
-``snede.output`` (series files, h5py) and ``snede.plotting`` (matplotlib) load on first use.
+``snede.output`` (series files, h5py) loads on first use. The applications (scenes, scene
+files, the command line, the live window) are ``snede.app``; the library imports neither them
+nor pyvista, VTK or matplotlib (the extras ``snede[view]`` and ``snede[plot]``).
 """
 import importlib
 
@@ -47,7 +49,7 @@ __all__ = [
 __version__ = "0.1.0"
 
 # Submodules that load slow libraries; importing snede does not load them until used.
-_ON_FIRST_USE = ("output", "plotting")
+_ON_FIRST_USE = ("output",)
 
 
 def __getattr__(name):

@@ -89,9 +89,9 @@ def compare_preconditioners(problem, comm, part) -> None:
 
 
 def compare_on_cantilever(divisions: int, comm) -> None:
-    from snede.scenes import cantilever
+    from snede.app.scenes import Parameters, cantilever
 
-    scene_options = argparse.Namespace(divisions=divisions, material=None, speed=None, mesh_size=None)
+    scene_options = Parameters(divisions=divisions)
     rows = []
     for preconditioner in PRECONDITIONERS:
         scene = cantilever.build(scene_options)

@@ -5,7 +5,7 @@
 For each beam (``cut --divisions n``: n × n/4 × n/4 cubes, 6 tetrahedra each) the same scripted
 drag as the tests' (tests/python/interactive/tool_scripts.py: the scalpel from a centimetre above
 the sagging beam's top at x = 5.6 cm down 70 % of its height) is played twice: headless through a
-``ToolSession`` (the moves alone) and in the window (``snede.interactive.window``: pyvista under
+``ToolSession`` (the moves alone) and in the window (``snede.app.interactive.window``: pyvista under
 whatever display there is, Xvfb with Mesa's software renderer in CI), which renders while the
 worker thread cuts and relaxes. Columns: cells; moves of the blade; the solver's rate (relaxations
 per second of solve time) and the headless session's (moves per second of wall time, cuts
@@ -21,8 +21,8 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT / "tests" / "python" / "interactive"))
 
-from snede.interactive import ToolSession  # noqa: E402
-from snede.interactive.events import events  # noqa: E402
+from snede.app.interactive import ToolSession  # noqa: E402
+from snede.app.interactive.events import events  # noqa: E402
 from tool_scripts import cut_events  # noqa: E402
 
 
@@ -38,7 +38,7 @@ def headless(divisions: int) -> dict:
 
 
 def windowed(divisions: int) -> dict:
-    from snede.interactive.window import Window
+    from snede.app.interactive.window import Window
 
     make = lambda: ToolSession("cut", {"divisions": divisions})  # noqa: E731
     scripted = events(cut_events(make()))

@@ -39,7 +39,7 @@ from snede import PETSc
 from studies.experiments.needle import (H7_RATE_GOAL_HZ, ISSUE_TOLERANCE, SPEEDS, THESIS_TABLE_6_5, TIMING_TOLERANCES, UPDATE_RATE_GOAL,
                                         cg_ratio, geometric_mean, haptic_row, plot_rates, replace_table_6_5,
                                         table_6_5_section)
-from snede.scenes.needle_slab import DEPTH, h, needle_for, slab_body
+from snede.app.scenes.needle_slab import DEPTH, h, needle_for, slab_body
 
 RESULTS = Path(__file__).resolve().parents[2] / "docs" / "results"
 SCAN_TOLERANCES = (0.01, 0.02, 0.03, 0.05, 0.07, 0.1)

@@ -2,7 +2,7 @@
 
     .venv/bin/python -m studies.experiments.needle [--quick] [--out DIR]
 
-The §6.8.1 slab (snede.scenes.needle_slab: 0.1 × 0.1 × 0.01 m, E = 34 kPa, ν = 0.34, fixed at
+The §6.8.1 slab (snede.app.scenes.needle_slab: 0.1 × 0.1 × 0.01 m, E = 34 kPa, ν = 0.34, fixed at
 x = 0.1 m) under the Figure 6.4 stand-in friction profile (snede.FrictionProfile.figure_6_4).
 
 * Static line load (Tables 6.1–6.3, Figure 6.10): the profile's force distribution applied
@@ -33,7 +33,7 @@ import numpy as np
 
 import snede
 from studies.experiments.common import PageTemplate, options_prefix, parse_arguments, pyplot, save_figure, write_csv
-from snede.scenes.needle_slab import DEPTH, ENTRY, SIZE, YOUNG, h, needle_for, slab_body
+from snede.app.scenes.needle_slab import DEPTH, ENTRY, SIZE, YOUNG, h, needle_for, slab_body
 
 ROUND_TOLERANCE = 1e-8  # ε_round of (6.9), §6.8.1
 REFERENCE_TOLERANCE = 1e-8  # Table 6.1's reference solve, and the "exact" solves of Tables 6.3 and 6.6

@@ -2,24 +2,23 @@
 `mpirun -n N python -m snede run cantilever` calls it): the probe and files as the serial run
 gives them; scenes that change their mesh are refused with NotImplementedError on every rank.
 On one rank the serial path runs (the serial tests cover it)."""
-import argparse
 import json
 from pathlib import Path
 
 import pytest
 from mpi4py import MPI
 
-from snede import DynamicRelaxation, StaticSolver, run_scene
+from snede import DynamicRelaxation, StaticSolver
+from snede.app import run_scene
 from snede.output import read_series
-from snede.scenes import cantilever, cylinder, needle
+from snede.app.scenes import Parameters, cantilever, cylinder, needle
 
 COMM = MPI.COMM_WORLD
 several = pytest.mark.skipif(COMM.size == 1, reason="the distributed path needs several ranks")
 
 
 def options(**given):
-    defaults = {"divisions": None, "material": None, "speed": None, "mesh_size": None}
-    return argparse.Namespace(**{**defaults, **given})
+    return Parameters(**given)
 
 
 @several

@@ -112,3 +112,13 @@ def test_the_library_does_not_import_the_studies():
             if any(module.split(".")[0] == "studies" for module in imports):
                 users.add(name)
     assert not users
+
+
+def test_the_library_does_not_import_the_applications():
+    """snede.app (scenes, scene files, the command line, the window) stands on the library, never
+    the other way round (issue 51, item 4); ``snede.__main__`` is the command line's entry."""
+    graph = import_graph()
+    users = {name for name, imports in graph.items()
+             if not name.startswith("snede.app") and name != "snede.__main__"
+             and any(module.startswith("snede.app") for module in imports)}
+    assert not users, f"library modules importing snede.app: {sorted(users)}"

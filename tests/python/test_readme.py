@@ -68,9 +68,9 @@ def test_the_scene_of_the_readme_prints_what_it_says(tmp_path):
 
 def test_the_demo_table_of_the_readme_is_the_demos_scene_list():
     """Every built-in scene has its row, and nothing else does."""
-    import snede.scenes
+    import snede.app.scenes
 
     table = re.search(r"^```text\nscene .*?^```", README.read_text(), re.S | re.M).group(0)
     lines = table.splitlines()[2:]
     rows = [line.split()[0] for line in lines[:lines.index("...")]]
-    assert rows == list(snede.scenes.builders())
+    assert rows == list(snede.app.scenes.builders())

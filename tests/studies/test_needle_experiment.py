@@ -8,7 +8,7 @@ import pytest
 
 import snede
 from studies.experiments import needle as experiment
-from snede.scenes.needle_slab import DEPTH, SIZE, h
+from snede.app.scenes.needle_slab import DEPTH, SIZE, h
 
 
 @pytest.fixture(scope="module")

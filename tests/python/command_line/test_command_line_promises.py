@@ -2,7 +2,6 @@
 ``python -m snede: error: ...``, and exit status 2; Ctrl-C gives one line, ``interrupted ...``,
 and status 130; never a traceback. The cases run ``python -m snede`` in a subprocess (all but the
 picture of a failed state)."""
-import argparse
 import os
 import shutil
 import subprocess
@@ -57,10 +56,10 @@ INTERRUPT_ON_IMPORT = textwrap.dedent("""
 
 
 @needs_sigint
-@pytest.mark.parametrize("module", ["numpy", "snede._snede", "snede.scenes", "matplotlib"])
+@pytest.mark.parametrize("module", ["numpy", "snede._snede", "snede.app.scenes", "matplotlib"])
 def test_ctrl_c_while_modules_load_is_the_one_interrupted_line(tmp_path, module):
     # numpy and the engine load with `import snede` (before the command line's own code runs),
-    # snede.scenes while the arguments are parsed, matplotlib for the picture: the first three
+    # snede.app.scenes while the arguments are parsed, matplotlib for the picture: the first three
     # ended in a traceback (status -2).
     (tmp_path / "sitecustomize.py").write_text(INTERRUPT_ON_IMPORT)
     run = run_cli("run", "cantilever", "--divisions", "4", "--out", str(tmp_path / "out"),
@@ -87,12 +86,12 @@ def test_a_nan_line_search_damping_is_bad_input(tmp_path):
 
 
 def test_a_failed_but_finite_state_is_drawn_with_its_reason(tmp_path, monkeypatch):
-    from snede import run_scene
-    from snede.scenes import cantilever
+    from snede.app import run_scene
+    from snede.app.scenes import Parameters, cantilever
 
     drawn = {}
     monkeypatch.setattr(run_scene, "plot_body", lambda body, path, **arguments: drawn.update(arguments) or path)
-    scene = cantilever.build(argparse.Namespace(material=None, divisions=4))
+    scene = cantilever.build(Parameters(divisions=4))
     files = run_scene.draw_picture(scene, "cg", tmp_path, {"converged": False, "reason": "DIVERGED_ITS"})
     assert files == {"png": str(tmp_path / "cantilever.png")}
     assert drawn["title"].endswith("NOT converged: DIVERGED_ITS"), drawn["title"]

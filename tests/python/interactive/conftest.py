@@ -2,7 +2,7 @@
 import pytest
 import tool_scripts
 
-from snede.interactive.window import display_answers
+from snede.app.interactive.window import display_answers
 
 
 @pytest.fixture

@@ -4,7 +4,7 @@ import json
 import pytest
 
 from expected_errors import refused
-from snede.interactive.events import drag, events, load
+from snede.app.interactive.events import drag, events, load
 
 GOOD = {"t": 0.0, "type": "press", "x": 0.5, "y": 0.5, "tool": "scalpel"}
 

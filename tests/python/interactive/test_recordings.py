@@ -10,8 +10,8 @@ import json
 
 import pytest
 
-from snede.interactive import replay
-from snede.interactive.recording import compare
+from snede.app.interactive import replay
+from snede.app.interactive.recording import compare
 from tool_scripts import RECORDINGS
 
 

@@ -8,7 +8,7 @@ import sys
 
 import pytest
 
-from snede.interactive.recording import save
+from snede.app.interactive.recording import save
 from tool_scripts import cut_events, needle_events, play
 
 

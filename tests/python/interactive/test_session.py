@@ -3,8 +3,8 @@ push of the needle inserts it, and both record moves a replay repeats to the dig
 import numpy as np
 
 from expected_errors import refused
-from snede.interactive import ToolSession, replay
-from snede.interactive.recording import compare, digest
+from snede.app.interactive import ToolSession, replay
+from snede.app.interactive.recording import compare, digest
 from tool_scripts import cut_events, needle_events, play
 
 
@@ -93,7 +93,7 @@ def test_unknown_scenes_and_options_are_refused():
 
 
 def test_a_tool_the_scene_has_not_is_refused(cut_session):
-    from snede.interactive.events import PointerEvent
+    from snede.app.interactive.events import PointerEvent
 
     refused(lambda: cut_session.handle(PointerEvent(0.0, "press", 0.5, 0.5, "needle")),
             "the cut scene's tool is the scalpel, not the needle")

@@ -86,7 +86,7 @@ def test_a_display_vtk_cannot_draw_on_is_one_line(tmp_path):
     import shutil
     import time
 
-    from snede.interactive.window import display_answers
+    from snede.app.interactive.window import display_answers
 
     if shutil.which("Xvfb") is None:
         pytest.skip("needs Xvfb")

@@ -9,8 +9,8 @@ import sys
 import numpy as np
 import pytest
 
-from snede.interactive import ToolSession, replay
-from snede.interactive.recording import save
+from snede.app.interactive import ToolSession, replay
+from snede.app.interactive.recording import save
 from tool_scripts import STEPS, play
 
 SCALPEL_FILE = """name = "beam-cut"
@@ -81,7 +81,7 @@ def scene_file(tmp_path, text: str) -> str:
 
 def straight_drag(session, start, end) -> list[dict]:
     """A drag from scene point ``start`` to ``end`` in window coordinates (the session's view)."""
-    from snede.interactive.events import drag
+    from snede.app.interactive.events import drag
 
     start, end = np.asarray(start, dtype=float), np.asarray(end, dtype=float)
     return drag(session.tool.name, [session.view.window(start + (end - start) * k / STEPS) for k in range(STEPS + 1)])

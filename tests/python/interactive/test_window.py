@@ -7,16 +7,16 @@ import numpy as np
 import pytest
 
 import snede
-from snede.interactive.events import events
+from snede.app.interactive.events import events
 from tool_scripts import cut_events, cut_session, needle_events, needle_session
 
 pytest.importorskip("pyvista", reason="the window needs pyvista (tools/requirements.txt)")
 
 
 def red_pixels(path) -> int:
-    """Pixels of the lips' red (snede.plotting.HIGHLIGHT, green and blue under a fifth of red,
+    """Pixels of the lips' red (snede.app.plotting.HIGHLIGHT, green and blue under a fifth of red,
     shaded): viridis, the body's colour map, the black edges and the loads' orange
-    (snede.plotting.LOAD, green half of red) have none."""
+    (snede.app.plotting.LOAD, green half of red) have none."""
     from PIL import Image
 
     rgb = np.asarray(Image.open(path).convert("RGB"), dtype=float) / 255
@@ -24,7 +24,7 @@ def red_pixels(path) -> int:
 
 
 def show(make_session, scripted, screenshot=None, tick=None):
-    from snede.interactive.window import Window
+    from snede.app.interactive.window import Window
 
     window = Window(make_session)
     window.run(events(scripted), screenshot, close=True, tick=tick)
@@ -47,7 +47,7 @@ def test_a_scripted_drag_in_the_window_cuts_the_beam_and_shows_the_lips(display,
 
 def test_the_window_and_the_headless_session_make_the_same_cut(display):
     """The window's pointer goes through pixels; the cut it records replays to its digest."""
-    from snede.interactive import replay
+    from snede.app.interactive import replay
 
     window = show(cut_session, cut_events(cut_session()))
     assert replay(window.worker.session.recording()).matches
@@ -75,7 +75,7 @@ def slow_needle_push():
     """One update pushing the needle3d scene's needle 5 cm into a neo-Hookean cube of 24 576
     tetrahedra sagging under gravity, by Newton with unpreconditioned CG to ε = 1e-10."""
     from snede.needle_forces import liver_profile
-    from snede.scenes import needle3d
+    from snede.app.scenes import needle3d
 
     body = snede.Body(snede.meshing.box((needle3d.SIZE,) * 3, (16, 16, 16)),
                       snede.NeoHookean(needle3d.YOUNG, needle3d.POISSON))
@@ -98,7 +98,7 @@ def beam(divisions, material):
 def test_the_window_renders_while_the_worker_solves(display, slow):
     """A deliberately slow solve (or needle update) in the worker: the window's loop keeps
     turning meanwhile — it could not if the engine held the GIL."""
-    from snede.interactive.window import Window
+    from snede.app.interactive.window import Window
 
     solve, frames = {}, []
 
@@ -132,7 +132,7 @@ def press_keys(window, keys, on_frame: int = 1):
 
 
 def test_keys_save_a_screenshot_and_write_the_series(display, tmp_path, monkeypatch):
-    from snede.interactive.window import Window
+    from snede.app.interactive.window import Window
 
     monkeypatch.chdir(tmp_path)
     window = Window(cut_session)
@@ -143,7 +143,7 @@ def test_keys_save_a_screenshot_and_write_the_series(display, tmp_path, monkeypa
 
 
 def test_pause_holds_the_events_and_reset_starts_again(display):
-    from snede.interactive.window import Window
+    from snede.app.interactive.window import Window
 
     scripted = cut_events(cut_session())
     window = Window(cut_session)
@@ -168,7 +168,7 @@ def test_pause_holds_the_events_and_reset_starts_again(display):
 
 
 def test_q_closes_the_window(display):
-    from snede.interactive.window import Window
+    from snede.app.interactive.window import Window
 
     window = Window(needle_session)
     window.run([], close=False, tick=press_keys(window, "q", on_frame=3))  # returns: q closed it
@@ -176,8 +176,8 @@ def test_q_closes_the_window(display):
 
 
 def test_the_window_draws_gravity_and_the_held_vertices(display):
-    from snede.interactive.snapshot import Snapshot
-    from snede.interactive.window import Window
+    from snede.app.interactive.snapshot import Snapshot
+    from snede.app.interactive.window import Window
 
     session = cut_session()
     snapshot = Snapshot.of(session)

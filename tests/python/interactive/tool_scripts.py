@@ -3,8 +3,8 @@ from pathlib import Path
 
 import numpy as np
 
-from snede.interactive import ToolSession
-from snede.interactive.events import drag, events
+from snede.app.interactive import ToolSession
+from snede.app.interactive.events import drag, events
 
 CUT_DIVISIONS = 12  # the smallest beam whose cut opens over several faces (8 leaves a notch of 4)
 NEEDLE_OPTIONS = {"divisions": 8, "speed": 1.0}  # the slab at h3, one h_ref per update
@@ -30,7 +30,7 @@ def top_at(session, x: float) -> float:
 def cut_events(session, x: float = 0.056, depth: float = 0.7) -> list[dict]:
     """A drag on the beam's front face from a centimetre above its top at x down to ``depth`` of
     its height below the top, in window coordinates (the session's view)."""
-    from snede.scenes.cut import HEIGHT
+    from snede.app.scenes.cut import HEIGHT
 
     top = top_at(session, x)
     start, end = (x, 0.0, top + 0.01), (x, 0.0, top - depth * HEIGHT)
@@ -40,7 +40,7 @@ def cut_events(session, x: float = 0.056, depth: float = 0.7) -> list[dict]:
 
 def needle_events(session, push: float) -> list[dict]:
     """A drag of ``push`` metres along the needle's shaft (+x) at its entry."""
-    from snede.scenes.needle_slab import ENTRY
+    from snede.app.scenes.needle_slab import ENTRY
 
     path = [session.view.window((ENTRY[0] + push * k / STEPS, ENTRY[1], 0.0)) for k in range(STEPS + 1)]
     return drag("needle", path)
@@ -57,7 +57,7 @@ RECORDINGS = Path(__file__).parent / "recordings"
 def record_all() -> list[Path]:
     """(Re)write the stored recordings (tests/python/interactive/recordings/) from the scripted
     drag and push: run this file when a change of the solvers or cutters is meant to change them."""
-    from snede.interactive.recording import save
+    from snede.app.interactive.recording import save
 
     cut, needle = cut_session(), needle_session()
     play(cut, cut_events(cut))

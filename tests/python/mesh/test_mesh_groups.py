@@ -157,7 +157,7 @@ def test_groups_of_a_plane_sheet_and_of_a_surface_follow_refinement():
 
 
 def test_a_scene_file_holds_and_loads_groups_of_its_mesh_file(tmp_path):
-    from snede import scene_file
+    from snede.app import scene_file
 
     path = gmsh_box(tmp_path, size=0.1)
     scene = tmp_path / "groups.toml"
@@ -184,7 +184,7 @@ force = [0.0, 0.0, -0.01]
     np.testing.assert_allclose(forces[loaded].sum(axis=0), (0.0, 0.0, -0.01))  # the region's total
     assert np.abs(np.delete(forces, loaded, axis=0)).max() == 0
     scene.write_text(scene.read_text().replace('group = "loaded"', 'group = "top"'))
-    with pytest.raises(snede.scene_file.SceneFileError, match="no group 'top'"):
+    with pytest.raises(snede.app.scene_file.SceneFileError, match="no group 'top'"):
         scene_file.load(scene)
 
 

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 import snede
-from snede.scenes.needle_slab import SIZE, h, needle_for, slab_body
+from snede.app.scenes.needle_slab import SIZE, h, needle_for, slab_body
 
 H_START, H_REF = 3, 5
 

@@ -13,8 +13,8 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from snede import run_scene
-from snede.scenes import cut
+from snede.app import run_scene
+from snede.app.scenes import cut
 
 from test_scenes import ROOT, assert_gif_shows_the_cut, built_and_run, not_blank, red_pixels, run_cli, run_cutting_scene_cli, written_files
 
@@ -151,7 +151,7 @@ def test_picture_shows_the_cut_the_supports_and_gravity(cut_beam, request):
     gravity's arrow, axes to scale."""
     import numpy.testing as npt
 
-    from snede.plotting import draw_body, highlighted
+    from snede.app.plotting import draw_body, highlighted
     import matplotlib.pyplot as plt
     from test_pictures import one, to_scale
 

@@ -5,7 +5,7 @@ import pytest
 def test_ctrl_c_while_a_gif_is_drawn_stays_a_keyboard_interrupt(tmp_path):
     # matplotlib's writer.saving() called finish() on the way out, which raised IndexError on a
     # GIF without frames and hid the KeyboardInterrupt (the command line then exited 1).
-    from snede.plotting import animate
+    from snede.app.plotting import animate
 
     def draw(ax, frame):
         raise KeyboardInterrupt

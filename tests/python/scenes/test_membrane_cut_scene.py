@@ -11,7 +11,7 @@ import pytest
 from PIL import Image
 
 from snede.output import read_series
-from snede.scenes import membrane_cut
+from snede.app.scenes import membrane_cut
 
 from test_scenes import assert_gif_shows_the_cut, built_and_run, not_blank, red_pixels, run_cli, written_files
 from test_sheet_cut_scene import lip_pairs, widest_gap

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from snede.needle_forces import INSERTION_FORCE, LIVER_SHEAR_MODULUS
-from snede.scenes import needle3d
+from snede.app.scenes import needle3d
 
 from test_scenes import built_and_run, not_blank
 

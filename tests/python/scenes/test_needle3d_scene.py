@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from snede.scenes import builders, needle3d
+from snede.app.scenes import builders, needle3d
 
 from test_needle_scene import assert_insertion_converged
 from test_scenes import built_and_run, not_blank

@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from snede import run_scene
-from snede.scenes import needle
+from snede.app import run_scene
+from snede.app.scenes import needle
 
 from test_scenes import built_and_run, run_cli, written_files
 
@@ -86,7 +86,7 @@ def test_bad_needle_options_give_a_message(args, message, tmp_path):
 
 def test_picture_shows_the_refined_mesh_the_supports_and_the_needle(inserted, request):
     """Issue 14 item 9: the mesh's edges (the refined mesh's), the held side marked, to scale."""
-    from snede.plotting import draw_body, mesh_edges
+    from snede.app.plotting import draw_body, mesh_edges
     import matplotlib.pyplot as plt
     from test_pictures import by_gid, one
 

@@ -1,7 +1,6 @@
 """What the scenes' pictures show (issue 14 item 9): the mesh's edges, the deformation to scale
 or with its factor in the title, the loads, the fixed vertices, axes to scale. The figures are
 inspected before they are saved (plotting.draw_body), against what the bodies hold."""
-import argparse
 
 import matplotlib
 import numpy as np
@@ -13,9 +12,9 @@ from matplotlib.quiver import Quiver  # noqa: E402
 from mpl_toolkits.mplot3d import proj3d  # noqa: E402
 
 import snede  # noqa: E402
-from snede import plotting, run_scene  # noqa: E402
-from snede.plotting import ARROW, draw_body  # noqa: E402
-from snede.scenes import builders  # noqa: E402
+from snede.app import plotting, run_scene  # noqa: E402
+from snede.app.plotting import ARROW, draw_body  # noqa: E402
+from snede.app.scenes import Parameters, builders  # noqa: E402
 
 
 @pytest.fixture(autouse=True)
@@ -25,8 +24,8 @@ def close_figures():
 
 
 def options(**given):
-    return argparse.Namespace(material=given.get("material"), divisions=given.get("divisions"),
-                              mesh_size=given.get("mesh_size"), speed=given.get("speed"))
+    return Parameters(material=given.get("material"), divisions=given.get("divisions"),
+                      mesh_size=given.get("mesh_size"), speed=given.get("speed"))
 
 
 def by_gid(ax, gid):

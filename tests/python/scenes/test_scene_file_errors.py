@@ -8,7 +8,7 @@ import sys
 
 import pytest
 
-from snede import scene_file
+from snede.app import scene_file
 from test_scene_files import BOX, ROOT
 
 GOOD = BOX + """

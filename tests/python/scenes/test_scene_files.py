@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 import snede
-from snede import run_scene, scene_file
+from snede.app import run_scene, scene_file
 from snede.output import read_series
 
 ROOT = Path(__file__).resolve().parents[3]

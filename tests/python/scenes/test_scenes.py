@@ -1,5 +1,4 @@
 """Scenes, the command line, output files and pictures."""
-import argparse
 import json
 import re
 import subprocess
@@ -12,17 +11,17 @@ import numpy as np
 import pytest
 
 import snede
-from snede import run_scene
+from snede.app import run_scene
 from snede.output import SeriesWriter
-from snede.scenes import builders
+from snede.app.scenes import Parameters, builders
 
 ROOT = Path(__file__).resolve().parents[3]
 SMALL = {"cantilever": dict(divisions=8), "cylinder": dict(), "slab": dict(divisions=8)}
 
 
 def options(**given):
-    return argparse.Namespace(material=given.get("material"), divisions=given.get("divisions"),
-                              mesh_size=given.get("mesh_size"))
+    return Parameters(material=given.get("material"), divisions=given.get("divisions"),
+                      mesh_size=given.get("mesh_size"))
 
 
 def read_step(h5_path, step, mesh):
@@ -149,7 +148,7 @@ def built_and_run(module, folder, tmp_path_factory, divisions, speed=None):
     """The scene of `module` built with these options (no material or mesh size) and run into
     a fresh folder named `folder`: the scene, its summary and the folder."""
     out = tmp_path_factory.mktemp(folder)
-    scene = module.build(argparse.Namespace(material=None, divisions=divisions, mesh_size=None, speed=speed))
+    scene = module.build(Parameters(divisions=divisions, speed=speed))
     return scene, run_scene.run(scene, None, None, out, progress=False), out
 
 

@@ -16,8 +16,8 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from snede import run_scene
-from snede.scenes import sheet_cut
+from snede.app import run_scene
+from snede.app.scenes import sheet_cut
 
 from test_scenes import assert_gif_shows_the_cut, built_and_run, red_pixels, run_cli, run_cutting_scene_cli, written_files
 
@@ -199,7 +199,7 @@ def test_bad_sheet_cut_options_give_a_message(args, message, tmp_path):
 
 def test_picture_marks_the_grips(sheet, request):
     """Issue 14 item 9: the vertices the grips hold, where they pulled them."""
-    from snede.plotting import draw_body
+    from snede.app.plotting import draw_body
     import matplotlib.pyplot as plt
     from test_pictures import one
 

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 import snede
-from snede.scenes.needle_slab import slab_body
+from snede.app.scenes.needle_slab import slab_body
 
 
 def fixed_vertices(body) -> np.ndarray:
