@@ -124,8 +124,8 @@ void bind_solve(py::module_& m) {
                                                    bisection ? &bisection->hierarchy() : nullptr);
            }),
            py::arg("model"), py::arg("options"), py::arg("bisection"), py::keep_alive<1, 2>(), py::keep_alive<1, 4>())
-      // Any problem on its communicator (a DistributedStatic): collective.
-      .def(py::init([](Problem& problem, StaticOptions options) {
+      // A distributed problem on its communicator: collective.
+      .def(py::init([](DistributedStatic& problem, StaticOptions options) {
              return std::make_unique<StaticSolver>(problem, std::move(options));
            }),
            py::arg("problem"), py::arg("options"), py::keep_alive<1, 2>())

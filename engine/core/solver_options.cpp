@@ -77,6 +77,40 @@ bool SolverOptions::bool_option(const std::string& name, bool fallback) const {
   throw std::invalid_argument("-" + name + " must be true or false (1/0, yes/no, on/off), got '" + *text + "'");
 }
 
+double SolverOptions::number_option(const std::string& name, double fallback) const {
+  const std::optional<std::string> text = string_option(name);
+  if (!text) return fallback;
+  try {
+    std::size_t used = 0;
+    const double value = std::stod(*text, &used);
+    if (used != text->size()) throw std::invalid_argument(*text);
+    return value;
+  } catch (const std::exception&) {
+    throw std::invalid_argument("-" + name + " must be a number, got '" + *text + "'");
+  }
+}
+
+void SolverOptions::renew_initial_guess(KSP ksp) const {
+  const char* prefix = nullptr;
+  SNEDE_PETSC(KSPGetOptionsPrefix(ksp, &prefix));
+  // KSPGetGuess would give a KSP without one an empty guess, which KSPSolve then consults.
+  if (!string_option(std::string(prefix ? prefix : "") + "ksp_guess_type")) return;
+  KSPGuess kept = nullptr;
+  SNEDE_PETSC(KSPGetGuess(ksp, &kept));
+  KSPGuessType type = nullptr;
+  SNEDE_PETSC(KSPGuessGetType(kept, &type));
+  if (!type) return;
+  const std::string kept_type = type;
+  KSPGuess fresh = nullptr;
+  SNEDE_PETSC(KSPGuessCreate(PetscObjectComm(reinterpret_cast<PetscObject>(ksp)), &fresh));
+  use_for(fresh);
+  SNEDE_PETSC(PetscObjectSetOptionsPrefix(reinterpret_cast<PetscObject>(fresh), prefix));
+  SNEDE_PETSC(KSPGuessSetType(fresh, kept_type.c_str()));
+  SNEDE_PETSC(KSPGuessSetFromOptions(fresh));
+  SNEDE_PETSC(KSPSetGuess(ksp, fresh));  // the KSP holds its own reference
+  SNEDE_PETSC(KSPGuessDestroy(&fresh));
+}
+
 void SolverOptions::set_string_option(const std::string& name, const std::string& value) {
   SNEDE_PETSC(PetscOptionsSetValue(database_, ("-" + name).c_str(), value.c_str()));
 }

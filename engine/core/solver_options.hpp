@@ -6,6 +6,7 @@
 // PETSc.Options) inserted over them, so that the command line still wins.
 #pragma once
 
+#include <petscksp.h>
 #include <petscsys.h>
 
 #include <optional>
@@ -50,9 +51,17 @@ class SolverOptions {
   // 1/0, true/false, yes/no, on/off in any case), or `fallback` if it is not set;
   // std::invalid_argument naming the option for any other value.
   bool bool_option(const std::string& name, bool fallback) const;
+  // The value of the numeric option `name`, or `fallback` if it is not set; std::invalid_argument
+  // naming the option for a value that is not a number.
+  double number_option(const std::string& name, double fallback) const;
   // Sets option `name` (with its prefix, without '-') in this database only.
   void set_string_option(const std::string& name, const std::string& value);
 
+  // KSPReset and SNESReset keep a KSP's initial-guess object (-<prefix>ksp_guess_type fischer
+  // or pod) with the vectors of the mesh before a change: the first solve after a needle's
+  // refinement failed with PETSc error 75 ("Incompatible vector local lengths"). Replaces it by
+  // an empty guess of the same type read from this database (nothing without such an option).
+  void renew_initial_guess(KSP ksp) const;
   // Marks the global options this solver has read as used in the global database, so that
   // -options_left lists only the options that no solver read.
   void mark_read_options_used() const;

@@ -148,13 +148,12 @@ BisectionMultigrid::BisectionMultigrid(Model& fine, const RefinementHierarchy& h
 
 BisectionMultigrid::~BisectionMultigrid() = default;
 
-bool BisectionMultigrid::matches_mesh(const Model& fine) const {
-  return &fine == &fine_ && fine.body().mesh().connectivity().revision() == revision_;
+bool BisectionMultigrid::matches_mesh() const {
+  return fine_.body().mesh().connectivity().revision() == revision_;
 }
 
-bool BisectionMultigrid::matches(const Model& fine) const {
-  return &fine == &fine_ && fine.body().mesh().connectivity().revision() == revision_ &&
-         fine.constraints().projection_fingerprint() == constraints_;
+bool BisectionMultigrid::matches() const {
+  return matches_mesh() && fine_.constraints().projection_fingerprint() == constraints_;
 }
 
 std::vector<std::size_t> BisectionMultigrid::level_unknowns() const {

@@ -41,8 +41,8 @@ class BisectionMultigrid final : public Multigrid {
   BisectionMultigrid& operator=(const BisectionMultigrid&) = delete;
 
   const char* source() const override { return "bisection"; }
-  bool matches(const Model& fine) const override;
-  bool matches_mesh(const Model& fine) const override;
+  bool matches() const override;
+  bool matches_mesh() const override;
   int n_levels() const override { return static_cast<int>(coarse_.size()) + 1; }
   // Elements per level, coarsest first, the fine mesh last.
   std::vector<std::size_t> level_sizes() const override;

@@ -22,20 +22,20 @@ GalerkinMultigrid::GalerkinMultigrid(Model& fine)
       topology_revision_(fine.body().mesh().connectivity().topology_revision()),
       constraints_(fine.constraints().projection_fingerprint()) {}
 
-bool GalerkinMultigrid::matches_mesh(const Model& fine) const {
-  return &fine == &fine_ && fine.body().mesh().connectivity().revision() == revision_;
+bool GalerkinMultigrid::matches_mesh() const {
+  return fine_.body().mesh().connectivity().revision() == revision_;
 }
 
-bool GalerkinMultigrid::carry_over_moved_vertices(const Model& fine) {
-  const Connectivity& mesh = fine.body().mesh().connectivity();
-  if (&fine != &fine_ || mesh.topology_revision() != topology_revision_) return false;
+bool GalerkinMultigrid::carry_over_moved_vertices() {
+  const Connectivity& mesh = fine_.body().mesh().connectivity();
+  if (mesh.topology_revision() != topology_revision_) return false;
   revision_ = mesh.revision();
   carried_ = true;
   return true;
 }
 
-bool GalerkinMultigrid::matches(const Model& fine) const {
-  return matches_mesh(fine) && fine.constraints().projection_fingerprint() == constraints_;
+bool GalerkinMultigrid::matches() const {
+  return matches_mesh() && fine_.constraints().projection_fingerprint() == constraints_;
 }
 
 void set_chebyshev_jacobi_smoother(KSP smoother, const SolverOptions& options, double largest_bound,

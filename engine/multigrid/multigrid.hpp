@@ -26,9 +26,9 @@ class Multigrid {
   virtual const char* source() const = 0;
   // Whether the fine mesh and its constraints' projections are still those the levels were
   // made for (no edit, no vertex fixed, released or made to slide since).
-  virtual bool matches(const Model& fine) const = 0;
+  virtual bool matches() const = 0;
   // Whether only the mesh is still the same (the constraints may have changed).
-  virtual bool matches_mesh(const Model& fine) const = 0;
+  virtual bool matches_mesh() const = 0;
   // After the fine constraints changed (not the mesh): the levels take them over. False if
   // they cannot (then the levels must be made anew).
   virtual bool follow_constraints() = 0;
@@ -36,7 +36,7 @@ class Multigrid {
   // levels that still precondition the mesh take it over and return true, keeping what they
   // were made with (interpolation, products) for the earlier positions until they are made
   // anew; false if they must be made anew now.
-  virtual bool carry_over_moved_vertices(const Model&) { return false; }
+  virtual bool carry_over_moved_vertices() { return false; }
   // After edits of elements: levels for the mesh as it is now made from these, equal to levels
   // made anew, or null where they are made anew only (the default).
   virtual std::unique_ptr<Multigrid> follow_edits() { return nullptr; }
@@ -72,12 +72,12 @@ class Multigrid {
 // constraints' projections, so any change of either means new levels.
 class GalerkinMultigrid : public Multigrid {
  public:
-  bool matches(const Model& fine) const override;
-  bool matches_mesh(const Model& fine) const override;
+  bool matches() const override;
+  bool matches_mesh() const override;
   bool follow_constraints() override { return false; }
   // An interpolation for the earlier positions is still an interpolation of the same vertices,
   // and the products of the earlier tangent still an SPD preconditioner of the present one.
-  bool carry_over_moved_vertices(const Model& fine) override;
+  bool carry_over_moved_vertices() override;
   bool made_for_earlier_positions() const override { return carried_; }
   bool needs_assembled_tangent() const override { return true; }
   // Recomputes Pᵀ A P level by level from the refilled fine matrix (numeric only while the

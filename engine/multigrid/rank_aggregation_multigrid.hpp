@@ -20,8 +20,8 @@ class RankAggregationMultigrid final : public Multigrid {
 
   const char* source() const override { return "aggregation"; }
   // A distributed problem's mesh and constraints do not change.
-  bool matches(const Model&) const override { return true; }
-  bool matches_mesh(const Model&) const override { return true; }
+  bool matches() const override { return true; }
+  bool matches_mesh() const override { return true; }
   bool follow_constraints() override { return true; }
   int n_levels() const override { return static_cast<int>(levels_.global_unknowns.size()); }
   // Unknowns per coarse level, then the mesh's cells (all ranks'), coarsest first.

@@ -5,12 +5,12 @@
 // through an incision it already made), the levels of an earlier solve — the assembled tangent at
 // that state, its Galerkin products, the coarse factorisation, the smoothers' bounds — still
 // precondition the tangent well. When only the projections change (a needle's stick-slip), the
-// levels keep their interpolation and are refilled at the new state (static_solver.cpp). Within
+// levels keep their interpolation and are refilled at the new state (preconditioner_state.cpp). Within
 // one solve from far away (a body loaded from rest) the tangent changes more from step to step.
 // Levels are kept until they show their age: a Newton iteration whose CG needs more than
 // `refresh_ratio` times the CG iterations of the first Newton iteration the levels served after
 // they were filled, or a linear solve or a solve that failed. Then they are filled at the state
-// of now (static_solver.cpp).
+// of now (preconditioner_state.cpp).
 #pragma once
 
 namespace snede {

@@ -40,4 +40,10 @@ struct SolveResult {
 // (tolerance …), energy … J, 0.012 s, 5.1 MFLOP".
 std::string summary(const SolveResult& result);
 
+// Converged means the stopping criterion holds at an admissible, finite final state, whatever
+// stopped PETSc (a line search's step tolerance, say): result.residual_norm and
+// result.tolerance are those of the final state; `inadmissible` names why it is not admissible
+// (empty if it is); `finite` and `inverted` are the final residual's check (problem.hpp).
+void judge_final_state(SolveResult& result, const std::string& inadmissible, bool finite, bool inverted);
+
 }  // namespace snede

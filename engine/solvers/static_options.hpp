@@ -2,6 +2,8 @@
 // iteration cap, the options prefix, the preconditioner and the solver's own PETSc options.
 #pragma once
 
+#include <mpi.h>
+
 #include <cstdint>
 #include <string>
 
@@ -64,5 +66,11 @@ struct StaticOptions {
     visit("preconditioner", &StaticOptions::preconditioner);
   }
 };
+
+// std::invalid_argument naming the first setting out of range (rtol, round_tolerance,
+// max_iterations, linear CG on a material that is not linear), or the setting that differs
+// between the ranks of `comm`: a rank with another method or tolerance would wait in a
+// collective call the others never make. Collective.
+void require_valid(const StaticOptions& options, bool linear_material, MPI_Comm comm);
 
 }  // namespace snede

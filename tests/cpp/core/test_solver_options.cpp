@@ -61,3 +61,18 @@ TEST(SolverOptions, BadNamesAreRejectedWithTheName) {
     }
   }
 }
+
+TEST(SolverOptions, NumbersAreReadWholeOrRefusedWithTheOption) {
+  const snede::SolverOptions options("opt_", {{"width", "2.5"}, {"ratio", "1e-3"}, {"bad", "2.5x"}, {"word", "wide"}});
+  EXPECT_EQ(options.number_option("opt_width", 7.0), 2.5);
+  EXPECT_EQ(options.number_option("opt_ratio", 7.0), 1e-3);
+  EXPECT_EQ(options.number_option("opt_absent", 7.0), 7.0);
+  for (const std::string name : {"opt_bad", "opt_word"}) {
+    try {
+      options.number_option(name, 0.0);
+      ADD_FAILURE() << name << " must be refused";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find("-" + name + " must be a number"), std::string::npos) << e.what();
+    }
+  }
+}
