@@ -10,9 +10,9 @@
 namespace snede::bindings {
 
 void bind_core(py::module_& m) {
-  py::register_exception<PetscException>(m, "PetscError", PyExc_RuntimeError);
-  py::register_exception<FileError>(m, "FileError", PyExc_OSError);
-  py::register_exception<BodyInUse>(m, "BodyInUse", PyExc_RuntimeError);
+  py::register_exception<PetscException>(m, "PetscError", error_bases(PyExc_RuntimeError));
+  py::register_exception<FileError>(m, "FileError", error_bases(PyExc_OSError));
+  py::register_exception<BodyInUse>(m, "BodyInUse", error_bases(PyExc_RuntimeError));
   // A solve stopped by Python — a petsc4py monitor that raised (PETSc then fails with
   // petsc4py's PETSC_ERR_PYTHON), or a Ctrl-C seen by the interrupt check below — comes back
   // as a PetscError while Python's exception is still set: that exception, with its type and

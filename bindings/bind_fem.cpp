@@ -113,7 +113,7 @@ py::class_<M> bind_material(py::module_& m, const char* name) {
 }  // namespace
 
 void bind_fem(py::module_& m) {
-  py::register_exception<DomainError>(m, "DomainError", PyExc_ArithmeticError);
+  py::register_exception<DomainError>(m, "DomainError", error_bases(PyExc_ArithmeticError));
   auto linear = bind_material<LinearElastic>(m, "LinearElastic");
   linear.def(py::init<double, double>(), py::arg("E"), py::arg("nu"));
   auto stvk = bind_material<StVenantKirchhoff>(m, "StVenantKirchhoff");

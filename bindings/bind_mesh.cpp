@@ -89,7 +89,7 @@ std::vector<std::int32_t> vertex_ids(const IndexArray& a) {
 }
 
 void bind_mesh(py::module_& m) {
-  py::register_exception<InvalidMesh>(m, "InvalidMesh", PyExc_ValueError);
+  py::register_exception<InvalidMesh>(m, "InvalidMesh", error_bases(PyExc_ValueError));
   py::class_<Mesh>(m, "Mesh")
       .def(py::init(&make_mesh), py::arg("points"), py::arg("cells"))
       .def_property_readonly("dim", &Mesh::dim)

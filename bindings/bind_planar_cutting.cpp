@@ -6,7 +6,7 @@
 namespace snede::bindings {
 
 void bind_planar_cutting(py::module_& m) {
-  py::register_exception<IncisionLost>(m, "IncisionLost", PyExc_RuntimeError);
+  py::register_exception<IncisionLost>(m, "IncisionLost", error_bases(PyExc_RuntimeError));
   bind_record<PlanarCutReport>(
       m, "PlanarCutReport",
       "What one ``move`` (or a whole ``cut``) did: edge ``flips``, ``nodes_removed`` near the active node,\n"

@@ -17,6 +17,13 @@ namespace snede::bindings {
 
 namespace py = pybind11;
 
+// The bases of a snede exception registered here: snede.Error (python/snede/_errors.py), then
+// `builtin`, the built-in base callers catch (PyExc_ValueError...). py::register_exception
+// hands its base to PyErr_NewException, which takes a tuple of bases.
+inline py::tuple error_bases(PyObject* builtin) {
+  return py::make_tuple(py::module_::import("snede._errors").attr("Error"), py::handle(builtin));
+}
+
 // The engine's Material from a Python material object (TypeError for anything else).
 Material material_from(const py::handle& object);
 

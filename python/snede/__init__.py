@@ -11,6 +11,7 @@ from snede._petsc import PETSc  # noqa: F401  (initialises PETSc before the engi
 from snede._command_line import abort_first_under_mpi4py
 
 abort_first_under_mpi4py()  # after petsc4py's exit handler is registered: see there
+from snede._errors import Error  # noqa: F401  (the base of every snede exception)
 from snede._snede import (  # noqa: F401
     BodyInUse,
     DomainError,
@@ -43,7 +44,7 @@ __all__ = [
     "IncisionLost",
     "SubdivisionCutter", "DistributedMesh", "DistributedRelaxation", "DistributedStatic", "distribute",
     "LinearElastic", "StVenantKirchhoff", "NeoHookean", "VerondaWestmann",
-    "BodyInUse", "EditResult", "FileError", "InvalidMesh", "PetscError", "DomainError", "LockingWarning", "formulations", "PETSc",
+    "Error", "BodyInUse", "EditResult", "FileError", "InvalidMesh", "PetscError", "DomainError", "LockingWarning", "formulations", "PETSc",
     "output_folder",
 ]
 __version__ = "0.1.0"

@@ -18,6 +18,7 @@ import petsc4py
 
 from snede import _command_line
 from snede._argv import split
+from snede._errors import Error
 
 if _command_line.is_loading():
     _command_line.on_ctrl_c(_command_line.stop_interrupted)
@@ -109,7 +110,7 @@ def unused_options() -> list[tuple[str, str | None]]:
             if name not in READ_AT_FINALIZE and not _snede.option_used(name)]
 
 
-class OptionValueError(ValueError):
+class OptionValueError(Error, ValueError):
     """A value PETSc refuses for one of its options."""
 
 

@@ -17,6 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from snede import _gmsh
+from snede._errors import Error
 
 #: meshio's format for each suffix Mesh.read knows by name
 MESHIO_FORMATS = {".msh": "gmsh", ".vtk": "vtk", ".vtu": "vtu", ".mesh": "medit", ".meshb": "medit", ".stl": "stl",
@@ -25,7 +26,7 @@ MESHIO_FORMATS = {".msh": "gmsh", ".vtk": "vtk", ".vtu": "vtu", ".mesh": "medit"
 GMSH_SUFFIXES = (".msh", ".vtk", ".stl", ".mesh", ".off")
 
 
-class DamagedFile(ValueError):
+class DamagedFile(Error, ValueError):
     """A file that contradicts itself (a count and the lines that follow it): no reader is tried
     on it."""
 

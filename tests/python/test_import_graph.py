@@ -6,8 +6,9 @@ import ast
 from pathlib import Path
 
 PACKAGE = Path(__file__).resolve().parents[2] / "python" / "snede"
-# The compiled extension: it imports none of snede's Python modules.
-EXTENSIONS = ("snede._snede",)
+# The compiled extension and the Python modules it imports: snede._errors, the base class of
+# the exceptions it registers (bindings/bindings.hpp, error_bases).
+EXTENSIONS = {"snede._snede": {"snede._errors"}}
 
 
 def module_names() -> dict[str, Path]:
@@ -45,7 +46,7 @@ def import_graph() -> dict[str, set[str]]:
     modules = module_names()
     known = set(modules) | set(EXTENSIONS)
     graph = {name: imported(name, path, known) for name, path in modules.items()}
-    graph.update({name: set() for name in EXTENSIONS})
+    graph.update({name: set(imports) for name, imports in EXTENSIONS.items()})
     return graph
 
 

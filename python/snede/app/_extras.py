@@ -5,10 +5,12 @@ from __future__ import annotations
 
 import importlib
 
+from snede._errors import Error
+
 EXTRAS = {"pyvista": "view", "vtk": "view", "vtkmodules": "view", "matplotlib": "plot", "PIL": "plot"}
 
 
-class MissingExtra(ImportError):
+class MissingExtra(Error, ImportError):
     """An application needs a package of one of snede's optional extras, and it is not installed."""
 
 

@@ -97,7 +97,7 @@ def picture_arguments(scene, method: str) -> dict:
             "decorate": scene.decorate, "fixed": fixed, **(scene.picture() if scene.picture else {})}
 
 
-class SerialOnly(NotImplementedError):
+class SerialOnly(snede.Error, NotImplementedError):
     """The scene cannot run on several MPI ranks; raised on every rank alike."""
 
 

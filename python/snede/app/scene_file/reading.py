@@ -10,8 +10,10 @@ import math
 from dataclasses import dataclass
 from typing import Callable, NoReturn
 
+from snede._errors import Error
 
-class SceneFileError(ValueError):
+
+class SceneFileError(Error, ValueError):
     """A mistake in a scene file: one line naming the file and the key."""
 
 
