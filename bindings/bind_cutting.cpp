@@ -25,7 +25,7 @@ std::unique_ptr<TetrahedralCutter> make_cutter(Mesh& mesh, Model* model, bool sn
 
 void bind_cutting(py::module_& m) {
   bind_record<CutReport>(
-      m, "CutReport",
+      m, "CutResult",
       "What one ``move`` or ``cut_triangle`` did.\n\n"
       "``faces_dissected`` counts selected faces the dissection opened; a face whose vertices' stars do not\n"
       "split yet (Figure 7.7) stays joined and is cut again with the next sweep. ``degenerate_found`` counts\n"
@@ -41,6 +41,7 @@ void bind_cutting(py::module_& m) {
       "``a + b``: both reports together (counts and times add up; ``components`` is ``b``'s unless it swept\n"
       "nothing), as ``move`` combines its halves.")
       .def("__str__", [](const CutReport& r) { return summary(r); });
+  m.attr("CutReport") = m.attr("CutResult");  // its name before issue 51: records pickled then load
 
   py::class_<TetrahedralCutter>(m, "TetrahedralCutter")
       .def(py::init(&make_cutter), py::arg("mesh"), py::arg("model"), py::arg("snap"), py::arg("remove_degeneracies"),

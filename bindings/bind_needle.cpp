@@ -47,13 +47,14 @@ void bind_needle(py::module_& m) {
                              "A needle insertion's settings (snede.NeedleInsertion documents each); the engine's struct.");
 
   bind_record<NeedleStepReport>(
-      m, "NeedleStepReport",
+      m, "NeedleStepResult",
       "One update (§6.7). ``rearrangements`` counts the solves (each followed by a rearrangement of the\n"
       "needle nodes); ``slipped``/``stuck``/``released``/``intercepted`` count node state changes;\n"
       "``converged`` is False if a solve did not converge (``reason`` ``SOLVE_<PETSc reason>``) or the\n"
       "rearrangements did not settle within ``max_rearrangements`` (``DIVERGED_REARRANGEMENT_LIMIT``).\n"
       "``settled`` is False when node states still had to change at the end (with ``solves_per_update``,\n"
       "carried into the next update).");
+  m.attr("NeedleStepReport") = m.attr("NeedleStepResult");  // its name before issue 51: old pickles load
 
   py::class_<NeedleInsertion>(m, "NeedleInsertion")
       .def(py::init(&make_needle), py::arg("model"), py::arg("bisection"), py::arg("entry"), py::arg("direction"),

@@ -8,7 +8,7 @@ namespace snede::bindings {
 void bind_planar_cutting(py::module_& m) {
   py::register_exception<IncisionLost>(m, "IncisionLost", error_bases(PyExc_RuntimeError));
   bind_record<PlanarCutReport>(
-      m, "PlanarCutReport",
+      m, "PlanarCutResult",
       "What one ``move`` (or a whole ``cut``) did: edge ``flips``, ``nodes_removed`` near the active node,\n"
       "``nodes_inserted`` (entry, exit and incision splits), ``incision_splits`` (Figure 5.5),\n"
       "``edges_contracted`` after exits (Figure 5.7), ``entries``, ``exits``, on surfaces ``branches``\n"
@@ -16,6 +16,7 @@ void bind_planar_cutting(py::module_& m) {
       "short of the scalpel (``stuck``), the triangle counts before and after, and the time in ``seconds``.\n"
       "``a + b``: counts and times add, ``triangles_after`` is ``b``'s.")
       .def("__str__", [](const PlanarCutReport& r) { return summary(r); });
+  m.attr("PlanarCutReport") = m.attr("PlanarCutResult");  // its name before issue 51: old pickles load
 
   py::class_<DelaunayCutter> cutter(m, "DelaunayCutter");
   def_delaunay_cutter_common(cutter);

@@ -117,6 +117,11 @@ void bind_solve(py::module_& m) {
   bind_record<StaticOptions>(m, "StaticOptions",
                              "A static solver's settings (snede.StaticSolver documents each); the engine's struct.\n"
                              "``method`` and ``criterion`` are their names (``\"ncg\"``, ``\"6.9\"``).");
+  // The names `method` takes, from the engine's table (static_options.hpp): Python lists them
+  // nowhere else.
+  py::tuple methods(static_method_names.size());
+  for (std::size_t i = 0; i < static_method_names.size(); ++i) methods[i] = py::str(std::string(static_method_names[i].second));
+  m.attr("static_methods") = methods;
 
   py::class_<StaticSolver>(m, "StaticSolver")
       .def(py::init([](Model& model, StaticOptions options, const Bisection* bisection) {

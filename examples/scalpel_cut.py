@@ -3,7 +3,7 @@ on the other, is cut from its side by a vertical blade moved in steps; the block
 static solve) after each step, and the cut opens like a mouth, wider the deeper it goes.
 
 Run it with `python -m snede run examples/scalpel_cut.py`; it prints what each move of the
-scalpel did (a CutReport) and how each solve ended, and writes out/scalpel_cut/ (with --out DIR,
+scalpel did (a CutResult) and how each solve ended, and writes out/scalpel_cut/ (with --out DIR,
 DIR/scalpel_cut/): the XDMF series (a new mesh after each move that cut; the point field
 `incision` is 1 on the lips) and a picture with the incision in red.
 """
@@ -41,7 +41,7 @@ path = [[(x, y, -0.01), (x, y, 0.03)] for y in np.linspace(-0.005, 0.024, 9)]
 #    mesh from the state the body carried across the cut.
 cutter = snede.TetrahedralCutter(body)
 cutter.move(path[0])
-total = snede.CutReport()
+total = snede.CutResult()
 for step, scalpel in enumerate(path[1:], start=1):
     report = cutter.move(scalpel)
     total = total + report

@@ -26,21 +26,22 @@ from snede._snede import (  # noqa: F401
 )
 from snede.mesh import Mesh, MeshQuality  # noqa: F401
 from snede.body import Body, LockingWarning, formulations  # noqa: F401
-from snede._snede import SolveResult  # noqa: F401
+from snede._snede import DynamicRelaxationOptions, NeedleOptions, SolveResult, StaticOptions  # noqa: F401
 from snede.static import StaticSolver  # noqa: F401
 from snede.dynamics import DynamicRelaxation  # noqa: F401
-from snede.needle import FrictionProfile, NeedleInsertion  # noqa: F401
-from snede.cutting import TetrahedralCutter, CutReport  # noqa: F401
-from snede.planar_cutting import DelaunayCutter, IncisionLost, PlanarCutReport  # noqa: F401
+from snede.needle import FrictionProfile, InsertionResult, NeedleInsertion, NeedleStepResult  # noqa: F401
+from snede.cutting import TetrahedralCutter, CutResult  # noqa: F401
+from snede.planar_cutting import DelaunayCutter, IncisionLost, PlanarCutResult  # noqa: F401
 from snede.surface_cutting import SurfaceCutter  # noqa: F401
 from snede.distributed import DistributedMesh, DistributedRelaxation, DistributedStatic, distribute  # noqa: F401
 from snede.subdivision_cutting import SubdivisionCutter  # noqa: F401
-from snede import meshing  # noqa: F401
+from snede import _renamed, meshing  # noqa: F401
 from snede._output_folder import output_folder  # noqa: F401
 
 __all__ = [
     "Mesh", "MeshQuality", "Body", "meshing", "StaticSolver", "DynamicRelaxation", "SolveResult",
-    "FrictionProfile", "NeedleInsertion", "TetrahedralCutter", "CutReport", "DelaunayCutter", "PlanarCutReport", "SurfaceCutter",
+    "StaticOptions", "DynamicRelaxationOptions", "NeedleOptions", "NeedleStepResult", "InsertionResult",
+    "FrictionProfile", "NeedleInsertion", "TetrahedralCutter", "CutResult", "DelaunayCutter", "PlanarCutResult", "SurfaceCutter",
     "IncisionLost",
     "SubdivisionCutter", "DistributedMesh", "DistributedRelaxation", "DistributedStatic", "distribute",
     "LinearElastic", "StVenantKirchhoff", "NeoHookean", "VerondaWestmann",
@@ -56,4 +57,4 @@ _ON_FIRST_USE = ("output",)
 def __getattr__(name):
     if name in _ON_FIRST_USE:
         return importlib.import_module(f"snede.{name}")
-    raise AttributeError(f"module 'snede' has no attribute {name!r}")
+    return _renamed.old_name(__name__, globals(), name)  # CutReport and the other names before issue 51

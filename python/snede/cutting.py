@@ -13,9 +13,9 @@ import math
 
 import numpy as np
 
-from snede import _checks, _snede
+from snede import _checks, _renamed, _snede
 from snede._engine import engine_property
-from snede._snede import CutReport
+from snede._snede import CutResult
 from snede.mesh import Mesh
 
 
@@ -67,7 +67,7 @@ class TetrahedralCutter:
 
     ``cut_triangle(corners)`` processes one sweep triangle ((3, 3), deformed coordinates);
     ``move(scalpel)`` moves the scalpel ((2, 3): its two ends) and cuts along the sweep from
-    its previous position (the first call only places it). Both return a :class:`CutReport`.
+    its previous position (the first call only places it). Both return a :class:`CutResult`.
     Invalid input raises ``ValueError`` before anything changes.
     """
 
@@ -85,19 +85,19 @@ class TetrahedralCutter:
                                               float(min_aspect_ratio), float(large_angle), bool(fix_free_pieces),
                                               _checks.count(max_fragment_elements, "max_fragment_elements", 0))
 
-    def cut_triangle(self, corners) -> CutReport:
+    def cut_triangle(self, corners) -> CutResult:
         return self._impl.cut_triangle(_checks.coordinates(corners, (3, 3), "corners"))
 
-    def move(self, scalpel) -> CutReport:
+    def move(self, scalpel) -> CutResult:
         return self._impl.move(_checks.coordinates(scalpel, (2, 3), "scalpel"))
 
-    def cut(self, path, progress=None) -> CutReport:
+    def cut(self, path, progress=None) -> CutResult:
         """Move the scalpel through ``path``, an (n, 2, 3) sequence of scalpel positions; the
         first places it. ``progress(done, total, report)`` is called after each move."""
         path = np.asarray(path, dtype=np.float64)
         if path.ndim != 3 or path.shape[1:] != (2, 3) or len(path) < 2:
             raise ValueError(f"path must be (n, 2, 3) scalpel positions with n >= 2, got shape {path.shape}")
-        return move_along(self.move, path, CutReport(), progress)
+        return move_along(self.move, path, CutResult(), progress)
 
     def lift(self) -> None:
         """Lift the scalpel out of the body: the next ``move`` only places it, and the next
@@ -109,3 +109,7 @@ class TetrahedralCutter:
     def incision_faces(self) -> np.ndarray:
         """The boundary faces the cuts opened, (n, 3) vertex ids, oriented outward."""
         return self._impl.incision_faces()
+
+
+def __getattr__(name):  # the names records had before issue 51 (snede._renamed)
+    return _renamed.old_name(__name__, globals(), name)

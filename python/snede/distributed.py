@@ -25,6 +25,9 @@ from snede._petsc import option_list
 from snede.mesh import Mesh
 from snede._snede import SolveResult
 
+# The engine's static defaults (a default record's), for the settings whose defaults here are its.
+_STATIC = _snede.StaticOptions()
+
 MATERIALS = (_snede.LinearElastic, _snede.StVenantKirchhoff, _snede.NeoHookean, _snede.VerondaWestmann)
 
 
@@ -141,9 +144,9 @@ class DistributedStatic:
         arguments = agreed(comm, conditions)
         self._impl = _snede.DistributedStatic(part._impl, material, *arguments)
 
-    def solve(self, method: str = "cg", rtol: float = 1e-8, max_iterations: int = 10000, preconditioner: str = "none",
-              options_prefix: str = "dstatic_", criterion: str = "relative", round_tolerance: float = 1e-12,
-              petsc_options: dict | None = None) -> SolveResult:
+    def solve(self, method: str = "cg", rtol: float = 1e-8, max_iterations: int = _STATIC.max_iterations,
+              preconditioner: str = "none", options_prefix: str = "dstatic_", criterion: str = "relative",
+              round_tolerance: float = _STATIC.round_tolerance, petsc_options: dict | None = None) -> SolveResult:
         """The serial :class:`snede.StaticSolver`'s engine on this problem: ``method`` "cg"
         (linear), "newton" or "ncg" (nonlinear CG, no preconditioner); ``preconditioner`` "none",
         "jacobi" (the tangent's diagonal, summed across the ranks), "mg" (multigrid by aggregation
@@ -210,25 +213,29 @@ def _per_vertex(values, n: int, dim: int, name: str) -> np.ndarray:
     return array
 
 
+def relaxation_options(damping: float, dt: float | None, options_prefix: str,
+                       petsc_options) -> _snede.DynamicRelaxationOptions:
+    """The engine's record of a relaxation's settings, which checks them (a negative or
+    non-finite damping or step is a ValueError naming it); ``dt`` None (or 0) takes the CFL
+    estimate. The serial and the distributed relaxation both make theirs here."""
+    return _snede.DynamicRelaxationOptions(damping=damping, dt=0.0 if dt is None else dt,
+                                           options_prefix=options_prefix, petsc_options=option_list(petsc_options))
+
+
 class DistributedRelaxation:
     """Dynamic relaxation (§2.5) of a :class:`DistributedStatic` problem: the damped motion
     M ü + η M u̇ = −F(u) with lumped masses, integrated by snede's central-difference TS
     (snede_ss22) on all ranks — the serial DynamicRelaxation's engine, on the problem's
     communicator; ``run(rtol, max_steps)`` stops at criterion (6.9)
     ‖F(u)‖ ≤ rtol·√(‖f_ext‖² + ‖f_react‖²). ``dt`` None takes the CFL estimate (2.61) of the
-    whole mesh. Options under ``options_prefix`` (``drelax_``): ``-drelax_ts_monitor`` and so
+    whole mesh (as 0 does). Options under ``options_prefix`` (``drelax_``): ``-drelax_ts_monitor`` and so
     on, or ``petsc_options`` (without the prefix) for this solver only. Collective."""
 
     def __init__(self, problem: DistributedStatic, damping: float, dt: float | None = None, *,
                  options_prefix: str = "drelax_", petsc_options: dict | None = None):
-        def checked():
-            if dt is not None and not (np.isfinite(dt) and dt > 0):
-                raise ValueError(f"dt must be positive and finite (or None for the CFL estimate), got {dt}")
-            return _snede.DynamicRelaxationOptions(damping=damping, dt=dt or 0.0, options_prefix=options_prefix,
-                                                   petsc_options=option_list(petsc_options))
-
         self.problem = problem
-        self._impl = _snede.DynamicRelaxation(problem._impl, agreed(problem.part.comm, checked))
+        self._impl = _snede.DynamicRelaxation(
+            problem._impl, agreed(problem.part.comm, lambda: relaxation_options(damping, dt, options_prefix, petsc_options)))
 
     @property
     def dt(self) -> float:

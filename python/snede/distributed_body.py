@@ -106,10 +106,12 @@ def _inputs(body) -> dict:
 
 class RunsOnRanks:
     """Mixed into the serial solvers: ``part``, and a guard on what only the serial solver has.
-    The solver sets ``_distributed`` (a DistributedBody or None) and ``_impl`` (None when
-    distributed); ``_on_ranks`` names what remains available then."""
+    The solver sets ``_distributed`` (a DistributedBody or None) and ``_impl``, the engine object
+    it wraps (None when distributed, until its solve makes one); reading ``_impl`` while it is
+    None raises NotImplementedError, ``_on_ranks`` naming what remains available then."""
 
     _on_ranks = "solve() and part"
+    _wrapped = None
 
     @property
     def part(self):
@@ -118,8 +120,12 @@ class RunsOnRanks:
         return None if self._distributed is None else self._distributed.part
 
     @property
-    def _engine(self):
-        if self._impl is None:
+    def _impl(self):
+        if self._wrapped is None:
             raise NotImplementedError(f"this {type(self).__name__} runs on MPI ranks (comm): only {self._on_ranks} "
                                       "are available")
-        return self._impl
+        return self._wrapped
+
+    @_impl.setter
+    def _impl(self, engine_object) -> None:
+        self._wrapped = engine_object

@@ -7,15 +7,16 @@ static equilibrium. The integrator is PETSc's TS of type ``snede_ss22`` with opt
 """
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
 from snede import _checks, _snede
-from snede._petsc import option_list
-from snede.distributed import DistributedRelaxation
+from snede.distributed import DistributedRelaxation, relaxation_options
 from snede.distributed_body import DistributedBody, RunsOnRanks
-from snede._snede import SolveResult
+from snede._snede import DynamicRelaxationOptions, SolveResult
+
+#: the settings' defaults: the engine's, a default record's (written nowhere else)
+DEFAULTS = DynamicRelaxationOptions()
+
 
 
 class DynamicRelaxation(RunsOnRanks):
@@ -23,7 +24,7 @@ class DynamicRelaxation(RunsOnRanks):
 
     * ``damping``: η (1/s) of the damping C = η M, ≥ 0. §4.1: the fastest relaxation has
       η = 2√λ₁ (λ₁ the lowest eigenvalue of M⁻¹K); Table 4.4 lists 17–27 1/s for its cylinder.
-    * ``dt``: time step (s); None takes the CFL estimate (2.61) ``cfl_time_step``, renewed
+    * ``dt``: time step (s); None (or 0) takes the CFL estimate (2.61) ``cfl_time_step``, renewed
       when the mesh changes size. Above the critical step the motion blows up; that is
       reported as ``reason == "DIVERGED_BLOW_UP"``, not raised.
     * ``petsc_options``: PETSc options without the prefix, e.g. ``{"ts_monitor": None}``, for
@@ -48,10 +49,9 @@ class DynamicRelaxation(RunsOnRanks):
 
     _on_ranks = "run(), dt and part"
 
-    def __init__(self, body, damping: float, dt: float | None = None, *, options_prefix: str = "dynamic_",
-                 petsc_options: dict | None = None, comm=None):
-        if dt is not None and not (math.isfinite(dt) and dt > 0):
-            raise ValueError(f"dt must be positive and finite (or None for the CFL estimate), got {dt}")
+    def __init__(self, body, damping: float, dt: float | None = None, *,
+                 options_prefix: str = DEFAULTS.options_prefix, petsc_options: dict | None = None, comm=None):
+        options = relaxation_options(damping, dt, options_prefix, petsc_options)
         self.body = body
         self._distributed = None
         comm = getattr(body, "comm", None) if comm is None else comm
@@ -61,8 +61,6 @@ class DynamicRelaxation(RunsOnRanks):
             self._start_relaxation()
             self._impl = None
             return
-        options = _snede.DynamicRelaxationOptions(damping=damping, dt=dt or 0.0, options_prefix=options_prefix,
-                                                  petsc_options=option_list(petsc_options))
         self._impl = _snede.DynamicRelaxation(body._model, options)
 
     def _start_relaxation(self) -> None:
@@ -74,7 +72,7 @@ class DynamicRelaxation(RunsOnRanks):
     def step(self, n: int = 1) -> SolveResult:
         """Take ``n`` time steps. ``converged`` is False only on divergence (blow-up, NaN,
         inverted elements); ``residual_norm`` is ‖F(u)‖ at the final state."""
-        return self._engine.step(_checks.count(n, "n"))
+        return self._impl.step(_checks.count(n, "n"))
 
     def run(self, rtol: float = 1e-3, max_steps: int = 100000) -> SolveResult:
         """Step until ‖F(u)‖ ≤ rtol·√(‖f_ext‖² + ‖f_react‖²) (criterion (6.9)), or
@@ -93,14 +91,14 @@ class DynamicRelaxation(RunsOnRanks):
         blow up (‖u‖ > 1e15 or NaN) within ``flop_budget`` flops (and at least ``min_steps``
         steps, which large meshes need), searched from ``initial`` (None: the CFL estimate) in
         factors of (1 − ``reduction``). The state is restored."""
-        return self._engine.critical_time_step(float(flop_budget), float(initial or 0.0), float(reduction),
+        return self._impl.critical_time_step(float(flop_budget), float(initial or 0.0), float(reduction),
                                              _checks.count(min_steps, "min_steps", 1))
 
     @property
     def cfl_time_step(self) -> float:
         """(2.61): (2/√3)·h/c, h the smallest inscribed-sphere diameter, c the dilatational
         wave speed √((λ+2μ)/ρ) (plane stress: √(E/((1−ν²)ρ)))."""
-        return self._engine.cfl_time_step()
+        return self._impl.cfl_time_step()
 
     @property
     def dt(self) -> float:
@@ -108,22 +106,22 @@ class DynamicRelaxation(RunsOnRanks):
 
     @dt.setter
     def dt(self, value: float) -> None:
-        self._engine.dt = float(value)
+        self._impl.dt = float(value)
 
     @property
     def damping(self) -> float:
-        return self._engine.damping
+        return self._impl.damping
 
     @property
     def velocity(self) -> np.ndarray:
         """Velocity (m/s) at the half step behind the displacement, (n_points, dim) (a copy)."""
-        return self._engine.velocity
+        return self._impl.velocity
 
     @velocity.setter
     def velocity(self, v) -> None:
-        self._engine.velocity = np.ascontiguousarray(self.body._field("velocity", v))
+        self._impl.velocity = np.ascontiguousarray(self.body._field("velocity", v))
 
     @property
     def ts(self):
         """The petsc4py TS (type ``snede_ss22``)."""
-        return self._engine.ts
+        return self._impl.ts

@@ -8,8 +8,8 @@ is relaxed and the needle nodes rearranged until no node changes state (§6.3.2,
     profile = snede.FrictionProfile.figure_6_4()
     needle = snede.NeedleInsertion(body, entry=(0.0, 0.05), direction=(1.0, 0.0), friction=profile,
                                    h_ref=0.1 / 2**6)
-    step = needle.advance(0.001)              # one update: NeedleStepReport
-    report = needle.insert(depth=0.07, step=0.001)   # InsertionReport
+    step = needle.advance(0.001)              # one update: NeedleStepResult
+    report = needle.insert(depth=0.07, step=0.001)   # InsertionResult
 """
 from __future__ import annotations
 
@@ -17,10 +17,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from snede import _checks, _snede
+from snede import _checks, _renamed, _snede
 from snede._engine import engine_property
 from snede._petsc import option_list
-from snede._snede import NeedleStepReport
+from snede._snede import NeedleOptions, NeedleStepResult, StaticOptions
+
+#: the engine's defaults (default records'): the needle's settings and its static solver's
+#: iteration cap; the solver's method, rtol, round_tolerance and prefix are the needle's own
+DEFAULTS, SOLVER_DEFAULTS = NeedleOptions(), StaticOptions()
 
 
 class FrictionProfile:
@@ -62,7 +66,7 @@ class FrictionProfile:
 
 
 @dataclass
-class InsertionReport:
+class InsertionResult:
     """A whole insertion: ``updates`` needle moves, ``rearrangements`` solves in all,
     ``update_rate`` = rearrangements per second (Table 6.5's "updates [Hz]"), CG (or Newton's
     inner CG) iterations per solve on average and at most; ``extensions`` moves carried into the
@@ -135,10 +139,12 @@ class NeedleInsertion:
     from vertices the user has not constrained.
     """
 
-    def __init__(self, body, entry, direction, friction: FrictionProfile, *, static_factor: float = 2.0,
-                 h_ref: float | None = None, radius: float | None = None, method: str = "cg", rtol: float = 1e-3, criterion: str = "6.9",
-                 round_tolerance: float = 1e-8, max_iterations: int = 10000, max_rearrangements: int = 200,
-                 solves_per_update: int | None = None, extrapolate: bool = False, extension_rings: int = 3,
+    def __init__(self, body, entry, direction, friction: FrictionProfile, *,
+                 static_factor: float = DEFAULTS.static_factor, h_ref: float | None = None, radius: float | None = None,
+                 method: str = "cg", rtol: float = 1e-3, criterion: str = SOLVER_DEFAULTS.criterion,
+                 round_tolerance: float = 1e-8, max_iterations: int = SOLVER_DEFAULTS.max_iterations,
+                 max_rearrangements: int = DEFAULTS.max_rearrangements, solves_per_update: int | None = None,
+                 extrapolate: bool = DEFAULTS.extrapolate, extension_rings: int = DEFAULTS.extension_rings,
                  options_prefix: str = "needle_", petsc_options: dict | None = None):
         body.mesh.require_serial("NeedleInsertion")
         if body.mesh.is_surface:
@@ -154,8 +160,6 @@ class NeedleInsertion:
                 raise ValueError(f"{name} must have {dim} components for this {dim}-D body, got shape {np.shape(value)}")
         if not isinstance(friction, FrictionProfile):
             raise TypeError(f"friction must be a snede.FrictionProfile, got {type(friction).__name__}")
-        if not (rtol > 0):
-            raise ValueError(f"rtol must be positive, got {rtol}")
         max_rearrangements = _checks.count(max_rearrangements, "max_rearrangements", 1)
         # None (or 0, as the engine has it) relaxes until no node changes state.
         solves_per_update = 0 if solves_per_update is None else _checks.count(solves_per_update, "solves_per_update")
@@ -164,28 +168,28 @@ class NeedleInsertion:
         self.body = body
         self.friction_profile = friction
         bisection = body.mesh._bisection() if h_ref is not None else None
-        options = _snede.NeedleOptions(static_factor=float(static_factor), h_ref=None if h_ref is None else float(h_ref),
-                                       radius=float(radius), max_rearrangements=max_rearrangements,
-                                       solves_per_update=solves_per_update, extrapolate=bool(extrapolate),
-                                       extension_rings=extension_rings)
-        solver_options = _snede.StaticOptions(method=method, rtol=float(rtol), criterion=criterion,
-                                              round_tolerance=float(round_tolerance), max_iterations=max_iterations,
-                                              options_prefix=options_prefix, petsc_options=option_list(petsc_options))
+        options = NeedleOptions(static_factor=float(static_factor), h_ref=None if h_ref is None else float(h_ref),
+                                radius=float(radius), max_rearrangements=max_rearrangements,
+                                solves_per_update=solves_per_update, extrapolate=bool(extrapolate),
+                                extension_rings=extension_rings)
+        solver_options = StaticOptions(method=method, rtol=float(rtol), criterion=criterion,
+                                       round_tolerance=float(round_tolerance), max_iterations=max_iterations,
+                                       options_prefix=options_prefix, petsc_options=option_list(petsc_options))
         self._impl = _snede.NeedleInsertion(body._model, bisection, np.asarray(entry, dtype=np.float64),
                                             np.asarray(direction, dtype=np.float64), friction._impl, options,
                                             solver_options)
 
-    def advance(self, distance: float) -> NeedleStepReport:
+    def advance(self, distance: float) -> NeedleStepResult:
         """Move the needle ``distance`` (≥ 0) further in and relax (one update of §6.7)."""
         if not (np.isfinite(distance) and distance >= 0):
             raise ValueError(f"the needle advances by a non-negative, finite distance; got {distance}")
         return self._impl.advance(float(distance))
 
-    def settle(self) -> NeedleStepReport:
+    def settle(self) -> NeedleStepResult:
         """Relax and rearrange without moving the needle."""
         return self._impl.settle()
 
-    def insert(self, depth: float, step: float, progress=None) -> InsertionReport:
+    def insert(self, depth: float, step: float, progress=None) -> InsertionResult:
         """Advance in steps of ``step`` until the tip is ``depth`` from the entry point (the last
         step shortened to land on it), then, with ``solves_per_update``, keep updating in place
         until no node changes state (as the thesis's automated insertion does).
@@ -251,16 +255,20 @@ class NeedleInsertion:
         return state
 
 
-def summarize(steps: list) -> InsertionReport:
-    """An InsertionReport over NeedleStepReports."""
+def summarize(steps: list) -> InsertionResult:
+    """An InsertionResult over NeedleStepResults."""
     rearrangements = sum(s.rearrangements for s in steps)
     seconds = sum(s.seconds for s in steps)
     iterations = sum(s.solver_iterations for s in steps)
     failed = [s for s in steps if not s.converged]
-    return InsertionReport(
+    return InsertionResult(
         updates=len(steps), rearrangements=rearrangements, seconds=seconds,
         update_rate=rearrangements / seconds if seconds > 0 else float("inf"),
         mean_iterations=iterations / rearrangements if rearrangements else 0.0,
         max_iterations=max((s.max_solver_iterations for s in steps), default=0),
         converged=not failed, reason=failed[0].reason if failed else "CONVERGED", steps=steps,
         extensions=sum(s.extensions for s in steps), halvings=sum(s.halvings for s in steps))
+
+
+def __getattr__(name):  # the names records had before issue 51 (snede._renamed)
+    return _renamed.old_name(__name__, globals(), name)

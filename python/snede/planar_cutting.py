@@ -12,9 +12,9 @@ import math
 
 import numpy as np
 
-from snede import _checks, _snede
+from snede import _checks, _renamed, _snede
 from snede._engine import engine_property
-from snede._snede import PlanarCutReport
+from snede._snede import PlanarCutResult
 from snede.cutting import body_and_mesh, move_along
 
 #: Raised by a Delaunay cutter's ``move`` (a RuntimeError) when edits others made to the mesh
@@ -88,7 +88,7 @@ class DelaunayCutter(IncisionCutter):
     ``move(point)`` moves the scalpel ((2,), deformed coordinates): the first move from outside
     the body that crosses its boundary enters, an incision follows the scalpel, and leaving
     the body finishes the cut. ``cut(path)`` samples the polyline ``path`` ((n, 2)) and moves
-    along it. Both return a :class:`PlanarCutReport`. Invalid input raises ``ValueError``
+    along it. Both return a :class:`PlanarCutResult`. Invalid input raises ``ValueError``
     before anything changes.
 
     The cutter watches the mesh (§7.4): edits made by others between moves (collapses, splits,
@@ -108,12 +108,16 @@ class DelaunayCutter(IncisionCutter):
         self._impl = _snede.DelaunayCutter(self.mesh._impl, model, _threshold(eps_edge, "eps_edge"),
                                            _threshold(eps_entry, "eps_entry"), _threshold(eps_exit, "eps_exit"), angle)
 
-    def move(self, point) -> PlanarCutReport:
+    def move(self, point) -> PlanarCutResult:
         return self._impl.move(_point(point))
 
-    def cut(self, path, step: float | None = None, progress=None) -> PlanarCutReport:
+    def cut(self, path, step: float | None = None, progress=None) -> PlanarCutResult:
         """Move along the polyline ``path`` ((n, 2)), sampled every ``step`` (default
         ``eps_edge``); ``progress(done, total, report)`` is called after each move."""
         points = sample_path(path, self.eps_edge if step is None else _threshold(step, "step"))
-        return move_along(self.move, points, PlanarCutReport(), progress)
+        return move_along(self.move, points, PlanarCutResult(), progress)
 
+
+
+def __getattr__(name):  # the names records had before issue 51 (snede._renamed)
+    return _renamed.old_name(__name__, globals(), name)

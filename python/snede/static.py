@@ -8,15 +8,26 @@ from __future__ import annotations
 from snede import _checks, _snede
 from snede._petsc import option_list
 from snede.distributed_body import DistributedBody, RunsOnRanks
-from snede._snede import SolveResult
+from snede._snede import SolveResult, StaticOptions
 
-METHODS = ("cg", "ncg", "newton")
+#: the names ``method`` takes, from the engine's table (static_options.hpp)
+METHODS = tuple(_snede.static_methods)
 LINE_SEARCHES = ("cp", "snede_newton", "snede_secant", "bt", "l2", "basic")
+NCG_TYPES = ("prp", "fr", "hs", "dy", "cd")
+#: the settings' defaults: the engine's, a default record's (written nowhere else)
+DEFAULTS = StaticOptions()
 
 
 class StaticSolver(RunsOnRanks):
     """``StaticSolver(body, method="newton", rtol=1e-6, ...)``; ``solve()`` relaxes
     ``body.displacement`` in place and returns a :class:`snede.SolveResult`.
+
+    * ``options``: a :class:`snede.StaticOptions` record holding every setting below but
+      ``line_search``, ``ncg_type`` and ``comm`` (default: ``StaticOptions()``, whose fields are
+      the defaults: method ``"newton"``, rtol 1e-6, criterion ``"6.9"``, round_tolerance 1e-12,
+      max_iterations 10000, options_prefix ``"static_"``). A keyword given (not None) changes
+      its field of that record; the record checks each value (a ValueError or TypeError naming
+      the field), the engine the whole at construction.
 
     * ``method``: ``"cg"`` (linear CG, LinearElastic only), ``"ncg"`` (nonlinear CG,
       Polak-Ribière by default; ``ncg_type="fr"`` for Fletcher-Reeves) or ``"newton"``
@@ -109,41 +120,50 @@ class StaticSolver(RunsOnRanks):
 
     _on_ranks = "solve() and part (the others after the first solve())"
 
-    def __init__(self, body, method: str = "newton", rtol: float = 1e-6, *, criterion: str = "6.9",
-                 round_tolerance: float = 1e-12, max_iterations: int = 10000, line_search: str | None = None,
-                 ncg_type: str | None = None, options_prefix: str = "static_", petsc_options: dict | None = None,
+    def __init__(self, body, method: str | None = None, rtol: float | None = None, *,
+                 options: StaticOptions | None = None, criterion: str | None = None,
+                 round_tolerance: float | None = None, max_iterations: int | None = None, line_search: str | None = None,
+                 ncg_type: str | None = None, options_prefix: str | None = None, petsc_options: dict | None = None,
                  preconditioner: str | None = None, comm=None):
-        if method not in METHODS:
-            raise ValueError(f"method must be one of {METHODS}, got {method!r}")
-        if not (rtol > 0):
-            raise ValueError(f"rtol must be positive, got {rtol}")
-        max_iterations = _checks.count(max_iterations, "max_iterations", 1)
-        options = dict(petsc_options or {})
-        if line_search is not None:
-            if method != "ncg":
-                raise ValueError("line_search applies to method='ncg'")
-            if line_search not in LINE_SEARCHES:
-                raise ValueError(f"line_search must be one of {LINE_SEARCHES}, got {line_search!r}")
-            options.setdefault("snes_linesearch_type", line_search)
-        if ncg_type is not None:
-            if ncg_type not in ("prp", "fr", "hs", "dy", "cd"):
-                raise ValueError(f"ncg_type must be 'prp' or 'fr' (or hs, dy, cd), got {ncg_type!r}")
-            options.setdefault("snes_ncg_type", ncg_type)
+        if options is not None and not isinstance(options, StaticOptions):
+            raise TypeError(f"options must be a snede.StaticOptions, got {type(options).__name__}")
+        if max_iterations is not None:
+            max_iterations = _checks.count(max_iterations, "max_iterations", 1)
         if preconditioner is not None and (not isinstance(preconditioner, str) or not preconditioner.strip()):
             raise ValueError(f"preconditioner must be a PETSc PC type name such as 'none', 'jacobi' or 'gamg', "
                              f"got {preconditioner!r}")
+        given = {"method": method, "rtol": rtol, "criterion": criterion, "round_tolerance": round_tolerance,
+                 "max_iterations": max_iterations, "options_prefix": options_prefix, "preconditioner": preconditioner}
+        settings = StaticOptions(**{**_fields(options or DEFAULTS),
+                                    **{name: value for name, value in given.items() if value is not None}})
+        # petsc_options (a dict) replaces the record's; line_search and ncg_type add to them
+        extra = dict(settings.petsc_options) if petsc_options is None else dict(petsc_options)
+        if line_search is not None:
+            if settings.method != "ncg":
+                raise ValueError("line_search applies to method='ncg'")
+            if line_search not in LINE_SEARCHES:
+                raise ValueError(f"line_search must be one of {LINE_SEARCHES}, got {line_search!r}")
+            extra.setdefault("snes_linesearch_type", line_search)
+        if ncg_type is not None:
+            if ncg_type not in NCG_TYPES:
+                raise ValueError(f"ncg_type must be 'prp' or 'fr' (or hs, dy, cd), got {ncg_type!r}")
+            extra.setdefault("snes_ncg_type", ncg_type)
+        settings.petsc_options = option_list(extra)
+        method = settings.method
         self.body = body
         self.method = method
-        self._settings = _snede.StaticOptions(method=method, rtol=float(rtol), criterion=criterion,
-                                              round_tolerance=float(round_tolerance), max_iterations=max_iterations,
-                                              options_prefix=options_prefix, petsc_options=option_list(options),
-                                              preconditioner=preconditioner or "")
+        self._settings = settings
         self._distributed, self._problem, self._impl = None, None, None
         comm = getattr(body, "comm", None) if comm is None else comm
         if comm is not None:
             self._distributed = DistributedBody(body, comm)
             return
         self._impl = _snede.StaticSolver(body._model, self._settings, body.mesh._bisection_if_any())
+
+    @property
+    def options(self) -> StaticOptions:
+        """A copy of the settings this solver was made with (a :class:`snede.StaticOptions`)."""
+        return StaticOptions(**_fields(self._settings))
 
     def solve(self) -> SolveResult:
         if self._distributed is not None:
@@ -165,50 +185,50 @@ class StaticSolver(RunsOnRanks):
     @property
     def preconditioner(self) -> str:
         """The PETSc PC type the CG uses ("none" for ncg)."""
-        return self._engine.preconditioner
+        return self._impl.preconditioner
 
     @property
     def multigrid_levels(self) -> list[int]:
         """Elements per level of the ``"mg"`` preconditioner, coarsest first, the body's mesh
         last (empty for other preconditioners); rebuilt at the first solve after a mesh change."""
-        return list(self._engine.multigrid_levels)
+        return list(self._impl.multigrid_levels)
 
     @property
     def multigrid_unknowns(self) -> list[int]:
         """Unknowns per level of the ``"mg"`` preconditioner, coarsest first, the body's last."""
-        return list(self._engine.multigrid_unknowns)
+        return list(self._impl.multigrid_unknowns)
 
     @property
     def multigrid_source(self) -> str:
         """What made the ``"mg"`` levels: ``"bisection"`` (the mesh's refinement tree), ``"grid"``
         or ``"aggregation"`` (any mesh); empty for other preconditioners."""
-        return self._engine.multigrid_source
+        return self._impl.multigrid_source
 
     @property
     def follow_seconds(self) -> float:
         """Seconds the last ``solve()`` spent following a change of the mesh or of the
         constraints before iterating (new vectors, assembled tangent, multigrid levels)."""
-        return self._engine.follow_seconds
+        return self._impl.follow_seconds
 
     @property
     def preconditioner_fills(self) -> int:
         """How many times this solver filled its preconditioner (an assembled tangent, multigrid
         levels at a state) since it was made: less than once per solve where it reuses one."""
-        return self._engine.preconditioner_fills
+        return self._impl.preconditioner_fills
 
     @property
     def sparsity_builds(self) -> int:
         """How many times this solver made its assembled tangent's sparsity: once per change of
         the mesh's elements (a cut, a flip, a refinement), not when vertices only moved (a cut
         snapping a vertex onto the blade keeps it; its values are filled again)."""
-        return self._engine.sparsity_builds
+        return self._impl.sparsity_builds
 
     @property
     def sparsity_edits(self) -> int:
         """How many of :attr:`sparsity_builds` were made from the earlier sparsity after a cut or
         a refinement: only the rows of the vertices the edit touched are found again
         (``-static_rebuild_after_edits`` makes them from scratch)."""
-        return self._engine.sparsity_edits
+        return self._impl.sparsity_edits
 
     @property
     def tangent_assemblies(self) -> int:
@@ -217,7 +237,7 @@ class StaticSolver(RunsOnRanks):
         material, not a membrane), Newton with Galerkin levels kept across solves makes the new
         tangent from the earlier one instead: only the blocks the edit touched are computed, the
         others keep their (exact) values (``-static_rebuild_after_edits`` assembles anew)."""
-        return self._engine.tangent_assemblies
+        return self._impl.tangent_assemblies
 
     @property
     def piece_labellings(self) -> int:
@@ -226,7 +246,7 @@ class StaticSolver(RunsOnRanks):
         after a cut only when a piece split off, pieces were joined or a piece is not held;
         otherwise only the pieces of the vertices the edit touched are found again
         (``-static_rebuild_after_edits`` labels them after every change of the elements)."""
-        return self._engine.piece_labellings
+        return self._impl.piece_labellings
 
     @property
     def multigrid_builds(self) -> int:
@@ -235,7 +255,7 @@ class StaticSolver(RunsOnRanks):
         constraints the levels did not take over in place. Newton's Galerkin levels keep their
         interpolation through changes of constraints alone (a needle's stick-slip) and are only
         refilled, until they show their age (``-static_mg_refresh_ratio``)."""
-        return self._engine.multigrid_builds
+        return self._impl.multigrid_builds
 
     @property
     def multigrid_edits(self) -> int:
@@ -243,16 +263,21 @@ class StaticSolver(RunsOnRanks):
         a cut or a refinement of a volume mesh: on the grid of the first build, only the node
         copies the edit reached are found again (``-static_rebuild_after_edits`` makes them from scratch, on the
         same grid)."""
-        return self._engine.multigrid_edits
+        return self._impl.multigrid_edits
 
     @property
     def ksp(self):
         """The petsc4py KSP: linear CG's, or Newton's inner one. Made afresh (what was set on
         the old one through petsc4py is lost; command-line options are read again) when the
         preconditioner "auto" chooses again after the mesh grew or shrank past 1 000 cells."""
-        return self._engine.ksp
+        return self._impl.ksp
 
     @property
     def snes(self):
         """The petsc4py SNES (None for linear CG); made afresh as :attr:`ksp` is."""
-        return self._engine.snes
+        return self._impl.snes
+
+
+def _fields(record) -> dict:
+    """A record's fields by name, as its keyword construction takes them."""
+    return record.__reduce__()[1][1]

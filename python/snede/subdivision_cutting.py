@@ -15,7 +15,7 @@ import time
 import numpy as np
 
 from snede.mesh import Mesh
-from snede.planar_cutting import PlanarCutReport, _point, _threshold, sample_path
+from snede.planar_cutting import PlanarCutResult, _point, _threshold, sample_path
 from snede.cutting import move_along
 
 _END = 1e-9  # a crossing this close to an edge's end (as a fraction of it) is at the vertex
@@ -73,7 +73,7 @@ class SubdivisionCutter:
         cells = self.mesh.cells
         return int(np.count_nonzero(np.any(cells == u, axis=1) & np.any(cells == v, axis=1))) == 2
 
-    def move(self, point) -> PlanarCutReport:
+    def move(self, point) -> PlanarCutResult:
         p = _point(point)
         start = time.perf_counter()
         before = self.mesh.n_cells
@@ -106,11 +106,11 @@ class SubdivisionCutter:
                 elif self._end is not None:
                     self._end = vertex
         self._last = p
-        return PlanarCutReport(**counts, triangles_before=before, triangles_after=self.mesh.n_cells,
+        return PlanarCutResult(**counts, triangles_before=before, triangles_after=self.mesh.n_cells,
                                seconds=time.perf_counter() - start)
 
-    def cut(self, path, step: float | None = None, progress=None) -> PlanarCutReport:
+    def cut(self, path, step: float | None = None, progress=None) -> PlanarCutResult:
         """Move along the polyline ``path`` ((n, 2)); ``step`` (default: the whole segments)
         only changes how often ``progress(done, total, report)`` is called."""
         points = sample_path(path, np.inf if step is None else _threshold(step, "step"))
-        return move_along(self.move, points, PlanarCutReport(), progress)
+        return move_along(self.move, points, PlanarCutResult(), progress)

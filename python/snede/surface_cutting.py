@@ -17,7 +17,7 @@ import numpy as np
 
 from snede import _checks, _snede
 from snede.cutting import body_and_mesh, move_along
-from snede.planar_cutting import IncisionCutter, PlanarCutReport, _threshold
+from snede.planar_cutting import IncisionCutter, PlanarCutResult, _threshold
 
 
 class SurfaceCutter(IncisionCutter):
@@ -35,7 +35,7 @@ class SurfaceCutter(IncisionCutter):
     crest; that incision branches at once). Each incision follows the scalpel, branches where
     the scalpel meets its triangles in several places, and ends where it leaves through the
     boundary or meets another incision. ``cut(path)`` moves through ``path`` ((n, 2, 3)
-    scalpel positions, the first places it). Both return a :class:`snede.PlanarCutReport`
+    scalpel positions, the first places it). Both return a :class:`snede.PlanarCutResult`
     (the 2D cutter's fields plus ``branches`` and ``annihilations``). Invalid input raises
     ``ValueError`` before anything changes.
 
@@ -63,13 +63,13 @@ class SurfaceCutter(IncisionCutter):
         nodes = self.active_nodes
         return nodes[0] if nodes else None
 
-    def move(self, segment) -> PlanarCutReport:
+    def move(self, segment) -> PlanarCutResult:
         segment = _checks.coordinates(segment, (2, 3), "segment")
         if np.array_equal(segment[0], segment[1]):
             raise ValueError(f"segment: the scalpel's two ends coincide: {segment.tolist()}")
         return self._impl.move(segment)
 
-    def cut(self, segments, progress=None) -> PlanarCutReport:
+    def cut(self, segments, progress=None) -> PlanarCutResult:
         """Move the scalpel through ``segments`` ((n, 2, 3), n >= 2; the first places it);
         ``progress(done, total, report)`` is called after each move. The whole path is checked
         before the first move."""
@@ -80,5 +80,5 @@ class SurfaceCutter(IncisionCutter):
             raise ValueError("segments has non-finite coordinates")
         if np.any(np.all(segments[:, 0] == segments[:, 1], axis=1)):
             raise ValueError("segments: a scalpel position has coinciding ends")
-        return move_along(self.move, segments, PlanarCutReport(), progress)
+        return move_along(self.move, segments, PlanarCutResult(), progress)
 

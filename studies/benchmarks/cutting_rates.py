@@ -6,7 +6,7 @@ Kuhn boxes snede.meshing.box((1, 1, 1), (n, n, n)) of 6n³ tetrahedra, from abou
 to about 10⁶ (n = 55), all cut by the same scalpel path in units of the mesh spacing h = 1/n:
 a blade 3h long, in a plane tilted against the mesh's faces, starting h/2 outside the front
 face (z = 1) and pushed 5 moves of h each into the body (each move is two sweep triangles,
-processed here with cut_triangle so that each triangle is timed alone: CutReport.seconds).
+processed here with cut_triangle so that each triangle is timed alone: CutResult.seconds).
 So every mesh sees the same cut, dissecting a handful of faces per sweep triangle.
 
 Columns (milliseconds per sweep triangle, medians over the triangles of ``--repeats`` cuts,
@@ -23,7 +23,7 @@ each on a fresh mesh):
   over all elements, for comparison: the cutter does not make it after every sweep. It
   counts the body's pieces (§3.3: free pieces are fixed) by a search from the elements the
   sweep changed, which stops once the searches meet around the incision's edge; 'search' is
-  the median number of elements it visited (CutReport.piece_search). Only a sweep that
+  the median number of elements it visited (CutResult.piece_search). Only a sweep that
   separates a piece relabels all elements.
 * later: all triangles after the first move (remove_degeneracies=True, bare mesh), dissecting
   or not; ratio: 'later' over the smallest mesh's.
@@ -71,7 +71,7 @@ def triangles(path) -> list[np.ndarray]:
 
 
 def run(n: int, remove: bool, body: bool):
-    """One cut on a fresh box; a list of (move index, CutReport) per sweep triangle."""
+    """One cut on a fresh box; a list of (move index, CutResult) per sweep triangle."""
     mesh = snede.meshing.box((1.0, 1.0, 1.0), (n, n, n))
     target = snede.Body(mesh, snede.LinearElastic(1e4, 0.25)) if body else mesh
     cutter = snede.TetrahedralCutter(target, remove_degeneracies=remove)
@@ -131,7 +131,7 @@ def main() -> None:
     arguments = parser.parse_args()
     sizes, repeats = ((6, 12, 26), 1) if arguments.quick else (arguments.sizes, arguments.repeats)
     print(f"blade {BLADE:g} h, {MOVES} moves of 1 h from {-START:g} h outside the front face; milliseconds per sweep "
-          f"triangle (CutReport.seconds), medians over {repeats} cut(s) per cell; first/later/no diss./+removal: "
+          f"triangle (CutResult.seconds), medians over {repeats} cut(s) per cell; first/later/no diss./+removal: "
           "bare mesh with removal; dissecting: without removal; w/ Body: on a Body, with removal")
     header = (f"{'tets':>8} {'n':>3} {'boundary':>8} {'build s':>7} | {'first':>6} {'later':>6} {'no diss.':>8} | "
               f"{'dissecting':>10} {'+removal':>8} {'removal':>7} {'w/ Body':>8} | {'faces':>5} {'#':>3} | "

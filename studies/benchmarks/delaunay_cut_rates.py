@@ -8,7 +8,7 @@ at mid-height and moves in steps of ε_edge = h̄/3 (the default threshold) alon
 tilted 0.1 rad against the grid, ``--moves`` moves into the body (on the smallest mesh it
 leaves the body first: only the moves before the exit count); three such incisions, at
 heights 0.5, 0.3 and 0.7, so that the medians are over about 120 moves. Columns (microseconds,
-CutReport.seconds):
+CutResult.seconds):
 
 * entry: the first incision's move that crosses the boundary (a scan of the boundary edges, O(√n) here).
 * move: median and 90th percentile of the moves after the entry fix-up (remeshing around

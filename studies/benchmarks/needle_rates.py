@@ -46,7 +46,7 @@ SCAN_TOLERANCES = (0.01, 0.02, 0.03, 0.05, 0.07, 0.1)
 
 
 def insert(h_ref, speed, rtol, args):
-    """One automated insertion; (InsertionReport, CPU seconds, wall seconds, final cells)."""
+    """One automated insertion; (InsertionResult, CPU seconds, wall seconds, final cells)."""
     body = slab_body(3)
     needle = needle_for(body, h_ref, method=args.method, rtol=rtol,
                         solves_per_update=1 if args.loop == "thesis" else None)
@@ -131,7 +131,7 @@ def phases(args, h_ref=6, speed=0.1):
     solver_name = "KSPSolve" if spent["KSPSolve"] else "SNESSolve"
     lines = [
         ("insertion, wall clock", wall),
-        ("  updates in the engine (sum of NeedleStepReport.seconds)", report.seconds),
+        ("  updates in the engine (sum of NeedleStepResult.seconds)", report.seconds),
         (f"    solver ({solver_name})", solver),
         ("      tangent products (SnedeTangentApply, matrix-free)", spent["SnedeTangentApply"]),
         ("    rest: refinement, interception, thresholds, rearrangement, evaluations", report.seconds - solver),

@@ -32,7 +32,7 @@ the 3D length of the boundary edges off the square's sides: both lips); triangle
 unit of incision length and per h̄ of it; the smallest and largest angle of any triangle (in
 3D), the mean smallest angle, the counts of triangles with an angle below 20° or above 120°
 (as in docs/results/delaunay_cut.md); time per move (mean and max, ms): the engine's
-PlanarCutReport.seconds for the surface cutter, the wall time of the Python reference
+PlanarCutResult.seconds for the surface cutter, the wall time of the Python reference
 SubdivisionCutter, which scans all edges at every crossing, so its times say nothing about an
 interactive subdivision; the surface cutter's events. The 'uncut' rows are the surfaces before
 any cut. No assertions: a benchmark prints and writes (surface_cut.csv,

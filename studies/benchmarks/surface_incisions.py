@@ -39,7 +39,7 @@ With --quick: the leaning paths only.
 Columns: triangles before and after, the events of the cut (entries, branches, annihilations,
 exits, stuck moves), the pieces the surface falls into (Mesh.connected_components), the
 smallest angle and the triangles with one below 20°, and the time per move (the engine's
-PlanarCutReport.seconds, the shortest of 5 runs per move for the scripted cuts, one run for
+PlanarCutResult.seconds, the shortest of 5 runs per move for the scripted cuts, one run for
 the random ones). Writes surface_incisions.csv and surface_incisions.png (the scripted cuts
 in 3D, pieces pulled apart) in docs/results/. No assertions.
 """

@@ -206,7 +206,7 @@ def cube_cut(snap: bool, remove: bool, threshold: float, large_angle: float, pat
     before = solver.solve()
     cutter = snede.TetrahedralCutter(body, snap=snap, remove_degeneracies=remove, min_aspect_ratio=threshold,
                                      large_angle=large_angle)
-    total = snede.CutReport()
+    total = snede.CutResult()
     relax_iterations = 0
     for k, scalpel in enumerate(path):
         total = total + cutter.move(scalpel)
@@ -351,7 +351,7 @@ def cylinder_rows(quick: bool):
                 mesh = cylinder_mesh(quick)
                 elements, vertices = mesh.n_cells, mesh.n_live_points
                 per_cut, incision = [], []
-                total = snede.CutReport()
+                total = snede.CutResult()
                 for k in range(3):
                     # A cutter per cut: the scalpel is lifted between cuts (one cutter would sweep from the
                     # end of one cut to the start of the next).

@@ -44,7 +44,7 @@ import numpy as np
 
 import snede
 from studies.experiments.common import Column, PageTemplate, markdown_table, parse_arguments, pyplot, save_figure, write_csv
-from snede.planar_cutting import PlanarCutReport, sample_path
+from snede.planar_cutting import PlanarCutResult, sample_path
 from snede.subdivision_cutting import SubdivisionCutter
 
 N_SMALL, N_LARGE = 5, 19  # 2·5² = 50 triangles (Figure 5.16), 2·19² = 722 (Figure 5.8)
@@ -204,7 +204,7 @@ def cut(n: int, method: str, path, fraction: float | None = None, origins: dict 
     if method == "subdivision":
         return mesh, SubdivisionCutter(mesh).cut(path), h
     cutter = snede.DelaunayCutter(mesh, eps_edge=h / (fraction or 3))
-    report = PlanarCutReport()
+    report = PlanarCutResult()
     for point in sample_path(path, cutter.eps_edge):
         before = mesh.live_vertices
         step = cutter.move(point)

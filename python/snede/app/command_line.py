@@ -30,9 +30,10 @@ from pathlib import Path
 
 from snede import _command_line
 from snede import _output_folder as output_folder
+from snede import static
 from snede.app._extras import MissingExtra
 
-METHODS = ("cg", "ncg", "newton", "dynamic")
+METHODS = (*static.METHODS, "dynamic")  # the engine's static methods, then dynamic relaxation
 SCENE_OPTIONS = ("divisions", "mesh_size", "speed", "formulation")  # apply to the scenes whose OPTIONS name them
 
 

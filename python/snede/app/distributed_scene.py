@@ -15,7 +15,7 @@ import time
 
 import snede
 
-DISTRIBUTED_METHODS = ("cg", "newton", "ncg", "dynamic")
+DISTRIBUTED_METHODS = (*snede.static.METHODS, "dynamic")
 
 
 def unsupported(scene, method: str) -> str | None:

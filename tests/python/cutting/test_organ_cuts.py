@@ -33,7 +33,7 @@ def test_a_blade_swept_through_the_whole_liver_leaves_two_pieces(liver, end, rel
     size = hi - lo
     x = lo[0] + 0.6 * size[0]
     cutter = snede.TetrahedralCutter(body)
-    total = snede.CutReport()
+    total = snede.CutResult()
     for y in np.linspace(lo[1] - 0.1 * size[1], lo[1] + end * size[1], 21):
         total = total + cutter.move([[x, y, lo[2] - 0.1 * size[2]], [x, y, hi[2] + 0.1 * size[2]]])
         if relaxed:

@@ -23,7 +23,7 @@ def test_random_paths_keep_the_surface_valid(surface, normal, seed):
     h = mean_edge(mesh)
     rng = np.random.default_rng(seed)
     tilt = rng.uniform(-1, 1, 2) * (seed % 2)  # odd seeds lean the scalpel by up to 55°
-    total = snede.PlanarCutReport()
+    total = snede.PlanarCutResult()
     for scalpel in vertical_scalpels(along(random_path(rng), cutter.eps_edge), tilt=tilt):
         total = total + cutter.move(scalpel)
         check_surface(mesh, cutter, normal, h)

@@ -20,7 +20,7 @@ def graph_normal(slope_x):
 def cut_checked(mesh, scalpels, normal):
     cutter = snede.SurfaceCutter(mesh)
     h = mean_edge(mesh)
-    total = snede.PlanarCutReport()
+    total = snede.PlanarCutResult()
     for scalpel in scalpels:
         total = total + cutter.move(scalpel)
         check_surface(mesh, cutter, normal, h)
@@ -154,7 +154,7 @@ def test_random_scalpels_keep_the_surface_valid(surface, normal, seed):
     cutter = snede.SurfaceCutter(mesh)
     scalpels = [s for s in random_sweep(np.random.default_rng(seed), cutter.eps_edge) if not np.allclose(s[0], s[1])]
     h = mean_edge(mesh)
-    total = snede.PlanarCutReport()
+    total = snede.PlanarCutResult()
     for scalpel in scalpels:
         total = total + cutter.move(scalpel)
         check_surface(mesh, cutter, normal, h)
@@ -182,7 +182,7 @@ def test_a_membrane_moved_rigidly_is_cut_as_it_lies():
     body = snede.Body(mesh, snede.NeoHookean(1e4, 0.3), thickness=1e-3)
     body.displacement = mesh.points @ turn.T + shift - mesh.points
     cutter = snede.SurfaceCutter(body)
-    total = snede.PlanarCutReport()
+    total = snede.PlanarCutResult()
     for scalpel in scalpels @ turn.T + shift:
         total = total + cutter.move(scalpel)
     for event in ("entries", "branches", "annihilations", "exits", "flips", "nodes_removed", "nodes_inserted"):

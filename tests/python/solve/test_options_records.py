@@ -23,11 +23,35 @@ def keyword_defaults(function, names):
 
 
 def test_static_defaults_are_the_public_solvers():
+    """StaticSolver writes no default of its own (issue 51): a keyword left out (None) is the
+    record's, and a solver made without any has a default record's settings."""
     options = StaticOptions()
-    public = keyword_defaults(snede.StaticSolver.__init__,
-                              ["method", "rtol", "criterion", "round_tolerance", "max_iterations", "options_prefix"])
-    assert {name: getattr(options, name) for name in public} == public
+    names = ["method", "rtol", "criterion", "round_tolerance", "max_iterations", "options_prefix"]
+    assert set(keyword_defaults(snede.StaticSolver.__init__, names).values()) == {None}
+    body = snede.Body(snede.meshing.box((1.0, 1.0, 1.0), (1, 1, 1)), snede.LinearElastic(E=1e3, nu=0.3))
+    assert snede.StaticSolver(body).options == options
     assert options.petsc_options == () and options.preconditioner == ""  # none given: PETSc's, and "auto"
+
+
+def test_a_static_solver_takes_a_record_whole_and_keywords_change_its_fields():
+    body = snede.Body(snede.meshing.box((1.0, 1.0, 1.0), (1, 1, 1)), snede.LinearElastic(E=1e3, nu=0.3))
+    record = snede.StaticOptions(method="ncg", rtol=1e-8, max_iterations=77, options_prefix="whole_")
+    assert snede.StaticSolver(body, options=record).options == record
+    changed = snede.StaticSolver(body, options=record, rtol=1e-5, ncg_type="fr").options
+    assert (changed.method, changed.rtol, changed.max_iterations) == ("ncg", 1e-5, 77)
+    assert changed.petsc_options == (("snes_ncg_type", "fr"),)
+    assert record.rtol == 1e-8  # the record given is not changed
+    with pytest.raises(TypeError, match="options must be a snede.StaticOptions"):
+        snede.StaticSolver(body, options={"rtol": 1e-3})
+    with pytest.raises(ValueError, match="criterion must be"):
+        snede.StaticSolver(body, criterion="6.7")
+    with pytest.raises(ValueError, match="rtol must be positive"):
+        snede.StaticSolver(body, rtol=0.0)
+
+
+def test_the_records_and_the_method_names_are_exported():
+    assert (snede.StaticOptions, snede.DynamicRelaxationOptions) == (StaticOptions, DynamicRelaxationOptions)
+    assert snede.static.METHODS == ("cg", "ncg", "newton")  # the engine's table, in its order
 
 
 def test_dynamic_defaults_are_the_public_solvers():

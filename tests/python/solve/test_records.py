@@ -9,9 +9,9 @@ import numpy as np
 import pytest
 
 import snede
-from snede._snede import NeedleOptions, NeedleStepReport
+from snede._snede import NeedleOptions, NeedleStepResult
 
-RECORDS = [snede.SolveResult, NeedleStepReport, NeedleOptions, snede.CutReport, snede.PlanarCutReport]
+RECORDS = [snede.SolveResult, NeedleStepResult, NeedleOptions, snede.CutResult, snede.PlanarCutResult]
 
 
 def a_solve():
@@ -65,24 +65,24 @@ def test_summary_line():
 
 
 def test_needle_step_report_is_the_engines_record():
-    report = NeedleStepReport(rearrangements=2, slipped=1, reason="CONVERGED")
+    report = NeedleStepResult(rearrangements=2, slipped=1, reason="CONVERGED")
     assert (report.rearrangements, report.slipped, report.stuck, report.converged) == (2, 1, 0, True)
     assert pickle.loads(pickle.dumps(report)) == report
-    assert repr(report).startswith("NeedleStepReport(rearrangements=2, solver_iterations=0,")
+    assert repr(report).startswith("NeedleStepResult(rearrangements=2, solver_iterations=0,")
 
 
 def test_cut_reports_add_as_the_engine_adds_them_and_read_sequences_as_tuples():
-    first = snede.CutReport(sweeps=2, faces_dissected=3, degenerate_shapes=[1, 0, 2, 0], components=1, seconds=0.5)
-    later = snede.CutReport(sweeps=1, faces_dissected=4, degenerate_shapes=[0, 1, 0, 1], components=2,
+    first = snede.CutResult(sweeps=2, faces_dissected=3, degenerate_shapes=[1, 0, 2, 0], components=1, seconds=0.5)
+    later = snede.CutResult(sweeps=1, faces_dissected=4, degenerate_shapes=[0, 1, 0, 1], components=2,
                             piece_elements=[40, 2], seconds=0.25)
     total = first + later
     assert (total.sweeps, total.faces_dissected, total.components, total.seconds) == (3, 7, 2, 0.75)
     assert total.degenerate_shapes == (1, 1, 2, 1) and total.piece_elements == (40, 2)
-    assert first == snede.CutReport(sweeps=2, faces_dissected=3, degenerate_shapes=(1, 0, 2, 0), components=1,
+    assert first == snede.CutResult(sweeps=2, faces_dissected=3, degenerate_shapes=(1, 0, 2, 0), components=1,
                                     seconds=0.5)
     assert str(total).startswith("7 faces dissected (0 vertices snapped, 0 refused)")
-    planar = snede.PlanarCutReport(moves=1, triangles_before=10, triangles_after=12) + \
-        snede.PlanarCutReport(moves=2, branches=1, triangles_before=12, triangles_after=15)
+    planar = snede.PlanarCutResult(moves=1, triangles_before=10, triangles_after=12) + \
+        snede.PlanarCutResult(moves=2, branches=1, triangles_before=12, triangles_after=15)
     assert (planar.moves, planar.triangles_before, planar.triangles_after) == (3, 10, 15)
     assert str(planar).endswith("1 branches, 0 annihilations; 10 → 15 triangles in 0.00 ms")
 

@@ -19,7 +19,7 @@ from snede.app.scenes.scene import MATERIAL_NAMES
 
 SECTIONS = ("name", "description", "mesh", "material", "hold", "loads", "solver", "tool")
 NEEDED = "a scene file needs [mesh], [material] and at least one [[hold]]"
-METHODS = ("cg", "ncg", "newton", "dynamic")
+METHODS = (*snede.static.METHODS, "dynamic")
 POISSON = number_kind("a number in (-1, 0.5)", lambda v: -1 < v < 0.5)
 NAME = Kind("a name of letters, digits, '-', '_' or '.' (the output folder's)",
             lambda v: v if isinstance(v, str) and re.fullmatch(r"[A-Za-z0-9_][A-Za-z0-9_.-]*", v) else REFUSED)

@@ -22,7 +22,7 @@ class ToolRun:
     def __init__(self, scene: Scene, tools: list):
         self.scene, self.body, self.tools = scene, scene.body, tools
         self.results, self.frames = [], Frames()
-        self._cutter, self.cut_report = None, snede.CutReport()
+        self._cutter, self.cut_report = None, snede.CutResult()
         self.needle = self.insertion = None
         self.solver = self.writer = None
         self.say = print

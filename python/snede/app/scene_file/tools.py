@@ -72,7 +72,7 @@ def _crosses(mesh, a, b) -> bool:
 class Scalpel:
     """A blade (a segment) moved from ``start`` to ``end`` in ``moves`` steps."""
 
-    methods = ("cg", "ncg", "newton")
+    methods = snede.static.METHODS
 
     def __init__(self, table: Table):
         self.key = table.name

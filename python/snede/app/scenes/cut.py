@@ -34,7 +34,7 @@ AT, DEPTH = 0.25, 0.7  # where the blade enters (fraction of the length), how de
 STEP, OFFSET = 0.75, 0.3
 OPTIONS = ("divisions", "formulation")  # the scene options it uses (the command line refuses the others)
 DESCRIPTION = "§3.2 scalpel cut 70 % into a soft beam sagging under gravity, relaxed after each step"
-METHODS = ("cg", "ncg", "newton")
+METHODS = snede.static.METHODS
 VIEW = (12.0, -70.0)  # camera (elevation, azimuth): the side and the top, where the V opens
 
 

@@ -26,7 +26,7 @@ import numpy as np
 
 import snede
 from snede.output import SeriesWriter
-from snede.planar_cutting import PlanarCutReport, sample_path
+from snede.planar_cutting import PlanarCutResult, sample_path
 from snede.app._extras import need
 from snede.app.plotting import animate, draw_3d, highlighted, outline_edges, save_3d
 from snede.app.scenes.scene import Parameters, Scene, briefly, material, solve_entries
@@ -90,7 +90,7 @@ def pieces(mesh) -> list[np.ndarray]:
     return [np.unique(cells[label == k]) for k in range(count)]
 
 
-def report_entries(report: PlanarCutReport) -> dict:
+def report_entries(report: PlanarCutResult) -> dict:
     """The summary entries of a cut: its events, mesh sizes and seconds."""
     return {"moves": report.moves, "entries": report.entries, "exits": report.exits, "branches": report.branches,
             "annihilations": report.annihilations, "stuck": report.stuck, "flips": report.flips,
@@ -161,13 +161,13 @@ class MembraneCut:
                      f"bell, rim pulled {PULL:.0%} outward")
 
         triangles = mesh.n_cells
-        total = PlanarCutReport(triangles_before=triangles, triangles_after=triangles)
+        total = PlanarCutResult(triangles_before=triangles, triangles_after=triangles)
         cuts, done, stopped = {}, 0, False
         for name, corners in BELL_PATHS:
             cutter = snede.SurfaceCutter(body)  # a new scalpel: placed, not swept, at the path's start
             self.cutters.append(cutter)
             path = scalpels(sample_path(corners, cutter.eps_edge))  # steps of ε_edge, as in §5.4
-            report = PlanarCutReport(triangles_before=mesh.n_cells, triangles_after=mesh.n_cells)
+            report = PlanarCutResult(triangles_before=mesh.n_cells, triangles_after=mesh.n_cells)
             for k, scalpel in enumerate(path, start=1):
                 if not result.converged:
                     say(f"membrane-cut: stopped the {name} before move {k}/{len(path)}: the relaxation did not "
@@ -223,7 +223,7 @@ class MembraneCut:
         self.fold_cutter = cutter = snede.SurfaceCutter(mesh)
         self._record(writer, "fold", mesh, still, cutter.incision_edges(), 0.0, None, "fold")
         path = scalpels(sample_path(FOLD_PATH, cutter.eps_edge), FOLD_TILT)
-        report = PlanarCutReport(triangles_before=mesh.n_cells, triangles_after=mesh.n_cells)
+        report = PlanarCutResult(triangles_before=mesh.n_cells, triangles_after=mesh.n_cells)
         for k, scalpel in enumerate(path, start=1):
             step = cutter.move(scalpel)
             report = report + step

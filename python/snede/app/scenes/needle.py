@@ -21,7 +21,7 @@ from snede.app.scenes.needle_slab import (DEPTH, DIRECTION, ENTRY, POISSON, SIZE
 OPTIONS = ("divisions", "speed", "formulation")  # the scene options it uses (the command line refuses the others)
 DESCRIPTION = "§6.8.1 needle inserted 70 mm into the slab: stick-slip friction, bisection at the tip"
 H_START, H_REF, SPEED, FRAMES = 3, 6, 0.1, 40
-METHODS = ("cg", "ncg", "newton")
+METHODS = snede.static.METHODS
 STATES = ((1, "tab:blue", "stick"), (2, "tab:red", "slip"))
 
 

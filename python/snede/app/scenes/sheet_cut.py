@@ -17,7 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 
 import snede
-from snede.planar_cutting import PlanarCutReport, sample_path
+from snede.planar_cutting import PlanarCutResult, sample_path
 from snede.app.plotting import HIGHLIGHT, animate, draw_2d
 from snede.app.scenes.scene import Parameters, Scene, briefly, divisions, material, solve_entries
 from snede.app.scenes.incision import incision_cells, lips_gap
@@ -29,7 +29,7 @@ DEPTH = 0.6  # how far down the scalpel goes, as a fraction of the height
 SWAY = 0.12  # the S-curve's amplitude, as a fraction of the length
 OPTIONS = ("divisions", "formulation")  # the scene options it uses (the command line refuses the others)
 DESCRIPTION = "§5.2 Delaunay cut along an S-curve into a stretched plane-stress sheet, relaxed after each move"
-METHODS = ("cg", "ncg", "newton")
+METHODS = snede.static.METHODS
 FRAMES = 30  # about this many frames in the series and the animation, besides the stretched sheet
 
 
@@ -91,7 +91,7 @@ class SheetCut:
         self.path = scalpel_path(self.cutter.eps_edge)  # steps of ε_edge, as DelaunayCutter.cut
         triangles = self.body.mesh.n_cells
         moves, done = len(self.path), 0
-        total = PlanarCutReport(triangles_before=triangles, triangles_after=triangles)  # as yet no moves
+        total = PlanarCutResult(triangles_before=triangles, triangles_after=triangles)  # as yet no moves
         every = math.ceil(moves / FRAMES)
         for k, point in enumerate(self.path, start=1):
             if not result.converged:
