@@ -216,8 +216,11 @@ def _per_vertex(values, n: int, dim: int, name: str) -> np.ndarray:
 def relaxation_options(damping: float, dt: float | None, options_prefix: str,
                        petsc_options) -> _snede.DynamicRelaxationOptions:
     """The engine's record of a relaxation's settings, which checks them (a negative or
-    non-finite damping or step is a ValueError naming it); ``dt`` None (or 0) takes the CFL
-    estimate. The serial and the distributed relaxation both make theirs here."""
+    non-finite damping or step is a ValueError naming it); ``dt`` None takes the CFL estimate
+    (the record's 0, which is refused here). The serial and the distributed relaxation both
+    make theirs here."""
+    if dt is not None and dt == 0:
+        raise ValueError(f"dt must be positive and finite (or None for the CFL estimate), got {dt}")
     return _snede.DynamicRelaxationOptions(damping=damping, dt=0.0 if dt is None else dt,
                                            options_prefix=options_prefix, petsc_options=option_list(petsc_options))
 
@@ -228,7 +231,7 @@ class DistributedRelaxation:
     (snede_ss22) on all ranks — the serial DynamicRelaxation's engine, on the problem's
     communicator; ``run(rtol, max_steps)`` stops at criterion (6.9)
     ‖F(u)‖ ≤ rtol·√(‖f_ext‖² + ‖f_react‖²). ``dt`` None takes the CFL estimate (2.61) of the
-    whole mesh (as 0 does). Options under ``options_prefix`` (``drelax_``): ``-drelax_ts_monitor`` and so
+    whole mesh. Options under ``options_prefix`` (``drelax_``): ``-drelax_ts_monitor`` and so
     on, or ``petsc_options`` (without the prefix) for this solver only. Collective."""
 
     def __init__(self, problem: DistributedStatic, damping: float, dt: float | None = None, *,

@@ -24,7 +24,7 @@ class DynamicRelaxation(RunsOnRanks):
 
     * ``damping``: η (1/s) of the damping C = η M, ≥ 0. §4.1: the fastest relaxation has
       η = 2√λ₁ (λ₁ the lowest eigenvalue of M⁻¹K); Table 4.4 lists 17–27 1/s for its cylinder.
-    * ``dt``: time step (s); None (or 0) takes the CFL estimate (2.61) ``cfl_time_step``, renewed
+    * ``dt``: time step (s); None takes the CFL estimate (2.61) ``cfl_time_step``, renewed
       when the mesh changes size. Above the critical step the motion blows up; that is
       reported as ``reason == "DIVERGED_BLOW_UP"``, not raised.
     * ``petsc_options``: PETSc options without the prefix, e.g. ``{"ts_monitor": None}``, for
