@@ -6,22 +6,21 @@
 #include <pybind11/stl.h>
 
 namespace snede::bindings {
-namespace {
 
-std::unique_ptr<TetrahedralCutter> make_cutter(Mesh& mesh, Model* model, bool snap, bool remove_degeneracies,
-                                               double min_aspect_ratio, double large_angle, bool fix_free_pieces,
-                                               int max_fragment_elements) {
-  CutterOptions options;
-  options.snap = snap;
-  options.remove_degeneracies = remove_degeneracies;
-  options.degeneracy.min_aspect_ratio = min_aspect_ratio;
-  options.degeneracy.large_angle = large_angle;
-  options.fix_free_pieces = fix_free_pieces;
-  options.max_fragment_elements = max_fragment_elements;
-  return std::make_unique<TetrahedralCutter>(mesh, cut_body_of(model, mesh, "TetrahedralCutter"), options);
-}
-
-}  // namespace
+// The engine's CutterOptions as a Python record (snede.TetrahedralCutterOptions): its fields by
+// name, the degeneracy thresholds flattened; the defaults are the engine's. The cutter checks
+// the thresholds when it is made.
+struct TetrahedralCutterOptions : CutterOptions {
+  template <class Visit>
+  static void visit_fields(Visit&& visit) {
+    visit("snap", &CutterOptions::snap);
+    visit("remove_degeneracies", &CutterOptions::remove_degeneracies);
+    visit("min_aspect_ratio", [](auto& options) -> auto& { return options.degeneracy.min_aspect_ratio; });
+    visit("large_angle", [](auto& options) -> auto& { return options.degeneracy.large_angle; });
+    visit("fix_free_pieces", &CutterOptions::fix_free_pieces);
+    visit("max_fragment_elements", &CutterOptions::max_fragment_elements);
+  }
+};
 
 void bind_cutting(py::module_& m) {
   bind_record<CutReport>(
@@ -43,11 +42,16 @@ void bind_cutting(py::module_& m) {
       .def("__str__", [](const CutReport& r) { return summary(r); });
   m.attr("CutReport") = m.attr("CutResult");  // its name before issue 51: records pickled then load
 
+  bind_record<TetrahedralCutterOptions>(
+      m, "TetrahedralCutterOptions",
+      "A TetrahedralCutter's settings (snede.TetrahedralCutter documents each); the engine's CutterOptions,\n"
+      "its degeneracy thresholds flattened. The cutter refuses thresholds out of range when it is made.");
+
   py::class_<TetrahedralCutter>(m, "TetrahedralCutter")
-      .def(py::init(&make_cutter), py::arg("mesh"), py::arg("model"), py::arg("snap"), py::arg("remove_degeneracies"),
-           py::arg("min_aspect_ratio"), py::arg("large_angle"), py::arg("fix_free_pieces"), py::arg("max_fragment_elements"),
-           py::keep_alive<1, 2>(),
-           py::keep_alive<1, 3>())
+      .def(py::init([](Mesh& mesh, Model* model, const TetrahedralCutterOptions& options) {
+             return std::make_unique<TetrahedralCutter>(mesh, cut_body_of(model, mesh, "TetrahedralCutter"), options);
+           }),
+           py::arg("mesh"), py::arg("model"), py::arg("options"), py::keep_alive<1, 2>(), py::keep_alive<1, 3>())
       // Without the GIL (other Python threads run), as the solves.
       .def("cut_triangle", [](TetrahedralCutter& c, const DoubleArray& corners) { return c.cut_triangle(view(corners)); },
            py::arg("corners"), py::call_guard<py::gil_scoped_release>())

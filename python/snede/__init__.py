@@ -30,7 +30,7 @@ from snede._snede import DynamicRelaxationOptions, NeedleOptions, SolveResult, S
 from snede.static import StaticSolver  # noqa: F401
 from snede.dynamics import DynamicRelaxation  # noqa: F401
 from snede.needle import FrictionProfile, InsertionResult, NeedleInsertion, NeedleStepResult  # noqa: F401
-from snede.cutting import TetrahedralCutter, CutResult  # noqa: F401
+from snede.cutting import TetrahedralCutter, TetrahedralCutterOptions, CutResult  # noqa: F401
 from snede.planar_cutting import DelaunayCutter, IncisionLost, PlanarCutResult  # noqa: F401
 from snede.surface_cutting import SurfaceCutter  # noqa: F401
 from snede.distributed import DistributedMesh, DistributedRelaxation, DistributedStatic, distribute  # noqa: F401
@@ -41,7 +41,7 @@ from snede._output_folder import output_folder  # noqa: F401
 __all__ = [
     "Mesh", "MeshQuality", "Body", "meshing", "StaticSolver", "DynamicRelaxation", "SolveResult",
     "StaticOptions", "DynamicRelaxationOptions", "NeedleOptions", "NeedleStepResult", "InsertionResult",
-    "FrictionProfile", "NeedleInsertion", "TetrahedralCutter", "CutResult", "DelaunayCutter", "PlanarCutResult", "SurfaceCutter",
+    "FrictionProfile", "NeedleInsertion", "TetrahedralCutter", "TetrahedralCutterOptions", "CutResult", "DelaunayCutter", "PlanarCutResult", "SurfaceCutter",
     "IncisionLost",
     "SubdivisionCutter", "DistributedMesh", "DistributedRelaxation", "DistributedStatic", "distribute",
     "LinearElastic", "StVenantKirchhoff", "NeoHookean", "VerondaWestmann",

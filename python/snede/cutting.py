@@ -9,13 +9,11 @@ continues from where it was.
 """
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
-from snede import _checks, _renamed, _snede
+from snede import _checks, _records, _renamed, _snede
 from snede._engine import engine_property
-from snede._snede import CutResult
+from snede._snede import CutResult, TetrahedralCutterOptions
 from snede.mesh import Mesh
 
 
@@ -46,6 +44,11 @@ class TetrahedralCutter:
     """``TetrahedralCutter(body_or_mesh, *, snap=True, remove_degeneracies=True,
     min_aspect_ratio=0.01, large_angle=0.99*pi, fix_free_pieces=True, max_fragment_elements=10)``.
 
+    * ``options``: a :class:`snede.TetrahedralCutterOptions` record holding every setting below
+      (default: ``TetrahedralCutterOptions()``, whose fields are the defaults above, the
+      engine's); a keyword given (not None) changes its field of a copy. The cutter refuses
+      thresholds out of range when it is made.
+
     * ``body_or_mesh``: a 3D ``snede.Body`` (the scalpel then acts on the deformed body,
       ``X + u``, as the user sees it) or a tetrahedral ``snede.Mesh`` (cut as it is).
     * ``snap``: move the cut faces' vertices onto the sweep (§3.2.2); without it the incision
@@ -71,19 +74,26 @@ class TetrahedralCutter:
     Invalid input raises ``ValueError`` before anything changes.
     """
 
-    def __init__(self, body_or_mesh, *, snap: bool = True, remove_degeneracies: bool = True,
-                 min_aspect_ratio: float = 0.01, large_angle: float = 0.99 * math.pi, fix_free_pieces: bool = True,
-                 max_fragment_elements: int = 10):
+    def __init__(self, body_or_mesh, *, options: TetrahedralCutterOptions | None = None, snap: bool | None = None,
+                 remove_degeneracies: bool | None = None, min_aspect_ratio: float | None = None,
+                 large_angle: float | None = None, fix_free_pieces: bool | None = None,
+                 max_fragment_elements: int | None = None):
         self.body, self.mesh, model = body_and_mesh(body_or_mesh, type(self).__name__)
         if self.mesh.cell_dim != 3:
             raise ValueError(f"TetrahedralCutter needs a tetrahedral mesh; this mesh has {self.mesh.cell_dim}-D cells")
-        if not (0 < min_aspect_ratio < 1):
-            raise ValueError(f"min_aspect_ratio must be in (0, 1), got {min_aspect_ratio}")
-        if not (0 < large_angle < math.pi):
-            raise ValueError(f"large_angle must be in (0, pi) radians, got {large_angle}")
-        self._impl = _snede.TetrahedralCutter(self.mesh._impl, model, bool(snap), bool(remove_degeneracies),
-                                              float(min_aspect_ratio), float(large_angle), bool(fix_free_pieces),
-                                              _checks.count(max_fragment_elements, "max_fragment_elements", 0))
+        if max_fragment_elements is not None:
+            max_fragment_elements = _checks.count(max_fragment_elements, "max_fragment_elements", 0)
+        settings = _records.settings(TetrahedralCutterOptions, options, snap=snap,
+                                     remove_degeneracies=remove_degeneracies, min_aspect_ratio=min_aspect_ratio,
+                                     large_angle=large_angle, fix_free_pieces=fix_free_pieces,
+                                     max_fragment_elements=max_fragment_elements)
+        self._impl = _snede.TetrahedralCutter(self.mesh._impl, model, settings)
+        self._settings = settings
+
+    @property
+    def options(self) -> TetrahedralCutterOptions:
+        """A copy of the settings this cutter was made with."""
+        return TetrahedralCutterOptions(**_records.fields(self._settings))
 
     def cut_triangle(self, corners) -> CutResult:
         return self._impl.cut_triangle(_checks.coordinates(corners, (3, 3), "corners"))

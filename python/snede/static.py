@@ -5,7 +5,7 @@ line tunes it: ``-static_snes_monitor``, ``-static_snes_ncg_type fr``,
 """
 from __future__ import annotations
 
-from snede import _checks, _snede
+from snede import _checks, _records, _snede
 from snede._petsc import option_list
 from snede.distributed_body import DistributedBody, RunsOnRanks
 from snede._snede import SolveResult, StaticOptions
@@ -14,8 +14,6 @@ from snede._snede import SolveResult, StaticOptions
 METHODS = tuple(_snede.static_methods)
 LINE_SEARCHES = ("cp", "snede_newton", "snede_secant", "bt", "l2", "basic")
 NCG_TYPES = ("prp", "fr", "hs", "dy", "cd")
-#: the settings' defaults: the engine's, a default record's (written nowhere else)
-DEFAULTS = StaticOptions()
 
 
 class StaticSolver(RunsOnRanks):
@@ -125,17 +123,14 @@ class StaticSolver(RunsOnRanks):
                  round_tolerance: float | None = None, max_iterations: int | None = None, line_search: str | None = None,
                  ncg_type: str | None = None, options_prefix: str | None = None, petsc_options: dict | None = None,
                  preconditioner: str | None = None, comm=None):
-        if options is not None and not isinstance(options, StaticOptions):
-            raise TypeError(f"options must be a snede.StaticOptions, got {type(options).__name__}")
         if max_iterations is not None:
             max_iterations = _checks.count(max_iterations, "max_iterations", 1)
         if preconditioner is not None and (not isinstance(preconditioner, str) or not preconditioner.strip()):
             raise ValueError(f"preconditioner must be a PETSc PC type name such as 'none', 'jacobi' or 'gamg', "
                              f"got {preconditioner!r}")
-        given = {"method": method, "rtol": rtol, "criterion": criterion, "round_tolerance": round_tolerance,
-                 "max_iterations": max_iterations, "options_prefix": options_prefix, "preconditioner": preconditioner}
-        settings = StaticOptions(**{**_fields(options or DEFAULTS),
-                                    **{name: value for name, value in given.items() if value is not None}})
+        settings = _records.settings(StaticOptions, options, method=method, rtol=rtol, criterion=criterion,
+                                     round_tolerance=round_tolerance, max_iterations=max_iterations,
+                                     options_prefix=options_prefix, preconditioner=preconditioner)
         # petsc_options (a dict) replaces the record's; line_search and ncg_type add to them
         extra = dict(settings.petsc_options) if petsc_options is None else dict(petsc_options)
         if line_search is not None:
@@ -163,7 +158,7 @@ class StaticSolver(RunsOnRanks):
     @property
     def options(self) -> StaticOptions:
         """A copy of the settings this solver was made with (a :class:`snede.StaticOptions`)."""
-        return StaticOptions(**_fields(self._settings))
+        return StaticOptions(**_records.fields(self._settings))
 
     def solve(self) -> SolveResult:
         if self._distributed is not None:
@@ -276,8 +271,3 @@ class StaticSolver(RunsOnRanks):
     def snes(self):
         """The petsc4py SNES (None for linear CG); made afresh as :attr:`ksp` is."""
         return self._impl.snes
-
-
-def _fields(record) -> dict:
-    """A record's fields by name, as its keyword construction takes them."""
-    return record.__reduce__()[1][1]
