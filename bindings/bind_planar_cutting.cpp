@@ -18,15 +18,18 @@ void bind_planar_cutting(py::module_& m) {
       .def("__str__", [](const PlanarCutReport& r) { return summary(r); });
   m.attr("PlanarCutReport") = m.attr("PlanarCutResult");  // its name before issue 51: old pickles load
 
+  bind_record<DelaunayCutterOptions>(
+      m, "DelaunayCutterOptions",
+      "A DelaunayCutter's settings (snede.DelaunayCutter documents each); the engine's struct. A threshold of\n"
+      "0 is the thesis's default from the mean edge length; the cutter refuses values out of range when made.");
+
   py::class_<DelaunayCutter> cutter(m, "DelaunayCutter");
   def_delaunay_cutter_common(cutter);
   cutter
-      .def(py::init([](Mesh& mesh, Model* model, double eps_edge, double eps_entry, double eps_exit, double angle) {
-             return std::make_unique<DelaunayCutter>(mesh, displacement_of(model, mesh, "DelaunayCutter"),
-                                                     DelaunayCutterOptions{{eps_edge, eps_entry, eps_exit}, angle});
+      .def(py::init([](Mesh& mesh, Model* model, const DelaunayCutterOptions& options) {
+             return std::make_unique<DelaunayCutter>(mesh, displacement_of(model, mesh, "DelaunayCutter"), options);
            }),
-           py::arg("mesh"), py::arg("model"), py::arg("eps_edge"), py::arg("eps_entry"), py::arg("eps_exit"),
-           py::arg("short_edge_angle"), py::keep_alive<1, 2>(), py::keep_alive<1, 3>())
+           py::arg("mesh"), py::arg("model"), py::arg("options"), py::keep_alive<1, 2>(), py::keep_alive<1, 3>())
       .def("move", [](DelaunayCutter& c, const DoubleArray& point) { return c.move(view(point)); }, py::arg("point"))
       .def_property_readonly("active_node", &DelaunayCutter::active_node);
 }

@@ -11,6 +11,14 @@ struct CutThresholds {
   double eps_edge = 0;
   double eps_entry = 0;
   double eps_exit = 0;
+
+  // Every setting with its name: the one list that bindings read (snede.SurfaceCutterOptions).
+  template <class Visit>
+  static void visit_fields(Visit&& visit) {
+    visit("eps_edge", &CutThresholds::eps_edge);
+    visit("eps_entry", &CutThresholds::eps_entry);
+    visit("eps_exit", &CutThresholds::eps_exit);
+  }
 };
 
 // `given` checked (finite and ≥ 0; the message names `cutter`), with every 0 replaced by the

@@ -51,6 +51,13 @@ struct DelaunayCutterOptions : CutThresholds {
   // > 0 (radians): an interior neighbour of the active node is removed when every angle
   // facing their edge is below this, instead of the distance ε_edge (scale free, §5.5).
   double short_edge_angle = 0;
+
+  // Every setting with its name: the one list that bindings read (snede.DelaunayCutterOptions).
+  template <class Visit>
+  static void visit_fields(Visit&& visit) {
+    CutThresholds::visit_fields(visit);
+    visit("short_edge_angle", &DelaunayCutterOptions::short_edge_angle);
+  }
 };
 
 class DelaunayCutter {

@@ -31,8 +31,8 @@ from snede.static import StaticSolver  # noqa: F401
 from snede.dynamics import DynamicRelaxation  # noqa: F401
 from snede.needle import FrictionProfile, InsertionResult, NeedleInsertion, NeedleStepResult  # noqa: F401
 from snede.cutting import TetrahedralCutter, TetrahedralCutterOptions, CutResult  # noqa: F401
-from snede.planar_cutting import DelaunayCutter, IncisionLost, PlanarCutResult  # noqa: F401
-from snede.surface_cutting import SurfaceCutter  # noqa: F401
+from snede.planar_cutting import DelaunayCutter, DelaunayCutterOptions, IncisionLost, PlanarCutResult  # noqa: F401
+from snede.surface_cutting import SurfaceCutter, SurfaceCutterOptions  # noqa: F401
 from snede.distributed import DistributedMesh, DistributedRelaxation, DistributedStatic, distribute  # noqa: F401
 from snede.subdivision_cutting import SubdivisionCutter  # noqa: F401
 from snede import _renamed, meshing  # noqa: F401
@@ -41,7 +41,8 @@ from snede._output_folder import output_folder  # noqa: F401
 __all__ = [
     "Mesh", "MeshQuality", "Body", "meshing", "StaticSolver", "DynamicRelaxation", "SolveResult",
     "StaticOptions", "DynamicRelaxationOptions", "NeedleOptions", "NeedleStepResult", "InsertionResult",
-    "FrictionProfile", "NeedleInsertion", "TetrahedralCutter", "TetrahedralCutterOptions", "CutResult", "DelaunayCutter", "PlanarCutResult", "SurfaceCutter",
+    "FrictionProfile", "NeedleInsertion", "TetrahedralCutter", "TetrahedralCutterOptions", "CutResult", "DelaunayCutter",
+    "DelaunayCutterOptions", "PlanarCutResult", "SurfaceCutter", "SurfaceCutterOptions",
     "IncisionLost",
     "SubdivisionCutter", "DistributedMesh", "DistributedRelaxation", "DistributedStatic", "distribute",
     "LinearElastic", "StVenantKirchhoff", "NeoHookean", "VerondaWestmann",

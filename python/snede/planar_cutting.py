@@ -12,9 +12,9 @@ import math
 
 import numpy as np
 
-from snede import _checks, _renamed, _snede
+from snede import _checks, _records, _renamed, _snede
 from snede._engine import engine_property
-from snede._snede import PlanarCutResult
+from snede._snede import DelaunayCutterOptions, PlanarCutResult
 from snede.cutting import body_and_mesh, move_along
 
 #: Raised by a Delaunay cutter's ``move`` (a RuntimeError) when edits others made to the mesh
@@ -23,15 +23,6 @@ from snede.cutting import body_and_mesh, move_along
 #: happened to it. Edits that leave a tip (a collapse into a neighbour, splits, bisection,
 #: flips) are followed instead, and the cut goes on.
 IncisionLost = _snede.IncisionLost
-
-
-def _threshold(value, name: str) -> float:
-    if value is None:
-        return 0.0
-    value = float(value)
-    if not (value > 0 and math.isfinite(value)):
-        raise ValueError(f"{name} must be positive and finite (or None for the default), got {value}")
-    return value
 
 
 def _point(value) -> np.ndarray:
@@ -79,11 +70,14 @@ class IncisionCutter:
 class DelaunayCutter(IncisionCutter):
     """Delaunay cutting of a 2D triangle mesh or plane-stress Body (§5.2.2, §5.4).
 
-    ``DelaunayCutter(body_or_mesh, *, eps_edge=None, eps_entry=None, eps_exit=None,
-    short_edge_angle=None)``: thresholds in the reference configuration; by default the
-    thesis's h̄/3, h̄/6 and h̄/6 with h̄ the mean edge length. ``short_edge_angle`` (radians)
-    replaces ``eps_edge`` by the scale-free criterion of §5.5: an interior neighbour of the
-    active node is removed when every angle facing their edge is smaller.
+    ``DelaunayCutter(body_or_mesh, *, options=None, eps_edge=None, eps_entry=None, eps_exit=None,
+    short_edge_angle=None)``: thresholds in the reference configuration; by default (None or 0)
+    the thesis's h̄/3, h̄/6 and h̄/6 with h̄ the mean edge length. ``short_edge_angle`` (radians,
+    below π/2) replaces ``eps_edge`` by the scale-free criterion of §5.5: an interior neighbour
+    of the active node is removed when every angle facing their edge is smaller. ``options``: a
+    :class:`snede.DelaunayCutterOptions` record holding them all (default: its defaults, the
+    engine's); a keyword given changes its field of a copy. The engine refuses a negative or
+    non-finite value when the cutter is made.
 
     ``move(point)`` moves the scalpel ((2,), deformed coordinates): the first move from outside
     the body that crosses its boundary enters, an incision follows the scalpel, and leaving
@@ -97,16 +91,15 @@ class DelaunayCutter(IncisionCutter):
     it only places it).
     """
 
-    def __init__(self, body_or_mesh, *, eps_edge=None, eps_entry=None, eps_exit=None, short_edge_angle=None):
+    def __init__(self, body_or_mesh, *, options: DelaunayCutterOptions | None = None, eps_edge=None, eps_entry=None,
+                 eps_exit=None, short_edge_angle=None):
         self.body, self.mesh, model = body_and_mesh(body_or_mesh, type(self).__name__)
         if self.mesh.cell_dim != 2 or self.mesh.space_dim != 2:
             raise ValueError(f"{type(self).__name__} needs a 2D triangle mesh; this one has {self.mesh.cell_dim}-D cells "
                              f"in {self.mesh.space_dim}-D")
-        angle = _threshold(short_edge_angle, "short_edge_angle")
-        if angle >= math.pi / 2:
-            raise ValueError(f"short_edge_angle must be below pi/2 radians, got {angle}")
-        self._impl = _snede.DelaunayCutter(self.mesh._impl, model, _threshold(eps_edge, "eps_edge"),
-                                           _threshold(eps_entry, "eps_entry"), _threshold(eps_exit, "eps_exit"), angle)
+        settings = _records.settings(DelaunayCutterOptions, options, eps_edge=eps_edge, eps_entry=eps_entry,
+                                     eps_exit=eps_exit, short_edge_angle=short_edge_angle)
+        self._impl = _snede.DelaunayCutter(self.mesh._impl, model, settings)
 
     def move(self, point) -> PlanarCutResult:
         return self._impl.move(_point(point))
@@ -114,7 +107,7 @@ class DelaunayCutter(IncisionCutter):
     def cut(self, path, step: float | None = None, progress=None) -> PlanarCutResult:
         """Move along the polyline ``path`` ((n, 2)), sampled every ``step`` (default
         ``eps_edge``); ``progress(done, total, report)`` is called after each move."""
-        points = sample_path(path, self.eps_edge if step is None else _threshold(step, "step"))
+        points = sample_path(path, self.eps_edge if step is None else _checks.positive(step, "step"))
         return move_along(self.move, points, PlanarCutResult(), progress)
 
 

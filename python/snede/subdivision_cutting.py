@@ -14,8 +14,9 @@ import time
 
 import numpy as np
 
+from snede import _checks
 from snede.mesh import Mesh
-from snede.planar_cutting import PlanarCutResult, _point, _threshold, sample_path
+from snede.planar_cutting import PlanarCutResult, _point, sample_path
 from snede.cutting import move_along
 
 _END = 1e-9  # a crossing this close to an edge's end (as a fraction of it) is at the vertex
@@ -112,5 +113,5 @@ class SubdivisionCutter:
     def cut(self, path, step: float | None = None, progress=None) -> PlanarCutResult:
         """Move along the polyline ``path`` ((n, 2)); ``step`` (default: the whole segments)
         only changes how often ``progress(done, total, report)`` is called."""
-        points = sample_path(path, np.inf if step is None else _threshold(step, "step"))
+        points = sample_path(path, np.inf if step is None else _checks.positive(step, "step"))
         return move_along(self.move, points, PlanarCutResult(), progress)

@@ -15,17 +15,20 @@ from __future__ import annotations
 
 import numpy as np
 
-from snede import _checks, _snede
+from snede import _checks, _records, _snede
 from snede.cutting import body_and_mesh, move_along
-from snede.planar_cutting import IncisionCutter, PlanarCutResult, _threshold
+from snede._snede import SurfaceCutterOptions
+from snede.planar_cutting import IncisionCutter, PlanarCutResult
 
 
 class SurfaceCutter(IncisionCutter):
     """Delaunay cutting of a surface mesh or membrane Body (triangles in 3D) with a segment.
 
-    ``SurfaceCutter(body_or_mesh, *, eps_edge=None, eps_entry=None, eps_exit=None)``:
-    thresholds in the reference configuration, by default h̄/3, h̄/6 and h̄/6 with h̄ the mean
-    edge length (§5.4).
+    ``SurfaceCutter(body_or_mesh, *, options=None, eps_edge=None, eps_entry=None, eps_exit=None)``:
+    thresholds in the reference configuration, by default (None or 0) h̄/3, h̄/6 and h̄/6 with h̄
+    the mean edge length (§5.4). ``options``: a :class:`snede.SurfaceCutterOptions` record
+    holding them (default: its defaults, the engine's); a keyword given changes its field of a
+    copy. The engine refuses a negative or non-finite value when the cutter is made.
 
     ``move(segment)`` moves the scalpel to ``segment`` ((2, 3): its two ends, deformed
     coordinates); the first move places it, entering where it pierces the surface. Later
@@ -44,13 +47,15 @@ class SurfaceCutter(IncisionCutter):
     naming it (the other incisions go on with the move after it).
     """
 
-    def __init__(self, body_or_mesh, *, eps_edge=None, eps_entry=None, eps_exit=None):
+    def __init__(self, body_or_mesh, *, options: SurfaceCutterOptions | None = None, eps_edge=None, eps_entry=None,
+                 eps_exit=None):
         self.body, self.mesh, model = body_and_mesh(body_or_mesh, type(self).__name__)
         if self.mesh.cell_dim != 2 or self.mesh.space_dim != 3:
             raise ValueError(f"{type(self).__name__} needs a surface mesh (triangles in 3D); this one has "
                              f"{self.mesh.cell_dim}-D cells in {self.mesh.space_dim}-D")
-        self._impl = _snede.SurfaceCutter(self.mesh._impl, model, _threshold(eps_edge, "eps_edge"),
-                                          _threshold(eps_entry, "eps_entry"), _threshold(eps_exit, "eps_exit"))
+        settings = _records.settings(SurfaceCutterOptions, options, eps_edge=eps_edge, eps_entry=eps_entry,
+                                     eps_exit=eps_exit)
+        self._impl = _snede.SurfaceCutter(self.mesh._impl, model, settings)
 
     @property
     def active_nodes(self) -> list[int]:

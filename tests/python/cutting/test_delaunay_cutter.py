@@ -234,7 +234,7 @@ def test_stretched_sheet_opens_as_it_is_cut_and_every_solve_converges():
 
 
 @pytest.mark.parametrize("options, message", [
-    ({"eps_edge": 0}, "eps_edge"), ({"eps_entry": -1}, "eps_entry"), ({"eps_exit": float("nan")}, "eps_exit"),
+    ({"eps_edge": float("inf")}, "eps_edge"), ({"eps_entry": -1}, "eps_entry"), ({"eps_exit": float("nan")}, "eps_exit"),
     ({"short_edge_angle": 2.0}, "short_edge_angle")])
 def test_bad_thresholds_are_refused(options, message):
     with pytest.raises(ValueError, match=message):

@@ -159,7 +159,7 @@ def test_bad_paths_are_refused_before_anything_changes(segments, message):
     np.testing.assert_array_equal(mesh.cells, cells)
 
 
-@pytest.mark.parametrize("options, message", [({"eps_edge": 0}, "eps_edge"), ({"eps_entry": -1}, "eps_entry"),
+@pytest.mark.parametrize("options, message", [({"eps_edge": float("inf")}, "eps_edge"), ({"eps_entry": -1}, "eps_entry"),
                                               ({"eps_exit": float("nan")}, "eps_exit")])
 def test_bad_thresholds_are_refused(options, message):
     with pytest.raises(ValueError, match=message):
