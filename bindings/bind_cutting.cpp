@@ -23,7 +23,7 @@ struct TetrahedralCutterOptions : CutterOptions {
 };
 
 void bind_cutting(py::module_& m) {
-  bind_record<CutReport>(
+  bind_record<CutResult>(
       m, "CutResult",
       "What one ``move`` or ``cut_triangle`` did.\n\n"
       "``faces_dissected`` counts selected faces the dissection opened; a face whose vertices' stars do not\n"
@@ -39,7 +39,7 @@ void bind_cutting(py::module_& m) {
       "the local search for separated pieces visited (it stays near the cut unless a piece separates).\n"
       "``a + b``: both reports together (counts and times add up; ``components`` is ``b``'s unless it swept\n"
       "nothing), as ``move`` combines its halves.")
-      .def("__str__", [](const CutReport& r) { return summary(r); });
+      .def("__str__", [](const CutResult& r) { return summary(r); });
   m.attr("CutReport") = m.attr("CutResult");  // its name before issue 51: records pickled then load
 
   bind_record<TetrahedralCutterOptions>(

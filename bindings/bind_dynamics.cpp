@@ -11,8 +11,9 @@ namespace snede::bindings {
 void bind_dynamics(py::module_& m) {
   bind_record<DynamicRelaxationOptions>(
       m, "DynamicRelaxationOptions",
-      "A dynamic relaxation's settings (snede.DynamicRelaxation documents each; ``dt`` 0 takes the CFL\n"
-      "estimate); the engine's struct. A negative or non-finite damping or step is a ValueError.");
+      "A dynamic relaxation's settings (snede.DynamicRelaxation documents each; ``dt`` None takes the CFL\n"
+      "estimate); the engine's struct. A negative or non-finite damping, or a step that is not positive\n"
+      "and finite, is a ValueError.");
 
   py::class_<DynamicRelaxation>(m, "DynamicRelaxation")
       .def(py::init<Model&, const DynamicRelaxationOptions&>(), py::arg("model"), py::arg("options"),

@@ -44,9 +44,10 @@ void bind_needle(py::module_& m) {
       .def_property_readonly("force_per_length", &FrictionProfile::force_per_length);
 
   bind_record<NeedleOptions>(m, "NeedleOptions",
-                             "A needle insertion's settings (snede.NeedleInsertion documents each); the engine's struct.");
+                             "A needle insertion's settings (snede.NeedleInsertion documents each); the engine's struct.")
+      .def_readonly_static("default_radius", &NeedleOptions::default_radius);
 
-  bind_record<NeedleStepReport>(
+  bind_record<NeedleStepResult>(
       m, "NeedleStepResult",
       "One update (§6.7). ``rearrangements`` counts the solves (each followed by a rearrangement of the\n"
       "needle nodes); ``slipped``/``stuck``/``released``/``intercepted`` count node state changes;\n"
@@ -62,6 +63,10 @@ void bind_needle(py::module_& m) {
            py::keep_alive<1, 3>())
       .def("advance", &NeedleInsertion::advance, py::arg("distance"), py::call_guard<py::gil_scoped_release>())
       .def("settle", &NeedleInsertion::settle)
+      .def_static("default_solver_options", &NeedleInsertion::default_solver_options)
+      .def_property_readonly("radius", &NeedleInsertion::radius)
+      .def_property_readonly("options", &NeedleInsertion::options)
+      .def_property_readonly("solver_options", [](NeedleInsertion& n) { return n.solver().options(); })
       .def_property_readonly("depth", &NeedleInsertion::depth)
       .def_property_readonly("surface_depth", &NeedleInsertion::surface_depth)
       .def_property_readonly("preconditioner_fills", [](NeedleInsertion& n) { return n.solver().preconditioner_fills(); })

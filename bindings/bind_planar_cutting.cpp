@@ -7,7 +7,7 @@ namespace snede::bindings {
 
 void bind_planar_cutting(py::module_& m) {
   py::register_exception<IncisionLost>(m, "IncisionLost", error_bases(PyExc_RuntimeError));
-  bind_record<PlanarCutReport>(
+  bind_record<PlanarCutResult>(
       m, "PlanarCutResult",
       "What one ``move`` (or a whole ``cut``) did: edge ``flips``, ``nodes_removed`` near the active node,\n"
       "``nodes_inserted`` (entry, exit and incision splits), ``incision_splits`` (Figure 5.5),\n"
@@ -15,7 +15,7 @@ void bind_planar_cutting(py::module_& m) {
       "(Figure 5.14) and ``annihilations`` (incisions meeting, Figure 5.13), moves that left the active node\n"
       "short of the scalpel (``stuck``), the triangle counts before and after, and the time in ``seconds``.\n"
       "``a + b``: counts and times add, ``triangles_after`` is ``b``'s.")
-      .def("__str__", [](const PlanarCutReport& r) { return summary(r); });
+      .def("__str__", [](const PlanarCutResult& r) { return summary(r); });
   m.attr("PlanarCutReport") = m.attr("PlanarCutResult");  // its name before issue 51: old pickles load
 
   bind_record<DelaunayCutterOptions>(

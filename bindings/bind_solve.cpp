@@ -122,6 +122,8 @@ void bind_solve(py::module_& m) {
   py::tuple methods(static_method_names.size());
   for (std::size_t i = 0; i < static_method_names.size(); ++i) methods[i] = py::str(std::string(static_method_names[i].second));
   m.attr("static_methods") = methods;
+  m.def("distributed_solve_options", &distributed_solve_options,
+        "The settings of DistributedStatic.solve unless told otherwise (a StaticOptions).");
 
   py::class_<StaticSolver>(m, "StaticSolver")
       .def(py::init([](Model& model, StaticOptions options, const Bisection* bisection) {

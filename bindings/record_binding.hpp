@@ -1,6 +1,6 @@
 // A report or options struct of the engine bound as a Python record, from the struct's one list
 // of fields (`Record::visit_fields`): keyword construction, read-write attributes, repr,
-// equality, pickling and, where the engine can combine two reports (`Record::add`), `+`. The
+// equality, `_asdict()`, pickling and, where the engine can combine two reports (`Record::add`), `+`. The
 // engine's structs are the records Python sees; nothing spells their fields a second time
 // (issue 36).
 //
@@ -130,6 +130,7 @@ py::class_<Record> bind_record(py::module_& m, const char* type_name, const char
           record = std::move(changed);
         });
   });
+  cls.def("_asdict", &record_fields<Record>, "The fields by name, as keyword construction takes them (as a namedtuple's).");
   cls.def("__repr__", [type_name](const Record& record) {
     std::string text = std::string(type_name) + "(";
     const char* separator = "";

@@ -178,12 +178,12 @@ std::optional<DelaunayCutter::Crossing> DelaunayCutter::first_boundary_crossing(
   return first;
 }
 
-PlanarCutReport DelaunayCutter::move(std::span<const double> point) {
+PlanarCutResult DelaunayCutter::move(std::span<const double> point) {
   if (point.size() != 2)
     throw std::invalid_argument("DelaunayCutter.move: the scalpel is a point, 2 coordinates; got " + std::to_string(point.size()));
   require_finite_points(point.data(), point.size(), 2, "DelaunayCutter.move", "point");
   CutterMove this_move(watch_, mesh_);
-  PlanarCutReport& report = this_move.report();
+  PlanarCutResult& report = this_move.report();
   const Point now{point[0], point[1]};
   if (exit_point_ && distance(now, *exit_point_) > 2 * options_.eps_exit) {
     exit_point_.reset();
@@ -235,7 +235,7 @@ PlanarCutReport DelaunayCutter::move(std::span<const double> point) {
   return this_move.finished();
 }
 
-void DelaunayCutter::legalize(PlanarCutReport& report) {
+void DelaunayCutter::legalize(PlanarCutResult& report) {
   const Connectivity& c = mesh_.connectivity();
   std::sort(touched_.begin(), touched_.end());
   touched_.erase(std::unique(touched_.begin(), touched_.end()), touched_.end());
@@ -300,7 +300,7 @@ void DelaunayCutter::settle(const Connectivity& c, const IncisionWatch::Fates& f
   lift();
 }
 
-void DelaunayCutter::enter(const Crossing& crossing, PlanarCutReport& report) {
+void DelaunayCutter::enter(const Crossing& crossing, PlanarCutResult& report) {
   const Point y = reference(crossing.y), z = reference(crossing.z);
   const Point at = lerp(y, z, crossing.lambda);
   VertexId a = -1;
@@ -322,7 +322,7 @@ void DelaunayCutter::enter(const Crossing& crossing, PlanarCutReport& report) {
   ++report.entries;
 }
 
-bool DelaunayCutter::fix_up_entry(const Point& p, PlanarCutReport& report) {
+bool DelaunayCutter::fix_up_entry(const Point& p, PlanarCutResult& report) {
   const Connectivity& c = mesh_.connectivity();
   const VertexId a = active_;
   // The node at the scalpel: inserted in the triangle that holds p, or on its nearest edge.
@@ -363,7 +363,7 @@ bool DelaunayCutter::fix_up_entry(const Point& p, PlanarCutReport& report) {
   return true;
 }
 
-bool DelaunayCutter::recover_edge(VertexId a, VertexId b, PlanarCutReport& report) {
+bool DelaunayCutter::recover_edge(VertexId a, VertexId b, PlanarCutResult& report) {
   const Point pa = reference(a), pb = reference(b);
   for (int attempt = 0; attempt < 64; ++attempt) {
     if (has_edge(mesh_.connectivity(), a, b)) return true;
@@ -410,7 +410,7 @@ bool DelaunayCutter::move_active_to(const Point& x) {
   return snap_vertex(mesh_, active_, VertexParents::barycentric(parents, weights)).done;
 }
 
-bool DelaunayCutter::advance(const Point& target, PlanarCutReport& report) {
+bool DelaunayCutter::advance(const Point& target, PlanarCutResult& report) {
   for (int step = 0; step < 256; ++step) {
     const Point x = reference(active_);
     const Point d = minus(target, x);
@@ -469,7 +469,7 @@ bool DelaunayCutter::advance(const Point& target, PlanarCutReport& report) {
   return false;
 }
 
-void DelaunayCutter::remesh_around(VertexId b, PlanarCutReport& report) {
+void DelaunayCutter::remesh_around(VertexId b, PlanarCutResult& report) {
   const Connectivity& c = mesh_.connectivity();
   // Flips towards Delaunay: the edges of the active triangles (spokes and link edges).
   flip_star_towards_delaunay(mesh_, b, [&](VertexId p, VertexId q) { return flip(p, q, report); });
@@ -500,7 +500,7 @@ void DelaunayCutter::remesh_around(VertexId b, PlanarCutReport& report) {
   }
 }
 
-bool DelaunayCutter::flip(VertexId p, VertexId q, PlanarCutReport& report) {
+bool DelaunayCutter::flip(VertexId p, VertexId q, PlanarCutResult& report) {
   std::vector<VertexId> quad{p, q};
   for (ElementId e : elements_with_edge(mesh_.connectivity(), p, q))
     for (VertexId v : mesh_.connectivity().element(e).simplex.vertices()) quad.push_back(v);
@@ -510,7 +510,7 @@ bool DelaunayCutter::flip(VertexId p, VertexId q, PlanarCutReport& report) {
   return true;
 }
 
-bool DelaunayCutter::remove_node(VertexId v, PlanarCutReport& report) {
+bool DelaunayCutter::remove_node(VertexId v, PlanarCutResult& report) {
   std::vector<VertexId> link;
   for (const Wedge& w : wedges(v)) link.insert(link.end(), {w.y, w.z});
   if (!remove_vertex_by_flips(mesh_, v).done) return false;
@@ -552,7 +552,7 @@ bool DelaunayCutter::move_lips_to(const Point& x, std::array<VertexId, 2> copies
   return true;
 }
 
-void DelaunayCutter::split_incision(PlanarCutReport& report) {
+void DelaunayCutter::split_incision(PlanarCutResult& report) {
   const Connectivity& c = mesh_.connectivity();
   const VertexId b = active_;
   // The cut edges: boundary edges b→c1 (in the wedge (b, c1, o1)) and c2→b (in (b, o2, c2)).
@@ -614,7 +614,7 @@ void DelaunayCutter::split_incision(PlanarCutReport& report) {
   remesh_around(b, report);
 }
 
-void DelaunayCutter::predict_exit(const Point& direction, PlanarCutReport& report) {
+void DelaunayCutter::predict_exit(const Point& direction, PlanarCutResult& report) {
   const double length = std::hypot(direction[0], direction[1]);
   if (length == 0 || phase_ != Phase::cutting) return;
   const Point x = reference(active_);
@@ -629,7 +629,7 @@ void DelaunayCutter::predict_exit(const Point& direction, PlanarCutReport& repor
   }
 }
 
-void DelaunayCutter::exit_through(VertexId y, VertexId z, double lambda, PlanarCutReport& report) {
+void DelaunayCutter::exit_through(VertexId y, VertexId z, double lambda, PlanarCutResult& report) {
   const Point py = reference(y), pz = reference(z), at = lerp(py, pz, lambda);
   VertexId w = -1;
   if (distance(at, py) <= options_.eps_exit)

@@ -42,7 +42,7 @@
 #include "cutting/cut_body.hpp"
 #include "cutting/cut_thresholds.hpp"
 #include "cutting/incision_star.hpp"
-#include "cutting/planar_cut_report.hpp"
+#include "cutting/planar_cut_result.hpp"
 
 namespace snede {
 
@@ -71,7 +71,7 @@ class DelaunayCutter {
   // std::invalid_argument, before changing anything, for a non-finite point, and IncisionLost
   // when edits by others took the incision's tip away since the last move (the scalpel is
   // lifted then: the next move only places it).
-  PlanarCutReport move(std::span<const double> point);
+  PlanarCutResult move(std::span<const double> point);
   // Lifts the scalpel: an incision in progress stays as it is, the next move only places it.
   void lift();
 
@@ -106,21 +106,21 @@ class DelaunayCutter {
   bool on_boundary(VertexId v) const;
   std::optional<Crossing> first_boundary_crossing(const Point& from, const Point& to, std::span<const double> u) const;
 
-  void enter(const Crossing& crossing, PlanarCutReport& report);
-  bool fix_up_entry(const Point& p, PlanarCutReport& report);
-  bool recover_edge(VertexId a, VertexId b, PlanarCutReport& report);
+  void enter(const Crossing& crossing, PlanarCutResult& report);
+  bool fix_up_entry(const Point& p, PlanarCutResult& report);
+  bool recover_edge(VertexId a, VertexId b, PlanarCutResult& report);
   // Moves the active node towards T (reference): true if it got there; an exit ends the cut.
-  bool advance(const Point& target, PlanarCutReport& report);
+  bool advance(const Point& target, PlanarCutResult& report);
   bool move_active_to(const Point& x);
-  void remesh_around(VertexId b, PlanarCutReport& report);
+  void remesh_around(VertexId b, PlanarCutResult& report);
   // Flips edge (p, q); the quadrilateral's corners count as touched.
-  bool flip(VertexId p, VertexId q, PlanarCutReport& report);
+  bool flip(VertexId p, VertexId q, PlanarCutResult& report);
   // Removes interior node v (retriangulating its star); its neighbours count as touched.
-  bool remove_node(VertexId v, PlanarCutReport& report);
+  bool remove_node(VertexId v, PlanarCutResult& report);
   // Lawson flips from the edges around the vertices this move touched until every interior
   // edge there is locally Delaunay (the rest of the mesh was not changed).
-  void legalize(PlanarCutReport& report);
-  void split_incision(PlanarCutReport& report);
+  void legalize(PlanarCutResult& report);
+  void split_incision(PlanarCutResult& report);
   struct TrailCrossing {
     Point point;
     std::size_t segment;  // trail_[segment] → trail_[segment + 1]
@@ -129,8 +129,8 @@ class DelaunayCutter {
   std::optional<TrailCrossing> trail_crossing(const Point& p, const Point& q, const Point& near) const;
   // Moves both copies of a new incision node to x; false (nothing moved) if either is refused.
   bool move_lips_to(const Point& x, std::array<VertexId, 2> copies, std::array<std::array<VertexId, 3>, 2> own_triangles);
-  void predict_exit(const Point& direction, PlanarCutReport& report);
-  void exit_through(VertexId y, VertexId z, double lambda, PlanarCutReport& report);
+  void predict_exit(const Point& direction, PlanarCutResult& report);
+  void exit_through(VertexId y, VertexId z, double lambda, PlanarCutResult& report);
   std::vector<VertexId> dissect_edge(VertexId a, VertexId b);
   // After edits by others: the active node is the heir that is still the tip, or the
   // incision is given up.

@@ -202,7 +202,7 @@ CutterMove::CutterMove(IncisionWatch& watch, const Mesh& mesh)
   report_.triangles_before = mesh.n_cells();
 }
 
-PlanarCutReport CutterMove::finished() {
+PlanarCutResult CutterMove::finished() {
   report_.triangles_after = mesh_.n_cells();
   report_.seconds = wall_seconds() - start_;
   return report_;

@@ -11,7 +11,7 @@
 #include <unordered_set>
 #include <vector>
 
-#include "cutting/planar_cut_report.hpp"
+#include "cutting/planar_cut_result.hpp"
 #include "mesh/mesh.hpp"
 #include "topology/flip_edge.hpp"
 
@@ -172,8 +172,8 @@ class IncisionWatch {
 class CutterMove {
  public:
   CutterMove(IncisionWatch& watch, const Mesh& mesh);
-  PlanarCutReport& report() { return report_; }
-  PlanarCutReport finished();
+  PlanarCutResult& report() { return report_; }
+  PlanarCutResult finished();
 
  private:
   static IncisionWatch& settled(IncisionWatch& watch);
@@ -181,7 +181,7 @@ class CutterMove {
   const Mesh& mesh_;
   IncisionWatch::OwnEdits own_;
   double start_;
-  PlanarCutReport report_;
+  PlanarCutResult report_;
 };
 
 }  // namespace snede

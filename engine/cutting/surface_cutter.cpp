@@ -341,7 +341,7 @@ bool SurfaceCutter::meets_ring(VertexId a, const Segment& scalpel) const {
   return false;
 }
 
-PlanarCutReport SurfaceCutter::move(std::span<const double> segment) {
+PlanarCutResult SurfaceCutter::move(std::span<const double> segment) {
   if (segment.size() != 6)
     throw std::invalid_argument("SurfaceCutter.move: the scalpel is a segment, 2 ends of 3 coordinates; got " +
                                 std::to_string(segment.size()) + " numbers");
@@ -349,7 +349,7 @@ PlanarCutReport SurfaceCutter::move(std::span<const double> segment) {
   const Segment now{{segment[0], segment[1], segment[2]}, {segment[3], segment[4], segment[5]}};
   if (now.head == now.tail) throw std::invalid_argument("SurfaceCutter.move: the scalpel's two ends coincide (segment)");
   CutterMove this_move(watch_, mesh_);
-  PlanarCutReport& report = this_move.report();
+  PlanarCutResult& report = this_move.report();
   displacement_.clear();
   moved_.clear();
   if (body_displacement_) {
@@ -389,7 +389,7 @@ void SurfaceCutter::lift() {
   watch_.follow({});
 }
 
-void SurfaceCutter::sweep(const Segment& from, const Segment& to, PlanarCutReport& report) {
+void SurfaceCutter::sweep(const Segment& from, const Segment& to, PlanarCutResult& report) {
   const double movement = std::max(distance(from.head, to.head), distance(from.tail, to.tail));
   const auto at = [&](double s) { return Segment{lerp(from.head, to.head, s), lerp(from.tail, to.tail, s)}; };
   Segment current = from;
@@ -437,7 +437,7 @@ bool SurfaceCutter::loses_place(const Segment& from, const Segment& to) const {
   });
 }
 
-void SurfaceCutter::follow_scalpel(const Segment& from, const Segment& to, PlanarCutReport& report) {
+void SurfaceCutter::follow_scalpel(const Segment& from, const Segment& to, PlanarCutResult& report) {
   for (VertexId a : active_nodes()) {
     const Incision* incision = incision_at(a);  // another incision may have ended this one
     if (!incision) continue;
@@ -457,7 +457,7 @@ VertexId SurfaceCutter::free_vertex_near(const Point3& at, std::span<const Verte
   return best;
 }
 
-bool SurfaceCutter::enter(const Contact& contact, PlanarCutReport& report) {
+bool SurfaceCutter::enter(const Contact& contact, PlanarCutResult& report) {
   const Connectivity& c = mesh_.connectivity();
   // Earlier edits of this step may have replaced the triangle (and its id been reused).
   if (!c.is_element(contact.element) || c.element(contact.element).simplex != contact.triangle) return false;
@@ -493,7 +493,7 @@ bool SurfaceCutter::enter(const Contact& contact, PlanarCutReport& report) {
   return true;
 }
 
-void SurfaceCutter::begin_incision(VertexId a, const Segment& scalpel, PlanarCutReport& report) {
+void SurfaceCutter::begin_incision(VertexId a, const Segment& scalpel, PlanarCutResult& report) {
   const std::vector<StarHit> hits = hits_in_star(a, scalpel);
   if (hits.empty()) {
     if (!meets_ring(a, scalpel)) std::erase_if(incisions_, [a](const Incision& i) { return i.active == a; });  // withdrawn
@@ -510,7 +510,7 @@ void SurfaceCutter::begin_incision(VertexId a, const Segment& scalpel, PlanarCut
   open_from(a, {b}, report);
 }
 
-void SurfaceCutter::open_from(VertexId a, const std::vector<VertexId>& ends, PlanarCutReport& report) {
+void SurfaceCutter::open_from(VertexId a, const std::vector<VertexId>& ends, PlanarCutResult& report) {
   std::vector<std::array<VertexId, 2>> slit;
   if (ends.size() == 1 && !on_boundary(a)) {
     // An interior edge does not open (both ends' stars stay whole): split it, so that the
@@ -555,7 +555,7 @@ std::vector<SurfaceCutter::StarHit> SurfaceCutter::branches(VertexId a, const Se
   return far.size() >= 2 ? far : std::vector<StarHit>{};
 }
 
-void SurfaceCutter::branch(VertexId a, const Segment& scalpel, double apart, PlanarCutReport& report) {
+void SurfaceCutter::branch(VertexId a, const Segment& scalpel, double apart, PlanarCutResult& report) {
   // Figure 5.14: a node at each place, inserted in turn (each into triangles the earlier
   // ones left alone), then the edges from a to them dissected.
   const Connectivity& c = mesh_.connectivity();
@@ -587,7 +587,7 @@ void SurfaceCutter::branch(VertexId a, const Segment& scalpel, double apart, Pla
 }
 
 VertexId SurfaceCutter::insert_at(const Wedge& w, VertexId b, const std::array<double, 3>& weights,
-                                  PlanarCutReport& report) {
+                                  PlanarCutResult& report) {
   const std::array<VertexId, 3> corners{b, w.y, w.z};
   const int smallest = static_cast<int>(std::min_element(weights.begin(), weights.end()) - weights.begin());
   VertexId made = -1;
@@ -618,7 +618,7 @@ VertexId SurfaceCutter::split(VertexId a, VertexId b, double t) {
   return result.vertex;
 }
 
-void SurfaceCutter::advance(VertexId b, Segment from, const Segment& to, PlanarCutReport& report) {
+void SurfaceCutter::advance(VertexId b, Segment from, const Segment& to, PlanarCutResult& report) {
   for (int attempt = 0; attempt < 64 && incision_at(b); ++attempt) {
     const std::vector<StarHit> hits = hits_in_star(b, to);
     if (!hits.empty()) {
@@ -691,7 +691,7 @@ void SurfaceCutter::advance(VertexId b, Segment from, const Segment& to, PlanarC
   }
 }
 
-VertexId SurfaceCutter::cut_to_edge(VertexId b, VertexId y, VertexId z, double mu, PlanarCutReport& report) {
+VertexId SurfaceCutter::cut_to_edge(VertexId b, VertexId y, VertexId z, double mu, PlanarCutResult& report) {
   const Point3 at = lerp(reference(y), reference(z), mu);
   // An end of the edge near the crossing is the node, if it can carry the incision.
   const auto usable = [&](VertexId v) {
@@ -719,14 +719,14 @@ VertexId SurfaceCutter::cut_to_edge(VertexId b, VertexId y, VertexId z, double m
   return incision_at(next) ? next : -1;
 }
 
-VertexId SurfaceCutter::cut_to_hit(VertexId b, const StarHit& hit, PlanarCutReport& report) {
+VertexId SurfaceCutter::cut_to_hit(VertexId b, const StarHit& hit, PlanarCutResult& report) {
   const VertexId next = insert_at(hit.wedge, b, hit.weights, report);
   if (next < 0 || !has_edge(mesh_.connectivity(), b, next)) return -1;
   open_from(b, {next}, report);
   return incision_at(next) ? next : -1;
 }
 
-bool SurfaceCutter::clear_link_edge(VertexId b, VertexId y, VertexId z, PlanarCutReport& report) {
+bool SurfaceCutter::clear_link_edge(VertexId b, VertexId y, VertexId z, PlanarCutResult& report) {
   if (flip(y, z, report)) return true;
   // A flip refused (Figure 5.9, or a fold): remove the nearer interior end instead.
   VertexId first = y, second = z;
@@ -761,7 +761,7 @@ bool SurfaceCutter::move_active_to(VertexId b, const Wedge& w, std::array<double
   return false;
 }
 
-bool SurfaceCutter::flip(VertexId p, VertexId q, PlanarCutReport& report) {
+bool SurfaceCutter::flip(VertexId p, VertexId q, PlanarCutResult& report) {
   const Connectivity& c = mesh_.connectivity();
   const std::vector<ElementId> wings = elements_with_edge(c, p, q);
   if (wings.size() != 2 || is_crease(p, q)) return false;
@@ -791,7 +791,7 @@ bool SurfaceCutter::flip(VertexId p, VertexId q, PlanarCutReport& report) {
   return true;
 }
 
-bool SurfaceCutter::remove_node(VertexId v, PlanarCutReport& report) {
+bool SurfaceCutter::remove_node(VertexId v, PlanarCutResult& report) {
   // §5.3.2: active nodes stay, and so do the nodes that separate two of them.
   if (is_active(v) || active_neighbours(v, -1).size() > 1 || on_crease(v)) return false;
   std::vector<VertexId> link;
@@ -808,7 +808,7 @@ bool SurfaceCutter::remove_node(VertexId v, PlanarCutReport& report) {
   return true;
 }
 
-void SurfaceCutter::remesh_around(VertexId b, PlanarCutReport& report) {
+void SurfaceCutter::remesh_around(VertexId b, PlanarCutResult& report) {
   if (!mesh_.is_vertex(b) || !incision_at(b)) return;
   // §5.3.1: the active triangles' edges to the unfolded Delaunay criterion.
   flip_star_towards_delaunay(mesh_, b, [&](VertexId p, VertexId q) { return flip(p, q, report); });
@@ -831,7 +831,7 @@ void SurfaceCutter::remesh_around(VertexId b, PlanarCutReport& report) {
   }
 }
 
-void SurfaceCutter::split_incision(VertexId b, PlanarCutReport& report) {
+void SurfaceCutter::split_incision(VertexId b, PlanarCutResult& report) {
   if (!incision_at(b)) return;
   // The cut edges: boundary edges (b, c1) of wedge (b, c1, o1) and (b, c2) of (b, o2, c2).
   std::optional<Wedge> out, in;
@@ -903,7 +903,7 @@ std::vector<VertexId> SurfaceCutter::dissect_edges(const std::vector<std::array<
   return copies;
 }
 
-void SurfaceCutter::end_at_edge(VertexId b, VertexId y, VertexId z, double mu, PlanarCutReport& report) {
+void SurfaceCutter::end_at_edge(VertexId b, VertexId y, VertexId z, double mu, PlanarCutResult& report) {
   const bool exit = elements_with_edge(mesh_.connectivity(), y, z).size() == 1;
   const Point3 py = reference(y), pz = reference(z), at = lerp(py, pz, mu);
   VertexId w = -1;
@@ -935,7 +935,7 @@ void SurfaceCutter::end_at_edge(VertexId b, VertexId y, VertexId z, double mu, P
       }
 }
 
-void SurfaceCutter::end_at_node(VertexId b, VertexId w, PlanarCutReport& report) {
+void SurfaceCutter::end_at_node(VertexId b, VertexId w, PlanarCutResult& report) {
   std::vector<VertexId> met{b};
   for (VertexId a : active_neighbours(w, b)) met.push_back(a);
   if (!join_at(w, met).empty() && met.size() > 1) ++report.annihilations;
@@ -965,7 +965,7 @@ std::vector<VertexId> SurfaceCutter::join_at(VertexId w, const std::vector<Verte
   return copies;
 }
 
-void SurfaceCutter::legalize(PlanarCutReport& report) {
+void SurfaceCutter::legalize(PlanarCutResult& report) {
   std::sort(touched_.begin(), touched_.end());
   touched_.erase(std::unique(touched_.begin(), touched_.end()), touched_.end());
   const Connectivity& c = mesh_.connectivity();

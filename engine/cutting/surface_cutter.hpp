@@ -81,7 +81,7 @@ class SurfaceCutter {
   // coinciding ends, and IncisionLost when edits by others took an incision's tip away since
   // the last move (that incision has ended; the next move goes on with the others). The
   // report's fields mean what they mean for the 2D cutter.
-  PlanarCutReport move(std::span<const double> segment);
+  PlanarCutResult move(std::span<const double> segment);
   // Lifts the scalpel: the incisions in progress stay as they are and stop being active.
   void lift();
 
@@ -164,13 +164,13 @@ class SurfaceCutter {
   // active node, or -1.
   VertexId free_vertex_near(const Point3& at, std::span<const VertexId> candidates, double radius) const;
 
-  void sweep(const Segment& from, const Segment& to, PlanarCutReport& report);
+  void sweep(const Segment& from, const Segment& to, PlanarCutResult& report);
   // How many distinct places the scalpel meets a's star at.
   std::size_t places_in_star(VertexId a, const Segment& scalpel) const;
   // Whether an entry node's star meets the scalpel in fewer places at `to` than at `from`
   // (than two for a crest).
   bool loses_place(const Segment& from, const Segment& to) const;
-  void follow_scalpel(const Segment& from, const Segment& to, PlanarCutReport& report);
+  void follow_scalpel(const Segment& from, const Segment& to, PlanarCutResult& report);
   // The earliest new contacts (simultaneous ones together) as the scalpel moves from `from`
   // to `to`, on triangles that touch no active node (surface_contacts.cpp).
   std::vector<Contact> first_contacts(const Segment& from, const Segment& to);
@@ -179,47 +179,47 @@ class SurfaceCutter {
   // Whether the scalpel meets the triangle with a weight above a tolerance at `corner` (each
   // corner when corner is -1): not just on the opposite side.
   bool meets_inside(const Segment& scalpel, ElementId triangle, int corner) const;
-  bool enter(const Contact& contact, PlanarCutReport& report);
-  void begin_incision(VertexId a, const Segment& scalpel, PlanarCutReport& report);
+  bool enter(const Contact& contact, PlanarCutResult& report);
+  void begin_incision(VertexId a, const Segment& scalpel, PlanarCutResult& report);
   // Dissects the edges from a to `ends` (after splitting a lone interior one, so that it
   // opens); `ends` become the active nodes in place of a.
-  void open_from(VertexId a, const std::vector<VertexId>& ends, PlanarCutReport& report);
-  void advance(VertexId b, Segment from, const Segment& to, PlanarCutReport& report);
+  void open_from(VertexId a, const std::vector<VertexId>& ends, PlanarCutResult& report);
+  void advance(VertexId b, Segment from, const Segment& to, PlanarCutResult& report);
   // §5.3.1's incision nodes on the scalpel's path where it crosses a crease: b's incision
   // goes on from a node where the swept scalpel crosses link edge (y, z) of b's star (a new
   // one, or y or z when within crease_step of the crossing). Returns the new active node, or -1.
-  VertexId cut_to_edge(VertexId b, VertexId y, VertexId z, double mu, PlanarCutReport& report);
+  VertexId cut_to_edge(VertexId b, VertexId y, VertexId z, double mu, PlanarCutResult& report);
   // b's incision goes on from a new node where the scalpel meets b's star (b on a crease
   // stays there). Returns the new active node, or -1.
-  VertexId cut_to_hit(VertexId b, const StarHit& hit, PlanarCutReport& report);
+  VertexId cut_to_hit(VertexId b, const StarHit& hit, PlanarCutResult& report);
   // Hits of `scalpel` in a's star farther than `apart` from a and from each other, or nothing
   // when fewer than two (Figure 5.14).
   std::vector<StarHit> branches(VertexId a, const Segment& scalpel, double apart) const;
   double branch_distance(VertexId a);  // `apart` for a's incision
-  void branch(VertexId a, const Segment& scalpel, double apart, PlanarCutReport& report);
+  void branch(VertexId a, const Segment& scalpel, double apart, PlanarCutResult& report);
   // Moves the active node b to the point with `weights` in its star triangle, or part of the way;
   // true only for the whole way. When keeps_facing refuses the whole way, the star triangle in
   // the way goes to *blocking.
   bool move_active_to(VertexId b, const Wedge& w, std::array<double, 3> weights,
                       std::optional<Wedge>* blocking = nullptr);
   // A new vertex at `weights` in triangle (b, y, z), on a side when a weight is (nearly) 0.
-  VertexId insert_at(const Wedge& w, VertexId b, const std::array<double, 3>& weights, PlanarCutReport& report);
+  VertexId insert_at(const Wedge& w, VertexId b, const std::array<double, 3>& weights, PlanarCutResult& report);
   VertexId split(VertexId a, VertexId b, double t);
-  bool flip(VertexId p, VertexId q, PlanarCutReport& report);
+  bool flip(VertexId p, VertexId q, PlanarCutResult& report);
   // Link edge (y, z) of b's star out of the way: flipped, or else its nearer interior end removed.
-  bool clear_link_edge(VertexId b, VertexId y, VertexId z, PlanarCutReport& report);
-  bool remove_node(VertexId v, PlanarCutReport& report);
-  void remesh_around(VertexId b, PlanarCutReport& report);
-  void split_incision(VertexId b, PlanarCutReport& report);
+  bool clear_link_edge(VertexId b, VertexId y, VertexId z, PlanarCutResult& report);
+  bool remove_node(VertexId v, PlanarCutResult& report);
+  void remesh_around(VertexId b, PlanarCutResult& report);
+  void split_incision(VertexId b, PlanarCutResult& report);
   // Ends b's incision at edge (y, z) of its star (Figure 5.7, 5.13), with every incision
   // whose active node is across it.
-  void end_at_edge(VertexId b, VertexId y, VertexId z, double mu, PlanarCutReport& report);
+  void end_at_edge(VertexId b, VertexId y, VertexId z, double mu, PlanarCutResult& report);
   // Ends b's incision at its neighbour w, with those of w's other active neighbours.
-  void end_at_node(VertexId b, VertexId w, PlanarCutReport& report);
+  void end_at_node(VertexId b, VertexId w, PlanarCutResult& report);
   // Ends the incisions of `actives` by dissecting their edges to w; returns the copies made.
   std::vector<VertexId> join_at(VertexId w, const std::vector<VertexId>& actives);
   std::vector<VertexId> dissect_edges(const std::vector<std::array<VertexId, 2>>& edges);
-  void legalize(PlanarCutReport& report);
+  void legalize(PlanarCutResult& report);
   // After edits by others: each active node is the heir that still carries its incision, or
   // the incision ends.
   void settle(const Connectivity& c, const IncisionWatch::Fates& fates);

@@ -48,14 +48,14 @@ std::optional<ExclusiveUse::Claim> TetrahedralCutter::claim_body() const {
   return body_.exclusive_use->claim("a cut");
 }
 
-CutReport TetrahedralCutter::cut_triangle(std::span<const double> corners) {
+CutResult TetrahedralCutter::cut_triangle(std::span<const double> corners) {
   const SweepTriangle sweep(corners);  // validates before anything changes
   const auto claim = claim_body();
   if (!cut_configuration_.empty() || !body_.displacement) return cut(sweep);
   // A sweep triangle given alone (not by a move of the placed scalpel) meets the body as it is.
   cut_configuration_ = displacement_now();
   try {
-    CutReport report = cut(sweep);
+    CutResult report = cut(sweep);
     cut_configuration_.clear();
     return report;
   } catch (...) {
@@ -64,9 +64,9 @@ CutReport TetrahedralCutter::cut_triangle(std::span<const double> corners) {
   }
 }
 
-CutReport TetrahedralCutter::cut(const SweepTriangle& sweep) {
+CutResult TetrahedralCutter::cut(const SweepTriangle& sweep) {
   const double start = wall_seconds();
-  CutReport report;
+  CutResult report;
   report.sweeps = 1;
   report.components = pieces_.pieces();
 
@@ -103,7 +103,7 @@ CutReport TetrahedralCutter::cut(const SweepTriangle& sweep) {
   return report;
 }
 
-std::vector<VertexId> TetrahedralCutter::snap(const FaceSelection& selection, CutReport& report) {
+std::vector<VertexId> TetrahedralCutter::snap(const FaceSelection& selection, CutResult& report) {
   std::vector<VertexId> snapped;
   std::vector<VertexId> vertices;
   for (FaceId f : selection.faces)
@@ -133,7 +133,7 @@ std::vector<VertexId> TetrahedralCutter::snap(const FaceSelection& selection, Cu
   return snapped;
 }
 
-std::vector<VertexId> TetrahedralCutter::dissect_selected(std::vector<FaceId> faces, CutReport& report) {
+std::vector<VertexId> TetrahedralCutter::dissect_selected(std::vector<FaceId> faces, CutResult& report) {
   Connectivity& c = mesh_.connectivity();
   std::vector<FaceId> mates;
   for (FaceId f : faces) mates.push_back(c.face(f).mate);
@@ -159,7 +159,7 @@ std::vector<VertexId> TetrahedralCutter::dissect_selected(std::vector<FaceId> fa
   return region;
 }
 
-bool TetrahedralCutter::remove_fragments(CutReport& report) {
+bool TetrahedralCutter::remove_fragments(CutResult& report) {
   Connectivity& c = mesh_.connectivity();
   // By volume: degeneracy removal splits elements, so a sliver can be several tiny ones.
   std::vector<double> volume(pieces_.pieces(), 0.0);
@@ -190,7 +190,7 @@ bool TetrahedralCutter::remove_fragments(CutReport& report) {
   return true;
 }
 
-void TetrahedralCutter::count_pieces(CutReport& report) {
+void TetrahedralCutter::count_pieces(CutResult& report) {
   const Connectivity& c = mesh_.connectivity();
   bool separated = pieces_.update(c);
   if (separated && options_.max_fragment_elements > 0 && remove_fragments(report)) {
@@ -216,7 +216,7 @@ void TetrahedralCutter::count_pieces(CutReport& report) {
   }
 }
 
-CutReport TetrahedralCutter::move(std::span<const double> scalpel) {
+CutResult TetrahedralCutter::move(std::span<const double> scalpel) {
   if (scalpel.size() != 6)
     throw std::invalid_argument("TetrahedralCutter.move: the scalpel is a segment, (2, 3) coordinates; got " +
                                 std::to_string(scalpel.size()) + " numbers");
@@ -226,7 +226,7 @@ CutReport TetrahedralCutter::move(std::span<const double> scalpel) {
   if (now[0] == now[3] && now[1] == now[4] && now[2] == now[5])
     throw std::invalid_argument("TetrahedralCutter.move: the scalpel's two ends coincide (a segment of zero length)");
   const auto claim = claim_body();
-  CutReport report;
+  CutResult report;
   if (!scalpel_ && body_.displacement) cut_configuration_ = displacement_now();
   if (scalpel_) {
     const std::array<double, 6>& was = *scalpel_;

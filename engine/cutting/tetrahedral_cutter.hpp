@@ -23,7 +23,7 @@
 #include <vector>
 
 #include "cutting/cut_body.hpp"
-#include "cutting/cut_report.hpp"
+#include "cutting/cut_result.hpp"
 #include "cutting/face_selection.hpp"
 #include "mesh/deformed_positions.hpp"
 #include "mesh/piece_tracker.hpp"
@@ -58,11 +58,11 @@ class TetrahedralCutter : public ConnectivityWatcher {
   // One sweep triangle, corners (3, 3) in deformed coordinates. Throws std::invalid_argument,
   // before changing anything, for non-finite or collinear corners. A triangle that misses the
   // body gives an empty report.
-  CutReport cut_triangle(std::span<const double> corners);
+  CutResult cut_triangle(std::span<const double> corners);
   // Moves the scalpel, a segment (2, 3), from its previous position: the two sweep triangles
   // between them. The first call only places the scalpel. Throws std::invalid_argument for a
   // non-finite or zero-length segment; a move that sweeps no area gives an empty report.
-  CutReport move(std::span<const double> scalpel);
+  CutResult move(std::span<const double> scalpel);
   bool placed() const { return scalpel_.has_value(); }
   // Lifts the scalpel out of the body: the next move only places it, and the next sweep
   // starts a new incision (earlier sweeps no longer count for the tetrahedra they left
@@ -80,14 +80,14 @@ class TetrahedralCutter : public ConnectivityWatcher {
 
  private:
   // One sweep triangle against cut_positions(): what cut_triangle and move do.
-  CutReport cut(const SweepTriangle& sweep);
+  CutResult cut(const SweepTriangle& sweep);
   // Snaps the selected faces' vertices; returns those moved.
-  std::vector<VertexId> snap(const FaceSelection& selection, CutReport& report);
-  std::vector<VertexId> dissect_selected(std::vector<FaceId> faces, CutReport& report);
-  void count_pieces(CutReport& report);
+  std::vector<VertexId> snap(const FaceSelection& selection, CutResult& report);
+  std::vector<VertexId> dissect_selected(std::vector<FaceId> faces, CutResult& report);
+  void count_pieces(CutResult& report);
   // Removes the pieces of at most max_fragment_elements mean elements' volume (never the
   // largest piece); true if any.
-  bool remove_fragments(CutReport& report);
+  bool remove_fragments(CutResult& report);
   bool constrained(VertexId v) const;
   // The body's owner for one cut, when the cutter has a body (cut_body.hpp).
   std::optional<ExclusiveUse::Claim> claim_body() const;

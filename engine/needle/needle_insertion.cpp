@@ -34,6 +34,34 @@ std::string point_text(const Point& x, int dim) {
 
 }  // namespace
 
+void NeedleOptions::validate() const {
+  if (!(static_factor >= 1.0) || !std::isfinite(static_factor))
+    throw std::invalid_argument("static_factor must be at least 1 (static friction ≥ dynamic), got " +
+                                std::to_string(static_factor));
+  if (h_ref && (!(*h_ref > 0) || !std::isfinite(*h_ref)))
+    throw std::invalid_argument("h_ref must be positive and finite, got " + std::to_string(*h_ref));
+  if (radius && (!(*radius > 0) || !std::isfinite(*radius)))
+    throw std::invalid_argument("radius must be positive and finite, got " + std::to_string(*radius));
+  if (max_rearrangements < 1)
+    throw std::invalid_argument("max_rearrangements must be at least 1, got " + std::to_string(max_rearrangements));
+  if (solves_per_update < 0)
+    throw std::invalid_argument("solves_per_update must be 0 (until settled) or positive, got " +
+                                std::to_string(solves_per_update));
+  if (extension_rings < 0)
+    throw std::invalid_argument("extension_rings must be 0 (halve at once) or positive, got " +
+                                std::to_string(extension_rings));
+  if (friction_channel.empty()) throw std::invalid_argument("friction_channel must name a load channel");
+}
+
+StaticOptions NeedleInsertion::default_solver_options() {
+  StaticOptions options;
+  options.method = StaticMethod::linear_cg;
+  options.stopping.rtol = 1e-3;
+  options.stopping.round_tolerance = 1e-8;
+  options.options_prefix = "needle_";
+  return options;
+}
+
 NeedleInsertion::NeedleInsertion(Model& model, Bisection* bisection, const Point& entry, const Point& direction,
                                  FrictionProfile friction, NeedleOptions options, StaticOptions solver_options)
     : model_(model), bisection_(bisection), dim_(model.dim()), friction_(std::move(friction)), options_(std::move(options)) {
@@ -52,25 +80,12 @@ NeedleInsertion::NeedleInsertion(Model& model, Bisection* bisection, const Point
     throw std::invalid_argument("needle direction must be non-zero and finite, got " + point_text(axis, dim_));
   for (int k = 0; k < 3; ++k) direction_[k] = axis[k] / length;
   normal_ = {-direction_[1], direction_[0], 0};
-  if (dim_ == 3 && !(options_.radius > 0 && std::isfinite(options_.radius)))
-    throw std::invalid_argument("a 3D needle needs a positive, finite radius, got " + std::to_string(options_.radius));
-  if (dim_ == 2 && options_.radius != 0)
-    throw std::invalid_argument("a radius is for 3D needles; in 2D the needle is a line (radius 0), got " +
-                                std::to_string(options_.radius));
-  if (!(options_.static_factor >= 1.0) || !std::isfinite(options_.static_factor))
-    throw std::invalid_argument("static_factor must be at least 1 (static friction ≥ dynamic), got " +
-                                std::to_string(options_.static_factor));
-  if (options_.solves_per_update < 0)
-    throw std::invalid_argument("solves_per_update must be 0 (until settled) or positive, got " +
-                                std::to_string(options_.solves_per_update));
-  if (options_.max_rearrangements < 1)
-    throw std::invalid_argument("max_rearrangements must be at least 1, got " +
-                                std::to_string(options_.max_rearrangements));
-  if (options_.h_ref) {
-    if (!(*options_.h_ref > 0) || !std::isfinite(*options_.h_ref))
-      throw std::invalid_argument("h_ref must be positive and finite, got " + std::to_string(*options_.h_ref));
-    if (!bisection_) throw std::invalid_argument("h_ref needs the mesh's bisection");
-  }
+  options_.validate();
+  if (dim_ == 2 && options_.radius)
+    throw std::invalid_argument("radius is for 3D needles; in 2D the needle is a line, got radius=" +
+                                std::to_string(*options_.radius));
+  radius_ = dim_ == 3 ? options_.radius.value_or(NeedleOptions::default_radius) : 0.0;
+  if (options_.h_ref && !bisection_) throw std::invalid_argument("h_ref needs the mesh's bisection");
   if (!first_contact())
     throw std::invalid_argument("the needle from entry " + point_text(entry_, dim_) + " along " +
                                 point_text(direction_, dim_) + " never meets the body");
@@ -173,13 +188,13 @@ void NeedleInsertion::fix_where_it_is(VertexId v, std::span<const double> u) {
   model_.fix(std::span<const VertexId>(&v, 1), u.subspan(at(v), static_cast<std::size_t>(dim_)));
 }
 
-NeedleStepReport NeedleInsertion::advance(double distance) {
+NeedleStepResult NeedleInsertion::advance(double distance) {
   if (!(distance >= 0) || !std::isfinite(distance))
     throw std::invalid_argument("the needle advances by a non-negative, finite distance; got " +
                                 std::to_string(distance));
   const ExclusiveUse::Claim claim = model_.exclusive_use().claim("a needle step");
   const double start = wall_seconds();
-  NeedleStepReport report = advance_in_steps(distance, 0);
+  NeedleStepResult report = advance_in_steps(distance, 0);
   report.seconds = wall_seconds() - start;
   return report;
 }
@@ -207,7 +222,7 @@ bool NeedleInsertion::move_admissible() const {
   return model_.admissible(model_.displacement(), nullptr, collapse_floor);
 }
 
-NeedleStepReport NeedleInsertion::advance_in_steps(double distance, int halvings) {
+NeedleStepResult NeedleInsertion::advance_in_steps(double distance, int halvings) {
   move_needle(distance);
   // A move that drags sticking nodes across their neighbours would start the solve from
   // inverted elements, which a material forbidding inversion cannot relax: carry the move into
@@ -223,12 +238,12 @@ NeedleStepReport NeedleInsertion::advance_in_steps(double distance, int halvings
   if (!admissible && halvings < max_halvings) {
     if (extended) SNEDE_PETSC(VecCopy(start_, model_.displacement()));
     move_needle(-distance);
-    NeedleStepReport first = advance_in_steps(0.5 * distance, halvings + 1);
+    NeedleStepResult first = advance_in_steps(0.5 * distance, halvings + 1);
     first.halvings += 1;
     if (!first.converged) return first;
     return merged(first, advance_in_steps(0.5 * distance, halvings + 1));
   }
-  NeedleStepReport report;
+  NeedleStepResult report;
   report.extensions = extended ? 1 : 0;
   predict(distance);
   const std::size_t cells_before = model_.body().mesh().n_cells();
@@ -240,8 +255,8 @@ NeedleStepReport NeedleInsertion::advance_in_steps(double distance, int halvings
   return report;
 }
 
-NeedleStepReport NeedleInsertion::merged(const NeedleStepReport& a, const NeedleStepReport& b) {
-  NeedleStepReport m = b;
+NeedleStepResult NeedleInsertion::merged(const NeedleStepResult& a, const NeedleStepResult& b) {
+  NeedleStepResult m = b;
   m.rearrangements += a.rearrangements;
   m.slipped += a.slipped;
   m.stuck += a.stuck;
@@ -256,9 +271,9 @@ NeedleStepReport NeedleInsertion::merged(const NeedleStepReport& a, const Needle
   return m;
 }
 
-NeedleStepReport NeedleInsertion::settle() {
+NeedleStepResult NeedleInsertion::settle() {
   const double start = wall_seconds();
-  NeedleStepReport report;
+  NeedleStepResult report;
   report.intercepted = intercept_nodes();
   report = solve_and_rearrange(report);
   report.seconds = wall_seconds() - start;
@@ -280,7 +295,7 @@ void NeedleInsertion::refine_at_tip() {
     return;
   }
   const Point from = refined_from_.value_or(*X);
-  refine_near_segment(*bisection_, std::span<const double>(from.data(), 3), x, *options_.h_ref, options_.radius);
+  refine_near_segment(*bisection_, std::span<const double>(from.data(), 3), x, *options_.h_ref, radius_);
   refined_from_ = X;
 }
 
@@ -308,7 +323,7 @@ int NeedleInsertion::intercept_nodes() {
   if (dim_ == 3) {
     const Mesh& mesh = model_.body().mesh();
     for (VertexId v = 0; v < mesh.n_points(); ++v)
-      if (mesh.is_vertex(v) && across(deformed_point(mesh, u, v)) <= options_.radius) added += catch_node(v, u);
+      if (mesh.is_vertex(v) && across(deformed_point(mesh, u, v)) <= radius_) added += catch_node(v, u);
   }
   return added;
 }
@@ -411,7 +426,7 @@ void NeedleInsertion::share_surface(double lo) {
     for (NeedleNode& node : nodes_) node.static_threshold = 0;
     return;
   }
-  const double r = options_.radius;
+  const double r = radius_;
   const double ring = std::min(r, options_.h_ref.value_or(r)) / surface_rings_per_h;
   const int n_rings = static_cast<int>(std::clamp(std::ceil(length / ring), 1.0, static_cast<double>(max_surface_rings)));
   // Two unit vectors across the shaft.
@@ -466,7 +481,7 @@ void NeedleInsertion::apply_friction() {
   else model_.set_nodal_forces(options_.friction_channel, slipping, forces);
 }
 
-int NeedleInsertion::rearrange(NeedleStepReport& report) {
+int NeedleInsertion::rearrange(NeedleStepResult& report) {
   static const PetscLogEvent event = log_event("SnedeNeedleRearrange");
   const ScopedEvent timed(event);
   const int released = update_thresholds();
@@ -500,7 +515,7 @@ int NeedleInsertion::rearrange(NeedleStepReport& report) {
   return changes;
 }
 
-NeedleStepReport NeedleInsertion::solve_and_rearrange(NeedleStepReport report) {
+NeedleStepResult NeedleInsertion::solve_and_rearrange(NeedleStepResult report) {
   report.released += update_thresholds();
   for (;;) {
     apply_friction();

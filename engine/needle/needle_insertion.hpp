@@ -60,7 +60,9 @@ struct NeedleNode {
 struct NeedleOptions {
   double static_factor = 2.0;
   std::optional<double> h_ref;  // refine around the tip (3D: and along the shaft) to this edge length
-  double radius = 0;            // 3D: the needle's radius (> 0); 2D: 0 (the needle is a line)
+  // 3D: the needle's radius (> 0; unset: default_radius). 2D: unset (the needle is a line).
+  std::optional<double> radius;
+  static constexpr double default_radius = 1e-3;
   int max_rearrangements = 200; // per update; exceeding it is reported, not hidden
   // The thesis's haptic loop (§6.7): at most this many solves per update (0: until settled);
   // rearrangements still pending are carried into the next update, which is not a failure.
@@ -73,6 +75,10 @@ struct NeedleOptions {
   // enough. 0: halve at once (the behaviour before issue 50).
   int extension_rings = 3;
   std::string friction_channel = "friction";
+
+  // std::invalid_argument naming the first setting out of range (what needs the body, a
+  // radius in 2D, is the constructor's).
+  void validate() const;
 
   // Every field with its name: the one list that bindings and printing read.
   template <class Visit>
@@ -88,7 +94,7 @@ struct NeedleOptions {
   }
 };
 
-struct NeedleStepReport {
+struct NeedleStepResult {
   int rearrangements = 0;        // solves in this update (each followed by a rearrangement)
   int slipped = 0, stuck = 0, released = 0, intercepted = 0;  // state changes in this update
   int cells_split = 0;
@@ -104,20 +110,20 @@ struct NeedleStepReport {
   // Every field with its name: the one list that bindings and printing read.
   template <class Visit>
   static void visit_fields(Visit&& visit) {
-    visit("rearrangements", &NeedleStepReport::rearrangements);
-    visit("solver_iterations", &NeedleStepReport::solver_iterations);
-    visit("max_solver_iterations", &NeedleStepReport::max_solver_iterations);
-    visit("slipped", &NeedleStepReport::slipped);
-    visit("stuck", &NeedleStepReport::stuck);
-    visit("released", &NeedleStepReport::released);
-    visit("intercepted", &NeedleStepReport::intercepted);
-    visit("cells_split", &NeedleStepReport::cells_split);
-    visit("extensions", &NeedleStepReport::extensions);
-    visit("halvings", &NeedleStepReport::halvings);
-    visit("converged", &NeedleStepReport::converged);
-    visit("settled", &NeedleStepReport::settled);
-    visit("reason", &NeedleStepReport::reason);
-    visit("seconds", &NeedleStepReport::seconds);
+    visit("rearrangements", &NeedleStepResult::rearrangements);
+    visit("solver_iterations", &NeedleStepResult::solver_iterations);
+    visit("max_solver_iterations", &NeedleStepResult::max_solver_iterations);
+    visit("slipped", &NeedleStepResult::slipped);
+    visit("stuck", &NeedleStepResult::stuck);
+    visit("released", &NeedleStepResult::released);
+    visit("intercepted", &NeedleStepResult::intercepted);
+    visit("cells_split", &NeedleStepResult::cells_split);
+    visit("extensions", &NeedleStepResult::extensions);
+    visit("halvings", &NeedleStepResult::halvings);
+    visit("converged", &NeedleStepResult::converged);
+    visit("settled", &NeedleStepResult::settled);
+    visit("reason", &NeedleStepResult::reason);
+    visit("seconds", &NeedleStepResult::seconds);
   }
 };
 
@@ -126,10 +132,14 @@ class NeedleInsertion : public ConnectivityWatcher {
   // The model is a 2D (plane-stress) or 3D (tetrahedral) one; entry and direction have its
   // dimension (the third component is ignored in 2D). bisection: the mesh's bisection (needed
   // when h_ref is set; may be null otherwise). Throws std::invalid_argument for a zero
-  // direction, a needle whose line from entry misses the body, a surface mesh, a radius that is
-  // not positive in 3D or not 0 in 2D, or bad options.
+  // direction, a needle whose line from entry misses the body, a surface mesh, a radius given
+  // in 2D, or bad options.
   NeedleInsertion(Model& model, Bisection* bisection, const Point& entry, const Point& direction,
                   FrictionProfile friction, NeedleOptions options, StaticOptions solver_options);
+  // The static solver a needle relaxes with unless told otherwise: linear CG to rtol 1e-3 (the
+  // thesis's ε of §6.8), a round-off floor of 1e-8 (the loop's corrections are small against
+  // the accumulated state) and the options prefix "needle_".
+  static StaticOptions default_solver_options();
   // Where "auto" starts multigrid for a 2D needle solved by linear CG (the constructor says why).
   static constexpr std::int64_t planar_linear_multigrid_from_cells = 10000;
   ~NeedleInsertion() override;
@@ -137,9 +147,9 @@ class NeedleInsertion : public ConnectivityWatcher {
   NeedleInsertion& operator=(const NeedleInsertion&) = delete;
 
   // One update of §6.7 with the needle moved `distance` ≥ 0 further in.
-  NeedleStepReport advance(double distance);
+  NeedleStepResult advance(double distance);
   // Solve and rearrange at the current needle position, without moving it.
-  NeedleStepReport settle();
+  NeedleStepResult settle();
 
   const std::vector<NeedleNode>& needle_nodes() const { return nodes_; }
   int dim() const { return dim_; }
@@ -155,6 +165,7 @@ class NeedleInsertion : public ConnectivityWatcher {
   std::vector<double> needle_forces();
   const FrictionProfile& friction_profile() const { return friction_; }
   const NeedleOptions& options() const { return options_; }
+  double radius() const { return radius_; }  // 0 in 2D
   StaticSolver& solver() { return *solver_; }
 
   void init(const Connectivity&) override {}
@@ -195,14 +206,14 @@ class NeedleInsertion : public ConnectivityWatcher {
   static constexpr int max_surface_rings = 4096;
   void apply_friction();
   // One rearrangement pass after a solve: the number of nodes whose state changed.
-  int rearrange(NeedleStepReport& report);
-  NeedleStepReport solve_and_rearrange(NeedleStepReport report);
+  int rearrange(NeedleStepResult& report);
+  NeedleStepResult solve_and_rearrange(NeedleStepResult report);
   // Shifts the depth and the sticking nodes' prescribed displacements.
   void move_needle(double distance);
   // advance without timing; halves the move (up to max_halvings times) where it would start
   // the solve from inverted elements.
-  NeedleStepReport advance_in_steps(double distance, int halvings);
-  static NeedleStepReport merged(const NeedleStepReport& first, const NeedleStepReport& second);
+  NeedleStepResult advance_in_steps(double distance, int halvings);
+  static NeedleStepResult merged(const NeedleStepResult& first, const NeedleStepResult& second);
   static constexpr int max_halvings = 12;
   // Frees the vertex's constraint and drops the node; erase_node only drops it.
   void release(std::size_t index);
@@ -219,6 +230,7 @@ class NeedleInsertion : public ConnectivityWatcher {
   std::optional<Point> refined_from_;  // 3D: where the shaft's refinement continues (reference)
   FrictionProfile friction_;
   NeedleOptions options_;
+  double radius_ = 0;  // options_.radius resolved: 0 in 2D (a line), its default in 3D
   std::unique_ptr<StaticSolver> solver_;
   std::vector<NeedleNode> nodes_;
   double last_tolerance_ = 0;

@@ -54,12 +54,11 @@ DynamicRelaxation::DynamicRelaxation(std::unique_ptr<Problem> owned, Problem* pr
   for (const auto& [name, value] : options.petsc_options) options_digest.add(name).add(value);
   RankAgreement("DynamicRelaxation")
       .input("damping", options.damping)
-      .input("dt", options.dt)
+      .input("dt", options.dt.value_or(0.0))
       .input("options_prefix", options.options_prefix)
       .input("petsc_options", options_digest)
       .require(problem_.comm());
   options.validate();  // after the agreement, so that every rank gives the same verdict
-  const double dt = options.dt;
   try {
     generation_ = problem_.generation();
     Vec u = problem_.state();
@@ -76,12 +75,12 @@ DynamicRelaxation::DynamicRelaxation(std::unique_ptr<Problem> owned, Problem* pr
     SNES snes = nullptr;  // unused by SS22, but TSSetFromOptions creates and configures it
     SNEDE_PETSC(TSGetSNES(ts_, &snes));
     option_database_.use_for(snes);
-    const double default_dt = dt > 0 ? dt : cfl_time_step();
+    const double default_dt = options.dt ? *options.dt : cfl_time_step();
     require(positive_finite(default_dt), "the CFL time step", "positive and finite (is the mesh empty?)", default_dt);
     set_up_ss22(ts_, {options.options_prefix, options.damping, default_dt, this, acceleration_callback,
                       post_step_callback, u, velocity_});
     option_database_.mark_read_options_used();
-    follows_cfl_ = dt == 0 && time_step() == default_dt;
+    follows_cfl_ = !options.dt && time_step() == default_dt;
   } catch (...) {
     problem_.remove_carried_field(velocity_.slot());  // the handles release the PETSc objects
     throw;

@@ -2,6 +2,7 @@
 // step, the options prefix and the solver's own PETSc options.
 #pragma once
 
+#include <optional>
 #include <string>
 
 #include "core/error.hpp"
@@ -12,7 +13,8 @@ namespace snede {
 
 struct DynamicRelaxationOptions {
   double damping = 0;  // η ≥ 0 (1/s); §4.1: fastest at 2√λ₁, λ₁ the lowest eigenvalue of M⁻¹K
-  double dt = 0;       // the time step (s), or 0 for the CFL estimate (2.61), renewed as the mesh changes size
+  // The time step (s); unset: the CFL estimate (2.61), renewed as the mesh changes size.
+  std::optional<double> dt;
   std::string options_prefix = "dynamic_";
   OptionList petsc_options;  // this solver's PETSc options, without the prefix
 
@@ -28,7 +30,7 @@ struct DynamicRelaxationOptions {
   // std::invalid_argument naming a damping or time step that is negative or not finite.
   void validate() const {
     require_valid_damping(damping);
-    require(dt == 0 || positive_finite(dt), "dt", "positive and finite (or 0 for the CFL estimate)", dt);
+    if (dt) require(positive_finite(*dt), "dt", "positive and finite (or unset: the CFL estimate)", *dt);
   }
 };
 

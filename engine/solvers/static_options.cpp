@@ -7,6 +7,16 @@
 
 namespace snede {
 
+StaticOptions distributed_solve_options() {
+  StaticOptions options;
+  options.method = StaticMethod::linear_cg;
+  options.stopping.rtol = 1e-8;
+  options.stopping.criterion = StoppingCriterion::relative;
+  options.preconditioner = "none";
+  options.options_prefix = "dstatic_";
+  return options;
+}
+
 void require_valid(const StaticOptions& options, bool linear_material, MPI_Comm comm) {
   InputDigest petsc_options;
   for (const auto& [name, value] : options.petsc_options) petsc_options.add(name).add(value);

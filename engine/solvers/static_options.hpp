@@ -67,6 +67,11 @@ struct StaticOptions {
   }
 };
 
+// The settings of DistributedStatic.solve unless told otherwise (issue 18's route): linear CG
+// without a preconditioner to ε‖r(u₀)‖ with ε = 1e-8, options prefix "dstatic_". Issue 52
+// makes one problem of the serial and distributed routes and, with it, one set of defaults.
+StaticOptions distributed_solve_options();
+
 // std::invalid_argument naming the first setting out of range (rtol, round_tolerance,
 // max_iterations, linear CG on a material that is not linear), or the setting that differs
 // between the ranks of `comm`: a rank with another method or tolerance would wait in a

@@ -56,6 +56,11 @@ def count(value, name: str, low: int = 0, high: int | None = INT32_MAX, why: str
     return number
 
 
+def optional_count(value, name: str, low: int = 0) -> int | None:
+    """None (a keyword not given: the options record's field stays) or :func:`count`."""
+    return None if value is None else count(value, name, low)
+
+
 def index(value, name: str, limit: int, ids: str = "ids") -> int:
     """``value`` as an id in ``0..limit − 1``: ``name {value} does not exist`` otherwise, with
     the range of ``ids`` (e.g. "vertex ids"). Refuses bools and non-integers."""

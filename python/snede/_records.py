@@ -6,7 +6,7 @@ from __future__ import annotations
 
 def fields(record) -> dict:
     """A record's fields by name, as its keyword construction takes them."""
-    return record.__reduce__()[1][1]
+    return record._asdict()
 
 
 def settings(record_type, given, **keywords):

@@ -20,13 +20,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from snede import _checks, _snede
+from snede import _checks, _records, _snede
 from snede._petsc import option_list
 from snede.mesh import Mesh
 from snede._snede import SolveResult
-
-# The engine's static defaults (a default record's), for the settings whose defaults here are its.
-_STATIC = _snede.StaticOptions()
 
 MATERIALS = (_snede.LinearElastic, _snede.StVenantKirchhoff, _snede.NeoHookean, _snede.VerondaWestmann)
 
@@ -144,10 +141,14 @@ class DistributedStatic:
         arguments = agreed(comm, conditions)
         self._impl = _snede.DistributedStatic(part._impl, material, *arguments)
 
-    def solve(self, method: str = "cg", rtol: float = 1e-8, max_iterations: int = _STATIC.max_iterations,
-              preconditioner: str = "none", options_prefix: str = "dstatic_", criterion: str = "relative",
-              round_tolerance: float = _STATIC.round_tolerance, petsc_options: dict | None = None) -> SolveResult:
-        """The serial :class:`snede.StaticSolver`'s engine on this problem: ``method`` "cg"
+    def solve(self, method: str | None = None, rtol: float | None = None, max_iterations: int | None = None,
+              preconditioner: str | None = None, options_prefix: str | None = None, criterion: str | None = None,
+              round_tolerance: float | None = None, petsc_options: dict | None = None, *,
+              options: _snede.StaticOptions | None = None) -> SolveResult:
+        """The serial :class:`snede.StaticSolver`'s engine on this problem. ``options``: a
+        :class:`snede.StaticOptions` record (default ``snede._snede.distributed_solve_options()``:
+        linear CG without a preconditioner, rtol 1e-8, criterion "relative", prefix ``dstatic_``);
+        each keyword given (not None) changes its field. ``method`` "cg"
         (linear), "newton" or "ncg" (nonlinear CG, no preconditioner); ``preconditioner`` "none",
         "jacobi" (the tangent's diagonal, summed across the ranks), "mg" (multigrid by aggregation
         of each rank's vertices, Galerkin levels of the assembled tangent), or any PETSc PC on the
@@ -156,17 +157,18 @@ class DistributedStatic:
         (MUMPS's factors: one CG iteration for a linear body). Starts from the current state (the
         previous solve's answer, or :meth:`set_displacement`'s).
 
-        ``criterion`` "relative" (default): ‖F‖ ≤ rtol·‖F(u₀)‖ on the true residual (CG's
+        ``criterion`` "relative": ‖F‖ ≤ rtol·‖F(u₀)‖ on the true residual (CG's
         unpreconditioned one); "6.9" or "6.8": the criteria of §6.6, ‖F‖ ≤ rtol·√(‖f_ext‖² +
         ‖f_react‖²) plus ``round_tolerance``'s floor, or ‖F‖ ≤ rtol·‖f_ext‖; ``tolerance`` in
         the result is the threshold. A start that already meets (6.9) is converged with no
         iteration under "relative" too (a residual at round-off cannot meet ε‖F(u₀)‖)."""
-        def checked():  # the engine's options check every value (a ValueError naming it)
-            return _snede.StaticOptions(method=method, rtol=float(rtol), criterion=str(criterion),
-                                        round_tolerance=float(round_tolerance),
-                                        max_iterations=_checks.count(max_iterations, "max_iterations"),
-                                        options_prefix=str(options_prefix), petsc_options=option_list(petsc_options),
-                                        preconditioner=str(preconditioner))
+        def checked():  # the engine's record checks every value (a ValueError naming it)
+            return _records.settings(
+                _snede.StaticOptions, _snede.distributed_solve_options() if options is None else options,
+                method=method, rtol=rtol, criterion=criterion, round_tolerance=round_tolerance,
+                max_iterations=_checks.optional_count(max_iterations, "max_iterations", 1),
+                options_prefix=options_prefix, preconditioner=preconditioner,
+                petsc_options=None if petsc_options is None else option_list(petsc_options))
 
         return _snede.StaticSolver(self._impl, agreed(self.part.comm, checked)).solve()
 
@@ -213,16 +215,14 @@ def _per_vertex(values, n: int, dim: int, name: str) -> np.ndarray:
     return array
 
 
-def relaxation_options(damping: float, dt: float | None, options_prefix: str,
-                       petsc_options) -> _snede.DynamicRelaxationOptions:
-    """The engine's record of a relaxation's settings, which checks them (a negative or
-    non-finite damping or step is a ValueError naming it); ``dt`` None takes the CFL estimate
-    (the record's 0, which is refused here). The serial and the distributed relaxation both
-    make theirs here."""
-    if dt is not None and dt == 0:
-        raise ValueError(f"dt must be positive and finite (or None for the CFL estimate), got {dt}")
-    return _snede.DynamicRelaxationOptions(damping=damping, dt=0.0 if dt is None else dt,
-                                           options_prefix=options_prefix, petsc_options=option_list(petsc_options))
+def relaxation_options(options, damping, dt, options_prefix, petsc_options) -> _snede.DynamicRelaxationOptions:
+    """The engine's record of a relaxation's settings: ``options`` (None: a default record) with
+    each keyword given (not None) as its field; the record checks them (a negative or
+    non-finite damping or step is a ValueError naming it; its ``dt`` None is the CFL estimate).
+    The serial and the distributed relaxation both make theirs here."""
+    return _records.settings(_snede.DynamicRelaxationOptions, options, damping=damping, dt=dt,
+                             options_prefix=options_prefix,
+                             petsc_options=None if petsc_options is None else option_list(petsc_options))
 
 
 class DistributedRelaxation:
@@ -231,14 +231,18 @@ class DistributedRelaxation:
     (snede_ss22) on all ranks — the serial DynamicRelaxation's engine, on the problem's
     communicator; ``run(rtol, max_steps)`` stops at criterion (6.9)
     ‖F(u)‖ ≤ rtol·√(‖f_ext‖² + ‖f_react‖²). ``dt`` None takes the CFL estimate (2.61) of the
-    whole mesh. Options under ``options_prefix`` (``drelax_``): ``-drelax_ts_monitor`` and so
-    on, or ``petsc_options`` (without the prefix) for this solver only. Collective."""
+    whole mesh. ``options``: a :class:`snede.DynamicRelaxationOptions` record (default: the
+    default record with ``options_prefix="drelax_"``), whose fields the keywords given (not None)
+    change. Options under ``options_prefix``: ``-drelax_ts_monitor`` and so on, or
+    ``petsc_options`` (without the prefix) for this solver only. Collective."""
 
-    def __init__(self, problem: DistributedStatic, damping: float, dt: float | None = None, *,
-                 options_prefix: str = "drelax_", petsc_options: dict | None = None):
+    def __init__(self, problem: DistributedStatic, damping: float | None = None, dt: float | None = None, *,
+                 options: _snede.DynamicRelaxationOptions | None = None, options_prefix: str | None = None,
+                 petsc_options: dict | None = None):
         self.problem = problem
-        self._impl = _snede.DynamicRelaxation(
-            problem._impl, agreed(problem.part.comm, lambda: relaxation_options(damping, dt, options_prefix, petsc_options)))
+        given = _snede.DynamicRelaxationOptions(options_prefix="drelax_") if options is None else options
+        self._impl = _snede.DynamicRelaxation(problem._impl, agreed(
+            problem.part.comm, lambda: relaxation_options(given, damping, dt, options_prefix, petsc_options)))
 
     @property
     def dt(self) -> float:

@@ -9,18 +9,19 @@ from __future__ import annotations
 
 import numpy as np
 
-from snede import _checks, _snede
+from snede import _checks, _records, _snede
 from snede.distributed import DistributedRelaxation, relaxation_options
 from snede.distributed_body import DistributedBody, RunsOnRanks
 from snede._snede import DynamicRelaxationOptions, SolveResult
 
-#: the settings' defaults: the engine's, a default record's (written nowhere else)
-DEFAULTS = DynamicRelaxationOptions()
-
-
 
 class DynamicRelaxation(RunsOnRanks):
-    """``DynamicRelaxation(body, damping, dt=None)``: relax ``body.displacement`` in time.
+    """``DynamicRelaxation(body, damping, dt=None, *, options=None, ...)``: relax
+    ``body.displacement`` in time.
+
+    * ``options``: a :class:`snede.DynamicRelaxationOptions` record holding ``damping``, ``dt``,
+      ``options_prefix`` (default ``"dynamic_"``) and ``petsc_options`` (default: the default
+      record); a keyword given (not None) changes its field; the record checks each value.
 
     * ``damping``: η (1/s) of the damping C = η M, ≥ 0. §4.1: the fastest relaxation has
       η = 2√λ₁ (λ₁ the lowest eigenvalue of M⁻¹K); Table 4.4 lists 17–27 1/s for its cylinder.
@@ -49,25 +50,28 @@ class DynamicRelaxation(RunsOnRanks):
 
     _on_ranks = "run(), dt and part"
 
-    def __init__(self, body, damping: float, dt: float | None = None, *,
-                 options_prefix: str = DEFAULTS.options_prefix, petsc_options: dict | None = None, comm=None):
-        options = relaxation_options(damping, dt, options_prefix, petsc_options)
+    def __init__(self, body, damping: float | None = None, dt: float | None = None, *,
+                 options: DynamicRelaxationOptions | None = None, options_prefix: str | None = None,
+                 petsc_options: dict | None = None, comm=None):
+        self._settings = relaxation_options(options, damping, dt, options_prefix, petsc_options)
         self.body = body
         self._distributed = None
         comm = getattr(body, "comm", None) if comm is None else comm
         if comm is not None:
             self._distributed = DistributedBody(body, comm)
-            self._settings = (damping, dt, options_prefix, petsc_options)
             self._start_relaxation()
             self._impl = None
             return
-        self._impl = _snede.DynamicRelaxation(body._model, options)
+        self._impl = _snede.DynamicRelaxation(body._model, self._settings)
+
+    @property
+    def options(self) -> DynamicRelaxationOptions:
+        """A copy of the settings this relaxation was made with."""
+        return DynamicRelaxationOptions(**_records.fields(self._settings))
 
     def _start_relaxation(self) -> None:
-        damping, dt, prefix, petsc_options = self._settings
         self._problem = self._distributed.problem()
-        self._relaxation = DistributedRelaxation(self._problem, damping, dt, options_prefix=prefix,
-                                                 petsc_options=petsc_options)
+        self._relaxation = DistributedRelaxation(self._problem, options=self._settings)
 
     def step(self, n: int = 1) -> SolveResult:
         """Take ``n`` time steps. ``converged`` is False only on divergence (blow-up, NaN,

@@ -17,14 +17,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from snede import _checks, _renamed, _snede
+from snede import _checks, _records, _renamed, _snede
 from snede._engine import engine_property
 from snede._petsc import option_list
 from snede._snede import NeedleOptions, NeedleStepResult, StaticOptions
-
-#: the engine's defaults (default records'): the needle's settings and its static solver's
-#: iteration cap; the solver's method, rtol, round_tolerance and prefix are the needle's own
-DEFAULTS, SOLVER_DEFAULTS = NeedleOptions(), StaticOptions()
 
 
 class FrictionProfile:
@@ -92,33 +88,40 @@ class InsertionResult:
 
 
 class NeedleInsertion:
-    """``NeedleInsertion(body, entry, direction, friction, *, static_factor=2.0, h_ref=None,
-    radius=None, method="cg", rtol=1e-3)`` on a 2D (plane-stress) or 3D (tetrahedral)
-    ``snede.Body`` of any material.
+    """``NeedleInsertion(body, entry, direction, friction, *, options=None, solver=None, **settings)``
+    on a 2D (plane-stress) or 3D (tetrahedral) ``snede.Body`` of any material.
 
+    * ``options``: a :class:`snede.NeedleOptions` record of the needle's settings below
+      (default ``NeedleOptions()``, whose fields are the defaults); ``solver``: a
+      :class:`snede.StaticOptions` record for its static solver (default
+      ``NeedleInsertion.default_solver_options()``: linear CG, rtol 1e-3, round_tolerance 1e-8,
+      options prefix ``needle_``). A keyword setting given (not None) changes its field of the
+      record it belongs to; the records check each value (a ValueError or TypeError naming the
+      field).
     * ``entry``, ``direction``: the needle's axis (dim components each, metres); the tip starts
       at ``entry`` (depth 0) and moves along ``direction`` (normalised). The line must meet the
       body. Points are in deformed coordinates: the needle is an object in space.
     * ``friction``: a :class:`FrictionProfile`; the dynamic threshold of a node is the profile
       integrated over its share of the shaft (half-way to its neighbours along the shaft,
-      within the body); the static threshold is ``static_factor`` times it. In 3D the profile
-      is a force per unit of shaft *surface* (N/m²): the integral is multiplied by 2πr.
-    * ``radius`` (3D only; default 1 mm there): the needle is a rigid cylinder. Its needle
-      nodes are the mesh's jagged image of its surface (Figure 6.14): the vertex nearest the
-      axis of every face the axis crosses, and every vertex the tip has passed within
-      ``radius`` of the axis (deformed coordinates). Giving a radius for a 2D body is an error.
+      within the body); the static threshold is ``static_factor`` (default 2) times it. In 3D
+      the profile is a force per unit of shaft *surface* (N/m²): the integral is multiplied by 2πr.
+    * ``radius`` (3D only; default ``NeedleOptions.default_radius``, 1 mm): the needle is a rigid
+      cylinder. Its needle nodes are the mesh's jagged image of its surface (Figure 6.14): the
+      vertex nearest the axis of every face the axis crosses, and every vertex the tip has passed
+      within ``radius`` of the axis (deformed coordinates). Giving a radius for a 2D body is an error.
     * ``h_ref``: refine by bisection (§6.5) around the tip to this edge length after every move;
       in 3D also along the shaft, every element within ``radius`` of the axis.
-    * ``method``, ``rtol``, ``criterion``, ``petsc_options``, ``options_prefix`` (default
-      ``needle_``): the static solver (see :class:`snede.StaticSolver`); stopping (6.9).
+    * ``method``, ``rtol``, ``criterion``, ``round_tolerance``, ``max_iterations``,
+      ``preconditioner``, ``petsc_options`` (a dict), ``options_prefix``: the solver record's fields (see
+      :class:`snede.StaticSolver`); stopping (6.9).
       Inexact Newton (``petsc_options={"snes_ksp_ew": None}`` or ``-needle_snes_ksp_ew``,
       Eisenstat–Walker: early steps solve their linear systems loosely) pays in the haptic
       loop: 12–16 % less time with one solve per update at 22k–34k neo-Hookean tetrahedra
       (``studies/benchmarks/needle3d_rates.py --thesis-size``), but 8 % more when every update is
       settled (the ``needle3d`` scene: more Newton steps, each with a new preconditioner).
-    * ``max_rearrangements``: per update; reaching it is reported, not hidden.
-    * ``solves_per_update``: None (default) relaxes and rearranges until no node changes state
-      in every update; an integer k allows at most k solves per update and carries pending
+    * ``max_rearrangements`` (default 200): per update; reaching it is reported, not hidden.
+    * ``solves_per_update``: 0 (default) relaxes and rearranges until no node changes state
+      in every update; k > 0 allows at most k solves per update and carries pending
       rearrangements into the next one — the thesis's haptic loop (§6.7, Table 6.5) is k = 1,
       which bounds the work per update.
     * ``extrapolate``: start each update's solve from the last state plus the last update's
@@ -139,45 +142,47 @@ class NeedleInsertion:
     from vertices the user has not constrained.
     """
 
-    def __init__(self, body, entry, direction, friction: FrictionProfile, *,
-                 static_factor: float = DEFAULTS.static_factor, h_ref: float | None = None, radius: float | None = None,
-                 method: str = "cg", rtol: float = 1e-3, criterion: str = SOLVER_DEFAULTS.criterion,
-                 round_tolerance: float = 1e-8, max_iterations: int = SOLVER_DEFAULTS.max_iterations,
-                 max_rearrangements: int = DEFAULTS.max_rearrangements, solves_per_update: int | None = None,
-                 extrapolate: bool = DEFAULTS.extrapolate, extension_rings: int = DEFAULTS.extension_rings,
-                 options_prefix: str = "needle_", petsc_options: dict | None = None):
+    default_solver_options = staticmethod(_snede.NeedleInsertion.default_solver_options)
+
+    def __init__(self, body, entry, direction, friction: FrictionProfile, *, options: NeedleOptions | None = None,
+                 solver: StaticOptions | None = None, static_factor: float | None = None, h_ref: float | None = None,
+                 radius: float | None = None, max_rearrangements: int | None = None,
+                 solves_per_update: int | None = None, extrapolate: bool | None = None,
+                 extension_rings: int | None = None, method: str | None = None, rtol: float | None = None,
+                 criterion: str | None = None, round_tolerance: float | None = None,
+                 max_iterations: int | None = None, preconditioner: str | None = None,
+                 options_prefix: str | None = None, petsc_options: dict | None = None):
         body.mesh.require_serial("NeedleInsertion")
-        if body.mesh.is_surface:
-            raise ValueError("needle insertion needs a 2D plane-stress or a 3D tetrahedral body, not a surface mesh")
-        dim = body.mesh.dim
-        if dim == 2 and radius is not None:
-            raise ValueError(f"radius is for 3D needles; in 2D the needle is a line, got radius={radius}")
-        radius = 0.0 if dim == 2 else (1e-3 if radius is None else radius)
-        if dim == 3:
-            _checks.positive(radius, "radius")
-        for name, value in (("entry", entry), ("direction", direction)):
-            if np.shape(value) != (dim,):
-                raise ValueError(f"{name} must have {dim} components for this {dim}-D body, got shape {np.shape(value)}")
         if not isinstance(friction, FrictionProfile):
             raise TypeError(f"friction must be a snede.FrictionProfile, got {type(friction).__name__}")
-        max_rearrangements = _checks.count(max_rearrangements, "max_rearrangements", 1)
-        # None (or 0, as the engine has it) relaxes until no node changes state.
-        solves_per_update = 0 if solves_per_update is None else _checks.count(solves_per_update, "solves_per_update")
-        max_iterations = _checks.count(max_iterations, "max_iterations", 1)
-        extension_rings = _checks.count(extension_rings, "extension_rings")
+        needle_settings = _records.settings(
+            NeedleOptions, options, static_factor=static_factor, h_ref=h_ref, radius=radius,
+            max_rearrangements=_checks.optional_count(max_rearrangements, "max_rearrangements", 1),
+            solves_per_update=_checks.optional_count(solves_per_update, "solves_per_update"),
+            extrapolate=extrapolate, extension_rings=_checks.optional_count(extension_rings, "extension_rings"))
+        solver_settings = _records.settings(
+            StaticOptions, self.default_solver_options() if solver is None else solver, method=method, rtol=rtol, criterion=criterion,
+            round_tolerance=round_tolerance, max_iterations=_checks.optional_count(max_iterations, "max_iterations", 1),
+            preconditioner=preconditioner, options_prefix=options_prefix,
+            petsc_options=None if petsc_options is None else option_list(petsc_options))
         self.body = body
         self.friction_profile = friction
-        bisection = body.mesh._bisection() if h_ref is not None else None
-        options = NeedleOptions(static_factor=float(static_factor), h_ref=None if h_ref is None else float(h_ref),
-                                radius=float(radius), max_rearrangements=max_rearrangements,
-                                solves_per_update=solves_per_update, extrapolate=bool(extrapolate),
-                                extension_rings=extension_rings)
-        solver_options = StaticOptions(method=method, rtol=float(rtol), criterion=criterion,
-                                       round_tolerance=float(round_tolerance), max_iterations=max_iterations,
-                                       options_prefix=options_prefix, petsc_options=option_list(petsc_options))
+        bisection = body.mesh._bisection() if needle_settings.h_ref is not None else None
         self._impl = _snede.NeedleInsertion(body._model, bisection, np.asarray(entry, dtype=np.float64),
-                                            np.asarray(direction, dtype=np.float64), friction._impl, options,
-                                            solver_options)
+                                            np.asarray(direction, dtype=np.float64), friction._impl,
+                                            needle_settings, solver_settings)
+
+    @property
+    def options(self) -> NeedleOptions:
+        """A copy of the needle's settings (a :class:`snede.NeedleOptions`)."""
+        return NeedleOptions(**_records.fields(self._impl.options))
+
+    @property
+    def solver_options(self) -> StaticOptions:
+        """A copy of the settings of the needle's static solver (a :class:`snede.StaticOptions`),
+        with what the needle adds to them: ``mg_coarsening grid`` among its PETSc options unless
+        given, and a 2D linear CG's later start of "auto" multigrid."""
+        return StaticOptions(**_records.fields(self._impl.solver_options))
 
     def advance(self, distance: float) -> NeedleStepResult:
         """Move the needle ``distance`` (≥ 0) further in and relax (one update of §6.7)."""
@@ -229,6 +234,7 @@ class NeedleInsertion:
         :attr:`snede.StaticSolver.multigrid_source`).""")
     multigrid_unknowns = engine_property(
         "multigrid_unknowns", "Unknowns per level of the needle solver's ``\"mg\"`` levels, coarsest first.", list)
+    radius = engine_property("radius", "The needle's radius (metres; 0 for a 2D needle, a line).")
     entry = engine_property("entry", convert=np.asarray)
     direction = engine_property("direction", convert=np.asarray)
     needle_nodes = engine_property("needle_nodes", "Vertex ids of the needle nodes.",

@@ -123,8 +123,7 @@ class StaticSolver(RunsOnRanks):
                  round_tolerance: float | None = None, max_iterations: int | None = None, line_search: str | None = None,
                  ncg_type: str | None = None, options_prefix: str | None = None, petsc_options: dict | None = None,
                  preconditioner: str | None = None, comm=None):
-        if max_iterations is not None:
-            max_iterations = _checks.count(max_iterations, "max_iterations", 1)
+        max_iterations = _checks.optional_count(max_iterations, "max_iterations", 1)
         if preconditioner is not None and (not isinstance(preconditioner, str) or not preconditioner.strip()):
             raise ValueError(f"preconditioner must be a PETSc PC type name such as 'none', 'jacobi' or 'gamg', "
                              f"got {preconditioner!r}")

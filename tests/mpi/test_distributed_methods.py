@@ -201,6 +201,21 @@ def test_a_solve_starts_from_a_displacement_set_on_every_rank():
     assert COMM.allreduce(1) == COMM.size
 
 
+def test_a_solve_takes_a_record_whole_and_keywords_change_its_fields():
+    """DistributedStatic.solve forwards (issue 51): a StaticOptions record given whole, a
+    keyword changing one field, and the defaults (linear CG to ε‖r(u₀)‖) the engine's."""
+    record = snede.StaticOptions(method="cg", rtol=1e-10, criterion="6.8", options_prefix="whole_dstatic_")
+    whole = linear_cantilever_problem(COMM).solve(options=record)
+    looser = linear_cantilever_problem(COMM).solve(options=record, rtol=1e-4)
+    assert whole.converged and looser.converged, (whole, looser)
+    assert looser.tolerance == pytest.approx(whole.tolerance * 1e6, rel=1e-12)  # (6.8): rtol·‖f_ext‖
+    assert looser.iterations < whole.iterations
+    default = linear_cantilever_problem(COMM).solve()
+    assert default.converged and default.residual_norm <= 1e-8 * default.initial_residual_norm, default
+    with pytest.raises(TypeError, match="options must be a snede.StaticOptions"):
+        linear_cantilever_problem(COMM).solve(options={"rtol": 1e-3})
+
+
 @pytest.mark.parametrize("preconditioner", ["bjacobi", "sor"])
 def test_local_preconditioners_on_the_assembled_tangent(preconditioner):
     """Block Jacobi (ILU(0) on each rank's block) and SOR (symmetric sweeps over each rank's

@@ -131,6 +131,7 @@ def run(scene, method: str | None, rtol: float | None, out: Path, progress: bool
     """Solve (or evolve) the scene with ``method`` (None: ``fitting_method(scene)``), write the
     series, the picture and summary.json; the summary."""
     method = method or fitting_method(scene)
+    scene.require_method(method)
     rtol = rtol or scene.default_rtol
     body = scene.body
     folder = Path(out) / scene.name

@@ -150,7 +150,7 @@ inline void expect_same_cut_translated(const Mesh& displaced, const std::vector<
 
 // The same for the Delaunay cutters, whose path across the body exits once and separates it
 // in two: the reports count the same edits.
-inline void expect_same_incision_translated(const PlanarCutReport& on_body, const PlanarCutReport& on_mesh,
+inline void expect_same_incision_translated(const PlanarCutResult& on_body, const PlanarCutResult& on_mesh,
                                             const Mesh& displaced, const std::vector<double>& t, const Mesh& moved) {
   EXPECT_EQ(on_body.exits, 1);
   EXPECT_EQ(on_body.flips, on_mesh.flips);

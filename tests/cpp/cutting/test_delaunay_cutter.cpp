@@ -12,8 +12,8 @@
 namespace snede::testing {
 namespace {
 
-PlanarCutReport cut_along(DelaunayCutter& cutter, const std::vector<PlanePoint>& corners) {
-  PlanarCutReport total;
+PlanarCutResult cut_along(DelaunayCutter& cutter, const std::vector<PlanePoint>& corners) {
+  PlanarCutResult total;
   for (const PlanePoint& p : sampled(corners, cutter.options().eps_edge)) total.add(cutter.move(p));
   return total;
 }
@@ -21,7 +21,7 @@ PlanarCutReport cut_along(DelaunayCutter& cutter, const std::vector<PlanePoint>&
 TEST(DelaunayCutter, ACutAcrossMakesTwoPiecesOfTheSquaresArea) {
   Mesh mesh = right_triangle_square(8);
   DelaunayCutter cutter(mesh, {}, DelaunayCutterOptions{});
-  PlanarCutReport report = cut_along(cutter, {{0.43, 1.2}, {0.43, 0.5}});
+  PlanarCutResult report = cut_along(cutter, {{0.43, 1.2}, {0.43, 0.5}});
   EXPECT_EQ(report.entries, 1);
   EXPECT_TRUE(cutter.cutting());
   EXPECT_EQ(count_pieces(mesh), 1);
@@ -42,8 +42,8 @@ TEST(DelaunayCutter, ACutOfARigidlyTranslatedBodyIsTheCutOfTheTranslatedMesh) {
   DelaunayCutter on_mesh(moved, {}, DelaunayCutterOptions{});
   std::vector<PlanePoint> path{{-0.2, 0.31}, {0.4, 0.62}, {0.7, 0.35}, {1.2, 0.58}};
   for (PlanePoint& p : path) p = {p[0] + t[0], p[1] + t[1]};
-  const PlanarCutReport body_report = cut_along(on_body, path);
-  const PlanarCutReport mesh_report = cut_along(on_mesh, path);
+  const PlanarCutResult body_report = cut_along(on_body, path);
+  const PlanarCutResult mesh_report = cut_along(on_mesh, path);
   expect_same_incision_translated(body_report, mesh_report, displaced, t, moved);
 }
 

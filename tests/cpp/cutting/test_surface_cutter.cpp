@@ -27,9 +27,9 @@ Mesh height_field(int n, Height height) {
 }
 
 // Vertical scalpels from z = −1 to 1 through the path's samples, all moved by t.
-PlanarCutReport cut_along(SurfaceCutter& cutter, const std::vector<PlanePoint>& corners,
+PlanarCutResult cut_along(SurfaceCutter& cutter, const std::vector<PlanePoint>& corners,
                           const std::vector<double>& t = {0, 0, 0}) {
-  PlanarCutReport total;
+  PlanarCutResult total;
   for (const PlanePoint& p : sampled(corners, cutter.options().eps_edge)) {
     const std::array<double, 6> scalpel{p[0] + t[0], p[1] + t[1], -1 + t[2], p[0] + t[0], p[1] + t[1], 1 + t[2]};
     total.add(cutter.move(scalpel));
@@ -40,7 +40,7 @@ PlanarCutReport cut_along(SurfaceCutter& cutter, const std::vector<PlanePoint>& 
 TEST(SurfaceCutter, ACutAcrossAFlatSquareMakesTwoPiecesOfItsArea) {
   Mesh mesh = height_field(8, [](double, double) { return 0.0; });
   SurfaceCutter cutter(mesh, {}, SurfaceCutterOptions{});
-  const PlanarCutReport report = cut_along(cutter, {{0.43, 1.2}, {0.43, 0.5}, {0.47, -0.2}});
+  const PlanarCutResult report = cut_along(cutter, {{0.43, 1.2}, {0.43, 0.5}, {0.47, -0.2}});
   EXPECT_EQ(report.entries, 1);
   EXPECT_EQ(report.exits, 1);
   EXPECT_EQ(count_pieces(mesh), 2);
@@ -51,7 +51,7 @@ TEST(SurfaceCutter, ACutAcrossAFlatSquareMakesTwoPiecesOfItsArea) {
 TEST(SurfaceCutter, ACutThatStopsInsideLeavesOnePiece) {
   Mesh mesh = height_field(8, [](double, double) { return 0.0; });
   SurfaceCutter cutter(mesh, {}, SurfaceCutterOptions{});
-  const PlanarCutReport report = cut_along(cutter, {{0.43, 1.2}, {0.43, 0.5}});
+  const PlanarCutResult report = cut_along(cutter, {{0.43, 1.2}, {0.43, 0.5}});
   EXPECT_EQ(report.entries, 1);
   EXPECT_GT(cutter.incision_edges().size(), 0u);
   EXPECT_EQ(count_pieces(mesh), 1);
@@ -67,8 +67,8 @@ TEST(SurfaceCutter, ACutOfARigidlyTranslatedBodyIsTheCutOfTheTranslatedMesh) {
   SurfaceCutter on_body(displaced, rigid_displacement(displaced, t), SurfaceCutterOptions{});
   SurfaceCutter on_mesh(moved, {}, SurfaceCutterOptions{});
   const std::vector<PlanePoint> path{{-0.2, 0.31}, {0.4, 0.62}, {0.7, 0.35}, {1.2, 0.58}};
-  const PlanarCutReport body_report = cut_along(on_body, path, t);
-  const PlanarCutReport mesh_report = cut_along(on_mesh, path, t);
+  const PlanarCutResult body_report = cut_along(on_body, path, t);
+  const PlanarCutResult mesh_report = cut_along(on_mesh, path, t);
   expect_same_incision_translated(body_report, mesh_report, displaced, t, moved);
 }
 

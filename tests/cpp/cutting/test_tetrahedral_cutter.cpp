@@ -43,8 +43,8 @@ Scalpel shifted(Scalpel s, const std::vector<double>& t) {
   return s;
 }
 
-CutReport cut_along(TetrahedralCutter& cutter, const std::vector<Scalpel>& path) {
-  CutReport total;
+CutResult cut_along(TetrahedralCutter& cutter, const std::vector<Scalpel>& path) {
+  CutResult total;
   for (const Scalpel& s : path) total.add(cutter.move(s));
   return total;
 }
@@ -63,7 +63,7 @@ TEST(TetrahedralCutter, APlaneThroughTheBoxMakesTwoPiecesOfTheBoxsVolume) {
     CutterOptions options;
     options.remove_degeneracies = remove;
     TetrahedralCutter cutter(mesh, CutBody{}, options);
-    const CutReport report = cut_along(cutter, planar_path({1, 0.4, 0.2}, 0.55, 3));
+    const CutResult report = cut_along(cutter, planar_path({1, 0.4, 0.2}, 0.55, 3));
     EXPECT_EQ(count_pieces(mesh), 2) << "degeneracy removal " << remove;
     EXPECT_EQ(report.components, 2);
     EXPECT_GT(report.faces_dissected, 36);  // at least the 6 × 6 × 2 faces of a grid plane
@@ -77,7 +77,7 @@ TEST(TetrahedralCutter, APlaneThroughTheBoxMakesTwoPiecesOfTheBoxsVolume) {
 TEST(TetrahedralCutter, ACutThatStopsInsideLeavesOnePiece) {
   Mesh mesh = kuhn_cube(8);
   TetrahedralCutter cutter(mesh, CutBody{}, CutterOptions{});
-  const CutReport report = cut_along(cutter, {{0.43, -0.5, -1, 0.43, -0.5, 2}, {0.43, 0.2, -1, 0.43, 0.2, 2},
+  const CutResult report = cut_along(cutter, {{0.43, -0.5, -1, 0.43, -0.5, 2}, {0.43, 0.2, -1, 0.43, 0.2, 2},
                                               {0.43, 0.6, -1, 0.43, 0.6, 2}});
   EXPECT_GT(report.faces_dissected, 0);
   EXPECT_EQ(count_pieces(mesh), 1);
@@ -92,8 +92,8 @@ TEST(TetrahedralCutter, ACutOfARigidlyTranslatedBodyIsTheCutOfTheTranslatedMesh)
   for (Scalpel& s : path) s = shifted(s, t);
   TetrahedralCutter on_body(displaced, CutBody{rigid_displacement(displaced, t), {}, {}, {}}, CutterOptions{});
   TetrahedralCutter on_mesh(moved, CutBody{}, CutterOptions{});
-  const CutReport body_report = cut_along(on_body, path);
-  const CutReport mesh_report = cut_along(on_mesh, path);
+  const CutResult body_report = cut_along(on_body, path);
+  const CutResult mesh_report = cut_along(on_mesh, path);
   EXPECT_EQ(body_report.faces_dissected, mesh_report.faces_dissected);
   EXPECT_EQ(body_report.vertices_snapped, mesh_report.vertices_snapped);
   EXPECT_GT(body_report.vertices_snapped, 0);
@@ -116,7 +116,7 @@ TEST(TetrahedralCutter, SupportsStayWhereTheyAre) {
     CutBody body;
     if (supported) body.is_support = [&](VertexId v) { return supports.count(v) > 0; };
     TetrahedralCutter cutter(mesh, body, without_degeneracy_removal());
-    const CutReport report = cut_along(cutter, planar_path({1, 0, 0}, 0.52, 3));
+    const CutResult report = cut_along(cutter, planar_path({1, 0, 0}, 0.52, 3));
     int left_in_place = 0;
     for (VertexId v : supports) left_in_place += mesh.point(v)[0] == 0.5;
     if (supported) {
@@ -167,7 +167,7 @@ TEST(TetrahedralCutter, APieceCutFreeOfTheSupportsIsHeldOnOneOfItsFaces) {
   cut_along(cutter, {{0.6, -0.5, -1, 0.6, -0.5, 2}, {0.6, 0.3, -1, 0.6, 0.3, 2}});
   EXPECT_EQ(left.queries, 0);
   cutter.lift();
-  const CutReport report = cut_along(cutter, planar_path({1, 0.1, 0.05}, 0.6, 3));
+  const CutResult report = cut_along(cutter, planar_path({1, 0.1, 0.05}, 0.6, 3));
   ASSERT_EQ(count_pieces(mesh), 2);
   EXPECT_GE(left.queries, 1);
   EXPECT_EQ(report.free_pieces, 1);
@@ -201,7 +201,7 @@ TEST(TetrahedralCutter, FreePiecesAreOnlyCountedWhenHoldingThemIsOff) {
   CutterOptions options;
   options.fix_free_pieces = false;
   TetrahedralCutter cutter(mesh, left.body(), options);
-  const CutReport report = cut_along(cutter, planar_path({1, 0.1, 0.05}, 0.6, 3));
+  const CutResult report = cut_along(cutter, planar_path({1, 0.1, 0.05}, 0.6, 3));
   EXPECT_EQ(report.free_pieces, 1);
   EXPECT_EQ(report.pieces_fixed, 0);
   EXPECT_TRUE(left.held_faces.empty());

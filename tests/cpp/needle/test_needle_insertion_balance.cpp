@@ -15,7 +15,7 @@ TEST(NeedleInsertionBalance, TheNeedlesForceOnTheBodyBalancesTheSupport) {
   snede::testing::NeedleSlab slab(20.0, "cpp_needle_balance_");
   for (int update = 0; update < 16; ++update) {
     SCOPED_TRACE(update);
-    const NeedleStepReport report = slab.needle.advance(0.5 * snede::testing::slab_edge);
+    const NeedleStepResult report = slab.needle.advance(0.5 * snede::testing::slab_edge);
     ASSERT_TRUE(report.converged) << report.reason;
     const std::vector<double> forces = slab.needle.needle_forces();
     ASSERT_EQ(forces.size(), 2 * slab.needle.needle_nodes().size());

@@ -17,7 +17,7 @@ TEST(NeedleInsertionFriction, NoNodeCarriesMoreThanItsFrictionThreshold) {
   std::size_t sticking_seen = 0, slipping_seen = 0;
   for (int update = 0; update < 16; ++update) {
     SCOPED_TRACE(update);
-    const NeedleStepReport report = slab.needle.advance(0.5 * snede::testing::slab_edge);
+    const NeedleStepResult report = slab.needle.advance(0.5 * snede::testing::slab_edge);
     ASSERT_TRUE(report.converged) << report.reason;
     const std::vector<double> gradient = slab.model.potential_gradient(slab.model.displacement());
     const std::vector<double>& external = slab.model.external_forces();

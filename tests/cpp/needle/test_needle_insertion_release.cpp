@@ -19,7 +19,7 @@ TEST(NeedleInsertionRelease, NodesDraggedPastTheTipAreReleasedAndFree) {
   std::vector<VertexId> every(slab.mesh.n_points());
   for (VertexId v = 0; v < slab.mesh.n_points(); ++v) every[v] = v;
   slab.model.add_nodal_force("push", every, std::vector<double>{0.005, 0.0});
-  const NeedleStepReport report = slab.needle.settle();
+  const NeedleStepResult report = slab.needle.settle();
   ASSERT_TRUE(report.converged) << report.reason;
   EXPECT_GT(report.released, 0);
   std::set<VertexId> after;

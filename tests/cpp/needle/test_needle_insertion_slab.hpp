@@ -39,7 +39,7 @@ struct NeedleSlab {
   // Advances the needle by `step` until it is `depth` in, each update converged.
   void insert(double depth, double step) {
     while (needle.depth() < depth - 1e-12) {
-      const NeedleStepReport report = needle.advance(step);
+      const NeedleStepResult report = needle.advance(step);
       ASSERT_TRUE(report.converged) << report.reason;
     }
   }

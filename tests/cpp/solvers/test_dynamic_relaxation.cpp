@@ -5,6 +5,7 @@
 
 #include <Eigen/Dense>
 #include <cmath>
+#include <optional>
 
 #include "core/error.hpp"
 #include "solvers/dynamic_relaxation.hpp"
@@ -45,8 +46,8 @@ struct Spring {
   }
 };
 
-// A damping η, a step (0: the CFL estimate) and the test's own options prefix.
-DynamicRelaxationOptions relaxation(double damping, double dt, const std::string& prefix) {
+// A damping η, a step (unset: the CFL estimate) and the test's own options prefix.
+DynamicRelaxationOptions relaxation(double damping, std::optional<double> dt, const std::string& prefix) {
   DynamicRelaxationOptions options;
   options.damping = damping;
   options.dt = dt;
@@ -58,7 +59,7 @@ DynamicRelaxationOptions relaxation(double damping, double dt, const std::string
 
 TEST(DynamicRelaxation, SettlesInTheStaticSolutionOfTheSpring) {
   Spring spring;
-  DynamicRelaxation dynamics(spring.model, relaxation(200.0, 0.0, "cpp_spring_"));
+  DynamicRelaxation dynamics(spring.model, relaxation(200.0, std::nullopt, "cpp_spring_"));
   const SolveResult result = dynamics.run(1e-8, 100000);
   ASSERT_TRUE(result.converged) << result.reason;
   EXPECT_EQ(result.reason, "CONVERGED_FNORM_ABS");
@@ -87,7 +88,7 @@ TEST(DynamicRelaxation, StabilityLimitIsTwoOverTheHighestFrequency) {
 
 TEST(DynamicRelaxation, CriticalStepSearchLandsWithinOneReductionOfTheLimit) {
   Spring spring;
-  DynamicRelaxation dynamics(spring.model, relaxation(50.0, 0.0, "cpp_search_"));
+  DynamicRelaxation dynamics(spring.model, relaxation(50.0, std::nullopt, "cpp_search_"));
   const double limit = spring.stability_limit();
   for (double start : {0.0, 0.3 * limit, 3.0 * limit}) {  // from the CFL estimate, below and above
     const double found = dynamics.critical_time_step(2e6, start, 0.15, 200);
@@ -103,7 +104,7 @@ TEST(DynamicRelaxation, OptionsPrefixReachesTheTs) {
   SNEDE_PETSC(PetscOptionsSetValue(nullptr, "-cpp_options_ts_max_steps", "4"));
   SNEDE_PETSC(PetscOptionsSetValue(nullptr, "-cpp_options_ts_ss22_damping", "7.5"));
   Spring spring;
-  DynamicRelaxation dynamics(spring.model, relaxation(1.0, 0.0, "cpp_options_"));
+  DynamicRelaxation dynamics(spring.model, relaxation(1.0, std::nullopt, "cpp_options_"));
   TSType type = nullptr;
   SNEDE_PETSC(TSGetType(dynamics.ts(), &type));
   EXPECT_STREQ(type, ts_ss22);
@@ -118,7 +119,8 @@ TEST(DynamicRelaxation, OptionsPrefixReachesTheTs) {
 
 TEST(DynamicRelaxation, RejectsNegativeDampingAndStep) {
   Spring spring;
-  EXPECT_THROW(DynamicRelaxation(spring.model, relaxation(-1.0, 0.0, "dynamic_")), std::invalid_argument);
+  EXPECT_THROW(DynamicRelaxation(spring.model, relaxation(-1.0, std::nullopt, "dynamic_")), std::invalid_argument);
   EXPECT_THROW(DynamicRelaxation(spring.model, relaxation(1.0, -1e-3, "dynamic_")), std::invalid_argument);
   EXPECT_THROW(DynamicRelaxation(spring.model, relaxation(1.0, std::nan(""), "dynamic_")), std::invalid_argument);
+  EXPECT_THROW(DynamicRelaxation(spring.model, relaxation(1.0, 0.0, "dynamic_")), std::invalid_argument);
 }

@@ -49,16 +49,43 @@ def test_a_static_solver_takes_a_record_whole_and_keywords_change_its_fields():
         snede.StaticSolver(body, rtol=0.0)
 
 
+def test_asdict_gives_the_fields_keyword_construction_takes():
+    for record in (StaticOptions(**SOME_STATIC), DynamicRelaxationOptions(**SOME_DYNAMIC), snede.NeedleOptions()):
+        fields = record._asdict()
+        assert type(record)(**fields) == record
+        assert all(getattr(record, name) == value for name, value in fields.items())
+    assert set(StaticOptions()._asdict()) == set(SOME_STATIC)  # every field, none but the fields
+    assert set(DynamicRelaxationOptions()._asdict()) == set(SOME_DYNAMIC)
+
+
 def test_the_records_and_the_method_names_are_exported():
     assert (snede.StaticOptions, snede.DynamicRelaxationOptions) == (StaticOptions, DynamicRelaxationOptions)
     assert snede.static.METHODS == ("cg", "ncg", "newton")  # the engine's table, in its order
 
 
 def test_dynamic_defaults_are_the_public_solvers():
+    """DynamicRelaxation writes no default of its own (issue 51): its keywords are None, and
+    the record's dt None is the CFL estimate, as the keyword's is (one meaning)."""
     options = DynamicRelaxationOptions()
-    assert options.options_prefix == keyword_defaults(snede.DynamicRelaxation.__init__, ["options_prefix"])[
-        "options_prefix"]
-    assert (options.damping, options.dt, options.petsc_options) == (0.0, 0.0, ())  # dt 0: the CFL estimate
+    names = ["damping", "dt", "options_prefix", "petsc_options"]
+    assert set(keyword_defaults(snede.DynamicRelaxation.__init__, names).values()) == {None}
+    assert (options.damping, options.dt, options.options_prefix, options.petsc_options) == (0.0, None, "dynamic_", ())
+    body = snede.Body(snede.meshing.box((1.0, 1.0, 1.0), (1, 1, 1)), snede.LinearElastic(E=1e3, nu=0.3))
+    relaxation = snede.DynamicRelaxation(body, 5.0)
+    assert relaxation.options == DynamicRelaxationOptions(damping=5.0)
+    assert relaxation.dt == pytest.approx(relaxation.cfl_time_step, rel=1e-12)
+
+
+def test_a_relaxation_takes_a_record_whole_and_keywords_change_its_fields():
+    body = snede.Body(snede.meshing.box((1.0, 1.0, 1.0), (1, 1, 1)), snede.LinearElastic(E=1e3, nu=0.3))
+    record = DynamicRelaxationOptions(damping=3.0, dt=1e-4, options_prefix="whole_relax_")
+    relaxation = snede.DynamicRelaxation(body, options=record)
+    assert relaxation.options == record and relaxation.dt == 1e-4
+    changed = snede.DynamicRelaxation(body, 8.0, options=record, petsc_options={"ts_max_steps": 4}).options
+    assert (changed.damping, changed.dt, changed.petsc_options) == (8.0, 1e-4, (("ts_max_steps", "4"),))
+    assert record.damping == 3.0  # the record given is not changed
+    with pytest.raises(TypeError, match="options must be a snede.DynamicRelaxationOptions"):
+        snede.DynamicRelaxation(body, options=StaticOptions())
 
 
 def test_keywords_set_every_field_and_method_and_criterion_read_back_as_names():
@@ -105,6 +132,7 @@ def test_every_pickle_protocol_gives_an_equal_record():
     (lambda: DynamicRelaxationOptions(damping=-0.5), ValueError, "damping .* got -0.5"),
     (lambda: DynamicRelaxationOptions(damping=float("inf")), ValueError, "damping .* got inf"),
     (lambda: DynamicRelaxationOptions(dt=-1e-3), ValueError, "dt must be .* got -0.001"),
+    (lambda: DynamicRelaxationOptions(dt=0.0), ValueError, "dt must be positive and finite .*CFL.* got 0"),
     (lambda: DynamicRelaxationOptions(dt=float("nan")), ValueError, "dt must be .* got nan"),
     (lambda: DynamicRelaxationOptions(damping="strong"), TypeError, "damping cannot be 'strong'"),
     (lambda: DynamicRelaxationOptions(dampnig=1.0), TypeError, "unexpected keyword argument 'dampnig'"),

@@ -123,9 +123,9 @@ class Needle:
         self.direction = direction / np.linalg.norm(direction)
         self.depth = table.get("depth", POSITIVE, meaning="how far the tip goes in past the surface, in metres")
         self.steps = table.get("steps", STEPS, meaning="how many updates the insertion takes")
-        self.radius = table.get("radius", POSITIVE, 1e-3)
+        self.radius = table.get("radius", POSITIVE, snede.NeedleOptions.default_radius)
         self.friction = table.get("friction", FRICTION, snede.FrictionProfile.figure_6_4())
-        self.static_factor = table.get("static_factor", STATIC_FACTOR, 2.0)
+        self.static_factor = table.get("static_factor", STATIC_FACTOR, snede.NeedleOptions().static_factor)
         self.h_ref = table.get("h_ref", POSITIVE, None)
         if self.h_ref is not None:
             # Bisection refines every element within radius of the shaft, and those up to one
@@ -168,7 +168,7 @@ class Needle:
         self.start = hit.point
         return snede.NeedleInsertion(body, hit.point, self.direction, self.friction, static_factor=self.static_factor,
                                      h_ref=self.h_ref, radius=self.radius, method=method, rtol=rtol,
-                                     **needle_options(solver_options))
+                                     **solver_options)
 
     def run(self, run) -> bool:
         """Insert the needle from where its line meets the deformed surface; False if an update
@@ -186,16 +186,6 @@ class Needle:
 
         run.insertion = run.needle.insert(self.depth, step, progress=after)
         return run.insertion.converged
-
-
-def needle_options(solver_options: dict) -> dict:
-    """A scene's solver options as NeedleInsertion takes them."""
-    options = dict(solver_options)
-    petsc = dict(options.pop("petsc_options", {}))
-    if options.get("preconditioner") is not None:
-        petsc["pc_type"] = options["preconditioner"]
-    return {"petsc_options": petsc, **({"max_iterations": options["max_iterations"]}
-                                        if "max_iterations" in options else {})}
 
 
 def _span(mesh) -> str:

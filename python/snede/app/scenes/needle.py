@@ -65,8 +65,6 @@ class Insertion:
     def evolve(self, method: str, rtol: float, writer, folder, progress: bool) -> dict:
         from snede.app.run_scene import Progress
 
-        if method not in METHODS:
-            raise ValueError(f"the needle scene solves with {', '.join(METHODS)}; got {method!r}")
         self.needle = needle_for(self.body, H_REF, method=method, rtol=rtol)
         self._record(writer)
         bar = Progress(f"needle ({method})", progress, total=math.ceil(DEPTH / (self.speed * h(H_REF)) - 1e-9),
@@ -130,6 +128,7 @@ def build(parameters: Parameters) -> Scene:
     body = slab_body(h_start, material(name, YOUNG, POISSON), formulation=parameters.formulation or "p1")
     insertion = Insertion(body, speed)
     return Scene(
+        methods=METHODS,
         name="needle", description=DESCRIPTION, body=body, default_method="cg" if name == "linear" else "newton",
         probe_name="needle force along shaft [N]", probe=lambda b: shaft_force(insertion.needle), default_rtol=1e-3,
         evolve=insertion.evolve, decorate=insertion.decorate, fixed=held,

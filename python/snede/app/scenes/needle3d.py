@@ -147,8 +147,6 @@ class Insertion:
     def evolve(self, method: str, rtol: float, writer, folder, progress: bool) -> dict:
         from snede.app.run_scene import Progress
 
-        if method not in METHODS:
-            raise ValueError(f"the needle3d scene solves with {', '.join(METHODS)}; got {method!r}")
         self.needle = needle_for(self.body, self.h_ref, method, rtol)
         self._record(writer)
         step = self.speed * self.h_ref
@@ -286,6 +284,7 @@ def build(parameters: Parameters) -> Scene:
     body = cube(material(name, YOUNG, POISSON), parameters.formulation or "p1")
     insertion = Insertion(body, SIZE / divisions, speed)
     return Scene(
+        methods=METHODS,
         name="needle3d", description=DESCRIPTION, body=body, default_method="cg" if name == "linear" else "newton",
         probe_name="needle force along shaft [N]", probe=lambda b: shaft_force(insertion.needle), default_rtol=1e-3,
         evolve=insertion.evolve, fixed=held, decorate=insertion.draw_needle,

@@ -56,6 +56,16 @@ class Scene:
     # Keyword arguments of the scene's static solver (snede.StaticSolver: preconditioner,
     # petsc_options, max_iterations); petsc_options and max_iterations also reach dynamic relaxation.
     solver_options: dict = field(default_factory=dict)
+    # The methods the scene runs with (None: every static method and "dynamic"), and why it
+    # refuses the others (a clause for the message).
+    methods: tuple | None = None
+    methods_note: str = ""
+
+    def require_method(self, method: str) -> None:
+        """ValueError naming the scene's methods when it does not run with ``method``."""
+        if self.methods is not None and method not in self.methods:
+            raise ValueError(f"the {self.name} scene solves with {', '.join(self.methods)}{self.methods_note}; "
+                             f"got {method!r}")
 
 
 def material(name: str, young: float, poisson: float, gamma: float = 8.0):

@@ -78,8 +78,6 @@ class SheetCut:
                                  None if scalpel is None else np.array(scalpel), label))
 
     def evolve(self, method: str, rtol: float, writer, folder, progress: bool) -> dict:
-        if method not in METHODS:
-            raise ValueError(f"the sheet-cut scene solves with {', '.join(METHODS)}; got {method!r}")
         say = print if progress else (lambda *args, **kwargs: None)
         solver = snede.StaticSolver(self.body, method, rtol=rtol)
         result = solver.solve()
@@ -169,6 +167,7 @@ def build(parameters: Parameters) -> Scene:
     body.fix(np.isclose(x[:, 0], LENGTH), (pull, 0.0))
     sheet = SheetCut(body)
     return Scene(
+        methods=METHODS,
         name="sheet-cut", description=DESCRIPTION, body=body,
         default_method="cg" if name == "linear" else "newton",
         probe_name="widest gap between the lips [m]", probe=lambda b: sheet.opening(),

@@ -8,7 +8,7 @@
 namespace snede {
 
 // What one move (or several, added up) did to the mesh.
-struct PlanarCutReport {
+struct PlanarCutResult {
   int moves = 0;
   int flips = 0;
   int nodes_removed = 0;
@@ -25,29 +25,29 @@ struct PlanarCutReport {
   double seconds = 0;
 
   // Accumulates a later report: counts and times add, triangles_after is the later one's.
-  void add(const PlanarCutReport& later);
+  void add(const PlanarCutResult& later);
   // Every field with its name: the one list that bindings and printing read.
   template <class Visit>
   static void visit_fields(Visit&& visit) {
-    visit("moves", &PlanarCutReport::moves);
-    visit("flips", &PlanarCutReport::flips);
-    visit("nodes_removed", &PlanarCutReport::nodes_removed);
-    visit("nodes_inserted", &PlanarCutReport::nodes_inserted);
-    visit("incision_splits", &PlanarCutReport::incision_splits);
-    visit("edges_contracted", &PlanarCutReport::edges_contracted);
-    visit("entries", &PlanarCutReport::entries);
-    visit("exits", &PlanarCutReport::exits);
-    visit("branches", &PlanarCutReport::branches);
-    visit("annihilations", &PlanarCutReport::annihilations);
-    visit("stuck", &PlanarCutReport::stuck);
-    visit("triangles_before", &PlanarCutReport::triangles_before);
-    visit("triangles_after", &PlanarCutReport::triangles_after);
-    visit("seconds", &PlanarCutReport::seconds);
+    visit("moves", &PlanarCutResult::moves);
+    visit("flips", &PlanarCutResult::flips);
+    visit("nodes_removed", &PlanarCutResult::nodes_removed);
+    visit("nodes_inserted", &PlanarCutResult::nodes_inserted);
+    visit("incision_splits", &PlanarCutResult::incision_splits);
+    visit("edges_contracted", &PlanarCutResult::edges_contracted);
+    visit("entries", &PlanarCutResult::entries);
+    visit("exits", &PlanarCutResult::exits);
+    visit("branches", &PlanarCutResult::branches);
+    visit("annihilations", &PlanarCutResult::annihilations);
+    visit("stuck", &PlanarCutResult::stuck);
+    visit("triangles_before", &PlanarCutResult::triangles_before);
+    visit("triangles_after", &PlanarCutResult::triangles_after);
+    visit("seconds", &PlanarCutResult::seconds);
   }
 };
 
 // One line for people: moves, flips, nodes, entries and exits (on surfaces branches and
 // annihilations), triangles before and after, time.
-std::string summary(const PlanarCutReport& report);
+std::string summary(const PlanarCutResult& report);
 
 }  // namespace snede

@@ -1,10 +1,10 @@
-#include "cutting/cut_report.hpp"
+#include "cutting/cut_result.hpp"
 
 #include "core/formatted.hpp"
 
 namespace snede {
 
-void CutReport::add(const CutReport& o) {
+void CutResult::add(const CutResult& o) {
   sweeps += o.sweeps;
   faces_selected += o.faces_selected;
   faces_dissected += o.faces_dissected;
@@ -27,7 +27,7 @@ void CutReport::add(const CutReport& o) {
   seconds += o.seconds;
 }
 
-std::string summary(const CutReport& r) {
+std::string summary(const CutResult& r) {
   return formatted(
       "%d faces dissected (%d vertices snapped, %d refused), %d degenerate: %d collapses, %d splits, %d cut free, "
       "%d fragments removed; %d pieces in %.2f ms",

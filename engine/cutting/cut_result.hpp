@@ -9,7 +9,7 @@
 
 namespace snede {
 
-struct CutReport {
+struct CutResult {
   int sweeps = 0;              // sweep triangles processed
   int faces_selected = 0;
   int faces_dissected = 0;     // selected faces the dissection opened (others stay joined, Figure 7.7)
@@ -36,34 +36,34 @@ struct CutReport {
 
   // Accumulates a later report: counts and times add up; components is the later report's
   // unless that one swept nothing.
-  void add(const CutReport& other);
+  void add(const CutResult& other);
   // Every field with its name: the one list that bindings and printing read.
   template <class Visit>
   static void visit_fields(Visit&& visit) {
-    visit("sweeps", &CutReport::sweeps);
-    visit("faces_selected", &CutReport::faces_selected);
-    visit("faces_dissected", &CutReport::faces_dissected);
-    visit("vertices_split", &CutReport::vertices_split);
-    visit("vertices_snapped", &CutReport::vertices_snapped);
-    visit("snaps_refused", &CutReport::snaps_refused);
-    visit("degenerate_found", &CutReport::degenerate_found);
-    visit("degenerate_shapes", &CutReport::degenerate_shapes);
-    visit("edges_collapsed", &CutReport::edges_collapsed);
-    visit("edges_split", &CutReport::edges_split);
-    visit("faces_split", &CutReport::faces_split);
-    visit("elements_cut_free", &CutReport::elements_cut_free);
-    visit("components", &CutReport::components);
-    visit("free_pieces", &CutReport::free_pieces);
-    visit("pieces_fixed", &CutReport::pieces_fixed);
-    visit("fragments_removed", &CutReport::fragments_removed);
-    visit("fragment_elements", &CutReport::fragment_elements);
-    visit("piece_elements", &CutReport::piece_elements);
-    visit("piece_search", &CutReport::piece_search);
-    visit("seconds", &CutReport::seconds);
+    visit("sweeps", &CutResult::sweeps);
+    visit("faces_selected", &CutResult::faces_selected);
+    visit("faces_dissected", &CutResult::faces_dissected);
+    visit("vertices_split", &CutResult::vertices_split);
+    visit("vertices_snapped", &CutResult::vertices_snapped);
+    visit("snaps_refused", &CutResult::snaps_refused);
+    visit("degenerate_found", &CutResult::degenerate_found);
+    visit("degenerate_shapes", &CutResult::degenerate_shapes);
+    visit("edges_collapsed", &CutResult::edges_collapsed);
+    visit("edges_split", &CutResult::edges_split);
+    visit("faces_split", &CutResult::faces_split);
+    visit("elements_cut_free", &CutResult::elements_cut_free);
+    visit("components", &CutResult::components);
+    visit("free_pieces", &CutResult::free_pieces);
+    visit("pieces_fixed", &CutResult::pieces_fixed);
+    visit("fragments_removed", &CutResult::fragments_removed);
+    visit("fragment_elements", &CutResult::fragment_elements);
+    visit("piece_elements", &CutResult::piece_elements);
+    visit("piece_search", &CutResult::piece_search);
+    visit("seconds", &CutResult::seconds);
   }
 };
 
 // One line for people: faces dissected, snaps, degeneracies, pieces, time.
-std::string summary(const CutReport& report);
+std::string summary(const CutResult& report);
 
 }  // namespace snede

@@ -1,10 +1,10 @@
-#include "cutting/planar_cut_report.hpp"
+#include "cutting/planar_cut_result.hpp"
 
 #include "core/formatted.hpp"
 
 namespace snede {
 
-void PlanarCutReport::add(const PlanarCutReport& later) {
+void PlanarCutResult::add(const PlanarCutResult& later) {
   if (moves == 0) triangles_before = later.triangles_before;
   moves += later.moves;
   flips += later.flips;
@@ -21,7 +21,7 @@ void PlanarCutReport::add(const PlanarCutReport& later) {
   seconds += later.seconds;
 }
 
-std::string summary(const PlanarCutReport& r) {
+std::string summary(const PlanarCutResult& r) {
   std::string line = std::to_string(r.moves) + " moves: " + std::to_string(r.flips) + " flips, " +
                      std::to_string(r.nodes_removed) + " nodes removed, " + std::to_string(r.nodes_inserted) +
                      " inserted (" + std::to_string(r.incision_splits) + " incision splits), " +
