@@ -27,6 +27,20 @@ void bind_distributed(py::module_& m) {
         return distribute_mesh(MPI_Comm_f2c(static_cast<MPI_Fint>(comm)), serial);
       },
       py::arg("comm"), py::arg("serial").none(true));
+  // This rank's part of a mesh: cells by global vertex ids, ((cell_dim + 1) per row), and the
+  // coordinates of this rank's range of vertices ((n, space_dim)).
+  m.def(
+      "distribute_cells",
+      [](std::int64_t comm, int cell_dim, const IndexArray& cells, const DoubleArray& coordinates) {
+        RankCells part;
+        part.cell_dim = cell_dim;
+        part.space_dim = coordinates.ndim() == 2 ? static_cast<int>(coordinates.shape(1)) : 0;
+        part.cells.assign(cells.data(), cells.data() + cells.size());
+        part.coordinates.assign(coordinates.data(), coordinates.data() + coordinates.size());
+        py::gil_scoped_release released;
+        return distribute_cells(MPI_Comm_f2c(static_cast<MPI_Fint>(comm)), part);
+      },
+      py::arg("comm"), py::arg("cell_dim"), py::arg("cells"), py::arg("coordinates"));
   // RankAgreement for Python's collective calls: `inputs` are (name, the input's bytes) pairs,
   // the same names in the same order on every rank.
   m.def(

@@ -1,5 +1,5 @@
-// A mesh partitioned over the ranks of a communicator by PETSc (issue 18): the serial cells
-// given on rank 0 are handed to DMPlex, distributed with DMPlexDistribute (its partitioner,
+// A mesh partitioned over the ranks of a communicator by PETSc (issue 18): the cells, given
+// whole on rank 0 or a part on every rank (issue 52: no rank need hold the whole), are handed to DMPlex, distributed with DMPlexDistribute (its partitioner,
 // PTScotch or the default, chosen with -petscpartitioner_type), and each rank's part is held
 // in snede's own connectivity, so the same kernels run on the local cells. Cells are not
 // overlapped: a cell lives on exactly one rank; a vertex on several ranks' cells is owned by
@@ -34,5 +34,22 @@ struct DistributedMesh {
 // std::invalid_argument on every rank when rank 0's mesh is missing or has unused vertices (the
 // decision is broadcast, so no rank waits for another).
 DistributedMesh distribute_mesh(MPI_Comm comm, const Mesh* serial);
+
+// A part of a mesh as a generator or a reader on one rank gives it (issue 52): some of the
+// cells, by global vertex ids, and the coordinates of a range of vertices; the ranges follow
+// each other in rank order (rank 0 the first ids, ...), so a rank's range starts where the
+// previous rank's ends. Every vertex must be in some cell.
+struct RankCells {
+  int cell_dim = 3;
+  int space_dim = 3;
+  std::vector<std::int64_t> cells;   // (cell_dim + 1) global vertex ids per cell
+  std::vector<double> coordinates;   // space_dim per vertex of this rank's range
+};
+
+// Collective: the mesh whose parts every rank gives, balanced by DMPlexDistribute (a rank's
+// cells need not stay on it). global_vertex holds the global ids. Throws the same
+// std::invalid_argument on every rank when a rank's part is malformed (sizes, dimensions that
+// differ between ranks, an id outside 0..n_vertices−1) or a vertex is in no cell.
+DistributedMesh distribute_cells(MPI_Comm comm, const RankCells& part);
 
 }  // namespace snede

@@ -33,7 +33,8 @@ from snede.needle import FrictionProfile, InsertionResult, NeedleInsertion, Need
 from snede.cutting import TetrahedralCutter, TetrahedralCutterOptions, CutResult  # noqa: F401
 from snede.planar_cutting import DelaunayCutter, DelaunayCutterOptions, IncisionLost, PlanarCutResult  # noqa: F401
 from snede.surface_cutting import SurfaceCutter, SurfaceCutterOptions  # noqa: F401
-from snede.distributed import DistributedMesh, DistributedRelaxation, DistributedStatic, distribute  # noqa: F401
+from snede.distributed import (DistributedMesh, DistributedRelaxation, DistributedStatic, distribute,  # noqa: F401
+                               distribute_cells)
 from snede.subdivision_cutting import SubdivisionCutter  # noqa: F401
 from snede import _renamed, meshing  # noqa: F401
 from snede._output_folder import output_folder  # noqa: F401
@@ -44,7 +45,7 @@ __all__ = [
     "FrictionProfile", "NeedleInsertion", "TetrahedralCutter", "TetrahedralCutterOptions", "CutResult", "DelaunayCutter",
     "DelaunayCutterOptions", "PlanarCutResult", "SurfaceCutter", "SurfaceCutterOptions",
     "IncisionLost",
-    "SubdivisionCutter", "DistributedMesh", "DistributedRelaxation", "DistributedStatic", "distribute",
+    "SubdivisionCutter", "DistributedMesh", "DistributedRelaxation", "DistributedStatic", "distribute", "distribute_cells",
     "LinearElastic", "StVenantKirchhoff", "NeoHookean", "VerondaWestmann",
     "Error", "BodyInUse", "EditResult", "FileError", "InvalidMesh", "PetscError", "DomainError", "LockingWarning", "formulations", "PETSc",
     "output_folder",

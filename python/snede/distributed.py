@@ -68,13 +68,49 @@ class DistributedMesh:
     n_global_cells: int
     _impl: object = None  # keeps the engine's part (which holds `local`) alive
 
+    def vertices_where(self, where) -> np.ndarray:
+        """The global ids of the vertices whose points ``where`` picks, the same sorted array on
+        every rank (collective): ``where(points)`` takes this rank's (n_local, dim) points and
+        returns a bool per point, e.g. ``lambda x: np.isclose(x[:, 2], 0.0)``. What a
+        :class:`DistributedStatic`'s ``fixed`` or ``forces`` take, without any rank holding the
+        whole mesh; the ids picked (a face, a patch) are gathered on every rank."""
+        def picked():
+            mask = np.asarray(where(self.local.points), dtype=bool)
+            if mask.shape != (self.local.n_points,):
+                raise ValueError(f"where(points) must give one bool per point, ({self.local.n_points},); "
+                                 f"got shape {mask.shape}")
+            return self.global_vertex[mask & self.owned]
+
+        mine = agreed(self.comm, picked)
+        return np.sort(np.concatenate(self.comm.allgather(mine))).astype(np.int64)
+
 
 def distribute(mesh: Mesh | None, comm=None) -> DistributedMesh:
     """Partition rank 0's ``mesh`` over ``comm`` (default ``MPI.COMM_WORLD``) with DMPlex;
     every rank returns its part. Collective."""
     comm = _world() if comm is None else comm
     serial = mesh._impl if (comm.rank == 0 and isinstance(mesh, Mesh)) else None
-    part = _snede.distribute_mesh(comm.py2f(), serial)
+    return _part(comm, _snede.distribute_mesh(comm.py2f(), serial))
+
+
+def distribute_cells(cells, coordinates, comm=None) -> DistributedMesh:
+    """A mesh that no rank holds whole (issue 52): every rank of ``comm`` (default
+    ``MPI.COMM_WORLD``) gives some of its cells, ``cells`` ((n, 3) triangles or (n, 4)
+    tetrahedra, by global vertex ids), and the coordinates of its range of vertices,
+    ``coordinates`` ((m, 2) or (m, 3)): rank 0 the first ids, each next rank's range starting
+    where the previous one's ends. DMPlex balances the cells over the ranks; every rank returns
+    its part, whose ``global_vertex`` are these global ids. Collective; a malformed part on any
+    rank raises the same ValueError on every rank."""
+    comm = _world() if comm is None else comm
+    cells = np.asarray(cells, dtype=np.int64)
+    coordinates = np.asarray(coordinates, dtype=np.float64)
+    corners = cells.shape[1] if cells.ndim == 2 else 0
+    space = coordinates.shape[1] if coordinates.ndim == 2 else 0
+    return _part(comm, _snede.distribute_cells(comm.py2f(), corners - 1, cells.reshape(-1, max(corners, 1)),
+                                               coordinates.reshape(-1, max(space, 1))))
+
+
+def _part(comm, part) -> DistributedMesh:
     local = Mesh._wrap(part.local)
     local._distributed_part = f"rank {comm.rank}'s part of a mesh distributed over {comm.size} MPI ranks"
     return DistributedMesh(comm=comm, local=local, global_vertex=part.global_vertex.ravel().copy(),

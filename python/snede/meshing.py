@@ -44,19 +44,44 @@ def _check(size, divisions, dim: int, cells_per_box: int, max_cells):
     return size, divisions
 
 
-def box(size=(1.0, 1.0, 1.0), divisions=(10, 10, 10), *, max_cells: int = MAX_CELLS) -> Mesh:
+def box(size=(1.0, 1.0, 1.0), divisions=(10, 10, 10), *, max_cells: int = MAX_CELLS, comm=None):
     """Structured tetrahedra on [0, size]: each of the nx·ny·nz cubes split into six
     tetrahedra around its main diagonal (the Kuhn split, which conforming bisection needs).
     Gives 6·nx·ny·nz cells and (nx+1)(ny+1)(nz+1) points; more than ``max_cells`` are refused
-    (see the module)."""
+    (see the module).
+
+    ``comm`` (an mpi4py communicator; collective): the same mesh made on the ranks, which no
+    rank holds whole (issue 52): each rank makes the cubes of its share of the x layers and the
+    points of its share of the point layers, and DMPlex balances them; it returns this rank's
+    part, a :class:`snede.distributed.DistributedMesh` whose ``global_vertex`` are the serial
+    box's vertex ids."""
     size, divisions = _check(size, divisions, 3, 6, max_cells)
+    if comm is None:
+        return Mesh(_grid_points(size, divisions), _box_cells(0, divisions[0], divisions))
+    from snede.distributed import distribute_cells
+
     nx, ny, nz = divisions
-    points = _grid_points(size, divisions)
+    first, last = _share(nx, comm.rank, comm.size)
+    low, high = _share(nx + 1, comm.rank, comm.size)
+    axes = [np.linspace(0.0, s, n + 1) for s, n in zip(size, divisions)]
+    axes[0] = axes[0][low:high]
+    points = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
+    return distribute_cells(_box_cells(first, last, divisions), points, comm)
+
+
+def _share(n: int, rank: int, ranks: int) -> tuple[int, int]:
+    """Rank ``rank``'s part of ``n`` layers split as evenly as possible, in rank order."""
+    return rank * n // ranks, (rank + 1) * n // ranks
+
+
+def _box_cells(first: int, last: int, divisions) -> np.ndarray:
+    """The Kuhn tetrahedra of the box's cubes in x layers first..last − 1 (serial vertex ids)."""
+    nx, ny, nz = divisions
 
     def vertex(i, j, k):
         return (i * (ny + 1) + j) * (nz + 1) + k
 
-    i, j, k = (a.ravel() for a in np.meshgrid(np.arange(nx), np.arange(ny), np.arange(nz), indexing="ij"))
+    i, j, k = (a.ravel() for a in np.meshgrid(np.arange(first, last), np.arange(ny), np.arange(nz), indexing="ij"))
     cells = []
     # Kuhn split: one tetrahedron per path 000 -> 111 along the axes in the order of a permutation.
     for permutation in itertools.permutations(range(3)):
@@ -69,7 +94,7 @@ def box(size=(1.0, 1.0, 1.0), divisions=(10, 10, 10), *, max_cells: int = MAX_CE
         if odd:  # keep every cell positively oriented
             path[2], path[3] = path[3], path[2]
         cells.append(np.stack(path, axis=1))
-    return Mesh(points, np.concatenate(cells))
+    return np.concatenate(cells).astype(np.int64, copy=False)
 
 
 def rectangle(size=(1.0, 1.0), divisions=(10, 10), *, max_cells: int = MAX_CELLS) -> Mesh:

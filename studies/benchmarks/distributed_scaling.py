@@ -13,6 +13,17 @@ tangent product (each ghost's dim values in, its dim contributions out: 2 · gho
 and the seconds per CG iteration (the slowest rank's). Not a test; the machine has 2 cores,
 so 2 ranks is the most that can show a speed-up.
 
+With --made-on-ranks the box is made on the ranks (snede.meshing.box(..., comm=), issue 52): no
+rank holds the whole mesh at any time; without it rank 0 makes the serial box and DMPlex
+distributes it. With --serial the same box and CG run on the serial Body and StaticSolver (one
+process; run it without mpirun). Every mode prints each rank's peak resident memory (MB, the
+process's ru_maxrss: Python, PETSc and the mesh included), the figure to compare between
+--serial and --made-on-ranks on 2 ranks at the same --divisions.
+
+With --newton (and --made-on-ranks) a neo-Hookean cube (E = 10 MPa, ν = 0.3, 1000 kg/m³) held
+at x = 0 sags under gravity: truncated Newton with Jacobi-preconditioned CG to rtol 1e-6 (6.9),
+the issue-52 goal's solve (≥ 1.5·10⁷ tetrahedra on 2 ranks: --divisions 136).
+
 With --to-tolerance the same body is instead solved to ‖r‖ ≤ 1e-8 ‖r₀‖ by CG with each
 preconditioner (none, Jacobi, GAMG on the assembled MPIAIJ tangent, mg by aggregation of each
 rank's vertices, block Jacobi, SOR, MUMPS's LU): iterations and seconds, assembly and set-up
@@ -22,6 +33,7 @@ slender `cantilever` scene (--divisions N) through StaticSolver(body, "cg", comm
 from __future__ import annotations
 
 import argparse
+import resource
 import time
 
 import numpy as np
@@ -36,22 +48,31 @@ def main() -> None:
     parser.add_argument("--iterations", type=int, default=100, help="CG iterations to time (default 100)")
     parser.add_argument("--to-tolerance", action="store_true", help="compare preconditioners solving to rtol 1e-8")
     parser.add_argument("--cantilever", type=int, metavar="N", help="compare them on the cantilever scene instead")
+    parser.add_argument("--made-on-ranks", action="store_true", help="make the box on the ranks (no rank holds it whole)")
+    parser.add_argument("--serial", action="store_true", help="the serial Body and StaticSolver instead (no mpirun)")
+    parser.add_argument("--newton", action="store_true", help="a neo-Hookean cube under gravity by Newton instead")
     arguments, _ = parser.parse_known_args()
     comm = MPI.COMM_WORLD
     if arguments.cantilever:
         compare_on_cantilever(arguments.cantilever, comm)
         return
     n = arguments.divisions
-    serial = snede.meshing.box((1.0, 1.0, 1.0), (n, n, n)) if comm.rank == 0 else None
+    if arguments.serial:
+        solve_serially(n, arguments.iterations)
+        return
     comm.Barrier()
     start = time.perf_counter()
-    part = snede.distribute(serial, comm)
+    if arguments.made_on_ranks:
+        part = snede.meshing.box((1.0, 1.0, 1.0), (n, n, n), comm=comm, max_cells=6 * n**3)
+    else:
+        serial = snede.meshing.box((1.0, 1.0, 1.0), (n, n, n), max_cells=6 * n**3) if comm.rank == 0 else None
+        part = snede.distribute(serial, comm)
+        del serial
     distribute_seconds = comm.allreduce(time.perf_counter() - start, op=MPI.MAX)
     x = part.local.points
-    # Conditions by serial id, the same on every rank: rebuilt from the grid's numbering.
-    grid = np.stack(np.meshgrid(*[np.arange(n + 1)] * 3, indexing="ij"), axis=-1).reshape(-1, 3)
-    fixed = np.flatnonzero(grid[:, 0] == 0)
-    pulled = np.flatnonzero(grid[:, 0] == n)
+    # Conditions by serial id, the same on every rank, picked on each rank's own points.
+    fixed = part.vertices_where(lambda x: x[:, 0] == 0.0)
+    pulled = part.vertices_where(lambda x: x[:, 0] == 1.0)
     def problem():
         return snede.DistributedStatic(part, snede.LinearElastic(1e5, 0.3), fixed=fixed,
                                        forces={int(v): (1.0 / len(pulled), 0.0, 0.0) for v in pulled})
@@ -59,20 +80,61 @@ def main() -> None:
     if arguments.to_tolerance:
         compare_preconditioners(problem, comm, part)
         return
+    if arguments.newton:
+        sag_under_gravity(part, fixed, distribute_seconds, comm)
+        return
     problem = problem()
     comm.Barrier()
     result = problem.solve("cg", rtol=1e-30, round_tolerance=0.0, max_iterations=arguments.iterations)
     seconds = comm.allreduce(result.seconds, op=MPI.MAX)
     ghosts = int((~part.owned).sum())
-    rows = comm.gather((comm.rank, part.local.n_cells, int(part.owned.sum()), ghosts, 2 * ghosts * 3 * 8), root=0)
+    rows = comm.gather((comm.rank, part.local.n_cells, int(part.owned.sum()), ghosts, 2 * ghosts * 3 * 8,
+                        peak_megabytes()), root=0)
     if comm.rank == 0:
+        made = "made on the ranks" if arguments.made_on_ranks else "distributed from rank 0"
         print(f"{comm.size} rank(s), {part.n_global_cells} tetrahedra, {part.n_global_vertices} vertices; "
-              f"distribute {distribute_seconds:.2f} s; CG {result.iterations} iterations ({result.reason}) in "
+              f"{made} in {distribute_seconds:.2f} s; CG {result.iterations} iterations ({result.reason}) in "
               f"{seconds:.3f} s: {1e3 * seconds / max(result.iterations, 1):.2f} ms per iteration")
-        print(f"{'rank':>4} {'cells':>9} {'owned':>9} {'ghosts':>7} {'bytes/product':>14}")
-        for rank, cells, owned, ghosts, volume in rows:
-            print(f"{rank:>4} {cells:>9} {owned:>9} {ghosts:>7} {volume:>14}")
+        print(f"{'rank':>4} {'cells':>9} {'owned':>9} {'ghosts':>7} {'bytes/product':>14} {'peak MB':>8}")
+        for rank, cells, owned, ghosts, volume, peak in rows:
+            print(f"{rank:>4} {cells:>9} {owned:>9} {ghosts:>7} {volume:>14} {peak:>8.0f}")
         print(f"(x spans {x[:, 0].min():.2f}..{x[:, 0].max():.2f} on rank 0)")
+
+
+def sag_under_gravity(part, fixed, made_seconds: float, comm) -> None:
+    problem = snede.DistributedStatic(part, snede.NeoHookean(1e7, 0.3), density=1000.0, fixed=fixed,
+                                      gravity=(0.0, 0.0, -9.81))
+    comm.Barrier()
+    result = problem.solve("newton", rtol=1e-6, criterion="6.9", preconditioner="jacobi", max_iterations=50)
+    seconds = comm.allreduce(result.seconds, op=MPI.MAX)
+    peaks = comm.gather(peak_megabytes(), root=0)
+    if comm.rank == 0:
+        print(f"{comm.size} rank(s), {part.n_global_cells} neo-Hookean tetrahedra: mesh in {made_seconds:.1f} s; Newton "
+              f"{result.iterations} steps, {result.linear_iterations} CG iterations, {result.reason} "
+              f"(converged {result.converged}) in {seconds:.1f} s; peak MB per rank: "
+              + ", ".join(f"{peak:.0f}" for peak in peaks))
+
+
+def peak_megabytes() -> float:
+    """This process's peak resident memory so far (Linux reports ru_maxrss in kB)."""
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+
+
+def solve_serially(n: int, iterations: int) -> None:
+    """The same box, conditions and CG iterations on the serial Body and StaticSolver."""
+    start = time.perf_counter()
+    mesh = snede.meshing.box((1.0, 1.0, 1.0), (n, n, n), max_cells=6 * n**3)
+    body = snede.Body(mesh, snede.LinearElastic(1e5, 0.3))
+    x = mesh.points
+    body.fix(x[:, 0] == 0.0)
+    pulled = np.flatnonzero(x[:, 0] == 1.0)
+    body.add_nodal_force(pulled, np.tile((1.0 / len(pulled), 0.0, 0.0), (len(pulled), 1)))
+    made = time.perf_counter() - start
+    result = snede.StaticSolver(body, "cg", rtol=1e-30, round_tolerance=0.0, max_iterations=iterations,
+                                preconditioner="none").solve()
+    print(f"serial, {mesh.n_cells} tetrahedra, {len(x)} vertices; made in {made:.2f} s; CG {result.iterations} "
+          f"iterations ({result.reason}) in {result.seconds:.3f} s: "
+          f"{1e3 * result.seconds / max(result.iterations, 1):.2f} ms per iteration; peak {peak_megabytes():.0f} MB")
 
 
 PRECONDITIONERS = ("none", "jacobi", "gamg", "mg", "bjacobi", "sor", "lu")
