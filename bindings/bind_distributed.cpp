@@ -18,6 +18,20 @@ void bind_distributed(py::module_& m) {
       .def_property_readonly("global_vertex", [](const DistributedMesh& d) { return to_array(d.global_vertex, 1); })
       .def_property_readonly("owned", [](const DistributedMesh& d) { return to_array(d.owned, 1); })
       .def_property_readonly("global_number", [](const DistributedMesh& d) { return to_array(d.global_number, 1); })
+      // Gives the vertices other global ids (a series written on ranks: its rows' serial ids),
+      // one per local vertex, each in 0..n_global_vertices − 1.
+      .def("renumber_vertices",
+           [](DistributedMesh& d, const IndexArray& ids) {
+             if (ids.size() != static_cast<py::ssize_t>(d.global_vertex.size()))
+               throw std::invalid_argument("renumber_vertices: " + std::to_string(ids.size()) + " ids for " +
+                                           std::to_string(d.global_vertex.size()) + " local vertices");
+             for (py::ssize_t k = 0; k < ids.size(); ++k)
+               if (ids.data()[k] < 0 || ids.data()[k] >= d.n_global_vertices)
+                 throw std::invalid_argument("renumber_vertices: id " + std::to_string(ids.data()[k]) +
+                                             " is outside 0.." + std::to_string(d.n_global_vertices - 1));
+             d.global_vertex.assign(ids.data(), ids.data() + ids.size());
+           },
+           py::arg("ids"))
       .def_readonly("n_global_vertices", &DistributedMesh::n_global_vertices)
       .def_readonly("n_global_cells", &DistributedMesh::n_global_cells);
   // `comm` is the communicator's Fortran handle (mpi4py's Comm.py2f()).

@@ -17,6 +17,7 @@ serial).
 from __future__ import annotations
 
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 
@@ -67,6 +68,31 @@ class DistributedMesh:
     n_global_vertices: int
     n_global_cells: int
     _impl: object = None  # keeps the engine's part (which holds `local`) alive
+
+    @classmethod
+    def read(cls, path, comm=None) -> "DistributedMesh":
+        """This rank's part of the mesh in ``path``, collective over ``comm`` (default
+        ``MPI.COMM_WORLD``). An XDMF series written by ``snede.output.SeriesWriter`` (its last
+        step's mesh) is read in shares: each rank reads only its share of the cells and of the
+        points from the HDF5 file, and DMPlex balances them (``distribute_cells``); no rank
+        holds the whole. A series written on ranks gives its vertices their serial ids back
+        (its field ``serial_vertex``), so conditions by serial id apply as before. Every other
+        format ``snede.Mesh.read`` takes is read whole by rank 0 and distributed
+        (``distribute``). A file that cannot be read raises the same error on every rank."""
+        from snede import series_files
+
+        comm = _world() if comm is None else comm
+        if Path(path).suffix.lower() in (".xdmf", ".xmf") and agreed(comm, lambda: series_files.is_series(path)):
+            cells, points, on_ranks = agreed(comm, lambda: series_files.read_last_mesh_share(path, comm.rank,
+                                                                                                comm.size))
+            part = distribute_cells(cells, points, comm)
+            if on_ranks:
+                serial = agreed(comm, lambda: series_files.read_serial_vertices(path, part.global_vertex))
+                part._impl.renumber_vertices(serial)
+                part.global_vertex = part._impl.global_vertex.ravel().copy()
+            return part
+        mesh = agreed(comm, lambda: Mesh.read(path) if comm.rank == 0 else None)
+        return distribute(mesh, comm)
 
     def vertices_where(self, where) -> np.ndarray:
         """The global ids of the vertices whose points ``where`` picks, the same sorted array on

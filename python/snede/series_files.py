@@ -174,6 +174,10 @@ class _Datasets:
                              f"the XDMF file says {item.shape}")
         return dataset
 
+    def rows(self, item: _Item, start: int, stop: int) -> np.ndarray:
+        """Rows start..stop − 1 of the dataset, read alone (a rank's share of a mesh)."""
+        return self._dataset(item)[start:stop]
+
     def read(self, item: _Item, z_only: bool = False) -> np.ndarray:
         """The dataset, or only its third column (``z_only``)."""
         key = (item, z_only)
@@ -184,6 +188,52 @@ class _Datasets:
             else:
                 self.cache[key] = dataset[()]
         return self.cache[key]
+
+
+def _last_step(path: Path) -> _StepRef:
+    collection = _series_collection(_xdmf_root(path))
+    if collection is None:
+        raise ValueError(f"{path}: no temporal collection of grids, not a series written by SeriesWriter")
+    refs = _step_refs(path, collection)
+    if not refs:
+        raise ValueError(f"{path}: the series has no steps (yet): no mesh to read")
+    if refs[-1].dim is None:
+        raise ValueError(f"{path}: from before series said their dimension; read it with snede.Mesh.read and "
+                         "snede.distribute")
+    return refs[-1]
+
+
+def read_last_mesh_share(path, rank: int, ranks: int) -> tuple[np.ndarray, np.ndarray, bool]:
+    """Rank ``rank``'s share of the last step's mesh of the series at ``path``, read alone (no
+    rank reads the whole): its share of the cells, in file order, and of the points, as
+    ``(cells, points, on_ranks)`` — what ``snede.distribute_cells`` takes; ``on_ranks``: the
+    series was written on MPI ranks, its points in PETSc's order with their serial ids in the
+    field ``serial_vertex`` (``read_serial_vertices``). Errors as ``read_series``."""
+    path = Path(path)
+    last = _last_step(path)
+
+    def share(n: int) -> tuple[int, int]:
+        return rank * n // ranks, (rank + 1) * n // ranks
+
+    with contextlib.ExitStack() as stack:
+        data = _Datasets(path, stack)
+        cells = data.rows(last.cells, *share(last.cells.shape[0]))
+        points = data.rows(last.points, *share(last.points.shape[0]))[:, :last.dim]
+    on_ranks = any(name == "serial_vertex" and center == "Node" for name, center, *_ in last.attributes)
+    return np.asarray(cells, dtype=np.int64), np.asarray(points, dtype=np.float64), on_ranks
+
+
+def read_serial_vertices(path, rows: np.ndarray) -> np.ndarray:
+    """The field ``serial_vertex`` of the last step at the point rows ``rows`` (read alone)."""
+    path = Path(path)
+    last = _last_step(path)
+    item = next(item for name, center, _, item in last.attributes if name == "serial_vertex" and center == "Node")
+    order = np.argsort(rows)
+    with contextlib.ExitStack() as stack:
+        values = _Datasets(path, stack)._dataset(item)[np.asarray(rows)[order]] if len(rows) else np.zeros(0)
+    serial = np.empty(len(rows), dtype=np.int64)
+    serial[order] = np.rint(np.asarray(values, dtype=np.float64)).astype(np.int64)
+    return serial
 
 
 def read_steps(path, make_mesh, last_only: bool = False) -> list[tuple]:

@@ -69,6 +69,7 @@ def main() -> None:
         part = snede.distribute(serial, comm)
         del serial
     distribute_seconds = comm.allreduce(time.perf_counter() - start, op=MPI.MAX)
+    mesh_megabytes = resident_megabytes()
     x = part.local.points
     # Conditions by serial id, the same on every rank, picked on each rank's own points.
     fixed = part.vertices_where(lambda x: x[:, 0] == 0.0)
@@ -84,20 +85,23 @@ def main() -> None:
         sag_under_gravity(part, fixed, distribute_seconds, comm)
         return
     problem = problem()
+    problem_megabytes = resident_megabytes()
     comm.Barrier()
     result = problem.solve("cg", rtol=1e-30, round_tolerance=0.0, max_iterations=arguments.iterations)
     seconds = comm.allreduce(result.seconds, op=MPI.MAX)
     ghosts = int((~part.owned).sum())
     rows = comm.gather((comm.rank, part.local.n_cells, int(part.owned.sum()), ghosts, 2 * ghosts * 3 * 8,
-                        peak_megabytes()), root=0)
+                        mesh_megabytes, problem_megabytes, peak_megabytes()), root=0)
     if comm.rank == 0:
         made = "made on the ranks" if arguments.made_on_ranks else "distributed from rank 0"
         print(f"{comm.size} rank(s), {part.n_global_cells} tetrahedra, {part.n_global_vertices} vertices; "
               f"{made} in {distribute_seconds:.2f} s; CG {result.iterations} iterations ({result.reason}) in "
               f"{seconds:.3f} s: {1e3 * seconds / max(result.iterations, 1):.2f} ms per iteration")
-        print(f"{'rank':>4} {'cells':>9} {'owned':>9} {'ghosts':>7} {'bytes/product':>14} {'peak MB':>8}")
-        for rank, cells, owned, ghosts, volume, peak in rows:
-            print(f"{rank:>4} {cells:>9} {owned:>9} {ghosts:>7} {volume:>14} {peak:>8.0f}")
+        print(f"{'rank':>4} {'cells':>9} {'owned':>9} {'ghosts':>7} {'bytes/product':>14} {'MB with mesh':>12} "
+              f"{'with problem':>12} {'peak MB':>8}")
+        for rank, cells, owned, ghosts, volume, with_mesh, with_problem, peak in rows:
+            print(f"{rank:>4} {cells:>9} {owned:>9} {ghosts:>7} {volume:>14} {with_mesh:>12.0f} {with_problem:>12.0f} "
+                  f"{peak:>8.0f}")
         print(f"(x spans {x[:, 0].min():.2f}..{x[:, 0].max():.2f} on rank 0)")
 
 
@@ -115,6 +119,12 @@ def sag_under_gravity(part, fixed, made_seconds: float, comm) -> None:
               + ", ".join(f"{peak:.0f}" for peak in peaks))
 
 
+def resident_megabytes() -> float:
+    """This process's resident memory now (Linux's /proc/self/statm, in pages of 4 kB)."""
+    with open("/proc/self/statm") as statm:
+        return int(statm.read().split()[1]) * 4096 / 2**20
+
+
 def peak_megabytes() -> float:
     """This process's peak resident memory so far (Linux reports ru_maxrss in kB)."""
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
@@ -130,11 +140,13 @@ def solve_serially(n: int, iterations: int) -> None:
     pulled = np.flatnonzero(x[:, 0] == 1.0)
     body.add_nodal_force(pulled, np.tile((1.0 / len(pulled), 0.0, 0.0), (len(pulled), 1)))
     made = time.perf_counter() - start
+    with_body = resident_megabytes()
     result = snede.StaticSolver(body, "cg", rtol=1e-30, round_tolerance=0.0, max_iterations=iterations,
                                 preconditioner="none").solve()
     print(f"serial, {mesh.n_cells} tetrahedra, {len(x)} vertices; made in {made:.2f} s; CG {result.iterations} "
           f"iterations ({result.reason}) in {result.seconds:.3f} s: "
-          f"{1e3 * result.seconds / max(result.iterations, 1):.2f} ms per iteration; peak {peak_megabytes():.0f} MB")
+          f"{1e3 * result.seconds / max(result.iterations, 1):.2f} ms per iteration; {with_body:.0f} MB with the body, "
+          f"peak {peak_megabytes():.0f} MB")
 
 
 PRECONDITIONERS = ("none", "jacobi", "gamg", "mg", "bjacobi", "sor", "lu")

@@ -106,6 +106,54 @@ def test_a_gmsh_mesh_given_in_chunks_or_by_one_rank_solves_as_serially(given):
     assert np.abs(u - body.displacement).max() <= 1e-6 * np.abs(body.displacement).max()
 
 
+def shared_folder(tmp_path) -> Path:
+    """Rank 0's temporary folder, the same path on every rank (each rank's pytest makes its own)."""
+    return Path(COMM.bcast(str(tmp_path) if COMM.rank == 0 else None))
+
+
+def test_a_series_file_is_read_in_shares_and_any_other_file_through_rank_0(tmp_path):
+    """DistributedMesh.read: a series SeriesWriter wrote serially (its last step's mesh, read by
+    each rank in its share of the HDF5 rows) and gmsh's .msh (read by rank 0 and distributed)
+    give the parts of the same mesh; a missing file raises on every rank."""
+    folder = shared_folder(tmp_path)
+    serial = snede.Mesh.read(CYLINDER)
+    if COMM.rank == 0:
+        snede.output.SeriesWriter(folder / "cylinder").write(snede.Body(serial, snede.LinearElastic(1e5, 0.3)))
+    COMM.Barrier()
+    for path in (folder / "cylinder.xdmf", CYLINDER):
+        part = snede.DistributedMesh.read(path, COMM)
+        gathered = gathered_cells(part)
+        assert len(gathered) == serial.n_cells, path
+        assert set(gathered) == {tuple(sorted(c)) for c in serial.cells.tolist()}, path
+        np.testing.assert_array_equal(part.local.points, serial.points[part.global_vertex])
+    with pytest.raises(FileNotFoundError, match="no mesh file"):
+        snede.DistributedMesh.read(folder / "missing.msh", COMM)
+
+
+def test_a_series_written_on_ranks_reads_back_with_its_serial_ids(tmp_path):
+    """From file to series and back on the ranks: a box made on the ranks, solved, written by
+    write_part (PETSc's vertex order, serial ids in 'serial_vertex'), read in shares: the parts
+    are the box again with the serial box's vertex ids, and a solve from them gives the same
+    displacement."""
+    folder = shared_folder(tmp_path)
+    material = snede.LinearElastic(1e5, 0.3)
+    part = snede.meshing.box(SIZE, DIVISIONS, comm=COMM)
+    held = part.vertices_where(lambda x: np.isclose(x[:, 0], 0.0))
+    problem = snede.DistributedStatic(part, material, fixed=held, gravity=(0.0, 0.0, -9.81))
+    assert problem.solve("cg", rtol=1e-12, criterion="6.9").converged
+    snede.output.SeriesWriter(folder / "on_ranks", comm=COMM).write_part(part, displacement=problem.local_displacement())
+    COMM.Barrier()
+    again = snede.DistributedMesh.read(folder / "on_ranks.xdmf", COMM)
+    serial = snede.meshing.box(SIZE, DIVISIONS)
+    assert set(gathered_cells(again)) == {tuple(sorted(c)) for c in serial.cells.tolist()}
+    np.testing.assert_array_equal(again.local.points, serial.points[again.global_vertex])
+    assert again.vertices_where(lambda x: np.isclose(x[:, 0], 0.0)).tolist() == held.tolist()
+    solved_again = snede.DistributedStatic(again, material, fixed=held, gravity=(0.0, 0.0, -9.81))
+    assert solved_again.solve("cg", rtol=1e-12, criterion="6.9").converged
+    u, v = problem.gathered_displacement(), solved_again.gathered_displacement()
+    assert np.abs(u - v).max() <= 1e-8 * np.abs(u).max()
+
+
 @pytest.mark.parametrize("bad, message", [
     ("id", "cell vertex id .* is outside 0.."),
     ("corners", "tetrahedra in 3D"),
