@@ -22,7 +22,6 @@ from pathlib import Path
 import numpy as np
 
 from snede import _checks, _records, _snede
-from snede._petsc import option_list
 from snede.mesh import Mesh
 from snede._snede import SolveResult
 
@@ -230,7 +229,7 @@ class DistributedStatic:
                 method=method, rtol=rtol, criterion=criterion, round_tolerance=round_tolerance,
                 max_iterations=_checks.optional_count(max_iterations, "max_iterations", 1),
                 options_prefix=options_prefix, preconditioner=preconditioner,
-                petsc_options=None if petsc_options is None else option_list(petsc_options))
+                petsc_options=petsc_options)
 
         return _snede.StaticSolver(self._impl, agreed(self.part.comm, checked)).solve()
 
@@ -284,7 +283,7 @@ def relaxation_options(options, damping, dt, options_prefix, petsc_options) -> _
     The serial and the distributed relaxation both make theirs here."""
     return _records.settings(_snede.DynamicRelaxationOptions, options, damping=damping, dt=dt,
                              options_prefix=options_prefix,
-                             petsc_options=None if petsc_options is None else option_list(petsc_options))
+                             petsc_options=petsc_options)
 
 
 class DistributedRelaxation:

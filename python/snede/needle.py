@@ -19,7 +19,6 @@ import numpy as np
 
 from snede import _checks, _records, _renamed, _snede
 from snede._engine import engine_property
-from snede._petsc import option_list
 from snede._snede import NeedleOptions, NeedleStepResult, StaticOptions
 
 
@@ -164,7 +163,7 @@ class NeedleInsertion:
             StaticOptions, self.default_solver_options() if solver is None else solver, method=method, rtol=rtol, criterion=criterion,
             round_tolerance=round_tolerance, max_iterations=_checks.optional_count(max_iterations, "max_iterations", 1),
             preconditioner=preconditioner, options_prefix=options_prefix,
-            petsc_options=None if petsc_options is None else option_list(petsc_options))
+            petsc_options=petsc_options)
         self.body = body
         self.friction_profile = friction
         bisection = body.mesh._bisection() if needle_settings.h_ref is not None else None
