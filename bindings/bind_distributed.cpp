@@ -52,7 +52,7 @@ void bind_distributed(py::module_& m) {
         part.cells.assign(cells.data(), cells.data() + cells.size());
         part.coordinates.assign(coordinates.data(), coordinates.data() + coordinates.size());
         py::gil_scoped_release released;
-        return distribute_cells(MPI_Comm_f2c(static_cast<MPI_Fint>(comm)), part);
+        return distribute_cells(MPI_Comm_f2c(static_cast<MPI_Fint>(comm)), std::move(part));
       },
       py::arg("comm"), py::arg("cell_dim"), py::arg("cells"), py::arg("coordinates"));
   // RankAgreement for Python's collective calls: `inputs` are (name, the input's bytes) pairs,

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <exception>
+#include <numeric>
 #include <stdexcept>
 #include <string>
 #include <unordered_set>
@@ -32,11 +33,13 @@ Connectivity Connectivity::from_cells(int dim, std::span<const VertexId> cells) 
   c.faces_.resize(n_cells * n_vertices_per_cell);
   c.n_elements_ = n_cells;
 
-  struct FaceKey {
-    std::array<VertexId, max_dimension> vertices;
-    FaceId face;
-  };
-  std::vector<FaceKey> keys(c.faces_.size());
+  // The faces sorted by their vertices bring the two sides of each interior face together: a
+  // counting sort by the first (smallest) vertex, then each vertex's few faces by the rest. Only
+  // face ids move (4 bytes a face): building a large mesh's connectivity peaks at what it keeps
+  // plus little more (issue 52).
+  VertexId n_vertices = 0;
+  for (VertexId v : cells) n_vertices = std::max(n_vertices, v + 1);
+  std::vector<FaceId> first(static_cast<std::size_t>(n_vertices) + 1, 0);  // each vertex's bucket start
   for (std::size_t e = 0; e < n_cells; ++e) {
     Element& element = c.elements_[e];
     element.simplex = Simplex(1, cells.subspan(e * n_vertices_per_cell, n_vertices_per_cell));
@@ -46,27 +49,35 @@ Connectivity Connectivity::from_cells(int dim, std::span<const VertexId> cells) 
       face.simplex = element.simplex.subn(j);
       face.element = static_cast<ElementId>(e);
       element.faces[j] = f;
-      FaceKey& key = keys[f];
-      key.vertices.fill(no_id);
-      for (int k = 0; k < dim; ++k) key.vertices[k] = face.simplex.vertex(k);
-      key.face = f;
+      ++first[static_cast<std::size_t>(face.simplex.vertex(0)) + 1];
     }
   }
-  std::sort(keys.begin(), keys.end(),
-            [](const FaceKey& a, const FaceKey& b) { return a.vertices < b.vertices; });
+  std::partial_sum(first.begin(), first.end(), first.begin());
+  std::vector<FaceId> keys(c.faces_.size());
+  for (FaceId f = 0; f < static_cast<FaceId>(keys.size()); ++f)
+    keys[static_cast<std::size_t>(first[static_cast<std::size_t>(c.faces_[f].simplex.vertex(0))]++)] = f;
+  // `first` now holds each bucket's end, which is the next one's start.
+  const auto by_vertices = [&](FaceId a, FaceId b) {
+    const auto va = c.faces_[a].simplex.vertices(), vb = c.faces_[b].simplex.vertices();
+    return std::lexicographical_compare(va.begin(), va.end(), vb.begin(), vb.end());
+  };
+  for (std::size_t v = 0, begin = 0; v < static_cast<std::size_t>(n_vertices); begin = first[v++])
+    std::sort(keys.begin() + static_cast<std::ptrdiff_t>(begin), keys.begin() + first[v], by_vertices);
+  std::vector<FaceId>().swap(first);
+  const auto same_vertices = [&](FaceId a, FaceId b) { return c.faces_[a].simplex.same_vertices(c.faces_[b].simplex); };
 
   for (std::size_t i = 0; i < keys.size();) {
     std::size_t end = i + 1;
-    while (end < keys.size() && keys[end].vertices == keys[i].vertices) ++end;
-    const FaceId a = keys[i].face;
+    while (end < keys.size() && same_vertices(keys[end], keys[i])) ++end;
+    const FaceId a = keys[i];
     if (end - i == 1) {
       c.boundary_.emplace(c.faces_[a].simplex, a);
     } else {
-      const FaceId b = keys[i + 1].face;
+      const FaceId b = keys[i + 1];
       const ElementId ea = c.faces_[a].element, eb = c.faces_[b].element;
       for (std::size_t p = i; p < end; ++p)  // a repeated cell is named as such, first
         for (std::size_t q = p + 1; q < end; ++q) {
-          const ElementId ep = c.faces_[keys[p].face].element, eq = c.faces_[keys[q].face].element;
+          const ElementId ep = c.faces_[keys[p]].element, eq = c.faces_[keys[q]].element;
           if (c.elements_[ep].simplex.same_vertices(c.elements_[eq].simplex))
             throw std::invalid_argument("Connectivity::from_cells: cells " + std::to_string(std::min(ep, eq)) +
                                         " and " + std::to_string(std::max(ep, eq)) + " have the same vertices");

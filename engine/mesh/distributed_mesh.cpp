@@ -11,6 +11,7 @@
 
 #include "core/error.hpp"
 #include "core/petsc_handle.hpp"
+#include "mesh/part_as_given.hpp"
 
 #ifdef SNEDE_HAVE_PTSCOTCH
 extern "C" void SCOTCH_randomReset(void);  // scotch.h's, which needs SCOTCH_Num's width
@@ -109,39 +110,24 @@ std::string agreed_rank_cells(MPI_Comm comm, const RankCells& part) {
   return problem;
 }
 
-// The signed volume (area) of a volume mesh's simplex, to restore snede's positive orientation.
-double orientation(const std::vector<double>& points, int space_dim, const std::vector<std::int64_t>& cell) {
-  const auto at = [&](std::size_t k, int d) { return points[static_cast<std::size_t>(cell[k]) * space_dim + d]; };
-  if (cell.size() == 3) {
-    return (at(1, 0) - at(0, 0)) * (at(2, 1) - at(0, 1)) - (at(1, 1) - at(0, 1)) * (at(2, 0) - at(0, 0));
-  }
-  double e[3][3];
-  for (int k = 0; k < 3; ++k)
-    for (int d = 0; d < 3; ++d) e[k][d] = at(k + 1, d) - at(0, d);
-  return e[0][0] * (e[1][1] * e[2][2] - e[1][2] * e[2][1]) - e[0][1] * (e[1][0] * e[2][2] - e[1][2] * e[2][0]) +
-         e[0][2] * (e[1][0] * e[2][1] - e[1][1] * e[2][0]);
-}
-
-// Distributes `dm` (unless `partition` is false: its cells stay where they are) and takes this
-// rank's part; `serial_id` gives the global vertex id of each of the DM's vertex points
-// (indexed by point, −1 for the others), carried along the migration. The DMs are freed before
-// snede's mesh is made, so that the two never hold the part at the same time.
+// Distributes `dm` and takes this rank's part; `serial_id` gives the global vertex id of each of
+// the DM's vertex points (indexed by point, −1 for the others), carried along the migration. The
+// DMs are freed before snede's mesh is made, so that the two never hold the part at the same
+// time.
 DistributedMesh take_part(MPI_Comm comm, DmHandle dm, std::vector<PetscInt> serial_id, int cell_dim, int space_dim,
-                          std::int64_t n_global_vertices, std::int64_t n_global_cells, bool partition = true) {
+                          std::int64_t n_global_vertices, std::int64_t n_global_cells) {
   SfHandle migration;
   DmHandle distributed;
-  if (partition) {
-    // -petscpartitioner_type (and its options) choose how the cells are split.
-    PetscPartitioner partitioner = nullptr;
-    SNEDE_PETSC(DMPlexGetPartitioner(dm, &partitioner));
-    SNEDE_PETSC(PetscPartitionerSetFromOptions(partitioner));
-    make_scotch_reproducible();
-    SNEDE_PETSC(DMPlexDistribute(dm, 0, migration.out(), distributed.out()));
-  }
+  // -petscpartitioner_type (and its options) choose how the cells are split.
+  PetscPartitioner partitioner = nullptr;
+  SNEDE_PETSC(DMPlexGetPartitioner(dm, &partitioner));
+  SNEDE_PETSC(PetscPartitionerSetFromOptions(partitioner));
+  make_scotch_reproducible();
+  SNEDE_PETSC(DMPlexDistribute(dm, 0, migration.out(), distributed.out()));
   PetscInt chart_start = 0, chart_end = 0;
   std::vector<PetscInt> local_serial_id = serial_id;
   DM part = dm;
-  if (distributed) {
+  if (distributed) {  // null on one rank: the DM is the part
     part = distributed;
     SNEDE_PETSC(DMPlexGetChart(part, &chart_start, &chart_end));
     local_serial_id.assign(static_cast<std::size_t>(chart_end - chart_start), -1);
@@ -196,7 +182,7 @@ DistributedMesh take_part(MPI_Comm comm, DmHandle dm, std::vector<PetscInt> seri
     SNEDE_PETSC(DMPlexRestoreTransitiveClosure(part, c, PETSC_TRUE, &size, &closure));
     // DMPlex may reorient. A membrane's triangle (in 3D) has no signed area; its cone keeps the
     // serial corners' order, and its energy does not depend on the order.
-    if (cell_dim == space_dim && orientation(points, space_dim, cell) < 0) std::swap(cell[0], cell[1]);
+    if (cell_dim == space_dim && simplex_orientation(points, space_dim, cell.data(), static_cast<int>(cell.size())) < 0) std::swap(cell[0], cell[1]);
     local_cells.insert(local_cells.end(), cell.begin(), cell.end());
   }
 
@@ -248,16 +234,27 @@ DistributedMesh distribute_mesh(MPI_Comm comm, const Mesh* serial) {
   return take_part(comm, std::move(dm), std::move(serial_id), cell_dim, space_dim, shape[2], shape[3]);
 }
 
-DistributedMesh distribute_cells(MPI_Comm comm, const RankCells& given) {
+DistributedMesh distribute_cells(MPI_Comm comm, RankCells given) {
   keep_petsc_communicator(comm);
   const std::string problem = agreed_rank_cells(comm, given);
   if (!problem.empty()) throw std::invalid_argument(problem);
   const PetscInt corners = given.cell_dim + 1;
   const auto n_cells = static_cast<PetscInt>(given.cells.size() / static_cast<std::size_t>(corners));
   const auto n_owned = static_cast<PetscInt>(given.coordinates.size() / static_cast<std::size_t>(given.space_dim));
-  std::vector<PetscInt> cells(given.cells.begin(), given.cells.end());
   std::int64_t totals[2] = {static_cast<std::int64_t>(n_owned), static_cast<std::int64_t>(n_cells)};
   MPI_Allreduce(MPI_IN_PLACE, totals, 2, MPI_INT64_T, MPI_SUM, comm);
+  // Parts as given are kept when they are balanced (the largest at most 1.2 times the mean, as
+  // a generator's are) and made without DMPlex (part_as_given.hpp); else DMPlex partitions them
+  // anew, which in parallel needs the faces and edges (an interpolated mesh: more memory while
+  // it lasts).
+  std::int64_t largest = static_cast<std::int64_t>(n_cells);
+  MPI_Allreduce(MPI_IN_PLACE, &largest, 1, MPI_INT64_T, MPI_MAX, comm);
+  int ranks = 1;
+  MPI_Comm_size(comm, &ranks);
+  if (static_cast<double>(largest) * ranks <= 1.2 * static_cast<double>(totals[1]))
+    return part_as_given(comm, std::move(given), totals[0], totals[1]);
+
+  std::vector<PetscInt> cells(given.cells.begin(), given.cells.end());
   DmHandle dm;
   // The global ids of the vertices of this rank's cells, in the DM's vertex point order (sorted).
   // PETSc 3.18 writes them into an array the caller gives (later versions allocate it).
@@ -270,15 +267,7 @@ DistributedMesh distribute_cells(MPI_Comm comm, const RankCells& given) {
                                                     cells.data(), given.space_dim, given.coordinates.data(), nullptr,
                                                     &adjacent, dm.out()));
   std::vector<PetscInt>().swap(cells);
-  // Parts as given are kept when they are balanced (the largest at most 1.2 times the mean, as
-  // a generator's are); else DMPlex partitions them anew, which in parallel needs the faces and
-  // edges (an interpolated mesh: more memory while it lasts).
-  std::int64_t largest = static_cast<std::int64_t>(n_cells);
-  MPI_Allreduce(MPI_IN_PLACE, &largest, 1, MPI_INT64_T, MPI_MAX, comm);
-  int ranks = 1;
-  MPI_Comm_size(comm, &ranks);
-  const bool balanced = static_cast<double>(largest) * ranks <= 1.2 * static_cast<double>(totals[1]);
-  if (!balanced) {
+  {
     DmHandle interpolated;
     SNEDE_PETSC(DMPlexInterpolate(dm, interpolated.out()));
     dm = std::move(interpolated);
@@ -294,7 +283,7 @@ DistributedMesh distribute_cells(MPI_Comm comm, const RankCells& given) {
   for (PetscInt v = v_start; v < v_end; ++v) serial_id[static_cast<std::size_t>(v - chart_start)] = adjacent[v - v_start];
   std::vector<PetscInt>().swap(adjacent_ids);
   DistributedMesh result = take_part(comm, std::move(dm), std::move(serial_id), given.cell_dim, given.space_dim, totals[0],
-                                     totals[1], !balanced);
+                                     totals[1]);
   std::int64_t owned = std::count(result.owned.begin(), result.owned.end(), std::uint8_t{1});
   MPI_Allreduce(MPI_IN_PLACE, &owned, 1, MPI_INT64_T, MPI_SUM, comm);
   if (owned != totals[0])

@@ -46,10 +46,11 @@ struct RankCells {
   std::vector<double> coordinates;   // space_dim per vertex of this rank's range
 };
 
-// Collective: the mesh whose parts every rank gives, balanced by DMPlexDistribute (a rank's
-// cells need not stay on it). global_vertex holds the global ids. Throws the same
+// Collective: the mesh whose parts every rank gives (consumed). Balanced parts (the largest at
+// most 1.2 times the mean) stay as given (part_as_given.hpp); others are balanced by
+// DMPlexDistribute (a rank's cells need not stay on it). global_vertex holds the global ids. Throws the same
 // std::invalid_argument on every rank when a rank's part is malformed (sizes, dimensions that
 // differ between ranks, an id outside 0..n_vertices−1) or a vertex is in no cell.
-DistributedMesh distribute_cells(MPI_Comm comm, const RankCells& part);
+DistributedMesh distribute_cells(MPI_Comm comm, RankCells part);
 
 }  // namespace snede

@@ -1,6 +1,6 @@
 """A mesh that no rank holds whole (issue 52, item 2, first part), on 1, 2 and 3 ranks:
 ``snede.meshing.box(..., comm=)`` makes each rank's share of the box and DMPlex balances it
-(``snede.distribute_cells``). Compared with the serial box: together the parts hold its cells,
+(``snede.distribute_cells``: kept as given when balanced, else DMPlex partitions them). Compared with the serial box: together the parts hold its cells,
 each once, every vertex owned once at its serial coordinates; no rank holds the whole (on
 more than one rank); a static solve on it gives the serial displacement; malformed parts
 raise the same ValueError on every rank."""
@@ -104,6 +104,30 @@ def test_a_gmsh_mesh_given_in_chunks_or_by_one_rank_solves_as_serially(given):
     assert snede.StaticSolver(body, "newton", rtol=1e-10).solve().converged
     u = problem.gathered_displacement()
     assert np.abs(u - body.displacement).max() <= 1e-6 * np.abs(body.displacement).max()
+
+
+@pytest.mark.parametrize("given", ["chunks", "rank 0"])
+def test_the_ranks_agree_on_every_vertex_owner_and_number(given):
+    """PETSc's vertex numbering, whether the part was kept as given (balanced chunks: made by
+    snede's own exchange) or partitioned by DMPlex (everything given by rank 0): each rank's
+    owned vertices are numbered after the lower ranks' ones, contiguously; a vertex held by
+    several ranks has exactly one owner among them and the same number on each; the numbers are
+    0..n−1, once each."""
+    serial = snede.Mesh.read(CYLINDER)
+    mine = chunk(serial.n_cells) if given == "chunks" else slice(None) if COMM.rank == 0 else slice(0, 0)
+    points = chunk(len(serial.points)) if given == "chunks" else mine
+    part = snede.distribute_cells(serial.cells[mine], serial.points[points], COMM)
+    n_owned = COMM.allgather(int(part.owned.sum()))
+    first = sum(n_owned[:COMM.rank])
+    np.testing.assert_array_equal(np.sort(part.global_number[part.owned]), np.arange(first, first + n_owned[COMM.rank]))
+    held = COMM.allgather((part.global_vertex, part.global_number, part.owned))
+    number, owners = {}, np.zeros(len(serial.points), dtype=int)
+    for ids, numbers, owned in held:
+        for vertex, n in zip(ids.tolist(), numbers.tolist()):
+            assert number.setdefault(vertex, n) == n, vertex
+        np.add.at(owners, ids[owned], 1)
+    np.testing.assert_array_equal(owners, 1)
+    assert sorted(number.values()) == list(range(len(serial.points)))
 
 
 def shared_folder(tmp_path) -> Path:
