@@ -107,6 +107,12 @@ void bind_distributed(py::module_& m) {
             s.set_displacement(std::span<const double>(serial.data(), static_cast<std::size_t>(serial.size())));
           },
           py::arg("serial_displacement"))
+      .def(
+          "set_local_displacement",
+          [](DistributedStatic& s, py::array_t<double, py::array::c_style | py::array::forcecast> local) {
+            s.set_local_displacement(std::span<const double>(local.data(), static_cast<std::size_t>(local.size())));
+          },
+          py::arg("local_displacement"))
       .def("energy", [](DistributedStatic& s) { return s.energy(); })
       .def("local_displacement", [](DistributedStatic& s) { return to_array(s.local_displacement(), 1); });
 }

@@ -230,15 +230,37 @@ void DistributedStatic::set_displacement(std::span<const double> serial) {
                                 " values (n_global_vertices × dim), got " + std::to_string(serial.size()));
   for (double x : serial)
     if (!std::isfinite(x)) throw std::invalid_argument("DistributedStatic.set_displacement: values must be finite");
+  assign_owned([&](std::size_t dof) {
+    const auto vertex = static_cast<std::size_t>(part_.global_vertex[dof / dim_]);
+    return serial.empty() ? 0.0 : serial[vertex * dim_ + dof % dim_];
+  });
+}
+
+void DistributedStatic::set_local_displacement(std::span<const double> local) {
+  const std::size_t expected = static_cast<std::size_t>(part_.local->n_points()) * dim_;
+  bool fits = local.size() == expected;
+  for (std::size_t k = 0; fits && k < local.size(); ++k) fits = std::isfinite(local[k]);
+  // Each rank checks its own array; all raise if one does, so none waits in a later collective.
+  int all_fit = fits;
+  MPI_Allreduce(MPI_IN_PLACE, &all_fit, 1, MPI_INT, MPI_MIN, part_.comm);
+  if (!all_fit) {
+    const std::string mine = fits ? "another rank's did not"
+                                  : "this rank gave " + std::to_string(local.size()) + " values for " +
+                                        std::to_string(expected) + " (or a non-finite one)";
+    throw std::invalid_argument("DistributedStatic.set_local_displacement: every rank must give (n_local_vertices × "
+                                "dim) finite values for its part; " + mine);
+  }
+  assign_owned([&](std::size_t dof) { return local[dof]; });
+}
+
+template <class ValueOfLocalDof>
+void DistributedStatic::assign_owned(ValueOfLocalDof value) {
   PetscInt start = 0, end = 0;
   SNEDE_PETSC(VecGetOwnershipRange(u_, &start, &end));
   {
     const WriteView u(u_);
-    for (std::size_t k = 0; k < owned_rows_.size(); ++k) {
-      const auto dof = static_cast<std::size_t>(owned_local_dof_[k]);
-      const auto vertex = static_cast<std::size_t>(part_.global_vertex[dof / dim_]);
-      u.span()[owned_rows_[k] - start] = serial.empty() ? 0.0 : serial[vertex * dim_ + dof % dim_];
-    }
+    for (std::size_t k = 0; k < owned_rows_.size(); ++k)
+      u.span()[owned_rows_[k] - start] = value(static_cast<std::size_t>(owned_local_dof_[k]));
   }
   enforce_constraints(u_);
 }

@@ -62,6 +62,11 @@ class DistributedStatic final : public Problem {
   // the constraints (Constraints::enforce: fixed vertices at their prescribed displacements,
   // sliding ones moved onto their lines). Empty: zero.
   void set_displacement(std::span<const double> serial_displacement);
+  // Collective: the same from this rank's vertices' displacement, (n_local_vertices × dim) in the
+  // part's local order; the owned vertices' values are taken (a ghost's comes from its owner), so
+  // no rank holds a whole-body array. Throws on every rank when some rank's array has the wrong
+  // size or a non-finite value.
+  void set_local_displacement(std::span<const double> local_displacement);
   // Π(u) = Π_int(u) − f_extᵀu over the whole body (collective), at the state or at u.
   double energy() { return energy(u_); }
   double energy(Vec u) override;
@@ -121,6 +126,9 @@ class DistributedStatic final : public Problem {
   ExclusiveUse exclusive_use_;
   friend class AssembledDistributedTangent;
   void to_local(Vec global, std::vector<double>& local);
+  // Writes value(local dof) into each owned row of the state, then meets the constraints.
+  template <class ValueOfLocalDof>
+  void assign_owned(ValueOfLocalDof value);
   void add_to_global(const std::vector<double>& local, Vec global);
 
   DistributedMesh& part_;

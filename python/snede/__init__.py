@@ -35,6 +35,7 @@ from snede.planar_cutting import DelaunayCutter, DelaunayCutterOptions, Incision
 from snede.surface_cutting import SurfaceCutter, SurfaceCutterOptions  # noqa: F401
 from snede.distributed import (DistributedMesh, DistributedRelaxation, DistributedStatic, distribute,  # noqa: F401
                                distribute_cells)
+from snede.part_body import PartBody  # noqa: F401
 from snede.subdivision_cutting import SubdivisionCutter  # noqa: F401
 from snede import _renamed, meshing  # noqa: F401
 from snede._output_folder import output_folder  # noqa: F401
@@ -46,7 +47,7 @@ __all__ = [
     "DelaunayCutterOptions", "PlanarCutResult", "SurfaceCutter", "SurfaceCutterOptions",
     "IncisionLost",
     "SubdivisionCutter", "DistributedMesh", "DistributedRelaxation", "DistributedStatic", "distribute", "distribute_cells",
-    "LinearElastic", "StVenantKirchhoff", "NeoHookean", "VerondaWestmann",
+    "PartBody", "LinearElastic", "StVenantKirchhoff", "NeoHookean", "VerondaWestmann",
     "Error", "BodyInUse", "EditResult", "FileError", "InvalidMesh", "PetscError", "DomainError", "LockingWarning", "formulations", "PETSc",
     "output_folder",
 ]

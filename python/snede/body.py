@@ -5,34 +5,21 @@ nodes); ``tangent_apply(u, d)`` is ∂²Π_int/∂u² · d. Arrays are ``(n_poin
 """
 from __future__ import annotations
 
-import warnings
-
 import numpy as np
 
 from snede import _checks, _snede
+from snede._body_arguments import (FORMULATIONS, LockingWarning, check_body, displacement_field,  # noqa: F401
+                                   face_forces, traction_faces, vertex_selection)
 from snede._engine import engine_property
+from snede.distributed import DistributedMesh
 from snede.mesh import Mesh
-
-# Above this Poisson's ratio linear tetrahedra visibly lock (docs/results/extremes.md: at
-# ν = 0.45 a 16×4×4 cantilever bends 73 % of beam theory, at ν = 0.499 only 10 %).
-LOCKING_POISSON_RATIO = 0.45
-
-FORMULATIONS = {
-    "p1": "one constant strain per linear simplex (the thesis's element, §2.3); tetrahedra lock as ν → ½",
-    "smoothed": "strains averaged over patches (smoothed FEM): on tetrahedra the shear part over edge patches and "
-                "the bulk part over vertex patches, free of volumetric locking; on plane triangles the whole energy "
-                "over edge patches. Tetrahedra and plane triangles only (docs/results/locking.md)",
-}
+from snede.part_body import PartBody
 
 
 def formulations() -> dict[str, str]:
     """The names ``Body(..., formulation=NAME)`` takes, each with what it does."""
     assert set(FORMULATIONS) == set(_snede.formulations())
     return dict(FORMULATIONS)
-
-
-class LockingWarning(UserWarning):
-    """Linear (P1) simplices lock for nearly incompressible materials: too stiff."""
 
 
 class Body:
@@ -64,31 +51,19 @@ class Body:
     ``comm`` (an mpi4py communicator, issue 18): the communicator its solvers run on when they
     are not given one (``StaticSolver``, ``DynamicRelaxation``: rank 0's body is distributed
     and the answer gathered back into every rank's). The body itself stays a serial
-    description, the same on every rank; None (default): serial solves.
+    description, the same on every rank; None (default): serial solves. A convenience for
+    bodies one process holds easily; a larger one is made on the ranks: ``Body(part, ...)`` of a
+    :class:`snede.DistributedMesh` is a :class:`snede.PartBody`, this rank's share of the body.
     """
+
+    def __new__(cls, mesh=None, *arguments, **keywords):  # mesh=None: copy and pickle make one empty
+        if isinstance(mesh, DistributedMesh):
+            return PartBody(mesh, *arguments, **keywords)
+        return super().__new__(cls)
 
     def __init__(self, mesh: Mesh, material, density: float = 1000.0, thickness: float | None = None, comm=None,
                  formulation: str = "p1"):
-        if not isinstance(mesh, Mesh):
-            raise TypeError(f"mesh must be a snede.Mesh, got {type(mesh).__name__}")
-        if mesh.is_surface and thickness is None:
-            raise ValueError("a surface mesh is an elastic membrane: give its thickness (e.g. thickness=0.001)")
-        if mesh.dim == 2 and thickness is None:
-            raise ValueError("a 2D mesh is a plane-stress sheet: give its thickness (e.g. thickness=0.01)")
-        if mesh.cell_dim == 3 and thickness is not None:
-            raise ValueError(f"thickness is only for 2D (plane-stress) meshes and membranes; this mesh is tetrahedral "
-                             f"(got thickness={thickness})")
-        if not isinstance(formulation, str) or formulation not in FORMULATIONS:
-            raise ValueError(f"unknown formulation {formulation!r}; snede.formulations() lists {sorted(FORMULATIONS)}")
-        if formulation != "p1" and mesh.is_surface:
-            raise ValueError(f"formulation {formulation!r} is for tetrahedra and plane triangles; a membrane (surface "
-                             "mesh) takes 'p1': in plane stress it does not lock")
-        lam, mu = material.lame
-        poisson = lam / (2 * (lam + mu))
-        if poisson >= LOCKING_POISSON_RATIO and formulation == "p1" and mesh.cell_dim == 3:
-            warnings.warn(f"Poisson's ratio {poisson:.4g} is close to 1/2: linear tetrahedra lock (volumetric locking) "
-                          "and the body will deform too little; Body(..., formulation=\"smoothed\") does not lock "
-                          "(docs/results/locking.md)", LockingWarning, stacklevel=2)
+        check_body(mesh, material, thickness, formulation, stacklevel=2)
         if comm is not None and not (hasattr(comm, "rank") and hasattr(comm, "size") and hasattr(comm, "bcast")):
             raise TypeError(f"comm must be an mpi4py communicator (or None), got {type(comm).__name__}")
         self.mesh = mesh
@@ -109,11 +84,7 @@ class Body:
         return self._impl.thickness if self.mesh.cell_dim == 2 else None
 
     def _field(self, name: str, value) -> np.ndarray:
-        array = np.asarray(value, dtype=np.float64)
-        expected = (self.mesh.n_points, self.dim)
-        if array.shape != expected:
-            raise ValueError(f"{name} must have shape {expected} (n_points, dim), got {array.shape}")
-        return np.ascontiguousarray(array)
+        return displacement_field(self.mesh, self.dim, name, value)
 
     def energy(self, u) -> float:
         """Internal elastic energy Π_int(u) (joules); +inf if an element is inverted under a
@@ -180,16 +151,7 @@ class Body:
 
     # -- constraints, loads and state (the model, §3.1, §6.6) ----------------------------
     def _vertices(self, vertices) -> np.ndarray:
-        if isinstance(vertices, str):  # a named group of the mesh
-            return self.mesh.group_vertices(vertices)
-        array = np.atleast_1d(np.asarray(vertices))
-        if array.dtype == bool:
-            if array.shape != (self.mesh.n_points,):
-                raise ValueError(f"a boolean vertex mask must have shape ({self.mesh.n_points},), got {array.shape}")
-            array = np.flatnonzero(array)
-        if array.dtype.kind not in "iu" or array.ndim != 1:
-            raise ValueError(f"vertices must be a 1-D array of vertex indices or a boolean mask, got {array.dtype} {array.shape}")
-        return _checks.index_array(array, "vertices", self.mesh.n_points, "a vertex of the mesh")
+        return vertex_selection(self.mesh, vertices)
 
     def fix(self, vertices, value=None) -> None:
         """Fix vertices (indices, a boolean mask, or the name of one of the mesh's boundary or
@@ -246,31 +208,21 @@ class Body:
         vertex, or (n_vertices, dim)."""
         self._model.add_nodal_force(str(channel), self._vertices(vertices), np.asarray(force, dtype=np.float64))
 
+    def boundary_faces(self) -> np.ndarray:
+        """The body's boundary faces, ``mesh.boundary_faces()`` (as a PartBody gives its rank's
+        share of them)."""
+        return self.mesh.boundary_faces()
+
     def add_traction(self, faces, traction, channel: str = "nodal") -> None:
         """Add a uniform traction (force per unit area of the reference boundary, a (dim,)
         vector) on boundary faces — the name of one of ``mesh.boundary_groups`` or (n, cell_dim)
         vertex indices — lumped to their vertices: each face's force (traction × area; edges in
         2D and on membranes: × length × thickness) split equally among its corners."""
-        if isinstance(faces, str):
-            groups = self.mesh.boundary_groups
-            if faces not in groups:
-                raise KeyError(f"no boundary group {faces!r} in this mesh (its boundary groups: "
-                               f"{', '.join(sorted(groups)) or 'none'})")
-            faces = groups[faces]
-        faces = np.asarray(faces)
-        cell_dim = self.mesh.cell_dim
-        if faces.dtype.kind not in "iu" or faces.ndim != 2 or faces.shape[1] != cell_dim:
-            raise ValueError(f"faces must be a boundary group's name or (n, {cell_dim}) vertex indices, got "
-                             f"{faces.shape} {faces.dtype}")
-        traction = np.broadcast_to(np.asarray(traction, dtype=np.float64), (self.dim,))
-        corners = self.mesh.points[_checks.index_array(faces, "faces", self.mesh.n_points, "a vertex of the mesh")]
-        if cell_dim == 3:
-            measure = 0.5 * np.linalg.norm(np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]), axis=1)
-        else:
-            measure = np.linalg.norm(corners[:, 1] - corners[:, 0], axis=1) * self.thickness
+        faces = traction_faces(self.mesh, faces)
+        shares = face_forces(self.mesh, faces, traction, self.dim, self.thickness)
         forces = np.zeros((self.mesh.n_points, self.dim))
-        for corner in range(cell_dim):
-            np.add.at(forces, faces[:, corner], np.outer(measure / cell_dim, traction))
+        for corner in range(self.mesh.cell_dim):
+            np.add.at(forces, faces[:, corner], shares)
         loaded = np.unique(faces)
         self.add_nodal_force(loaded, forces[loaded], channel)
 

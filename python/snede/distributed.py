@@ -250,6 +250,14 @@ class DistributedStatic:
 
         self._impl.set_displacement(agreed(part.comm, checked))
 
+    def set_local_displacement(self, displacement) -> None:
+        """Start the next solve from this rank's vertices' displacement, (n_local_vertices, dim)
+        in the part's local order (the owned vertices' values are taken; fixed and sliding
+        vertices as :meth:`set_displacement` treats them): no array of the whole body. Collective;
+        an array of the wrong size or with a non-finite value on any rank raises ValueError on
+        every rank."""
+        self._impl.set_local_displacement(np.ascontiguousarray(displacement, dtype=np.float64).ravel())
+
     def energy(self) -> float:
         """Π(u) = Π_int(u) − f_extᵀu of the whole body."""
         return self._impl.energy()

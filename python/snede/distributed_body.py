@@ -21,6 +21,7 @@ import numpy as np
 
 from snede import _snede
 from snede.distributed import DistributedStatic, agreed, distribute
+from snede.part_body import PartBody
 
 
 class DistributedBody:
@@ -67,6 +68,10 @@ class DistributedBody:
         self._last = inputs
         return self._problem
 
+    def require_held(self) -> None:
+        """The serial body's check that every piece is held (ValueError naming a loose one)."""
+        self.body._model.require_held()
+
     def gather_into_body(self, problem: DistributedStatic) -> None:
         """The answer into the body on every rank; should it not fit one rank's body, every
         rank raises."""
@@ -102,6 +107,18 @@ def _inputs(body) -> dict:
             "nodal forces": b"".join(name.encode() + b"\0" + f.tobytes() for name, f in sorted(channels.items())),
             "displacement": body.displacement.tobytes(),
             "gravity": (loads - sum(channels.values(), np.zeros_like(loads))).tobytes()}
+
+
+def on_ranks(body, comm):
+    """What a solver of ``body`` runs on over MPI ranks: a :class:`snede.PartBody` itself (on its
+    part's communicator), a serial Body given a communicator (``comm`` or the body's own) as a
+    :class:`DistributedBody`, or None: a serial solve."""
+    if isinstance(body, PartBody):
+        if comm is not None and comm is not body.comm:
+            raise ValueError("a PartBody is solved on its part's communicator; leave comm out")
+        return body
+    comm = getattr(body, "comm", None) if comm is None else comm
+    return None if comm is None else DistributedBody(body, comm)
 
 
 class RunsOnRanks:

@@ -11,7 +11,7 @@ import numpy as np
 
 from snede import _checks, _records, _snede
 from snede.distributed import DistributedRelaxation, relaxation_options
-from snede.distributed_body import DistributedBody, RunsOnRanks
+from snede.distributed_body import RunsOnRanks, on_ranks
 from snede._snede import DynamicRelaxationOptions, SolveResult
 
 
@@ -55,10 +55,8 @@ class DynamicRelaxation(RunsOnRanks):
                  petsc_options: dict | None = None, comm=None):
         self._settings = relaxation_options(options, damping, dt, options_prefix, petsc_options)
         self.body = body
-        self._distributed = None
-        comm = getattr(body, "comm", None) if comm is None else comm
-        if comm is not None:
-            self._distributed = DistributedBody(body, comm)
+        self._distributed = on_ranks(body, comm)
+        if self._distributed is not None:
             self._start_relaxation()
             self._impl = None
             return

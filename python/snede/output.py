@@ -22,6 +22,7 @@ from snede import _snede, series_files
 from snede._engine import engine_property
 from snede.distributed import agreed
 from snede.mesh import Mesh
+from snede.part_body import PartBody
 
 __all__ = ["SeriesWriter", "SeriesStep", "read_series"]
 
@@ -75,7 +76,14 @@ class SeriesWriter:
         among them the fields the writer makes itself (``displacement``, ``aspect_ratio``,
         ``min_angle``, ``inverted``, ``group:<name>`` of the mesh's groups), which a field of
         the same name would replace. Any other name raises ValueError naming the field and the
-        reason, before the step writes anything (the series stays readable, the writer usable)."""
+        reason, before the step writes anything (the series stays readable, the writer usable).
+
+        A :class:`snede.PartBody` (a rank's share of a distributed body) is written as
+        :meth:`write_part` writes its part (collective; no ``inverted`` field yet)."""
+        if isinstance(body, PartBody):
+            u = body.displacement if displacement is None else displacement
+            self.write_part(body.part, time, u, point_fields, **cell_fields)
+            return
         _refuse_built_in(cell_fields, ("inverted",), "cell")
         u = body.displacement if displacement is None else np.asarray(displacement, dtype=np.float64)
         inverted = np.zeros(body.mesh.n_cells)

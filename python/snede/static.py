@@ -7,7 +7,7 @@ from __future__ import annotations
 
 from snede import _checks, _records, _snede
 from snede._petsc import option_list
-from snede.distributed_body import DistributedBody, RunsOnRanks
+from snede.distributed_body import RunsOnRanks, on_ranks
 from snede._snede import SolveResult, StaticOptions
 
 #: the names ``method`` takes, from the engine's table (static_options.hpp)
@@ -147,10 +147,9 @@ class StaticSolver(RunsOnRanks):
         self.body = body
         self.method = method
         self._settings = settings
-        self._distributed, self._problem, self._impl = None, None, None
-        comm = getattr(body, "comm", None) if comm is None else comm
-        if comm is not None:
-            self._distributed = DistributedBody(body, comm)
+        self._problem, self._impl = None, None
+        self._distributed = on_ranks(body, comm)
+        if self._distributed is not None:
             return
         self._impl = _snede.StaticSolver(body._model, self._settings, body.mesh._bisection_if_any())
 
@@ -168,8 +167,8 @@ class StaticSolver(RunsOnRanks):
 
     def _solve_distributed(self) -> SolveResult:
         problem = self._distributed.problem()
-        # The serial check, on the body every rank now agrees on: all ranks raise, none waits.
-        self.body._model.require_held()
+        # On the conditions every rank now agrees on: all ranks raise, none waits.
+        self._distributed.require_held()
         if problem is not self._problem:  # a new mesh or new conditions: a solver for them
             self._problem, self._impl = problem, _snede.StaticSolver(problem._impl, self._settings)
         result = self._impl.solve()
