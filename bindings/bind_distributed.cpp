@@ -113,6 +113,14 @@ void bind_distributed(py::module_& m) {
             s.set_local_displacement(std::span<const double>(local.data(), static_cast<std::size_t>(local.size())));
           },
           py::arg("local_displacement"))
+      .def(
+          "inverted_local_elements",
+          [](const DistributedStatic& s, py::array_t<double, py::array::c_style | py::array::forcecast> local) {
+            return to_array(s.inverted_local_elements(
+                                std::span<const double>(local.data(), static_cast<std::size_t>(local.size()))),
+                            1);
+          },
+          py::arg("local_displacement"))
       .def("energy", [](DistributedStatic& s) { return s.energy(); })
       .def("local_displacement", [](DistributedStatic& s) { return to_array(s.local_displacement(), 1); });
 }

@@ -72,6 +72,11 @@ class DistributedStatic final : public Problem {
   double energy(Vec u) override;
   // The displacement of this rank's vertices (owned and ghosts), (n_local_vertices, dim).
   std::vector<double> local_displacement();
+  // This rank's cells (local element ids) that `local_displacement` ((n_local_vertices, dim))
+  // inverts, as ElasticBody::inverted_elements finds them. Local: no communication.
+  std::vector<ElementId> inverted_local_elements(std::span<const double> local_displacement) const {
+    return body_.inverted_elements(local_displacement);
+  }
 
   // What the solvers (SNES callbacks, DynamicRelaxation) use. All collective.
   // F = P(−f_int(u) − f_ext) + c (I − P)(u − ū). Not admissible when an element on some rank is

@@ -79,16 +79,15 @@ class SeriesWriter:
         reason, before the step writes anything (the series stays readable, the writer usable).
 
         A :class:`snede.PartBody` (a rank's share of a distributed body) is written as
-        :meth:`write_part` writes its part (collective; no ``inverted`` field yet)."""
-        if isinstance(body, PartBody):
-            u = body.displacement if displacement is None else displacement
-            self.write_part(body.part, time, u, point_fields, **cell_fields)
-            return
+        :meth:`write_part` writes its part (collective)."""
         _refuse_built_in(cell_fields, ("inverted",), "cell")
         u = body.displacement if displacement is None else np.asarray(displacement, dtype=np.float64)
         inverted = np.zeros(body.mesh.n_cells)
         inverted[body.inverted_elements(u)] = 1.0
-        self.write_mesh(body.mesh, time, u, point_fields, inverted=inverted, **cell_fields)
+        if isinstance(body, PartBody):
+            self.write_part(body.part, time, u, point_fields, inverted=inverted, **cell_fields)
+        else:
+            self.write_mesh(body.mesh, time, u, point_fields, inverted=inverted, **cell_fields)
 
     def write_mesh(self, mesh, time: float = 0.0, displacement=None, point_fields: dict | None = None,
                    **cell_fields) -> None:

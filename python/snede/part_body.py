@@ -229,6 +229,13 @@ class PartBody:
         self._displacement = displacement_field(self.mesh, self.dim, "displacement", u).copy()
         self._edits += 1
 
+    def inverted_elements(self, u=None) -> np.ndarray:
+        """This rank's cells (indices of ``body.mesh``'s cells) that ``u`` ((n_local_points,
+        dim); None: the body's displacement) inverts. Collective (the first call makes the
+        distributed problem)."""
+        u = agreed(self.comm, lambda: self._displacement if u is None else displacement_field(self.mesh, self.dim, "u", u))
+        return np.asarray(self.problem()._impl.inverted_local_elements(u.ravel()), dtype=np.int64).ravel()
+
     def gathered_displacement(self) -> np.ndarray:
         """The whole body's displacement, (n_global_vertices, dim) in serial vertex order, on
         every rank (collective; an array of the whole body, for small bodies and checks)."""

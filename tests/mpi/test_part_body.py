@@ -165,16 +165,22 @@ def test_dynamic_relaxation_of_a_part_body_follows_the_serial_one():
 
 
 def test_a_series_written_from_a_part_body_reads_back_with_serial_ids(tmp_path):
+    """SeriesWriter.write of a PartBody writes the part: its displacement by serial vertex id,
+    and the inverted cells (none at the solved state, all of them mirrored)."""
     folder = Path(COMM.bcast(str(tmp_path) if COMM.rank == 0 else None))
     part = snede.meshing.box(SIZE, DIVISIONS, comm=COMM)
     body = snede.Body(part, snede.LinearElastic(1e5, 0.3))
     body.fix(np.isclose(body.mesh.points[:, 0], 0.0))
     body.add_gravity((0.0, 0.0, -9.81))
     assert snede.StaticSolver(body, "cg", rtol=1e-10).solve().converged
-    snede.output.SeriesWriter(folder / "part_body", comm=COMM).write(body)
+    writer = snede.output.SeriesWriter(folder / "part_body", comm=COMM)
+    writer.write(body)
+    mirrored = -2.0 * body.mesh.points  # x → −x: every cell turned inside out
+    writer.write(body, time=1.0, displacement=mirrored)
     COMM.Barrier()
     u = body.gathered_displacement()
     if COMM.rank == 0:
-        step = snede.output.read_series(folder / "part_body.xdmf")[-1]
-        serial_ids = step.point_fields["serial_vertex"].astype(np.int64)
-        np.testing.assert_array_equal(step.displacement, u[serial_ids])
+        solved, inverted = snede.output.read_series(folder / "part_body.xdmf")
+        serial_ids = solved.point_fields["serial_vertex"].astype(np.int64)
+        np.testing.assert_array_equal(solved.displacement, u[serial_ids])
+        assert not solved.cell_fields["inverted"].any() and inverted.cell_fields["inverted"].all()
