@@ -8,6 +8,7 @@
 #include "core/error.hpp"
 #include "core/rank_agreement.hpp"
 #include "multigrid/coarse_basis.hpp"
+#include "multigrid/rank_smoothed_interpolation.hpp"
 
 namespace snede {
 namespace {
@@ -47,13 +48,14 @@ NodeLevel owned_vertex_level(const DistributedMesh& part, const VertexProjection
 // vertices (empty when it does).
 RankAggregationLevels levels_over(const DistributedMesh& part, const VertexProjection& projection,
                                   const std::string& misfit, double aggregate_width, int max_levels,
-                                  PetscInt direct_unknowns) {
+                                  PetscInt direct_unknowns, bool smooth_first_level) {
   const Mesh& mesh = *part.local;
   // After this every rank takes the same branch below: the checks throw on all ranks or none.
   RankAgreement("rank_aggregation_levels")
       .input("aggregate_width", aggregate_width)
       .input("max_levels", static_cast<double>(max_levels))
       .input("direct_unknowns", static_cast<double>(direct_unknowns))
+      .input("smooth_first_level", static_cast<double>(smooth_first_level))
       .input("constraints fit the rank's vertices", static_cast<double>(misfit.empty()))
       .require(part.comm);
   if (!misfit.empty()) throw std::invalid_argument("rank_aggregation_levels: " + misfit);
@@ -67,6 +69,9 @@ RankAggregationLevels levels_over(const DistributedMesh& part, const VertexProje
   const NodeLevel vertices = owned_vertex_level(part, projection);
   std::vector<AggregateLevel> finest_first = aggregate_levels(
       vertices, aggregate_width * global_mean_edge_length(part), max_levels, direct_unknowns, part.comm);
+  if (smooth_first_level && !finest_first.empty())
+    finest_first.front().interpolation =
+        rank_smoothed_interpolation(part, projection, finest_first.front().interpolation);
   RankAggregationLevels levels;
   for (auto level = finest_first.rbegin(); level != finest_first.rend(); ++level) {
     PetscInt rows = 0, columns = 0;
@@ -81,7 +86,8 @@ RankAggregationLevels levels_over(const DistributedMesh& part, const VertexProje
 }  // namespace
 
 RankAggregationLevels rank_aggregation_levels(const DistributedMesh& part, const Constraints& constraints,
-                                              double aggregate_width, int max_levels, PetscInt direct_unknowns) {
+                                              double aggregate_width, int max_levels, PetscInt direct_unknowns,
+                                              bool smooth_first_level) {
   const Mesh& mesh = *part.local;
   const bool fits = constraints.n_points() == mesh.n_points() && constraints.dim() == mesh.dim();
   const std::string misfit = fits ? "" : "the constraints have " + std::to_string(constraints.n_points()) +
@@ -89,11 +95,12 @@ RankAggregationLevels rank_aggregation_levels(const DistributedMesh& part, const
                                              std::to_string(mesh.n_points()) + " in " + std::to_string(mesh.dim()) + "D";
   return levels_over(
       part, [&](VertexId v, std::span<double> block) { constraints.projection_block(v, block); }, misfit,
-      aggregate_width, max_levels, direct_unknowns);
+      aggregate_width, max_levels, direct_unknowns, smooth_first_level);
 }
 
 RankAggregationLevels rank_aggregation_levels(const DistributedMesh& part, std::span<const std::uint8_t> fixed_local,
-                                              double aggregate_width, int max_levels, PetscInt direct_unknowns) {
+                                              double aggregate_width, int max_levels, PetscInt direct_unknowns,
+                                              bool smooth_first_level) {
   const int d = part.local->dim();
   const std::size_t n_local_dofs = static_cast<std::size_t>(part.local->n_points()) * static_cast<std::size_t>(d);
   const std::string misfit = fixed_local.size() == n_local_dofs
@@ -106,7 +113,7 @@ RankAggregationLevels rank_aggregation_levels(const DistributedMesh& part, std::
     for (int k = 0; k < d; ++k)
       block[static_cast<std::size_t>(k) * d + k] = fixed_local[static_cast<std::size_t>(v) * d + k] ? 0.0 : 1.0;
   };
-  return levels_over(part, projection, misfit, aggregate_width, max_levels, direct_unknowns);
+  return levels_over(part, projection, misfit, aggregate_width, max_levels, direct_unknowns, smooth_first_level);
 }
 
 }  // namespace snede

@@ -4,7 +4,7 @@
 // rigid motion of an aggregate, projected by the constraints — lives on one rank and the
 // interpolation has no off-rank entries. Coarser levels aggregate each rank's aggregates again.
 // Aggregates never cross a rank's border, which costs a few more coarse unknowns there but no
-// communication to build the levels.
+// communication to build the levels (the smoothed first level's functions do cross it).
 #pragma once
 
 #include <cstdint>
@@ -34,14 +34,18 @@ struct RankAggregationLevels {
 // coarse unknowns. Throws std::invalid_argument (the same on every rank) for a surface mesh
 // (preconditioner "mg" is for volume meshes), a width that is not positive, max_levels 1 or
 // negative, or constraints of another size than the rank's vertices on some rank.
+// smooth_first_level: the first level's interpolation is smoothed (rank_smoothed_interpolation.hpp;
+// its coarse functions then reach into the neighbouring ranks' vertices).
 RankAggregationLevels rank_aggregation_levels(const DistributedMesh& part, const Constraints& constraints,
                                               double aggregate_width, int max_levels = 0,
-                                              PetscInt direct_unknowns = default_direct_unknowns);
+                                              PetscInt direct_unknowns = default_direct_unknowns,
+                                              bool smooth_first_level = false);
 
 // The same with whole dofs fixed: fixed_local, per local dof (n_local_vertices × dim), is 1
 // where the dof is fixed.
 RankAggregationLevels rank_aggregation_levels(const DistributedMesh& part, std::span<const std::uint8_t> fixed_local,
                                               double aggregate_width, int max_levels = 0,
-                                              PetscInt direct_unknowns = default_direct_unknowns);
+                                              PetscInt direct_unknowns = default_direct_unknowns,
+                                              bool smooth_first_level = false);
 
 }  // namespace snede

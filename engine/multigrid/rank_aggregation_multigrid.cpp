@@ -4,9 +4,11 @@
 
 namespace snede {
 
-RankAggregationMultigrid::RankAggregationMultigrid(DistributedStatic& problem, int max_levels, double aggregate_width)
+RankAggregationMultigrid::RankAggregationMultigrid(DistributedStatic& problem, int max_levels, double aggregate_width,
+                                                   bool smooth_first_level)
     : n_cells_(problem.n_global_cells()),
-      levels_(rank_aggregation_levels(problem.part(), problem.local_constraints(), aggregate_width, max_levels)) {}
+      levels_(rank_aggregation_levels(problem.part(), problem.local_constraints(), aggregate_width, max_levels,
+                                      default_direct_unknowns, smooth_first_level)) {}
 
 std::vector<std::size_t> RankAggregationMultigrid::level_sizes() const {
   std::vector<std::size_t> sizes = level_unknowns();

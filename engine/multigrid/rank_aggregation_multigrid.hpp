@@ -15,8 +15,10 @@ namespace snede {
 class RankAggregationMultigrid final : public Multigrid {
  public:
   // Collective. max_levels counts the fine level (0: coarsened until the coarsest level is
-  // small); aggregate_width in mean edge lengths, as serially.
-  RankAggregationMultigrid(DistributedStatic& problem, int max_levels, double aggregate_width);
+  // small); aggregate_width in mean edge lengths, as serially; smooth_first_level as
+  // rank_aggregation_levels takes it.
+  RankAggregationMultigrid(DistributedStatic& problem, int max_levels, double aggregate_width,
+                           bool smooth_first_level);
 
   const char* source() const override { return "aggregation"; }
   // A distributed problem's mesh and constraints do not change.

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "core/error.hpp"
+#include "multigrid/dense_matrix.hpp"
 #include "multigrid/grid_multigrid.hpp"
 #include "topology/bisection.hpp"
 #include "topology/dissect.hpp"
@@ -64,17 +65,7 @@ struct Levels {
     levels.configure(pc, options);
     Mat interpolation = nullptr;
     SNEDE_PETSC(PCMGGetInterpolation(pc, 1, &interpolation));
-    PetscInt rows = 0, columns = 0;
-    SNEDE_PETSC(MatGetSize(interpolation, &rows, &columns));
-    P = Eigen::MatrixXd::Zero(rows, columns);
-    for (PetscInt r = 0; r < rows; ++r) {
-      PetscInt n_entries = 0;
-      const PetscInt* at = nullptr;
-      const PetscScalar* values = nullptr;
-      SNEDE_PETSC(MatGetRow(interpolation, r, &n_entries, &at, &values));
-      for (PetscInt k = 0; k < n_entries; ++k) P(r, at[k]) = values[k];
-      SNEDE_PETSC(MatRestoreRow(interpolation, r, &n_entries, &at, &values));
-    }
+    P = snede::testing::dense_matrix(interpolation);
   }
   bool is_free(VertexId v) const {
     return mesh.is_vertex(v) && !fixed[v] && slide_direction[v] == std::array<double, 3>{0, 0, 0};

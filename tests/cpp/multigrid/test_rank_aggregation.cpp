@@ -13,6 +13,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <limits>
+#include <memory>
 #include <string>
 #include <tuple>
 #include <vector>
@@ -22,6 +23,7 @@
 #include "fem/linear_elastic.hpp"
 #include "mesh/distributed_mesh.hpp"
 #include "mesh/fixtures.hpp"
+#include "multigrid/dense_matrix.hpp"
 #include "problem/distributed_assembly.hpp"
 #include "multigrid/rank_aggregation.hpp"
 
@@ -249,6 +251,65 @@ TEST(RankAggregation, BadInputsThrowOnEveryRank) {
   EXPECT_THROW(rank_aggregation_levels(part, short_by_one, 2.5), std::invalid_argument);
 }
 
+// Collective: the whole of a distributed matrix, dense, on every rank.
+Matrix gathered(Mat A) {
+  int ranks = 1;
+  MPI_Comm_size(MPI_COMM_WORLD, &ranks);
+  Mat whole = nullptr;
+  SNEDE_PETSC(MatCreateRedundantMatrix(A, ranks, MPI_COMM_NULL, MAT_INITIAL_MATRIX, &whole));
+  Matrix dense = snede::testing::dense_matrix(whole);
+  MatDestroy(&whole);
+  return dense;
+}
+
+TEST(RankAggregation, TheSmoothedFirstLevelIsOneJacobiStepOfTheWholeMeshsGraphLaplacian) {
+  // Rebuilt here from the serial box that every rank makes: Π (I − ω D⁻¹ L) T with L the graph
+  // Laplacian of the whole mesh (an edge weighs the cells that share it), so an interface vertex's
+  // row must count the other ranks' cells too.
+  const int d = 3, n = 4;
+  const Mesh serial = unit_box(d, n);
+  const DistributedMesh part = distribute_mesh(MPI_COMM_WORLD, world_rank() == 0 ? &serial : nullptr);
+  const std::vector<std::uint8_t> fixed = bottom_fixed(part);
+  const RankAggregationLevels plain = rank_aggregation_levels(part, fixed, 2.5, 2);
+  const RankAggregationLevels smoothed = rank_aggregation_levels(part, fixed, 2.5, 2, default_direct_unknowns, true);
+  ASSERT_EQ(smoothed.global_unknowns, plain.global_unknowns);
+  const Matrix T = gathered(plain.interpolations.back()), P = gathered(smoothed.interpolations.back());
+  // The fine level's row of each serial vertex: PETSc's number, from its owner.
+  std::vector<std::int64_t> pairs;
+  for (VertexId v = 0; v < part.local->n_points(); ++v)
+    if (part.owned[v]) pairs.insert(pairs.end(), {part.global_vertex[v], part.global_number[v]});
+  int count = static_cast<int>(pairs.size()), ranks = 1;
+  MPI_Comm_size(MPI_COMM_WORLD, &ranks);
+  std::vector<int> counts(static_cast<std::size_t>(ranks)), offsets(counts.size(), 0);
+  MPI_Allgather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, MPI_COMM_WORLD);
+  for (std::size_t r = 1; r < counts.size(); ++r) offsets[r] = offsets[r - 1] + counts[r - 1];
+  std::vector<std::int64_t> all(static_cast<std::size_t>(offsets.back() + counts.back()));
+  MPI_Allgatherv(pairs.data(), count, MPI_INT64_T, all.data(), counts.data(), offsets.data(), MPI_INT64_T, MPI_COMM_WORLD);
+  std::vector<Eigen::Index> number(static_cast<std::size_t>(serial.n_points()));
+  for (std::size_t k = 0; k < all.size(); k += 2) number[static_cast<std::size_t>(all[k])] = all[k + 1];
+
+  const Eigen::Index n_vertices = serial.n_points();
+  Matrix adjacency = Matrix::Zero(n_vertices, n_vertices);
+  const std::vector<VertexId> cells = serial.cells();
+  for (std::size_t c = 0; c < cells.size(); c += 4)
+    for (int i = 0; i < 4; ++i)
+      for (int j = 0; j < 4; ++j)
+        if (i != j) adjacency(number[cells[c + i]], number[cells[c + j]]) += 1.0;
+  Matrix S = Matrix::Zero(n_vertices * d, n_vertices * d);
+  const double omega = 2.0 / 3.0;
+  for (VertexId v = 0; v < n_vertices; ++v) {
+    const Eigen::Index a = number[static_cast<std::size_t>(v)];
+    const double kept = serial.point(v)[1] == 0 ? 0.0 : 1.0;  // Π: the bottom is fixed
+    const double degree = adjacency.row(a).sum();
+    for (Eigen::Index b = 0; b < n_vertices; ++b) {
+      const double factor = b == a ? 1.0 - omega : omega * adjacency(a, b) / degree;
+      for (int k = 0; k < d; ++k) S(a * d + k, b * d + k) = kept * factor;
+    }
+  }
+  const Matrix expected = S * T;
+  EXPECT_LT((P - expected).cwiseAbs().maxCoeff(), 1e-14 * expected.cwiseAbs().maxCoeff());
+}
+
 // Collective: CG's iterations to a relative residual of 1e-8 on A x = A x_true, with `pc`
 // set up by `set_up`; the relative error of x.
 template <class SetUp>
@@ -279,51 +340,90 @@ PetscInt cg_iterations(Mat A, Vec x_true, double& relative_error, SetUp&& set_up
   return iterations;
 }
 
-TEST(RankAggregation, MultigridCgNeedsFarFewerIterationsThanJacobiCg) {
-  const DistributedMesh part = distributed_box(3, 12);
-  const int d = 3;
-  const std::vector<std::uint8_t> fixed = bottom_fixed(part);
-  ElasticBody body(*part.local, LinearElastic(3e3, 0.3), 1000.0, 0.0);
+// Collective: the tangent of an elastic box held at y = 0, assembled, and a right-hand side
+// A x_true with x_true(row) = sin(row) + 1 (smooth and rough components alike).
+struct BoxSystem {
+  std::unique_ptr<ElasticBody> body;
+  std::unique_ptr<DistributedAssembledTangent> tangent;
+  VecHandle x_true;
+};
+
+BoxSystem box_system(const DistributedMesh& part, const std::vector<std::uint8_t>& fixed) {
+  const int d = part.local->dim();
+  BoxSystem system;
+  system.body = std::make_unique<ElasticBody>(*part.local, LinearElastic(3e3, 0.3), 1000.0, 0.0);
   std::vector<PetscInt> rows(fixed.size());
   PetscInt n_owned_dofs = 0;
   for (VertexId v = 0; v < part.local->n_points(); ++v) {
     for (int k = 0; k < d; ++k) rows[static_cast<std::size_t>(v) * d + k] = static_cast<PetscInt>(part.global_number[v] * d + k);
     n_owned_dofs += part.owned[v] ? d : 0;
   }
-  DistributedAssembledTangent tangent(part, body, rows, fixed, n_owned_dofs);
-  tangent.assemble(std::vector<double>(fixed.size(), 0.0));
-  const RankAggregationLevels levels = rank_aggregation_levels(part, fixed, 2.5);
-
-  // x_true(row) = sin(row) + 1: smooth and rough components alike.
-  VecHandle x_true;
-  SNEDE_PETSC(MatCreateVecs(tangent.mat(), x_true.out(), nullptr));
+  system.tangent = std::make_unique<DistributedAssembledTangent>(part, *system.body, rows, fixed, n_owned_dofs);
+  system.tangent->assemble(std::vector<double>(fixed.size(), 0.0));
+  SNEDE_PETSC(MatCreateVecs(system.tangent->mat(), system.x_true.out(), nullptr));
   PetscInt start = 0, end = 0;
-  SNEDE_PETSC(VecGetOwnershipRange(x_true, &start, &end));
-  for (PetscInt row = start; row < end; ++row) SNEDE_PETSC(VecSetValue(x_true, row, std::sin(double(row)) + 1.0, INSERT_VALUES));
-  SNEDE_PETSC(VecAssemblyBegin(x_true));
-  SNEDE_PETSC(VecAssemblyEnd(x_true));
+  SNEDE_PETSC(VecGetOwnershipRange(system.x_true, &start, &end));
+  for (PetscInt row = start; row < end; ++row)
+    SNEDE_PETSC(VecSetValue(system.x_true, row, std::sin(double(row)) + 1.0, INSERT_VALUES));
+  SNEDE_PETSC(VecAssemblyBegin(system.x_true));
+  SNEDE_PETSC(VecAssemblyEnd(system.x_true));
+  return system;
+}
 
+// PCMG on `levels` with Chebyshev/Jacobi smoothing and Galerkin coarse operators.
+void set_up_multigrid(PC pc, const RankAggregationLevels& levels) {
+  const auto n_levels = static_cast<PetscInt>(levels.interpolations.size()) + 1;
+  SNEDE_PETSC(PCSetType(pc, PCMG));
+  SNEDE_PETSC(PCMGSetLevels(pc, n_levels, nullptr));
+  SNEDE_PETSC(PCMGSetGalerkin(pc, PC_MG_GALERKIN_BOTH));
+  for (PetscInt l = 1; l < n_levels; ++l) {
+    SNEDE_PETSC(PCMGSetInterpolation(pc, l, levels.interpolations[l - 1]));
+    KSP smoother = nullptr;
+    PC jacobi_pc = nullptr;
+    SNEDE_PETSC(PCMGGetSmoother(pc, l, &smoother));
+    SNEDE_PETSC(KSPSetType(smoother, KSPCHEBYSHEV));
+    SNEDE_PETSC(KSPGetPC(smoother, &jacobi_pc));
+    SNEDE_PETSC(PCSetType(jacobi_pc, PCJACOBI));
+  }
+}
+
+PetscInt multigrid_cg_iterations(const DistributedMesh& part, const std::vector<std::uint8_t>& fixed,
+                                 const RankAggregationLevels& levels) {
+  const BoxSystem system = box_system(part, fixed);
+  double error = 0;
+  const PetscInt iterations =
+      cg_iterations(system.tangent->mat(), system.x_true, error, [&](PC pc) { set_up_multigrid(pc, levels); });
+  EXPECT_LT(error, 1e-5);
+  return iterations;
+}
+
+TEST(RankAggregation, MultigridCgNeedsFarFewerIterationsThanJacobiCg) {
+  const DistributedMesh part = distributed_box(3, 12);
+  const std::vector<std::uint8_t> fixed = bottom_fixed(part);
+  const BoxSystem system = box_system(part, fixed);
+  const RankAggregationLevels levels = rank_aggregation_levels(part, fixed, 2.5);
   double jacobi_error = 0, multigrid_error = 0;
-  const PetscInt jacobi = cg_iterations(tangent.mat(), x_true, jacobi_error, [](PC pc) { SNEDE_PETSC(PCSetType(pc, PCJACOBI)); });
-  const PetscInt multigrid = cg_iterations(tangent.mat(), x_true, multigrid_error, [&](PC pc) {
-    const auto n_levels = static_cast<PetscInt>(levels.interpolations.size()) + 1;
-    SNEDE_PETSC(PCSetType(pc, PCMG));
-    SNEDE_PETSC(PCMGSetLevels(pc, n_levels, nullptr));
-    SNEDE_PETSC(PCMGSetGalerkin(pc, PC_MG_GALERKIN_BOTH));
-    for (PetscInt l = 1; l < n_levels; ++l) {
-      SNEDE_PETSC(PCMGSetInterpolation(pc, l, levels.interpolations[l - 1]));
-      KSP smoother = nullptr;
-      PC jacobi_pc = nullptr;
-      SNEDE_PETSC(PCMGGetSmoother(pc, l, &smoother));
-      SNEDE_PETSC(KSPSetType(smoother, KSPCHEBYSHEV));
-      SNEDE_PETSC(KSPGetPC(smoother, &jacobi_pc));
-      SNEDE_PETSC(PCSetType(jacobi_pc, PCJACOBI));
-    }
-  });
+  const PetscInt jacobi =
+      cg_iterations(system.tangent->mat(), system.x_true, jacobi_error, [](PC pc) { SNEDE_PETSC(PCSetType(pc, PCJACOBI)); });
+  const PetscInt multigrid =
+      cg_iterations(system.tangent->mat(), system.x_true, multigrid_error, [&](PC pc) { set_up_multigrid(pc, levels); });
   if (world_rank() == 0) std::printf("CG iterations: Jacobi %d, multigrid %d\n", int(jacobi), int(multigrid));
   EXPECT_LT(jacobi_error, 1e-5);
   EXPECT_LT(multigrid_error, 1e-5);
   EXPECT_LT(3 * multigrid, jacobi);
+}
+
+TEST(RankAggregation, SmoothingTheFirstLevelSavesCgIterations) {
+  const DistributedMesh part = distributed_box(3, 12);
+  const std::vector<std::uint8_t> fixed = bottom_fixed(part);
+  const RankAggregationLevels plain = rank_aggregation_levels(part, fixed, 2.5);
+  const RankAggregationLevels smoothed = rank_aggregation_levels(part, fixed, 2.5, 0, default_direct_unknowns, true);
+  const PetscInt plain_iterations = multigrid_cg_iterations(part, fixed, plain);
+  const PetscInt smoothed_iterations = multigrid_cg_iterations(part, fixed, smoothed);
+  if (world_rank() == 0)
+    std::printf("CG iterations with multigrid: plain aggregates %d, smoothed first level %d\n", int(plain_iterations),
+                int(smoothed_iterations));
+  EXPECT_LT(smoothed_iterations, plain_iterations);
 }
 
 }  // namespace
