@@ -188,15 +188,13 @@ DistributedMesh take_part(MPI_Comm comm, DmHandle dm, std::vector<PetscInt> seri
 
   distributed.reset();
   dm.reset();
-  DistributedMesh result;
-  result.comm = comm;
-  result.local = std::make_unique<Mesh>(cell_dim, space_dim, std::move(points), local_cells);
-  result.global_vertex = std::move(global_vertex);
-  result.owned = std::move(owned);
-  result.global_number = std::move(global_number);
-  result.n_global_vertices = n_global_vertices;
-  result.n_global_cells = n_global_cells;
-  return result;
+  return DistributedMesh{.comm = comm,
+                         .local = std::make_unique<Mesh>(cell_dim, space_dim, std::move(points), local_cells),
+                         .global_vertex = std::move(global_vertex),
+                         .owned = std::move(owned),
+                         .global_number = std::move(global_number),
+                         .n_global_vertices = n_global_vertices,
+                         .n_global_cells = n_global_cells};
 }
 
 }  // namespace

@@ -149,15 +149,13 @@ DistributedMesh part_as_given(MPI_Comm comm, RankCells given, std::int64_t n_glo
     for (std::size_t c = 0; c < cells.size(); c += static_cast<std::size_t>(corners))
       if (simplex_orientation(points, space_dim, &cells[c], corners) < 0) std::swap(cells[c], cells[c + 1]);
 
-  DistributedMesh result;
-  result.comm = comm;
-  result.local = std::make_unique<Mesh>(given.cell_dim, space_dim, std::move(points), cells);
-  result.global_vertex = std::move(ids);
-  result.owned = std::move(owned);
-  result.global_number = std::move(global_number);
-  result.n_global_vertices = n_global_vertices;
-  result.n_global_cells = n_global_cells;
-  return result;
+  return DistributedMesh{.comm = comm,
+                         .local = std::make_unique<Mesh>(given.cell_dim, space_dim, std::move(points), cells),
+                         .global_vertex = std::move(ids),
+                         .owned = std::move(owned),
+                         .global_number = std::move(global_number),
+                         .n_global_vertices = n_global_vertices,
+                         .n_global_cells = n_global_cells};
 }
 
 }  // namespace snede

@@ -106,9 +106,13 @@ class PartBody:
         Collective."""
         self._edits += 1
         direction = np.asarray(direction, dtype=np.float64)
-        if direction.shape != (self.dim,) or not np.all(np.isfinite(direction)) or not np.any(direction):
-            raise ValueError(f"direction must be a non-zero finite {self.dim}-vector, got {direction.tolist()}")
-        ids, anchors = self._joined(vertices, lambda local: self._displacement[local])
+
+        def anchors_of(local):  # checked inside the ranks' agreement: a bad direction raises on all
+            if direction.shape != (self.dim,) or not np.all(np.isfinite(direction)) or not np.any(direction):
+                raise ValueError(f"direction must be a non-zero finite {self.dim}-vector, got {direction.tolist()}")
+            return self._displacement[local]
+
+        ids, anchors = self._joined(vertices, anchors_of)
         unit = tuple(direction / np.linalg.norm(direction))
         for v, anchor in zip(ids.tolist(), anchors):
             self._fixed.pop(v, None)

@@ -122,6 +122,9 @@ def test_refusals_name_the_reason_on_every_rank():
         snede.StaticSolver(body, "cg", comm=COMM.Dup())
     with pytest.raises(ValueError, match="shape"):
         body.displacement = np.zeros((3, 3))
+    with pytest.raises(ValueError, match="non-zero finite 3-vector"):  # on one rank: every rank raises
+        body.slide(np.isclose(body.mesh.points[:, 0], 1.0), (0.0, 0.0, 0.0) if COMM.rank == COMM.size - 1 else (0, 0, 1))
+    assert COMM.allreduce(1) == COMM.size
 
 
 def test_no_array_of_the_whole_body_on_a_rank():
