@@ -21,7 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
-from snede import _checks, _records, _snede
+from snede import _checks, _records, _snede, part_groups
 from snede.mesh import Mesh
 from snede._snede import SolveResult
 
@@ -77,7 +77,8 @@ class DistributedMesh:
         holds the whole. A series written on ranks gives its vertices their serial ids back
         (its field ``serial_vertex``), so conditions by serial id apply as before. Every other
         format ``snede.Mesh.read`` takes is read whole by rank 0 and distributed
-        (``distribute``). A file that cannot be read raises the same error on every rank."""
+        (``distribute``), with its named groups (a series read in shares has none). A file that
+        cannot be read raises the same error on every rank."""
         from snede import series_files
 
         comm = _world() if comm is None else comm
@@ -112,10 +113,14 @@ class DistributedMesh:
 
 def distribute(mesh: Mesh | None, comm=None) -> DistributedMesh:
     """Partition rank 0's ``mesh`` over ``comm`` (default ``MPI.COMM_WORLD``) with DMPlex;
-    every rank returns its part. Collective."""
+    every rank returns its part, with the mesh's named groups (their members on the rank,
+    ``part_groups.py``). Collective."""
     comm = _world() if comm is None else comm
     serial = mesh._impl if (comm.rank == 0 and isinstance(mesh, Mesh)) else None
-    return _part(comm, _snede.distribute_mesh(comm.py2f(), serial))
+    part = _part(comm, _snede.distribute_mesh(comm.py2f(), serial))
+    groups = agreed(comm, lambda: part_groups.serial_groups(mesh) if comm.rank == 0 else None)
+    part_groups.give_groups(part, *comm.bcast(groups, root=0))
+    return part
 
 
 def distribute_cells(cells, coordinates, comm=None) -> DistributedMesh:
