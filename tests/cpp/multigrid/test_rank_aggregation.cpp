@@ -22,7 +22,7 @@
 #include "fem/elastic_body.hpp"
 #include "fem/linear_elastic.hpp"
 #include "mesh/distributed_mesh.hpp"
-#include "mesh/fixtures.hpp"
+#include "mesh/distributed_box.hpp"
 #include "multigrid/dense_matrix.hpp"
 #include "problem/distributed_assembly.hpp"
 #include "multigrid/rank_aggregation.hpp"
@@ -32,35 +32,9 @@ using namespace snede;
 namespace {
 
 using Matrix = Eigen::MatrixXd;
-
-int world_rank() {
-  int rank = 0;
-  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
-  return rank;
-}
-
-// The unit square (n × n squares, two triangles each) or cube (n³ Kuhn-split cubes).
-Mesh unit_box(int dim, int n) {
-  const std::vector<std::vector<VertexId>> cells = dim == 2 ? snede::testing::grid_triangles(n, n) : snede::testing::kuhn_box(n);
-  std::vector<double> points;
-  for (int i = 0; i <= n; ++i)
-    for (int j = 0; j <= n; ++j) {
-      if (dim == 2) {
-        points.insert(points.end(), {double(i) / n, double(j) / n});
-        continue;
-      }
-      for (int k = 0; k <= n; ++k) points.insert(points.end(), {double(i) / n, double(j) / n, double(k) / n});
-    }
-  std::vector<std::int64_t> flat;
-  for (const auto& cell : cells) flat.insert(flat.end(), cell.begin(), cell.end());
-  return Mesh(dim, dim, std::move(points), flat);
-}
-
-// Collective: the box distributed over MPI_COMM_WORLD.
-DistributedMesh distributed_box(int dim, int n) {
-  const Mesh serial = unit_box(dim, n);
-  return distribute_mesh(MPI_COMM_WORLD, world_rank() == 0 ? &serial : nullptr);
-}
+using snede::testing::distributed_box;
+using snede::testing::unit_box;
+using snede::testing::world_rank;
 
 // 1 on every dof of the local vertices on the face y = 0.
 std::vector<std::uint8_t> bottom_fixed(const DistributedMesh& part) {
