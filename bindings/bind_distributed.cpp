@@ -121,6 +121,9 @@ void bind_distributed(py::module_& m) {
                             1);
           },
           py::arg("local_displacement"))
+      .def("require_held", &DistributedStatic::require_held,
+           "Collective: ValueError on every rank when some piece of the body (on any ranks) is not held "
+           "(the serial Body's check, problem/rank_piece_holding.hpp).")
       .def("energy", [](DistributedStatic& s) { return s.energy(); })
       .def("local_displacement", [](DistributedStatic& s) { return to_array(s.local_displacement(), 1); });
 }

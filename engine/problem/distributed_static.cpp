@@ -17,6 +17,7 @@
 #include "mesh/element_quality.hpp"
 #include "fem/stable_time_step.hpp"
 #include "problem/projected_stiffness.hpp"
+#include "problem/rank_piece_holding.hpp"
 #include "problem/stopping.hpp"
 
 namespace snede {
@@ -414,6 +415,8 @@ class AssembledDistributedTangent final : public AssembledProblemTangent {
   DistributedAssembledTangent tangent_;
   std::vector<double> u_local_;
 };
+
+void DistributedStatic::require_held() const { require_held_on_ranks(part_, constraints_); }
 
 std::unique_ptr<AssembledProblemTangent> DistributedStatic::make_assembled_tangent(MatrixFormat) {
   return std::make_unique<AssembledDistributedTangent>(*this);

@@ -78,6 +78,10 @@ class DistributedStatic final : public Problem {
     return body_.inverted_elements(local_displacement);
   }
 
+  // Collective: throws the same std::invalid_argument on every rank when a piece of the body,
+  // wherever its cells lie, is not held by the constraints (rank_piece_holding.hpp).
+  void require_held() const;
+
   // What the solvers (SNES callbacks, DynamicRelaxation) use. All collective.
   // F = P(−f_int(u) − f_ext) + c (I − P)(u − ū). Not admissible when an element on some rank is
   // inverted (for a material that forbids it) or not finite; F is then NaN on every rank.

@@ -15,49 +15,7 @@
 namespace snede {
 namespace {
 
-// The rigid motions' values at x (relative to the piece's origin), (dim × n_motions) row-major
-// into `rows`: translations, then rotations, u = a + ω × x = a − [x]× ω (3D) or a + ω (−y, x) (2D).
-void rigid_motions_at(std::span<const double> x, int dim, std::span<double> rows) {
-  const int n = dim == 3 ? 6 : 3;
-  std::fill(rows.begin(), rows.end(), 0.0);
-  for (int k = 0; k < dim; ++k) rows[k * n + k] = 1;
-  if (dim == 2) {
-    rows[0 * n + 2] = -x[1];
-    rows[1 * n + 2] = x[0];
-    return;
-  }
-  // −[x]× in columns 3–5: (x × ω)_i = ε_ijk x_j ω_k, negated.
-  rows[0 * n + 4] = x[2], rows[0 * n + 5] = -x[1];
-  rows[1 * n + 3] = -x[2], rows[1 * n + 5] = x[0];
-  rows[2 * n + 3] = x[1], rows[2 * n + 4] = -x[0];
-}
-
 }  // namespace
-
-// A piece's constraint rows on its rigid motions, accumulated as the Gram matrix Σ Rᵀ(I − P)R,
-// with the motions taken about the piece's first constrained vertex (the rank does not depend
-// on the origin; about a constrained vertex, span measures the supports' own extent).
-struct PieceHolding::Gram {
-  Eigen::MatrixXd gram;
-  std::array<double, 3> origin{0, 0, 0};
-  double span = 0;  // largest |x − origin| over its constrained vertices: the rotations' scale
-  std::size_t components = 0;
-
-  // The rank of the rows: rotations scaled by 1/span so that every entry is O(1); the
-  // eigenvalues of a direction the rows do not constrain are then rounding, O(1e-16) relative,
-  // and 1e-10 leaves six orders of margin (it counts as a hinge a set of vertices off a line by
-  // less than 1e-5 of their span, which holds the piece no better numerically).
-  std::size_t rank() const {
-    if (components == 0) return 0;
-    const int n = static_cast<int>(gram.rows());
-    Eigen::VectorXd scale = Eigen::VectorXd::Ones(n);
-    if (span > 0) scale.tail(n / 2).setConstant(1 / span);
-    const Eigen::MatrixXd scaled = scale.asDiagonal() * gram * scale.asDiagonal();
-    const Eigen::VectorXd eigenvalues = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(scaled).eigenvalues();
-    const double largest = eigenvalues.maxCoeff();
-    return static_cast<std::size_t>((eigenvalues.array() > 1e-10 * largest).count());
-  }
-};
 
 // The labels of the elements kept through the edits, and the vertices whose stars the edits
 // changed since the last time they were settled.
@@ -206,29 +164,16 @@ void PieceHolding::follow_edits() {
   labelled_changes_ = watcher_->changes_heard();
 }
 
-std::vector<PieceHolding::Gram> PieceHolding::grams(const Constraints& constraints) const {
-  const int dim = constraints.dim(), n_motions = dim == 3 ? 6 : 3;
-  std::vector<Gram> grams(pieces_, Gram{Eigen::MatrixXd::Zero(n_motions, n_motions)});
-  std::vector<double> block(static_cast<std::size_t>(dim * dim)), rows(static_cast<std::size_t>(dim * n_motions));
-  Eigen::MatrixXd complement(dim, dim);
+std::vector<RigidMotionGram> PieceHolding::grams(const Constraints& constraints) const {
+  const int dim = constraints.dim();
+  std::vector<RigidMotionGram> grams(pieces_, RigidMotionGram(dim));
+  std::vector<double> block(static_cast<std::size_t>(dim * dim));
   const VertexId n = std::min(constraints.n_points(), static_cast<VertexId>(vertex_piece_.size()));
   auto add = [&](VertexId v, int piece) {
     const std::size_t components = constraints.constrained_components(v);
     if (components == 0) return;
-    Gram& g = grams[piece];
-    if (g.components == 0)
-      for (int k = 0; k < dim; ++k) g.origin[k] = mesh_.point(v)[k];
-    std::array<double, 3> x{0, 0, 0};
-    for (int k = 0; k < dim; ++k) x[k] = mesh_.point(v)[k] - g.origin[k];
-    g.span = std::max(g.span, std::sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]));
-    g.components += components;
-    rigid_motions_at(x, dim, rows);
     constraints.projection_block(v, block);
-    for (int i = 0; i < dim; ++i)
-      for (int j = 0; j < dim; ++j) complement(i, j) = (i == j) - block[static_cast<std::size_t>(i * dim + j)];
-    const Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>> R(rows.data(), dim,
-                                                                                                      n_motions);
-    g.gram += R.transpose() * complement * R;
+    grams[piece].add(mesh_.point(v), block, components);
   };
   for (VertexId v = 0; v < n; ++v)
     if (vertex_piece_[v] >= 0) add(v, vertex_piece_[v]);
@@ -237,7 +182,7 @@ std::vector<PieceHolding::Gram> PieceHolding::grams(const Constraints& constrain
   return grams;
 }
 
-std::vector<LoosePiece> PieceHolding::loose_of(const std::vector<Gram>& grams, bool by_count) const {
+std::vector<LoosePiece> PieceHolding::loose_of(const std::vector<RigidMotionGram>& grams, bool by_count) const {
   const std::size_t n_motions = grams.empty() ? 0 : static_cast<std::size_t>(grams.front().gram.rows());
   std::vector<LoosePiece> loose;
   for (int piece = 0; piece < pieces_; ++piece) {
@@ -271,12 +216,16 @@ std::vector<LoosePiece> PieceHolding::loose_pieces(const Constraints& constraint
 void PieceHolding::require_held(const Constraints& constraints) {
   const std::vector<LoosePiece> loose = loose_pieces(constraints);
   if (loose.empty()) return;
+  throw std::invalid_argument(
+      not_held_message(loose, mesh_.connectivity().element(loose.front().first_cell).simplex.vertices()[0]));
+}
+
+std::string not_held_message(const std::vector<LoosePiece>& loose, std::int64_t vertex_of_first) {
   const LoosePiece& first = loose.front();
   const std::string which =
       first.pieces == 1 ? "it is one piece of " + std::to_string(first.cells) + " cells with "
                         : "piece " + std::to_string(first.piece + 1) + " of " + std::to_string(first.pieces) + " (" +
-                              std::to_string(first.cells) + " cells, vertex " +
-                              std::to_string(mesh_.connectivity().element(first.first_cell).simplex.vertices()[0]) +
+                              std::to_string(first.cells) + " cells, vertex " + std::to_string(vertex_of_first) +
                               " among them) has ";
   std::string message = "the body is not held: " + which + std::to_string(first.constrained_components) +
                         " constrained displacement components, which stop " +
@@ -284,14 +233,12 @@ void PieceHolding::require_held(const Constraints& constraints) {
                         std::to_string(first.rigid_motions) +
                         " rigid motions (3 in 2D, 6 in 3D: vertices on one line leave a solid free to turn " +
                         "about it; a membrane needs 6 constrained components)";
-  if (first.pieces == 1)
-    throw std::invalid_argument(message + "; fix some of its vertices with body.fix");
+  if (first.pieces == 1) return message + "; fix some of its vertices with body.fix";
   message += "; " + std::to_string(loose.size()) + " of the " + std::to_string(first.pieces) + " pieces " +
              (loose.size() == 1 ? "is" : "are") + " not held. A static solve needs every piece held (a cut can " +
              "free one): fix some vertices of each with body.fix, or call body.fix_free_pieces() to fix each on " +
              "one of its cells where it is now (TetrahedralCutter(fix_free_pieces=True) does this while cutting)";
-  throw std::invalid_argument(message);
+  return message;
 }
-
 
 }  // namespace snede

@@ -15,11 +15,13 @@
 #include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <string>
 #include <utility>
 #include <vector>
 
 #include "mesh/mesh.hpp"
 #include "problem/constraints.hpp"
+#include "problem/rigid_motion_gram.hpp"
 
 namespace snede {
 
@@ -64,7 +66,6 @@ class PieceHolding {
 
  private:
   class EditWatcher;
-  struct Gram;
 
   void label_from_scratch();
   void sort_hinges();
@@ -72,8 +73,8 @@ class PieceHolding {
   void label_vertices(Label label, int pieces);
   void follow_edits();
   void label_vertex(VertexId v);
-  std::vector<Gram> grams(const Constraints& constraints) const;
-  std::vector<LoosePiece> loose_of(const std::vector<Gram>& grams, bool by_count) const;
+  std::vector<RigidMotionGram> grams(const Constraints& constraints) const;
+  std::vector<LoosePiece> loose_of(const std::vector<RigidMotionGram>& grams, bool by_count) const;
 
   const Mesh& mesh_;
   Connectivity* followed_ = nullptr;      // null: labelled from scratch at each topology revision
@@ -89,5 +90,9 @@ class PieceHolding {
   std::vector<ElementId> piece_first_cell_;
   std::size_t whole_labellings_ = 0;
 };
+
+// The error a static solve gives when pieces are not held: the first of `loose` (naming
+// `vertex_of_first`, a vertex of it) and the remedies.
+std::string not_held_message(const std::vector<LoosePiece>& loose, std::int64_t vertex_of_first);
 
 }  // namespace snede

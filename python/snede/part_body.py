@@ -150,11 +150,10 @@ class PartBody:
         return faces[~inside]
 
     def require_held(self) -> None:
-        """ValueError unless some vertex is fixed or sliding (a static solve needs supports).
-        Unlike the serial Body's check, pieces are not told apart on ranks yet."""
-        if not self._fixed and not self._sliding:
-            raise ValueError("the body is not held: no vertex of it is fixed or sliding; fix some of its vertices "
-                             "with body.fix")
+        """ValueError on every rank unless the constraints hold every piece of the body (cells
+        joined through faces, wherever they lie), as the serial Body checks before a static
+        solve: each piece's fixed and sliding vertices must stop its rigid motions. Collective."""
+        self.problem()._impl.require_held()
 
     # -- loads (§6.6: gravity and named nodal-force channels) --------------------------------
     def add_gravity(self, g=(0.0, 0.0, -9.81)) -> None:
