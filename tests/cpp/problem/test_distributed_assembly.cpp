@@ -17,46 +17,15 @@
 #include "core/petsc_util.hpp"
 #include "fem/neo_hookean.hpp"
 #include "mesh/distributed_box.hpp"
+#include "problem/distributed_cases.hpp"
 #include "problem/distributed_static.hpp"
 
 using namespace snede;
+using snede::testing::deformation;
+using snede::testing::held_and_sliding;
+using snede::testing::norm;
 
 namespace {
-
-// Fixed at y = 0; sliding along an oblique line at x = 1 (not at y = 0); by serial ids.
-DistributedConditions held_and_sliding(const Mesh& serial) {
-  const int d = serial.dim();
-  DistributedConditions conditions;
-  for (VertexId v = 0; v < serial.n_points(); ++v) {
-    const std::span<const double> x = serial.point(v);
-    if (x[1] == 0) {
-      conditions.fixed.push_back(v);
-      conditions.fixed_values.insert(conditions.fixed_values.end(), static_cast<std::size_t>(d), 0.0);
-    } else if (x[0] == 1) {
-      conditions.sliding.push_back(v);
-      for (int k = 0; k < d; ++k) conditions.sliding_directions.push_back(1.0 + k);
-      conditions.sliding_anchors.insert(conditions.sliding_anchors.end(), static_cast<std::size_t>(d), 0.0);
-    }
-  }
-  return conditions;
-}
-
-// A smooth deformation of the serial vertices, `amount` of the box's size.
-std::vector<double> deformation(const Mesh& serial, double amount) {
-  const int d = serial.dim();
-  std::vector<double> u(static_cast<std::size_t>(serial.n_points()) * d);
-  for (VertexId v = 0; v < serial.n_points(); ++v) {
-    const std::span<const double> x = serial.point(v);
-    for (int k = 0; k < d; ++k) u[static_cast<std::size_t>(v) * d + k] = amount * std::sin(2.0 * x[0] + k) * x[1];
-  }
-  return u;
-}
-
-double norm(Vec x) {
-  double value = 0;
-  SNEDE_PETSC(VecNorm(x, NORM_2, &value));
-  return value;
-}
 
 void expect_entries_give_the_shells_product(int dim, int n) {
   const Mesh serial = snede::testing::unit_box(dim, n);
