@@ -10,8 +10,8 @@
 
 #include "core/csr_matrix.hpp"
 #include "core/error.hpp"
-#include "mesh/traversal.hpp"
 #include "problem/projected_stiffness.hpp"
+#include "problem/vertex_neighbours.hpp"
 
 namespace snede {
 namespace {
@@ -87,38 +87,13 @@ DistributedAssembledTangent::DistributedAssembledTangent(const DistributedMesh& 
 }
 
 void DistributedAssembledTangent::find_neighbours() {
-  const Connectivity& c = part_.local->connectivity();
-  const auto n = static_cast<VertexId>(part_.owned.size());
-  const VertexStars stars = all_vertex_stars(c, n);
-  const std::vector<std::int64_t>& number = part_.global_number;
-  neighbour_start_.assign(static_cast<std::size_t>(n) + 1, 0);
-  neighbours_.clear();
-  neighbours_.reserve(stars.entries.size() * 2 + n);
-  block_rank_.assign(static_cast<std::size_t>(c.element_capacity()) * corners_ * corners_, 0);
-  self_rank_.resize(n);
-  std::vector<std::int32_t> place(n, -1);
-  for (VertexId v = 0; v < n; ++v) {
-    const std::size_t first = neighbours_.size();
-    for (std::size_t s = stars.start[v]; s < stars.start[v + 1]; ++s)
-      for (VertexId w : std::span(stars.vertices[stars.element_of(stars.entries[s])]).first(corners_))
-        if (place[w] < 0) {
-          place[w] = 0;
-          neighbours_.push_back(w);
-        }
-    // Sorted by global number, so a row's columns come in PETSc's order.
-    std::sort(neighbours_.begin() + static_cast<std::ptrdiff_t>(first), neighbours_.end(),
-              [&](VertexId a, VertexId b) { return number[a] < number[b]; });
-    for (std::size_t k = first; k < neighbours_.size(); ++k) place[neighbours_[k]] = static_cast<std::int32_t>(k - first);
-    self_rank_[v] = place[v];
-    for (std::size_t s = stars.start[v]; s < stars.start[v + 1]; ++s) {
-      const std::size_t k = stars.element_of(stars.entries[s]);
-      std::int32_t* ranks =
-          block_rank_.data() + (static_cast<std::size_t>(stars.elements[k]) * corners_ + stars.corner_of(stars.entries[s])) * corners_;
-      for (int b = 0; b < corners_; ++b) ranks[b] = place[stars.vertices[k][b]];
-    }
-    for (std::size_t k = first; k < neighbours_.size(); ++k) place[neighbours_[k]] = -1;
-    neighbour_start_[v + 1] = neighbours_.size();
-  }
+  // Sorted by global number, so that a row's columns come in PETSc's order.
+  VertexNeighbours found = vertex_neighbours(part_.local->connectivity(), static_cast<VertexId>(part_.owned.size()),
+                                             corners_, false, part_.global_number);
+  neighbour_start_ = std::move(found.start);
+  neighbours_ = std::move(found.neighbours);
+  block_rank_ = std::move(found.block_rank);
+  self_rank_ = std::move(found.self_rank);
 }
 
 void DistributedAssembledTangent::make_matrix(PetscInt n_owned_dofs) {

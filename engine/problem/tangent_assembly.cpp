@@ -11,8 +11,8 @@
 
 #include "core/error.hpp"
 #include "core/petsc_util.hpp"
-#include "mesh/traversal.hpp"
 #include "problem/projected_stiffness.hpp"
+#include "problem/vertex_neighbours.hpp"
 
 namespace snede {
 namespace {
@@ -50,51 +50,14 @@ AssembledTangent::AssembledTangent(const Model& model, MatrixFormat format, Memb
 
 void AssembledTangent::find_neighbours(const Model& model) {
   const Mesh& mesh = model.body().mesh();
-  const Connectivity& c = mesh.connectivity();
-  const VertexId n = mesh.n_points();
-  // Each vertex's neighbours (itself included), sorted, in one flat array (CSR), and every
-  // element block's place among them, made vertex by vertex from the elements around each (one
-  // small sort per vertex, a scratch array for the places) rather than by searching sorted lists.
-  const VertexStars stars = all_vertex_stars(c, n);
-  const int corners = corners_per_cell(model);
   // A smoothed formulation's vertex patch joins every pair of its vertex's neighbours: blocks
   // for every vertex within two edges, their ranks found per patch (patch_block_ranks).
   patches_ = model.body().formulation() != Formulation::p1;
-  auto add_star = [&](VertexId v, auto&& add) {
-    for (std::size_t s = stars.start[v]; s < stars.start[v + 1]; ++s)
-      for (VertexId w : std::span(stars.vertices[stars.element_of(stars.entries[s])]).first(corners)) add(w);
-  };
-  neighbour_start_.assign(static_cast<std::size_t>(n) + 1, 0);
-  neighbours_.clear();
-  neighbours_.reserve(stars.entries.size() * 2 + n);
-  std::vector<std::int32_t> place(n, -1);
-  if (!patches_) block_rank_.assign(static_cast<std::size_t>(c.element_capacity()) * corners * corners, 0);
-  self_rank_.resize(n);
-  for (VertexId v = 0; v < n; ++v) {
-    const std::size_t first = neighbours_.size();
-    neighbours_.push_back(v);
-    place[v] = 0;
-    auto add = [&](VertexId w) {
-      if (place[w] < 0) {
-        place[w] = 0;
-        neighbours_.push_back(w);
-      }
-    };
-    add_star(v, add);
-    if (patches_)
-      for (std::size_t k = first + 1, end = neighbours_.size(); k < end; ++k) add_star(neighbours_[k], add);
-    std::sort(neighbours_.begin() + static_cast<std::ptrdiff_t>(first), neighbours_.end());
-    for (std::size_t k = first; k < neighbours_.size(); ++k) place[neighbours_[k]] = static_cast<std::int32_t>(k - first);
-    self_rank_[v] = place[v];
-    for (std::size_t s = stars.start[v]; s < stars.start[v + 1] && !patches_; ++s) {
-      const std::size_t k = stars.element_of(stars.entries[s]);
-      const int a = stars.corner_of(stars.entries[s]);
-      std::int32_t* ranks = block_rank_.data() + (static_cast<std::size_t>(stars.elements[k]) * corners + a) * corners;
-      for (int b = 0; b < corners; ++b) ranks[b] = place[stars.vertices[k][b]];
-    }
-    for (std::size_t k = first; k < neighbours_.size(); ++k) place[neighbours_[k]] = -1;
-    neighbour_start_[v + 1] = neighbours_.size();
-  }
+  VertexNeighbours found = vertex_neighbours(mesh.connectivity(), mesh.n_points(), corners_per_cell(model), patches_);
+  neighbour_start_ = std::move(found.start);
+  neighbours_ = std::move(found.neighbours);
+  block_rank_ = std::move(found.block_rank);
+  self_rank_ = std::move(found.self_rank);
 }
 
 void AssembledTangent::follow_neighbours(const Model& model, const AssembledTangent& earlier,
