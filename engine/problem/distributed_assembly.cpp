@@ -4,11 +4,11 @@
 #include <initializer_list>
 #include <limits>
 #include <memory>
-#include <numeric>
 #include <type_traits>
 #include <unordered_map>
 
 #include "core/csr_matrix.hpp"
+#include "core/rank_messages.hpp"
 #include "core/error.hpp"
 #include "problem/projected_stiffness.hpp"
 #include "problem/vertex_neighbours.hpp"
@@ -119,15 +119,7 @@ void DistributedAssembledTangent::make_matrix(PetscInt n_owned_dofs) {
     message.push_back(static_cast<PetscInt>(neighbour_start_[v + 1] - neighbour_start_[v]));
     columns_of(v, [&](PetscInt column) { message.push_back(column); });
   }
-  std::vector<int> send_counts(size), receive_counts(size), send_starts(size + 1, 0), receive_starts(size + 1, 0);
-  for (int r = 0; r < size; ++r) send_counts[r] = static_cast<int>(outgoing[r].size());
-  MPI_Alltoall(send_counts.data(), 1, MPI_INT, receive_counts.data(), 1, MPI_INT, comm);
-  std::partial_sum(send_counts.begin(), send_counts.end(), send_starts.begin() + 1);
-  std::partial_sum(receive_counts.begin(), receive_counts.end(), receive_starts.begin() + 1);
-  std::vector<PetscInt> sent, received(static_cast<std::size_t>(receive_starts[size]));
-  for (const auto& message : outgoing) sent.insert(sent.end(), message.begin(), message.end());
-  MPI_Alltoallv(sent.data(), send_counts.data(), send_starts.data(), MPIU_INT, received.data(), receive_counts.data(),
-                receive_starts.data(), MPIU_INT, comm);
+  const std::vector<PetscInt> received = exchange_messages(comm, outgoing, MPIU_INT);
   // The columns other ranks' cells give an owned row, by the row's global number.
   std::unordered_map<PetscInt, std::vector<PetscInt>> extra;
   for (std::size_t at = 0; at < received.size();) {

@@ -8,6 +8,7 @@
 #include <stdexcept>
 #include <vector>
 
+#include "core/rank_messages.hpp"
 #include "mesh/traversal.hpp"
 #include "problem/piece_holding.hpp"
 #include "problem/rigid_motion_gram.hpp"
@@ -25,21 +26,6 @@ int size_of(MPI_Comm comm) {
   int size = 1;
   MPI_Comm_size(comm, &size);
   return size;
-}
-
-// Every rank's `sent[r]` to rank r: what this rank received, in rank order.
-std::vector<std::int64_t> all_to_all(MPI_Comm comm, const std::vector<std::vector<std::int64_t>>& sent) {
-  const int size = size_of(comm);
-  std::vector<int> send_counts(size), receive_counts(size), send_starts(size + 1, 0), receive_starts(size + 1, 0);
-  for (int r = 0; r < size; ++r) send_counts[r] = static_cast<int>(sent[r].size());
-  MPI_Alltoall(send_counts.data(), 1, MPI_INT, receive_counts.data(), 1, MPI_INT, comm);
-  std::partial_sum(send_counts.begin(), send_counts.end(), send_starts.begin() + 1);
-  std::partial_sum(receive_counts.begin(), receive_counts.end(), receive_starts.begin() + 1);
-  std::vector<std::int64_t> flat, received(static_cast<std::size_t>(receive_starts[size]));
-  for (const auto& part : sent) flat.insert(flat.end(), part.begin(), part.end());
-  MPI_Alltoallv(flat.data(), send_counts.data(), send_starts.data(), MPI_INT64_T, received.data(), receive_counts.data(),
-                receive_starts.data(), MPI_INT64_T, comm);
-  return received;
 }
 
 int find_root(std::vector<int>& parent, int node) {
@@ -66,7 +52,7 @@ std::pair<std::vector<int>, int> global_pieces(const DistributedMesh& part, cons
     message.push_back(rank);
     message.push_back(element_piece[c.face(face).element]);
   }
-  const std::vector<std::int64_t> judged = all_to_all(comm, to_judge);
+  const std::vector<std::int64_t> judged = exchange_messages(comm, to_judge, MPI_INT64_T);
   // A face given twice joins two ranks' pieces: [rank, piece, rank, piece] to rank 0.
   const std::size_t record = static_cast<std::size_t>(corners) + 2;
   std::vector<std::size_t> order(judged.size() / record);
@@ -82,7 +68,7 @@ std::pair<std::vector<int>, int> global_pieces(const DistributedMesh& part, cons
       for (std::size_t side : {order[k], order[k + 1]})
         joins[0].insert(joins[0].end(), judged.begin() + static_cast<std::ptrdiff_t>(side * record + corners),
                         judged.begin() + static_cast<std::ptrdiff_t>(side * record + record));
-  const std::vector<std::int64_t> all_joins = all_to_all(comm, joins);
+  const std::vector<std::int64_t> all_joins = exchange_messages(comm, joins, MPI_INT64_T);
   // Rank 0 joins the pieces (nodes numbered rank by rank) and numbers the classes in that order.
   std::vector<int> counts(size), starts(size + 1, 0);
   MPI_Allgather(&local_pieces, 1, MPI_INT, counts.data(), 1, MPI_INT, comm);
