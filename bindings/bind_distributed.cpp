@@ -4,6 +4,7 @@
 #include "solvers/dynamic_relaxation.hpp"
 #include "problem/distributed_static.hpp"
 #include "problem/model.hpp"
+#include "topology/rank_refinement.hpp"
 
 #include <pybind11/stl.h>
 
@@ -55,6 +56,32 @@ void bind_distributed(py::module_& m) {
         return distribute_cells(MPI_Comm_f2c(static_cast<MPI_Fint>(comm)), std::move(part));
       },
       py::arg("comm"), py::arg("cell_dim"), py::arg("cells"), py::arg("coordinates"));
+  // Conforming bisection on ranks (collective): (new part, `field` carried to it as (n, width),
+  // (n_new, 3) new vertices this rank numbered with their parents, cells split over all ranks).
+  const auto refined = [](RefinedPart r, int width) {
+    return py::make_tuple(std::move(r.part), to_array(r.field, width), to_array(r.new_vertices, 3), r.n_split);
+  };
+  m.def(
+      "refine_part_uniform",
+      [refined](const DistributedMesh& part, int levels, const DoubleArray& field, int width) {
+        std::span<const double> values(field.data(), static_cast<std::size_t>(field.size()));
+        py::gil_scoped_release released;
+        RefinedPart r = refine_part_uniform(part, levels, values, width);
+        py::gil_scoped_acquire acquired;
+        return refined(std::move(r), width);
+      },
+      py::arg("part"), py::arg("levels"), py::arg("field"), py::arg("width"));
+  m.def(
+      "refine_part_around",
+      [refined](const DistributedMesh& part, const DoubleArray& x, double h, const DoubleArray& field, int width) {
+        std::span<const double> point(x.data(), static_cast<std::size_t>(x.size())),
+            values(field.data(), static_cast<std::size_t>(field.size()));
+        py::gil_scoped_release released;
+        RefinedPart r = refine_part_around(part, point, h, values, width);
+        py::gil_scoped_acquire acquired;
+        return refined(std::move(r), width);
+      },
+      py::arg("part"), py::arg("x"), py::arg("h"), py::arg("field"), py::arg("width"));
   // RankAgreement for Python's collective calls: `inputs` are (name, the input's bytes) pairs,
   // the same names in the same order on every rank.
   m.def(

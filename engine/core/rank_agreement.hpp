@@ -8,6 +8,7 @@
 #include <mpi.h>
 
 #include <cstdint>
+#include <limits>
 #include <span>
 #include <stdexcept>
 #include <string>
@@ -83,5 +84,22 @@ class RankAgreement {
   std::vector<std::string> names_;
   std::vector<std::uint64_t> digests_;
 };
+
+// Collective: the problem the lowest rank found (`problem` empty where a rank found none),
+// prefixed "<caller>: rank r: ", the same on every rank; empty when no rank found any. A rank
+// that finds a problem throws it only after this, so no rank waits alone.
+inline std::string first_rank_problem(MPI_Comm comm, const std::string& caller, std::string problem) {
+  int rank = 0;
+  MPI_Comm_rank(comm, &rank);
+  int first = problem.empty() ? std::numeric_limits<int>::max() : rank;
+  MPI_Allreduce(MPI_IN_PLACE, &first, 1, MPI_INT, MPI_MIN, comm);
+  if (first == std::numeric_limits<int>::max()) return "";
+  if (rank == first) problem = caller + ": rank " + std::to_string(rank) + ": " + problem;
+  int length = static_cast<int>(problem.size());
+  MPI_Bcast(&length, 1, MPI_INT, first, comm);
+  problem.resize(static_cast<std::size_t>(length));
+  MPI_Bcast(problem.data(), length, MPI_CHAR, first, comm);
+  return problem;
+}
 
 }  // namespace snede

@@ -11,6 +11,7 @@
 
 #include "core/error.hpp"
 #include "core/petsc_handle.hpp"
+#include "core/rank_agreement.hpp"
 #include "mesh/part_as_given.hpp"
 
 #ifdef SNEDE_HAVE_PTSCOTCH
@@ -96,18 +97,7 @@ std::string agreed_rank_cells(MPI_Comm comm, const RankCells& part) {
         break;
       }
   }
-  int rank = 0;
-  MPI_Comm_rank(comm, &rank);
-  // The lowest rank that found a problem tells it to every rank.
-  int first = problem.empty() ? std::numeric_limits<int>::max() : rank;
-  MPI_Allreduce(MPI_IN_PLACE, &first, 1, MPI_INT, MPI_MIN, comm);
-  if (first == std::numeric_limits<int>::max()) return "";
-  if (rank == first) problem = "distribute_cells: rank " + std::to_string(rank) + "'s part: " + problem;
-  int length = static_cast<int>(problem.size());
-  MPI_Bcast(&length, 1, MPI_INT, first, comm);
-  problem.resize(static_cast<std::size_t>(length));
-  MPI_Bcast(problem.data(), length, MPI_CHAR, first, comm);
-  return problem;
+  return first_rank_problem(comm, "distribute_cells", problem);
 }
 
 // Distributes `dm` and takes this rank's part; `serial_id` gives the global vertex id of each of

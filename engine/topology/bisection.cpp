@@ -7,7 +7,15 @@
 
 namespace snede {
 
-Bisection::Bisection(Mesh& mesh) : mesh_(mesh), hierarchy_(mesh) {}
+Bisection::Bisection(Mesh& mesh, std::optional<BisectionRule> rule) : mesh_(mesh), hierarchy_(mesh, rule) {}
+
+std::vector<ElementId> Bisection::around_edge(VertexId a, VertexId b, ElementId start) const {
+  if (rings_) {
+    std::vector<ElementId> found = rings_->around(a, b);
+    if (!found.empty()) return found;
+  }
+  return elements_around(mesh_.connectivity(), Simplex(1, {a, b}), start);
+}
 
 ElementId Bisection::live_element_with_edge(NodeId node, VertexId a, VertexId b) const {
   while (!hierarchy_.node(node).is_leaf()) {
@@ -49,7 +57,7 @@ std::size_t Bisection::bisect(ElementId element) {
   while (!pending.empty()) {
     const EdgeToBisect edge = pending.back();
     const ElementId start = live_element_with_edge(edge.node, edge.a, edge.b);
-    const std::vector<ElementId> around = elements_around(mesh_.connectivity(), Simplex(1, {edge.a, edge.b}), start);
+    const std::vector<ElementId> around = around_edge(edge.a, edge.b, start);
     const auto other = std::find_if(around.begin(), around.end(), [&](ElementId e) {
       return !hierarchy_.label(e).has_refinement_edge(edge.a, edge.b);
     });
@@ -69,8 +77,7 @@ std::size_t Bisection::bisect(ElementId element) {
       // up the stack instead can leave the next one cycling again, without end.
       const EdgeToBisect requested = pending.front();
       const ElementId holder = live_element_with_edge(requested.node, requested.a, requested.b);
-      n_split += simple_bisect(requested.a, requested.b,
-                               elements_around(mesh_.connectivity(), Simplex(1, {requested.a, requested.b}), holder));
+      n_split += simple_bisect(requested.a, requested.b, around_edge(requested.a, requested.b, holder));
       ++n_forced_splits_;
       break;
     }

@@ -8,6 +8,7 @@
 #pragma once
 
 #include <cstddef>
+#include <optional>
 #include <vector>
 
 #include "mesh/mesh.hpp"
@@ -15,10 +16,21 @@
 
 namespace snede {
 
+// Every live element around an edge, where a walk across faces from one of them may not reach
+// them all: on a rank's part of a distributed mesh, other ranks' cells can lie between the
+// fans of cells around an edge of the rank boundary (rank_refinement.hpp).
+class EdgeRings {
+ public:
+  virtual ~EdgeRings() = default;
+  // The live elements containing edge (a, b), or empty to let the walk find them.
+  virtual std::vector<ElementId> around(VertexId a, VertexId b) const = 0;
+};
+
 class Bisection {
  public:
-  // Labels the mesh (initial_labelling) and watches it for as long as this object lives.
-  explicit Bisection(Mesh& mesh);
+  // Labels the mesh (initial_labelling; the 3D rule chosen from the mesh unless given) and
+  // watches it for as long as this object lives.
+  explicit Bisection(Mesh& mesh, std::optional<BisectionRule> rule = std::nullopt);
   Bisection(const Bisection&) = delete;
   Bisection& operator=(const Bisection&) = delete;
 
@@ -41,6 +53,10 @@ class Bisection {
   // labelled, this doubles the element count exactly). Returns the number of elements split.
   std::size_t refine_uniform(int levels);
 
+  // Splits found around an edge by `rings` (which must outlive this object or be reset to
+  // nullptr) as well as by the walk across faces.
+  void set_edge_rings(const EdgeRings* rings) { rings_ = rings; }
+
   std::size_t memory_bytes() const { return hierarchy_.memory_bytes(); }
   // How many edges were bisected against an incompatible labelling (see bisect).
   std::size_t n_forced_splits() const { return n_forced_splits_; }
@@ -56,10 +72,13 @@ class Bisection {
   // The simple-bisect of §6.5: `around` is every element containing (a, b); those whose
   // refinement edge is another are relabelled first (a forced split).
   std::size_t simple_bisect(VertexId a, VertexId b, const std::vector<ElementId>& around);
+  // Every element containing (a, b), `start` among them.
+  std::vector<ElementId> around_edge(VertexId a, VertexId b, ElementId start) const;
 
   Mesh& mesh_;
   RefinementHierarchy hierarchy_;
   std::size_t n_forced_splits_ = 0;
+  const EdgeRings* rings_ = nullptr;
 };
 
 }  // namespace snede

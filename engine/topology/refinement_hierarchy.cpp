@@ -14,7 +14,8 @@ constexpr double on_face_tolerance = 1e-10;
 
 }  // namespace
 
-RefinementHierarchy::RefinementHierarchy(Mesh& mesh) : mesh_(mesh) {
+RefinementHierarchy::RefinementHierarchy(Mesh& mesh, std::optional<BisectionRule> rule)
+    : mesh_(mesh), given_rule_(rule) {
   mesh_.connectivity().add_watcher(this, WatchMode::each_operation);  // follows every split
 }
 
@@ -25,7 +26,7 @@ void RefinementHierarchy::init(const Connectivity& connectivity) {
   roots_.clear();
   root_grid_.clear();
   node_of_element_.assign(connectivity.element_capacity(), no_id);
-  rule_ = bisection_rule_for(mesh_);
+  rule_ = given_rule_ ? *given_rule_ : bisection_rule_for(mesh_);
   for (ElementId e : connectivity.element_ids())
     add_root(initial_labelling(mesh_, connectivity.element(e).simplex, rule_), e);
   n_points_seen_ = mesh_.n_points();

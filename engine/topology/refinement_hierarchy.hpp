@@ -11,6 +11,7 @@
 #pragma once
 
 #include <array>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -31,8 +32,10 @@ struct RefinementNode {
 
 class RefinementHierarchy : public ConnectivityWatcher {
  public:
-  // Labels every element of `mesh` as a root (initial_labelling) and starts watching it.
-  explicit RefinementHierarchy(Mesh& mesh);
+  // Labels every element of `mesh` as a root (initial_labelling) and starts watching it. The
+  // 3D rule is chosen from the mesh unless given (a rank's part of a distributed mesh takes the
+  // rule every rank agreed on, which the whole mesh would choose).
+  explicit RefinementHierarchy(Mesh& mesh, std::optional<BisectionRule> rule = std::nullopt);
   ~RefinementHierarchy() override;
   RefinementHierarchy(const RefinementHierarchy&) = delete;
   RefinementHierarchy& operator=(const RefinementHierarchy&) = delete;
@@ -97,6 +100,7 @@ class RefinementHierarchy : public ConnectivityWatcher {
   std::vector<ExpectedSplit> expected_;
   mutable RootGrid root_grid_;
   VertexId n_points_seen_ = 0;
+  std::optional<BisectionRule> given_rule_;
   BisectionRule rule_ = BisectionRule::newest_vertex;  // ids below this may be in roots' labels: reusing one moves a root
 };
 

@@ -17,8 +17,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from snede import _checks, _snede
 from snede._body_arguments import check_body, displacement_field, face_forces, traction_faces, vertex_selection
-from snede.distributed import DistributedMesh, DistributedStatic, _world, agreed
+from snede.distributed import DistributedMesh, DistributedStatic, _part, _world, agreed
 
 
 class PartBody:
@@ -247,6 +248,69 @@ class PartBody:
         for ids, values in self.comm.allgather((part.global_vertex[part.owned], self._displacement[part.owned])):
             out[ids] = values
         return out
+
+    # -- refinement on ranks (§6.5) -----------------------------------------------------------
+    def refine_uniform(self, levels: int = 1) -> int:
+        """Bisect every cell ``levels`` times, as ``Mesh.refine_uniform`` does serially: the
+        same cells however the body is partitioned (the ranks agree on the edges of their common
+        boundary). Returns how many cells were split, over all ranks. Collective; see
+        :meth:`refine_around` for what is carried to the refined part."""
+        def checked():
+            counted = _checks.count(levels, "levels", 0, 20)
+            self._require_same("PartBody.refine_uniform", levels=np.int64(counted).tobytes())
+            return counted
+
+        counted = agreed(self.comm, checked)
+        return self._refined(lambda field: _snede.refine_part_uniform(self.part._impl, counted, field, self.dim))
+
+    def refine_around(self, point, h: float) -> int:
+        """Bisect until every cell containing ``point`` (shape (dim,)) has edges no longer than
+        ``h``, as ``Mesh.refine_around`` does serially, on whichever ranks hold the point; the
+        refinement spreads across the rank boundary as far as conformity needs. Collective.
+
+        The body's part is replaced by the refined one (``body.part``, ``body.mesh``; DMPlex
+        rebalances it when the largest rank holds more than 1.2 times the mean cells); the
+        displacement is carried (a new vertex takes its parents' mean), a new vertex between two
+        fixed ones is fixed (as serially), loads stay on their vertices and new vertices carry
+        none. The part's named groups are not carried yet. Returns how many cells were split."""
+        def checked():
+            x, size = _checks.coordinates(point, (self.dim,), "point"), _checks.positive(h, "h")
+            self._require_same("PartBody.refine_around", point=x.tobytes(), h=np.float64(size).tobytes())
+            return x, size
+
+        x, size = agreed(self.comm, checked)
+        return self._refined(lambda field: _snede.refine_part_around(self.part._impl, x, size, field, self.dim))
+
+    def _require_same(self, caller: str, **inputs) -> None:
+        _snede.require_same_on_every_rank(self.comm.py2f(), caller, list(inputs.items()))
+
+    def _refined(self, refine) -> int:
+        """The body on the part ``refine(displacement)`` makes (collective)."""
+        new_part, field, new_vertices, split = refine(np.ascontiguousarray(self._displacement).ravel())
+        self._inherit_fixed(new_vertices)
+        self.part = _part(self.comm, new_part)
+        self.mesh = self.part.local
+        self._displacement = np.ascontiguousarray(field).reshape(self.mesh.n_points, self.dim)
+        self._local_order = np.argsort(self.part.global_vertex, kind="stable")
+        self._problem, self._problem_conditions = None, None
+        self._edits += 1
+        return int(split)
+
+    def _inherit_fixed(self, new_vertices: np.ndarray) -> None:
+        """A new vertex both of whose parents are fixed is fixed at their mean (as the serial
+        Constraints::inherit does); ``new_vertices`` are this rank's (id, parent, parent) rows.
+        Rounds until no rank finds more (a midpoint of midpoints waits for its parents)."""
+        waiting = np.asarray(new_vertices, dtype=np.int64).reshape(-1, 3)
+        while True:
+            fixed = np.fromiter(self._fixed, dtype=np.int64, count=len(self._fixed))
+            ready = np.isin(waiting[:, 1], fixed) & np.isin(waiting[:, 2], fixed) & ~np.isin(waiting[:, 0], fixed)
+            found = [(v, tuple(0.5 * np.asarray(self._fixed[a]) + 0.5 * np.asarray(self._fixed[b])))
+                     for v, a, b in waiting[ready].tolist()]
+            waiting = waiting[~ready]
+            every = [entry for rank_found in self.comm.allgather(found) for entry in rank_found]
+            if not every:
+                return
+            self._fixed.update(every)
 
     # -- what a solver takes (StaticSolver) --------------------------------------------------
     def problem(self) -> DistributedStatic:

@@ -1,0 +1,428 @@
+#include "topology/rank_refinement.hpp"
+
+#include <algorithm>
+#include <initializer_list>
+#include <numeric>
+#include <stdexcept>
+#include <string>
+#include <unordered_map>
+#include <utility>
+
+#include "core/rank_agreement.hpp"
+#include "core/rank_messages.hpp"
+#include "topology/bisection.hpp"
+#include "topology/refine_around.hpp"
+
+namespace snede {
+namespace {
+
+std::int64_t sum_over_ranks(MPI_Comm comm, std::int64_t value) {
+  MPI_Allreduce(MPI_IN_PLACE, &value, 1, MPI_INT64_T, MPI_SUM, comm);
+  return value;
+}
+
+// Appends `items` to the message for rank r.
+void append(std::vector<std::vector<std::int64_t>>& messages, std::int64_t r, std::initializer_list<std::int64_t> items) {
+  auto& message = messages[static_cast<std::size_t>(r)];
+  message.insert(message.end(), items);
+}
+
+struct EdgeKeyHash {
+  std::size_t operator()(const std::pair<std::int64_t, std::int64_t>& edge) const {
+    return std::hash<std::int64_t>()(edge.first * 2654435761LL ^ edge.second);
+  }
+};
+
+// The vertices a rank shares with others, which ranks may hold each, and the live elements
+// around each: a watcher (§7.4) follows every split. A midpoint may be held by the ranks that
+// hold both its parents (a superset: a rank may hold both ends of an edge and not the edge).
+class RankBoundary final : public ConnectivityWatcher, public EdgeRings {
+ public:
+  RankBoundary(Mesh& mesh, std::unordered_map<VertexId, std::vector<int>> holders)
+      : mesh_(mesh), holders_(std::move(holders)) {
+    mesh_.connectivity().add_watcher(this, WatchMode::each_operation);
+  }
+  ~RankBoundary() override { mesh_.connectivity().remove_watcher(this); }
+  RankBoundary(const RankBoundary&) = delete;
+  RankBoundary& operator=(const RankBoundary&) = delete;
+
+  // The other ranks that may hold v; nullptr when no other rank does.
+  const std::vector<int>* other_holders(VertexId v) const {
+    const auto it = holders_.find(v);
+    return it == holders_.end() ? nullptr : &it->second;
+  }
+
+  std::vector<ElementId> around(VertexId a, VertexId b) const override {
+    std::vector<ElementId> found;
+    if (!holders_.count(a) || !holders_.count(b)) return found;
+    for (ElementId e : stars_.at(a))
+      if (mesh_.connectivity().element(e).simplex.contains(b)) found.push_back(e);
+    return found;
+  }
+
+  void init(const Connectivity& c) override {
+    stars_.clear();
+    for (ElementId e : c.element_ids()) add(e, c.element(e).simplex);
+  }
+
+  void on_change(const Connectivity& c, const ConnectivityChange& change) override {
+    for (const VertexEvent& event : change.vertex_events) {
+      if (event.kind != VertexEventKind::added || event.parents.count() != 2) continue;
+      const auto a = holders_.find(event.parents.vertex[0]), b = holders_.find(event.parents.vertex[1]);
+      if (a == holders_.end() || b == holders_.end()) continue;
+      std::vector<int> both;
+      std::set_intersection(a->second.begin(), a->second.end(), b->second.begin(), b->second.end(),
+                            std::back_inserter(both));
+      if (!both.empty()) holders_[event.vertex] = std::move(both);
+    }
+    for (const auto& [e, simplex] : change.removed_elements) remove(e, simplex);
+    for (const auto& [e, before] : change.changed_elements) {
+      remove(e, before);
+      add(e, c.element(e).simplex);
+    }
+    for (ElementId e : change.added_elements) add(e, c.element(e).simplex);
+  }
+
+ private:
+  void add(ElementId e, const Simplex& s) {
+    for (VertexId v : s.vertices())
+      if (holders_.count(v)) stars_[v].push_back(e);
+  }
+  void remove(ElementId e, const Simplex& s) {
+    for (VertexId v : s.vertices()) {
+      const auto it = stars_.find(v);
+      if (it != stars_.end()) it->second.erase(std::remove(it->second.begin(), it->second.end(), e), it->second.end());
+    }
+  }
+
+  Mesh& mesh_;
+  std::unordered_map<VertexId, std::vector<int>> holders_;  // sorted rank lists
+  std::unordered_map<VertexId, std::vector<ElementId>> stars_;
+};
+
+// For every vertex this rank holds that others hold too (by local id), the other ranks. Each
+// global id is asked about at rank (id mod size), which answers every holder.
+std::unordered_map<VertexId, std::vector<int>> shared_vertices(MPI_Comm comm, const std::vector<std::int64_t>& gid) {
+  int rank = 0, size = 1;
+  MPI_Comm_rank(comm, &rank);
+  MPI_Comm_size(comm, &size);
+  std::vector<std::vector<std::int64_t>> asked(static_cast<std::size_t>(size));
+  for (std::int64_t g : gid) append(asked, g % size, {g, rank});
+  std::vector<std::int64_t> held = exchange_messages(comm, asked, MPI_INT64_T);
+  std::vector<std::pair<std::int64_t, std::int64_t>> by_id;  // (global id, holder)
+  for (std::size_t i = 0; i < held.size(); i += 2) by_id.emplace_back(held[i], held[i + 1]);
+  std::sort(by_id.begin(), by_id.end());
+  std::vector<std::vector<std::int64_t>> answers(static_cast<std::size_t>(size));  // id, k, k ranks
+  for (std::size_t first = 0, last = 0; first < by_id.size(); first = last) {
+    while (last < by_id.size() && by_id[last].first == by_id[first].first) ++last;
+    if (last - first < 2) continue;
+    for (std::size_t i = first; i < last; ++i) {
+      append(answers, by_id[i].second, {by_id[i].first, static_cast<std::int64_t>(last - first - 1)});
+      for (std::size_t j = first; j < last; ++j)
+        if (j != i) append(answers, by_id[i].second, {by_id[j].second});
+    }
+  }
+  const std::vector<std::int64_t> told = exchange_messages(comm, answers, MPI_INT64_T);
+  std::unordered_map<std::int64_t, VertexId> local_of;
+  for (std::size_t v = 0; v < gid.size(); ++v) local_of.emplace(gid[v], static_cast<VertexId>(v));
+  std::unordered_map<VertexId, std::vector<int>> holders;
+  for (std::size_t i = 0; i < told.size();) {
+    const std::int64_t id = told[i], k = told[i + 1];
+    std::vector<int>& others = holders[local_of.at(id)];
+    for (std::int64_t j = 0; j < k; ++j) others.push_back(static_cast<int>(told[i + 2 + static_cast<std::size_t>(j)]));
+    std::sort(others.begin(), others.end());
+    i += 2 + static_cast<std::size_t>(k);
+  }
+  return holders;
+}
+
+// The part's vertices in the order of their global ids, so that the labelling's ties between
+// equal edges (vertex ids: initial_labelling.hpp) break as in the serial mesh.
+struct SortedPart {
+  std::vector<std::int64_t> gid;
+  std::vector<double> points, field;
+  std::vector<std::int64_t> cells;
+};
+
+SortedPart sorted_part(const DistributedMesh& part, std::span<const double> field, int width) {
+  const Mesh& local = *part.local;
+  const auto n = static_cast<std::size_t>(local.n_points());
+  if (field.size() != n * static_cast<std::size_t>(width))
+    throw std::invalid_argument("refine_part: the field holds " + std::to_string(field.size()) + " values, not " +
+                                std::to_string(width) + " per each of the part's " + std::to_string(n) + " vertices");
+  std::vector<std::size_t> order(n);
+  std::iota(order.begin(), order.end(), std::size_t{0});
+  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return part.global_vertex[a] < part.global_vertex[b]; });
+  std::vector<std::int64_t> sorted_of(n);
+  SortedPart out;
+  const auto d = static_cast<std::size_t>(local.space_dim()), w = static_cast<std::size_t>(width);
+  for (std::size_t i = 0; i < n; ++i) {
+    sorted_of[order[i]] = static_cast<std::int64_t>(i);
+    out.gid.push_back(part.global_vertex[order[i]]);
+    out.points.insert(out.points.end(), local.points().begin() + static_cast<std::ptrdiff_t>(order[i] * d),
+                      local.points().begin() + static_cast<std::ptrdiff_t>((order[i] + 1) * d));
+    out.field.insert(out.field.end(), field.begin() + static_cast<std::ptrdiff_t>(order[i] * w),
+                     field.begin() + static_cast<std::ptrdiff_t>((order[i] + 1) * w));
+  }
+  for (VertexId v : local.cells()) out.cells.push_back(sorted_of[static_cast<std::size_t>(v)]);
+  return out;
+}
+
+// The rule the whole mesh would choose (initial_labelling.hpp): newest-vertex only when every
+// rank's cells allow it.
+BisectionRule agreed_rule(MPI_Comm comm, const Mesh& mesh) {
+  int longest = bisection_rule_for(mesh) == BisectionRule::longest_edge;
+  MPI_Allreduce(MPI_IN_PLACE, &longest, 1, MPI_INT, MPI_MAX, comm);
+  return longest ? BisectionRule::longest_edge : BisectionRule::newest_vertex;
+}
+
+// One rank's share of a distributed refinement: its cells, bisected locally, and the exchanges
+// that number the new vertices and close the refinement across the rank boundary.
+class RankRefinement {
+ public:
+  RankRefinement(const DistributedMesh& part, std::span<const double> field, int width)
+      : RankRefinement(part.comm, sorted_part(part, field, width), part.local->cell_dim(), part.local->space_dim(),
+                       part.n_global_vertices, width) {}
+
+  Bisection& bisection() { return bisection_; }
+
+  // After this rank's own splits: numbers the new vertices and splits the edges other ranks
+  // split, until no rank splits any more (collective). Returns the cells split here.
+  std::int64_t close_across_ranks() {
+    std::int64_t split = 0;
+    for (;;) {
+      number_new_vertices();
+      std::vector<std::vector<std::int64_t>> told(static_cast<std::size_t>(size_));
+      for (VertexId v = n_told_; v < mesh_.n_points(); ++v)
+        if (const std::vector<int>* others = boundary_.other_holders(v)) {
+          const VertexParents parents = mesh_.parents(v);
+          for (int r : *others)
+            append(told, r, {gid_[static_cast<std::size_t>(parents.vertex[0])], gid_[static_cast<std::size_t>(parents.vertex[1])]});
+        }
+      n_told_ = mesh_.n_points();
+      // An edge told of may end at a midpoint this rank made in the same round and has not
+      // numbered yet: it waits for the next round's numbers.
+      std::vector<std::int64_t> split_elsewhere = exchange_messages(comm_, told, MPI_INT64_T);
+      split_elsewhere.insert(split_elsewhere.end(), waiting_.begin(), waiting_.end());
+      waiting_.clear();
+      std::int64_t made = 0;
+      for (std::size_t i = 0; i < split_elsewhere.size(); i += 2) {
+        const auto a = local_of_.find(split_elsewhere[i]), b = local_of_.find(split_elsewhere[i + 1]);
+        if (a == local_of_.end() || b == local_of_.end()) {
+          waiting_.insert(waiting_.end(), {split_elsewhere[i], split_elsewhere[i + 1]});
+          continue;
+        }
+        // Split the elements around the edge at their refinement edges until it is split.
+        for (std::vector<ElementId> ring = boundary_.around(a->second, b->second); !ring.empty();
+             ring = boundary_.around(a->second, b->second))
+          made += static_cast<std::int64_t>(bisection_.bisect(ring.front()));
+      }
+      split += made;
+      if (sum_over_ranks(comm_, made) == 0) return split;
+    }
+  }
+
+  // The refined cells as a new part, the field carried to it (collective).
+  RefinedPart finish(std::int64_t n_split) {
+    interpolate_field();
+    RankCells given{.cell_dim = mesh_.cell_dim(), .space_dim = mesh_.space_dim(), .cells = {}, .coordinates = {}};
+    for (VertexId v : mesh_.cells()) given.cells.push_back(gid_[static_cast<std::size_t>(v)]);
+    // Each rank takes the coordinates and field of one range of global ids.
+    const auto d = static_cast<std::size_t>(mesh_.space_dim()), w = static_cast<std::size_t>(width_);
+    std::vector<std::vector<std::int64_t>> ids(static_cast<std::size_t>(size_));
+    std::vector<std::vector<double>> values(static_cast<std::size_t>(size_));
+    for (VertexId v = 0; v < mesh_.n_points(); ++v) {
+      const auto r = static_cast<std::size_t>(range_holder(gid_[v]));
+      ids[r].push_back(gid_[v]);
+      values[r].insert(values[r].end(), mesh_.point(v).begin(), mesh_.point(v).end());
+      values[r].insert(values[r].end(), field_.begin() + static_cast<std::ptrdiff_t>(v * w),
+                       field_.begin() + static_cast<std::ptrdiff_t>((v + 1) * w));
+    }
+    const std::vector<std::int64_t> got_ids = exchange_messages(comm_, ids, MPI_INT64_T);
+    const std::vector<double> got_values = exchange_messages(comm_, values, MPI_DOUBLE);
+    const std::int64_t start = range_start(rank_), n_range = range_start(rank_ + 1) - start;
+    given.coordinates.assign(static_cast<std::size_t>(n_range) * d, 0.0);
+    std::vector<double> range_field(static_cast<std::size_t>(n_range) * w, 0.0);
+    for (std::size_t i = 0; i < got_ids.size(); ++i) {  // a vertex several ranks hold comes alike from each
+      const auto at = static_cast<std::size_t>(got_ids[i] - start);
+      std::copy_n(got_values.begin() + static_cast<std::ptrdiff_t>(i * (d + w)), d, given.coordinates.begin() + static_cast<std::ptrdiff_t>(at * d));
+      std::copy_n(got_values.begin() + static_cast<std::ptrdiff_t>(i * (d + w) + d), w, range_field.begin() + static_cast<std::ptrdiff_t>(at * w));
+    }
+    RefinedPart out{.part = distribute_cells(comm_, std::move(given)), .field = {}, .new_vertices = std::move(judged_), .n_split = n_split};
+    out.field = field_from_ranges(out.part.global_vertex, range_field, start);
+    return out;
+  }
+
+ private:
+  RankRefinement(MPI_Comm comm, SortedPart sorted, int cell_dim, int space_dim, std::int64_t n_global, int width)
+      : comm_(comm),
+        mesh_(cell_dim, space_dim, std::move(sorted.points), sorted.cells),
+        gid_(std::move(sorted.gid)),
+        field_(std::move(sorted.field)),
+        width_(width),
+        n_global_(n_global),
+        boundary_(mesh_, shared_vertices(comm, gid_)),
+        bisection_(mesh_, agreed_rule(comm, mesh_)) {
+    MPI_Comm_rank(comm_, &rank_);
+    MPI_Comm_size(comm_, &size_);
+    for (std::size_t v = 0; v < gid_.size(); ++v) local_of_.emplace(gid_[v], static_cast<VertexId>(v));
+    n_numbered_ = n_told_ = mesh_.n_points();
+    bisection_.set_edge_rings(&boundary_);
+  }
+
+  // Global ids for the new vertices: a midpoint is named by its parents' ids and numbered by
+  // rank (smaller parent id mod size), so every rank that splits an edge gives its midpoint the
+  // same id. Midpoints of midpoints wait for their parents' ids (collective rounds).
+  void number_new_vertices() {
+    gid_.resize(static_cast<std::size_t>(mesh_.n_points()), -1);
+    for (;;) {
+      std::vector<std::vector<std::int64_t>> asked(static_cast<std::size_t>(size_));
+      std::int64_t waiting = 0;
+      for (VertexId v = n_numbered_; v < mesh_.n_points(); ++v) {
+        if (gid_[v] >= 0) continue;
+        const VertexParents parents = mesh_.parents(v);
+        const std::int64_t a = gid_[parents.vertex[0]], b = gid_[parents.vertex[1]];
+        if (a < 0 || b < 0) {
+          ++waiting;
+          continue;
+        }
+        const auto [low, high] = std::minmax(a, b);
+        append(asked, low % size_, {low, high, v, rank_});
+      }
+      std::int64_t asking = 0;
+      for (const auto& list : asked) asking += static_cast<std::int64_t>(list.size());
+      if (sum_over_ranks(comm_, asking + waiting) == 0) break;
+      const std::vector<std::int64_t> questions = exchange_messages(comm_, asked, MPI_INT64_T);
+      std::vector<std::pair<std::int64_t, std::int64_t>> fresh;  // edges numbered in this round, in order
+      for (std::size_t i = 0; i < questions.size(); i += 4)
+        if (numbered_.emplace(std::make_pair(questions[i], questions[i + 1]), -1).second)
+          fresh.emplace_back(questions[i], questions[i + 1]);
+      std::int64_t first = 0, n_fresh = static_cast<std::int64_t>(fresh.size());
+      MPI_Exscan(&n_fresh, &first, 1, MPI_INT64_T, MPI_SUM, comm_);
+      if (rank_ == 0) first = 0;
+      for (std::size_t k = 0; k < fresh.size(); ++k) {
+        const std::int64_t id = n_global_ + first + static_cast<std::int64_t>(k);
+        numbered_[fresh[k]] = id;
+        judged_.insert(judged_.end(), {id, fresh[k].first, fresh[k].second});
+      }
+      n_global_ += sum_over_ranks(comm_, n_fresh);
+      std::vector<std::vector<std::int64_t>> answers(static_cast<std::size_t>(size_));
+      for (std::size_t i = 0; i < questions.size(); i += 4)
+        append(answers, questions[i + 3], {questions[i + 2], numbered_.at({questions[i], questions[i + 1]})});
+      const std::vector<std::int64_t> ids = exchange_messages(comm_, answers, MPI_INT64_T);
+      for (std::size_t i = 0; i < ids.size(); i += 2) {
+        gid_[static_cast<std::size_t>(ids[i])] = ids[i + 1];
+        local_of_.emplace(ids[i + 1], static_cast<VertexId>(ids[i]));
+      }
+      while (n_numbered_ < mesh_.n_points() && gid_[n_numbered_] >= 0) ++n_numbered_;
+    }
+  }
+
+  // New vertices' values from their parents', in the order they were made (parents first).
+  void interpolate_field() {
+    const auto w = static_cast<std::size_t>(width_);
+    const auto n_before = field_.size() / std::max<std::size_t>(w, 1);
+    field_.resize(static_cast<std::size_t>(mesh_.n_points()) * w, 0.0);
+    for (auto v = static_cast<VertexId>(n_before); w > 0 && v < mesh_.n_points(); ++v) {
+      const VertexParents parents = mesh_.parents(v);
+      for (std::size_t i = 0; i < parents.count(); ++i)
+        for (std::size_t k = 0; k < w; ++k)
+          field_[static_cast<std::size_t>(v) * w + k] += parents.weight[i] * field_[static_cast<std::size_t>(parents.vertex[i]) * w + k];
+    }
+  }
+
+  std::int64_t range_start(int r) const { return n_global_ * r / size_; }
+  int range_holder(std::int64_t id) const {
+    int r = static_cast<int>(id * size_ / std::max<std::int64_t>(n_global_, 1));
+    while (r > 0 && id < range_start(r)) --r;
+    while (r + 1 < size_ && id >= range_start(r + 1)) ++r;
+    return r;
+  }
+
+  // The field at each of `ids`, asked of the ranks holding their ranges (collective).
+  std::vector<double> field_from_ranges(const std::vector<std::int64_t>& ids, const std::vector<double>& range_field,
+                                        std::int64_t start) const {
+    const auto w = static_cast<std::size_t>(width_);
+    std::vector<std::vector<std::int64_t>> asked(static_cast<std::size_t>(size_));
+    for (std::int64_t id : ids) append(asked, range_holder(id), {id, rank_});
+    const std::vector<std::int64_t> questions = exchange_messages(comm_, asked, MPI_INT64_T);
+    std::vector<std::vector<double>> answers(static_cast<std::size_t>(size_));
+    for (std::size_t i = 0; i < questions.size(); i += 2) {
+      auto& answer = answers[static_cast<std::size_t>(questions[i + 1])];
+      const auto at = static_cast<std::size_t>(questions[i] - start) * w;
+      answer.insert(answer.end(), range_field.begin() + static_cast<std::ptrdiff_t>(at),
+                    range_field.begin() + static_cast<std::ptrdiff_t>(at + w));
+    }
+    const std::vector<double> got = exchange_messages(comm_, answers, MPI_DOUBLE);
+    // Answers come by holder rank, each in the order this rank asked it.
+    std::vector<std::size_t> next(static_cast<std::size_t>(size_ + 1), 0);
+    for (int r = 0; r < size_; ++r) next[static_cast<std::size_t>(r + 1)] = next[static_cast<std::size_t>(r)] + asked[static_cast<std::size_t>(r)].size() / 2 * w;
+    std::vector<double> field(ids.size() * w);
+    for (std::size_t i = 0; i < ids.size(); ++i) {
+      auto& from = next[static_cast<std::size_t>(range_holder(ids[i]))];
+      std::copy_n(got.begin() + static_cast<std::ptrdiff_t>(from), w, field.begin() + static_cast<std::ptrdiff_t>(i * w));
+      from += w;
+    }
+    return field;
+  }
+
+  MPI_Comm comm_;
+  int rank_ = 0, size_ = 1;
+  Mesh mesh_;
+  std::vector<std::int64_t> gid_;
+  std::vector<double> field_;
+  int width_;
+  std::int64_t n_global_;
+  std::unordered_map<std::int64_t, VertexId> local_of_;
+  // As the numbering rank: the edges whose midpoints this rank numbered, and the triples.
+  std::unordered_map<std::pair<std::int64_t, std::int64_t>, std::int64_t, EdgeKeyHash> numbered_;
+  std::vector<std::int64_t> judged_;
+  std::vector<std::int64_t> waiting_;  // edges told of, by global ids, with an end not (yet) here
+  VertexId n_numbered_ = 0, n_told_ = 0;
+  RankBoundary boundary_;
+  Bisection bisection_;
+};
+
+}  // namespace
+
+RefinedPart refine_part_uniform(const DistributedMesh& part, int levels, std::span<const double> field, int width) {
+  if (levels < 0) throw std::invalid_argument("refine_part_uniform: levels must be ≥ 0, got " + std::to_string(levels));
+  RankRefinement refinement(part, field, width);
+  std::int64_t split = 0;
+  for (int level = 0; level < levels; ++level) {
+    split += static_cast<std::int64_t>(refinement.bisection().refine_uniform(1));
+    split += refinement.close_across_ranks();
+  }
+  return refinement.finish(sum_over_ranks(part.comm, split));
+}
+
+RefinedPart refine_part_around(const DistributedMesh& part, std::span<const double> x, double h,
+                               std::span<const double> field, int width) {
+  if (x.size() != static_cast<std::size_t>(part.local->space_dim()))
+    throw std::invalid_argument("refine_around: the point has " + std::to_string(x.size()) + " coordinates, the mesh is " +
+                                std::to_string(part.local->space_dim()) + "-D");
+  RankRefinement refinement(part, field, width);
+  const bool holds_x = !refinement.bisection().hierarchy().roots_containing(x).empty();
+  if (sum_over_ranks(part.comm, holds_x ? 1 : 0) == 0) {
+    std::string point;
+    for (double c : x) point += (point.empty() ? "" : ", ") + std::to_string(c);
+    throw std::invalid_argument("refine_around: point (" + point + ") is outside the mesh (no rank's cells hold it)");
+  }
+  std::int64_t split = 0;
+  for (;;) {
+    std::int64_t marked = 0;
+    std::string problem;
+    try {
+      if (holds_x) marked = static_cast<std::int64_t>(refine_around(refinement.bisection(), x, h));
+    } catch (const std::invalid_argument& error) {
+      problem = error.what();
+    }
+    if (problem = first_rank_problem(part.comm, "refine_part_around", problem); !problem.empty())
+      throw std::invalid_argument(problem);
+    split += marked + refinement.close_across_ranks();
+    if (sum_over_ranks(part.comm, marked) == 0) break;
+  }
+  return refinement.finish(sum_over_ranks(part.comm, split));
+}
+
+}  // namespace snede

@@ -1,0 +1,40 @@
+// Conforming bisection (§6.5) of a mesh distributed over ranks (issue 52): each rank bisects
+// its own cells, and the ranks tell each other which edges of their common boundary they
+// split until no rank has a hanging vertex. Every split made is one that the serial closure
+// makes too (an element is split only at its refinement edge, and only when a mark or a split
+// edge of a neighbour requires it), so the result is the least conforming refinement of the
+// marks, which is the serial one: the same cells as serially, however the body is partitioned.
+// The refined cells go to a new part through distribute_cells, which keeps balanced parts and
+// has DMPlex rebalance them when the largest rank holds more than 1.2 times the mean.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "mesh/distributed_mesh.hpp"
+
+namespace snede {
+
+struct RefinedPart {
+  DistributedMesh part;
+  // `width` values per vertex of the new part: the field given for the old vertices, new
+  // vertices interpolated from their parents (§7.4, as a serial Body's watchers carry state).
+  std::vector<double> field;
+  // (global id, parent's global id, parent's global id) of the new vertices this rank numbered:
+  // every new vertex is listed on exactly one rank.
+  std::vector<std::int64_t> new_vertices;
+  std::int64_t n_split = 0;  // cells split, over all ranks (as serially)
+};
+
+// Collective. Every cell bisected `levels` times (Bisection::refine_uniform). `field` holds
+// `width` values per vertex of part.local.
+RefinedPart refine_part_uniform(const DistributedMesh& part, int levels, std::span<const double> field, int width);
+
+// Collective. Bisected until every cell whose closure contains x has edges no longer than h
+// (refine_around). Throws the same std::invalid_argument on every rank when no rank's cells
+// contain x or h is below round-off there.
+RefinedPart refine_part_around(const DistributedMesh& part, std::span<const double> x, double h,
+                               std::span<const double> field, int width);
+
+}  // namespace snede
