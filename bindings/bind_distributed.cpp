@@ -82,6 +82,18 @@ void bind_distributed(py::module_& m) {
         return refined(std::move(r), width);
       },
       py::arg("part"), py::arg("x"), py::arg("h"), py::arg("field"), py::arg("width"));
+  m.def(
+      "refine_part_near_segment",
+      [refined](const DistributedMesh& part, const DoubleArray& a, const DoubleArray& b, double h, double radius,
+                const DoubleArray& field, int width) {
+        std::span<const double> from(a.data(), static_cast<std::size_t>(a.size())),
+            to(b.data(), static_cast<std::size_t>(b.size())), values(field.data(), static_cast<std::size_t>(field.size()));
+        py::gil_scoped_release released;
+        RefinedPart r = refine_part_near_segment(part, from, to, h, radius, values, width);
+        py::gil_scoped_acquire acquired;
+        return refined(std::move(r), width);
+      },
+      py::arg("part"), py::arg("a"), py::arg("b"), py::arg("h"), py::arg("radius"), py::arg("field"), py::arg("width"));
   // RankAgreement for Python's collective calls: `inputs` are (name, the input's bytes) pairs,
   // the same names in the same order on every rank.
   m.def(

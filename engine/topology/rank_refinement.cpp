@@ -12,6 +12,7 @@
 #include "core/rank_messages.hpp"
 #include "topology/bisection.hpp"
 #include "topology/refine_around.hpp"
+#include "topology/refine_near_segment.hpp"
 
 namespace snede {
 namespace {
@@ -396,33 +397,73 @@ RefinedPart refine_part_uniform(const DistributedMesh& part, int levels, std::sp
   return refinement.finish(sum_over_ranks(part.comm, split));
 }
 
+namespace {
+
+// Marks and splits on each rank (`mark`: the cells split, or std::invalid_argument), then closes
+// across the ranks, until no rank marks any more: the serial loops' fixed point (refine_around,
+// refine_near_segment), each mark being one the serial loop makes.
+template <class Mark>
+RefinedPart refine_until_unmarked(const DistributedMesh& part, std::span<const double> field, int width,
+                                  const std::string& caller, Mark mark) {
+  RankRefinement refinement(part, field, width);
+  std::int64_t split = 0;
+  for (bool first = true;; first = false) {
+    std::int64_t marked = 0;
+    std::string problem;
+    try {
+      marked = static_cast<std::int64_t>(mark(refinement.bisection(), first));
+    } catch (const std::invalid_argument& error) {
+      problem = error.what();
+    }
+    if (problem = first_rank_problem(part.comm, caller, problem); !problem.empty()) throw std::invalid_argument(problem);
+    split += marked + refinement.close_across_ranks();
+    if (sum_over_ranks(part.comm, marked) == 0) break;
+  }
+  return refinement.finish(sum_over_ranks(part.comm, split));
+}
+
+std::string point_text(std::span<const double> x) {
+  std::string text;
+  for (double c : x) text += (text.empty() ? "" : ", ") + std::to_string(c);
+  return "(" + text + ")";
+}
+
+}  // namespace
+
 RefinedPart refine_part_around(const DistributedMesh& part, std::span<const double> x, double h,
                                std::span<const double> field, int width) {
   if (x.size() != static_cast<std::size_t>(part.local->space_dim()))
     throw std::invalid_argument("refine_around: the point has " + std::to_string(x.size()) + " coordinates, the mesh is " +
                                 std::to_string(part.local->space_dim()) + "-D");
-  RankRefinement refinement(part, field, width);
-  const bool holds_x = !refinement.bisection().hierarchy().roots_containing(x).empty();
-  if (sum_over_ranks(part.comm, holds_x ? 1 : 0) == 0) {
-    std::string point;
-    for (double c : x) point += (point.empty() ? "" : ", ") + std::to_string(c);
-    throw std::invalid_argument("refine_around: point (" + point + ") is outside the mesh (no rank's cells hold it)");
-  }
-  std::int64_t split = 0;
-  for (;;) {
-    std::int64_t marked = 0;
+  bool holds_x = false;
+  return refine_until_unmarked(part, field, width, "refine_part_around", [&](Bisection& bisection, bool first) {
+    if (first) {
+      holds_x = !bisection.hierarchy().roots_containing(x).empty();
+      if (sum_over_ranks(part.comm, holds_x ? 1 : 0) == 0)
+        throw std::invalid_argument("point " + point_text(x) + " is outside the mesh (no rank's cells hold it)");
+    }
+    return holds_x ? refine_around(bisection, x, h) : std::size_t{0};
+  });
+}
+
+RefinedPart refine_part_near_segment(const DistributedMesh& part, std::span<const double> a, std::span<const double> b,
+                                     double h, double radius, std::span<const double> field, int width) {
+  return refine_until_unmarked(part, field, width, "refine_part_near_segment", [&](Bisection& bisection, bool first) {
+    bool near_here = false;
+    std::size_t split = 0;
     std::string problem;
     try {
-      if (holds_x) marked = static_cast<std::int64_t>(refine_around(refinement.bisection(), x, h));
+      split = refine_near_segment(bisection, a, b, h, radius, &near_here);
     } catch (const std::invalid_argument& error) {
-      problem = error.what();
+      problem = error.what();  // thrown after the reduction below, which every rank enters
     }
-    if (problem = first_rank_problem(part.comm, "refine_part_around", problem); !problem.empty())
-      throw std::invalid_argument(problem);
-    split += marked + refinement.close_across_ranks();
-    if (sum_over_ranks(part.comm, marked) == 0) break;
-  }
-  return refinement.finish(sum_over_ranks(part.comm, split));
+    const bool near_anywhere = !first || sum_over_ranks(part.comm, near_here ? 1 : 0) > 0;
+    if (!problem.empty()) throw std::invalid_argument(problem);
+    if (!near_anywhere)
+      throw std::invalid_argument("the segment does not come within radius " + std::to_string(radius) +
+                                  " of the mesh (on no rank)");
+    return split;
+  });
 }
 
 }  // namespace snede

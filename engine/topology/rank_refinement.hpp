@@ -37,4 +37,10 @@ RefinedPart refine_part_uniform(const DistributedMesh& part, int levels, std::sp
 RefinedPart refine_part_around(const DistributedMesh& part, std::span<const double> x, double h,
                                std::span<const double> field, int width);
 
+// Collective. Bisected until every cell near the segment a–b has edges no longer than h
+// (refine_near_segment); the same std::invalid_argument on every rank when no rank's cells come
+// within `radius` of it or h is below round-off there.
+RefinedPart refine_part_near_segment(const DistributedMesh& part, std::span<const double> a, std::span<const double> b,
+                                     double h, double radius, std::span<const double> field, int width);
+
 }  // namespace snede

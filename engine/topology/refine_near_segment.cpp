@@ -41,7 +41,7 @@ void check_point(std::span<const double> x, int dim, const char* name) {
 }  // namespace
 
 std::size_t refine_near_segment(Bisection& bisection, std::span<const double> a, std::span<const double> b, double h,
-                                double radius) {
+                                double radius, bool* near_found) {
   const Mesh& mesh = bisection.mesh();
   const int d = mesh.dim();
   if (!(std::isfinite(h) && h > 0))
@@ -82,7 +82,8 @@ std::size_t refine_near_segment(Bisection& bisection, std::span<const double> a,
       }
       if (longest > h) too_long.push_back(node.element);
     }
-    if (!any_near)
+    if (near_found) *near_found = any_near;
+    if (!any_near && !near_found)
       throw std::invalid_argument("refine_near_segment: the segment does not come within radius " +
                                   std::to_string(radius) + " of the mesh");
     if (too_long.empty()) return n_split;

@@ -17,8 +17,9 @@ namespace snede {
 // size; neighbours are split only as conformity needs. Returns the number of elements split. Throws std::invalid_argument for h not
 // positive and finite, radius negative or not finite, points of the wrong dimension or not
 // finite, h below 1e-12 of a nearby edge length (beyond round-off), or a segment that does not
-// come within radius of any element.
+// come within radius of any element — unless `near_found` is given: it then tells whether any
+// element came near (a rank's part of a distributed mesh, which may hold none of the segment).
 std::size_t refine_near_segment(Bisection& bisection, std::span<const double> a, std::span<const double> b, double h,
-                                double radius);
+                                double radius, bool* near_found = nullptr);
 
 }  // namespace snede

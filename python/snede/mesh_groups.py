@@ -138,7 +138,8 @@ def _rows(rows, n: int, what: str, of: str) -> np.ndarray:
     return array
 
 
-def _containing(points: np.ndarray, simplices: np.ndarray, oriented: np.ndarray | None = None) -> np.ndarray:
+def _containing(points: np.ndarray, simplices: np.ndarray, oriented: np.ndarray | None = None,
+                nearest: bool = True) -> np.ndarray:
     """For each point (q, dim), the index of a simplex of ``simplices`` (s, k, dim) containing it
     (k = dim + 1: volume simplices; k ≤ dim: faces or edges, the point within a hundredth of the
     simplex's size off it), else the nearest within a quarter of a simplex (in barycentric
@@ -147,7 +148,8 @@ def _containing(points: np.ndarray, simplices: np.ndarray, oriented: np.ndarray 
     ``oriented`` (q, k, dim), each point's own face, that nearest one must be parallel to it
     (within 25°), so that a face a cut opened next to the boundary does not pass for boundary.
     Candidates come from a uniform grid over the simplices' bounding boxes: first the exact
-    boxes, then, for the points left, boxes grown by a quarter."""
+    boxes, then, for the points left, boxes grown by a quarter. Without ``nearest``, only the
+    first: a point in none of ``simplices`` (a subset of a mesh's) is −1."""
     q, (s, k, dim) = len(points), simplices.shape
     found = np.full(q, -1, dtype=np.int64)
     if q == 0 or s == 0:
@@ -162,7 +164,8 @@ def _containing(points: np.ndarray, simplices: np.ndarray, oriented: np.ndarray 
     lower = k <= dim
     if lower and oriented is not None:
         directions, own_directions = _direction(simplices), _direction(oriented)
-    for grow, slack, off_limit in ((0.0, 1e-9, 1e-2), (_NEAREST, _NEAREST, _NEAREST)):
+    passes = ((0.0, 1e-9, 1e-2), (_NEAREST, _NEAREST, _NEAREST)) if nearest else ((0.0, 1e-9, 1e-2),)
+    for grow, slack, off_limit in passes:
         left = np.flatnonzero(found < 0)
         if len(left) == 0:
             break

@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from snede import _checks, _snede
+from snede import _checks, _snede, part_groups
 from snede._body_arguments import check_body, displacement_field, face_forces, traction_faces, vertex_selection
 from snede.distributed import DistributedMesh, DistributedStatic, _part, _world, agreed
 
@@ -272,7 +272,8 @@ class PartBody:
         rebalances it when the largest rank holds more than 1.2 times the mean cells); the
         displacement is carried (a new vertex takes its parents' mean), a new vertex between two
         fixed ones is fixed (as serially), loads stay on their vertices and new vertices carry
-        none. The part's named groups are not carried yet. Returns how many cells were split."""
+        none, and the named groups follow (a cell in its parent's groups, a boundary face in its
+        parent face's). Returns how many cells were split."""
         def checked():
             x, size = _checks.coordinates(point, (self.dim,), "point"), _checks.positive(h, "h")
             self._require_same("PartBody.refine_around", point=x.tobytes(), h=np.float64(size).tobytes())
@@ -281,15 +282,32 @@ class PartBody:
         x, size = agreed(self.comm, checked)
         return self._refined(lambda field: _snede.refine_part_around(self.part._impl, x, size, field, self.dim))
 
+    def refine_near_segment(self, a, b, h: float, radius: float = 0.0) -> int:
+        """Bisect until every cell that comes within ``radius`` of the segment ``a``–``b`` (a
+        needle's shaft) has edges no longer than ``h``, as ``Mesh.refine_near_segment`` does
+        serially. Collective; see :meth:`refine_around` for what is carried."""
+        def checked():
+            ends = [_checks.coordinates(end, (self.dim,), name) for end, name in ((a, "a"), (b, "b"))]
+            size, reach = _checks.positive(h, "h"), _checks.non_negative(radius, "radius")
+            self._require_same("PartBody.refine_near_segment", a=ends[0].tobytes(), b=ends[1].tobytes(),
+                               h=np.float64(size).tobytes(), radius=np.float64(reach).tobytes())
+            return ends, size, reach
+
+        (start, end), size, reach = agreed(self.comm, checked)
+        return self._refined(lambda field: _snede.refine_part_near_segment(self.part._impl, start, end, size, reach,
+                                                                           field, self.dim))
+
     def _require_same(self, caller: str, **inputs) -> None:
         _snede.require_same_on_every_rank(self.comm.py2f(), caller, list(inputs.items()))
 
     def _refined(self, refine) -> int:
         """The body on the part ``refine(displacement)`` makes (collective)."""
+        groups = part_groups.group_shapes(self.mesh, self.comm)
         new_part, field, new_vertices, split = refine(np.ascontiguousarray(self._displacement).ravel())
         self._inherit_fixed(new_vertices)
         self.part = _part(self.comm, new_part)
         self.mesh = self.part.local
+        part_groups.give_group_shapes(self.mesh, self.boundary_faces(), *groups)
         self._displacement = np.ascontiguousarray(field).reshape(self.mesh.n_points, self.dim)
         self._local_order = np.argsort(self.part.global_vertex, kind="stable")
         self._problem, self._problem_conditions = None, None

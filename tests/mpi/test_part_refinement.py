@@ -88,6 +88,50 @@ def test_refinement_around_a_point_on_ranks_is_the_serial_one(make, partition):
     assert_same_cells(body, serial)
 
 
+@pytest.mark.parametrize("partition", ["dmplex", "chunks"])
+def test_refinement_along_a_needle_shaft_on_ranks_is_the_serial_one(partition):
+    serial = cylinder()
+    body = snede.Body(part_of(serial, partition), MATERIAL)
+    low, high = serial.points.min(axis=0), serial.points.max(axis=0)
+    a, b = low + (high - low) * (0.1, 0.45, 0.5), low + (high - low) * (0.9, 0.55, 0.45)
+    h, radius = 0.04 * np.max(high - low), 0.01 * np.max(high - low)
+    split = body.refine_near_segment(a, b, h, radius)
+    assert split == serial.refine_near_segment(a, b, h, radius) > 0
+    assert_same_cells(body, serial)
+
+
+def gathered_groups(body) -> tuple[dict, dict]:
+    """The body's cell and boundary groups over every rank, as sorted corner coordinates."""
+    mesh = body.mesh
+    mine = ({name: cell_corners(mesh.points, mesh.cells[rows]) for name, rows in mesh.cell_groups.items()},
+            {name: cell_corners(mesh.points, faces) for name, faces in mesh.boundary_groups.items() if name != "incision"})
+    every = COMM.allgather(mine)
+    return tuple({name: sorted(member for groups in every for member in groups[kind].get(name, []))
+                  for name in every[0][kind]} for kind in (0, 1))
+
+
+@pytest.mark.parametrize("partition", ["dmplex", "chunks"])
+def test_named_groups_follow_the_refinement_as_serially(partition):
+    serial = box()
+    x = serial.points
+    serial.add_cell_group("left", np.flatnonzero(x[serial.cells].mean(axis=1)[:, 0] < 0.5))
+    top = serial.boundary_faces()
+    serial.add_boundary_group("top", top[np.all(np.isclose(x[top][:, :, 2], 0.4), axis=1)])
+    body = snede.Body(part_of(serial, partition), MATERIAL)
+    if partition == "chunks":  # distribute_cells takes no groups: name them on the parts
+        centroids = body.mesh.points[body.mesh.cells].mean(axis=1)
+        body.mesh.add_cell_group("left", np.flatnonzero(centroids[:, 0] < 0.5))
+        faces = body.boundary_faces()
+        body.mesh.add_boundary_group("top", faces[np.all(np.isclose(body.mesh.points[faces][:, :, 2], 0.4), axis=1)])
+    body.refine_around((0.45, 0.3, 0.38), 0.1)
+    serial.refine_around((0.45, 0.3, 0.38), 0.1)
+    cells, faces = gathered_groups(body)
+    assert cells["left"] == cell_corners(serial.points, serial.cells[serial.cell_groups["left"]])
+    assert faces["top"] == cell_corners(serial.points, serial.boundary_groups["top"])
+    assert len(faces["top"]) > 5 * 3 * 2  # refined: more than the 30 faces it started with
+    body.fix("top")  # a group of the refined part is a condition as serially
+
+
 def test_a_linear_displacement_is_carried_exactly_and_midpoints_of_fixed_vertices_are_fixed():
     serial = box()
     body = snede.Body(part_of(serial, "chunks"), MATERIAL)
