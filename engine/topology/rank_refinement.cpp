@@ -8,6 +8,7 @@
 #include <unordered_map>
 #include <utility>
 
+#include "core/log_event.hpp"
 #include "core/rank_agreement.hpp"
 #include "core/rank_messages.hpp"
 #include "topology/bisection.hpp"
@@ -190,6 +191,7 @@ class RankRefinement {
   // After this rank's own splits: numbers the new vertices and splits the edges other ranks
   // split, until no rank splits any more (collective). Returns the cells split here.
   std::int64_t close_across_ranks() {
+    const ScopedEvent timed(log_event("SnedeRankAgreeSplits"));
     std::int64_t split = 0;
     for (;;) {
       number_new_vertices();
@@ -225,6 +227,7 @@ class RankRefinement {
 
   // The refined cells as a new part, the field carried to it (collective).
   RefinedPart finish(std::int64_t n_split) {
+    const ScopedEvent timed(log_event("SnedeRankNewPart"));
     interpolate_field();
     RankCells given{.cell_dim = mesh_.cell_dim(), .space_dim = mesh_.space_dim(), .cells = {}, .coordinates = {}};
     for (VertexId v : mesh_.cells()) given.cells.push_back(gid_[static_cast<std::size_t>(v)]);
@@ -391,7 +394,10 @@ RefinedPart refine_part_uniform(const DistributedMesh& part, int levels, std::sp
   RankRefinement refinement(part, field, width);
   std::int64_t split = 0;
   for (int level = 0; level < levels; ++level) {
-    split += static_cast<std::int64_t>(refinement.bisection().refine_uniform(1));
+    {
+      const ScopedEvent timed(log_event("SnedeRankBisect"));
+      split += static_cast<std::int64_t>(refinement.bisection().refine_uniform(1));
+    }
     split += refinement.close_across_ranks();
   }
   return refinement.finish(sum_over_ranks(part.comm, split));
@@ -411,6 +417,7 @@ RefinedPart refine_until_unmarked(const DistributedMesh& part, std::span<const d
     std::int64_t marked = 0;
     std::string problem;
     try {
+      const ScopedEvent timed(log_event("SnedeRankBisect"));
       marked = static_cast<std::int64_t>(mark(refinement.bisection(), first));
     } catch (const std::invalid_argument& error) {
       problem = error.what();

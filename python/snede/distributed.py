@@ -11,8 +11,8 @@ several ranks' cells is owned by exactly one). Cells are not overlapped. A probl
 every rank's cells, PETSc's SNES and KSP on a vector distributed by owned vertices, so the
 same problem gives the same displacement on any number of ranks: linear CG, Newton, nonlinear
 CG, with no preconditioner, Jacobi or GAMG; :class:`DistributedRelaxation` relaxes it in time.
-Gravity is given as nodal forces, and the mesh cannot be edited (cuts, bisection, needles stay
-serial).
+Gravity is given as nodal forces, and the mesh cannot be edited (a PartBody refines on the ranks:
+part_body.py; cuts and needles stay serial).
 """
 from __future__ import annotations
 
