@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <initializer_list>
 #include <numeric>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <unordered_map>
@@ -142,6 +143,7 @@ std::unordered_map<VertexId, std::vector<int>> shared_vertices(MPI_Comm comm, co
 // equal edges (vertex ids: initial_labelling.hpp) break as in the serial mesh.
 struct SortedPart {
   std::vector<std::int64_t> gid;
+  std::vector<std::uint8_t> owned;
   std::vector<double> points, field;
   std::vector<std::int64_t> cells;
 };
@@ -161,6 +163,7 @@ SortedPart sorted_part(const DistributedMesh& part, std::span<const double> fiel
   for (std::size_t i = 0; i < n; ++i) {
     sorted_of[order[i]] = static_cast<std::int64_t>(i);
     out.gid.push_back(part.global_vertex[order[i]]);
+    out.owned.push_back(part.owned[order[i]]);
     out.points.insert(out.points.end(), local.points().begin() + static_cast<std::ptrdiff_t>(order[i] * d),
                       local.points().begin() + static_cast<std::ptrdiff_t>((order[i] + 1) * d));
     out.field.insert(out.field.end(), field.begin() + static_cast<std::ptrdiff_t>(order[i] * w),
@@ -186,7 +189,7 @@ class RankRefinement {
       : RankRefinement(part.comm, sorted_part(part, field, width), part.local->cell_dim(), part.local->space_dim(),
                        part.n_global_vertices, width) {}
 
-  Bisection& bisection() { return bisection_; }
+  Bisection& bisection() { return *bisection_; }
 
   // After this rank's own splits: numbers the new vertices and splits the edges other ranks
   // split, until no rank splits any more (collective). Returns the cells split here.
@@ -197,7 +200,7 @@ class RankRefinement {
       number_new_vertices();
       std::vector<std::vector<std::int64_t>> told(static_cast<std::size_t>(size_));
       for (VertexId v = n_told_; v < mesh_.n_points(); ++v)
-        if (const std::vector<int>* others = boundary_.other_holders(v)) {
+        if (const std::vector<int>* others = boundary_->other_holders(v)) {
           const VertexParents parents = mesh_.parents(v);
           for (int r : *others)
             append(told, r, {gid_[static_cast<std::size_t>(parents.vertex[0])], gid_[static_cast<std::size_t>(parents.vertex[1])]});
@@ -216,9 +219,9 @@ class RankRefinement {
           continue;
         }
         // Split the elements around the edge at their refinement edges until it is split.
-        for (std::vector<ElementId> ring = boundary_.around(a->second, b->second); !ring.empty();
-             ring = boundary_.around(a->second, b->second))
-          made += static_cast<std::int64_t>(bisection_.bisect(ring.front()));
+        for (std::vector<ElementId> ring = boundary_->around(a->second, b->second); !ring.empty();
+             ring = boundary_->around(a->second, b->second))
+          made += static_cast<std::int64_t>(bisection_->bisect(ring.front()));
       }
       split += made;
       if (sum_over_ranks(comm_, made) == 0) return split;
@@ -229,6 +232,17 @@ class RankRefinement {
   RefinedPart finish(std::int64_t n_split) {
     const ScopedEvent timed(log_event("SnedeRankNewPart"));
     interpolate_field();
+    // Balanced parts (as distribute_cells judges them) stay as they are: the refined mesh
+    // becomes the part, with no copy; others go to DMPlex to be balanced.
+    std::int64_t n_cells = static_cast<std::int64_t>(mesh_.n_cells()), largest = n_cells;
+    MPI_Allreduce(MPI_IN_PLACE, &largest, 1, MPI_INT64_T, MPI_MAX, comm_);
+    const std::int64_t total = sum_over_ranks(comm_, n_cells);
+    if (static_cast<double>(largest) * size_ <= 1.2 * static_cast<double>(total)) return part_in_place(n_split, total);
+    return rebalanced_part(n_split);
+  }
+
+ private:
+  RefinedPart rebalanced_part(std::int64_t n_split) {
     RankCells given{.cell_dim = mesh_.cell_dim(), .space_dim = mesh_.space_dim(), .cells = {}, .coordinates = {}};
     for (VertexId v : mesh_.cells()) given.cells.push_back(gid_[static_cast<std::size_t>(v)]);
     // Each rank takes the coordinates and field of one range of global ids.
@@ -257,7 +271,68 @@ class RankRefinement {
     return out;
   }
 
- private:
+  // The refined mesh as this rank's part: owners for the new vertices that other ranks hold
+  // too (the lowest rank holding one), and PETSc's vertex numbering anew (owned vertices
+  // contiguous in rank order), both agreed by global id at rank (id mod size).
+  RefinedPart part_in_place(std::int64_t n_split, std::int64_t n_global_cells) {
+    const VertexId n = mesh_.n_points();
+    owned_.resize(static_cast<std::size_t>(n), 1);
+    std::vector<VertexId> shared;  // vertices other ranks may hold
+    for (VertexId v = 0; v < n; ++v)
+      if (boundary_->other_holders(v)) shared.push_back(v);
+    // The owner of each shared new vertex.
+    std::vector<std::vector<std::int64_t>> asked(static_cast<std::size_t>(size_));
+    for (VertexId v : shared)
+      if (v >= n_old_) append(asked, gid_[static_cast<std::size_t>(v)] % size_, {gid_[static_cast<std::size_t>(v)], rank_});
+    const std::vector<std::int64_t> holders = exchange_messages(comm_, asked, MPI_INT64_T);
+    std::unordered_map<std::int64_t, std::int64_t> owner;
+    for (std::size_t i = 0; i < holders.size(); i += 2) {
+      const auto [at, fresh] = owner.emplace(holders[i], holders[i + 1]);
+      if (!fresh) at->second = std::min(at->second, holders[i + 1]);
+    }
+    std::vector<std::vector<std::int64_t>> told(static_cast<std::size_t>(size_));
+    for (std::size_t i = 0; i < holders.size(); i += 2) append(told, holders[i + 1], {holders[i], owner.at(holders[i])});
+    const std::vector<std::int64_t> owners = exchange_messages(comm_, told, MPI_INT64_T);
+    for (std::size_t i = 0; i < owners.size(); i += 2)
+      owned_[static_cast<std::size_t>(local_of_.at(owners[i]))] = owners[i + 1] == rank_;
+    // PETSc's numbering: this rank's owned vertices after the lower ranks'.
+    std::int64_t first = 0, n_owned = std::count(owned_.begin(), owned_.end(), std::uint8_t{1});
+    MPI_Exscan(&n_owned, &first, 1, MPI_INT64_T, MPI_SUM, comm_);
+    if (rank_ == 0) first = 0;
+    std::vector<std::int64_t> number(static_cast<std::size_t>(n), -1);
+    for (std::size_t v = 0; v < number.size(); ++v)
+      if (owned_[v]) number[v] = first++;
+    // A ghost learns its owner's number.
+    std::vector<std::vector<std::int64_t>> given(static_cast<std::size_t>(size_));
+    for (VertexId v : shared) {
+      const std::int64_t id = gid_[static_cast<std::size_t>(v)];
+      append(given, id % size_, {id, rank_, number[static_cast<std::size_t>(v)]});
+    }
+    const std::vector<std::int64_t> numbers = exchange_messages(comm_, given, MPI_INT64_T);
+    std::unordered_map<std::int64_t, std::int64_t> owners_number;
+    for (std::size_t i = 0; i < numbers.size(); i += 3)
+      if (numbers[i + 2] >= 0) owners_number.emplace(numbers[i], numbers[i + 2]);
+    std::vector<std::vector<std::int64_t>> answers(static_cast<std::size_t>(size_));
+    for (std::size_t i = 0; i < numbers.size(); i += 3)
+      if (numbers[i + 2] < 0) append(answers, numbers[i + 1], {numbers[i], owners_number.at(numbers[i])});
+    const std::vector<std::int64_t> ghost_numbers = exchange_messages(comm_, answers, MPI_INT64_T);
+    for (std::size_t i = 0; i < ghost_numbers.size(); i += 2)
+      number[static_cast<std::size_t>(local_of_.at(ghost_numbers[i]))] = ghost_numbers[i + 1];
+    bisection_.reset();  // they watch the mesh, which moves into the part
+    boundary_.reset();
+    RefinedPart out{.part = DistributedMesh{.comm = comm_,
+                                            .local = std::make_unique<Mesh>(std::move(mesh_)),
+                                            .global_vertex = std::move(gid_),
+                                            .owned = std::move(owned_),
+                                            .global_number = std::move(number),
+                                            .n_global_vertices = n_global_,
+                                            .n_global_cells = n_global_cells},
+                    .field = std::move(field_),
+                    .new_vertices = std::move(judged_),
+                    .n_split = n_split};
+    return out;
+  }
+
   RankRefinement(MPI_Comm comm, SortedPart sorted, int cell_dim, int space_dim, std::int64_t n_global, int width)
       : comm_(comm),
         mesh_(cell_dim, space_dim, std::move(sorted.points), sorted.cells),
@@ -265,13 +340,15 @@ class RankRefinement {
         field_(std::move(sorted.field)),
         width_(width),
         n_global_(n_global),
-        boundary_(mesh_, shared_vertices(comm, gid_)),
-        bisection_(mesh_, agreed_rule(comm, mesh_)) {
+        owned_(std::move(sorted.owned)),
+        n_old_(mesh_.n_points()) {
+    boundary_.emplace(mesh_, shared_vertices(comm, gid_));
+    bisection_.emplace(mesh_, agreed_rule(comm, mesh_));
     MPI_Comm_rank(comm_, &rank_);
     MPI_Comm_size(comm_, &size_);
     for (std::size_t v = 0; v < gid_.size(); ++v) local_of_.emplace(gid_[v], static_cast<VertexId>(v));
     n_numbered_ = n_told_ = mesh_.n_points();
-    bisection_.set_edge_rings(&boundary_);
+    bisection_->set_edge_rings(&*boundary_);
   }
 
   // Global ids for the new vertices: a midpoint is named by its parents' ids and numbered by
@@ -383,8 +460,11 @@ class RankRefinement {
   std::vector<std::int64_t> judged_;
   std::vector<std::int64_t> waiting_;  // edges told of, by global ids, with an end not (yet) here
   VertexId n_numbered_ = 0, n_told_ = 0;
-  RankBoundary boundary_;
-  Bisection bisection_;
+  std::vector<std::uint8_t> owned_;  // of the part's vertices
+  VertexId n_old_;                    // the part's vertices, before the new ones
+  // Made in place and dropped before the mesh becomes the new part (they watch it).
+  std::optional<RankBoundary> boundary_;
+  std::optional<Bisection> bisection_;
 };
 
 }  // namespace

@@ -149,16 +149,42 @@ def test_a_linear_displacement_is_carried_exactly_and_midpoints_of_fixed_vertice
     assert all(body._fixed[v] == (0.001, -0.002, 0.003) for v in fixed)  # the mean of equal anchors
 
 
-def test_the_refined_body_solves_as_the_serial_refined_body():
+EDITS = {"uniform": lambda target: target.refine_uniform(1),
+         "around": lambda target: target.refine_around((0.7, 0.3, 0.2), 0.08)}
+
+
+@pytest.mark.parametrize("edit", EDITS)
+@pytest.mark.parametrize("partition", ["dmplex", "chunks"])
+def test_the_refined_part_numbers_every_vertex_once(edit, partition):
+    """Owners and PETSc's numbering, whether the refined part stays in place (balanced) or
+    DMPlex rebalances it: each vertex owned by one rank, owned rows contiguous in rank order,
+    a ghost carrying its owner's row."""
+    body = snede.Body(part_of(box(), partition), MATERIAL)
+    EDITS[edit](body)
+    part = body.part
+    every = COMM.allgather((part.global_vertex, part.owned, part.global_number))
+    owned_ids = np.concatenate([ids[owned] for ids, owned, _ in every])
+    assert np.array_equal(np.sort(owned_ids), np.arange(part.n_global_vertices))
+    rows = np.concatenate([numbers[owned] for _, owned, numbers in every])
+    assert np.array_equal(np.sort(rows), np.arange(part.n_global_vertices))
+    starts = np.cumsum([0] + [int(owned.sum()) for _, owned, _ in every])
+    for rank, (_, owned, numbers) in enumerate(every):
+        assert np.all((numbers[owned] >= starts[rank]) & (numbers[owned] < starts[rank + 1]))
+    row_of = dict(zip(owned_ids.tolist(), rows.tolist()))
+    for ids, owned, numbers in every:
+        assert all(row_of[i] == r for i, r in zip(ids[~owned].tolist(), numbers[~owned].tolist()))
+
+
+@pytest.mark.parametrize("edit", EDITS)
+def test_the_refined_body_solves_as_the_serial_refined_body(edit):
     serial = box()
     body = snede.Body(part_of(serial, "dmplex"), MATERIAL)
     serial_body = snede.Body(serial, MATERIAL)
     for b in (body, serial_body):
         b.fix(np.isclose(b.mesh.points[:, 0], 0.0))
         b.add_gravity((0.0, 0.0, -9.81))
-    point = (0.7, 0.3, 0.2)
-    body.refine_around(point, 0.08)
-    serial_body.mesh.refine_around(point, 0.08)
+    EDITS[edit](body)
+    EDITS[edit](serial_body.mesh)
     for b in (body, serial_body):
         assert snede.StaticSolver(b, "cg", rtol=1e-12).solve().converged
     order = np.lexsort(serial.points.T[::-1])
