@@ -8,6 +8,7 @@
 
 #include <pybind11/stl.h>
 
+#include <optional>
 #include <string_view>
 
 namespace snede::bindings {
@@ -57,43 +58,57 @@ void bind_distributed(py::module_& m) {
       },
       py::arg("comm"), py::arg("cell_dim"), py::arg("cells"), py::arg("coordinates"));
   // Conforming bisection on ranks (collective): (new part, `field` carried to it as (n, width),
-  // (n_new, 3) new vertices this rank numbered with their parents, cells split over all ranks).
+  // (n_new, 3) new vertices this rank numbered with their parents, cells split over all ranks,
+  // the labels for the next refinement as (rule, (n_cells, cell_dim + 2))). `labels`: those a
+  // previous refinement gave, or None.
   const auto refined = [](RefinedPart r, int width) {
-    return py::make_tuple(std::move(r.part), to_array(r.field, width), to_array(r.new_vertices, 3), r.n_split);
+    const auto corners = static_cast<py::ssize_t>(r.part.local->cell_dim() + 2);
+    return py::make_tuple(std::move(r.part), to_array(r.field, width), to_array(r.new_vertices, 3), r.n_split,
+                          static_cast<int>(r.labels.rule), to_array(r.labels.cells, corners));
+  };
+  const auto labels_of = [](const py::object& given) -> std::optional<PartLabels> {
+    if (given.is_none()) return std::nullopt;
+    const auto [rule, cells] = given.cast<std::pair<int, IndexArray>>();
+    return PartLabels{.rule = static_cast<BisectionRule>(rule), .cells = std::vector<std::int64_t>(cells.data(), cells.data() + cells.size())};
   };
   m.def(
       "refine_part_uniform",
-      [refined](const DistributedMesh& part, int levels, const DoubleArray& field, int width) {
+      [refined, labels_of](const DistributedMesh& part, int levels, const DoubleArray& field, int width, const py::object& labels) {
         std::span<const double> values(field.data(), static_cast<std::size_t>(field.size()));
+        const std::optional<PartLabels> given = labels_of(labels);
         py::gil_scoped_release released;
-        RefinedPart r = refine_part_uniform(part, levels, values, width);
+        RefinedPart r = refine_part_uniform(part, levels, values, width, given ? &*given : nullptr);
         py::gil_scoped_acquire acquired;
         return refined(std::move(r), width);
       },
-      py::arg("part"), py::arg("levels"), py::arg("field"), py::arg("width"));
+      py::arg("part"), py::arg("levels"), py::arg("field"), py::arg("width"), py::arg("labels").none(true));
   m.def(
       "refine_part_around",
-      [refined](const DistributedMesh& part, const DoubleArray& x, double h, const DoubleArray& field, int width) {
+      [refined, labels_of](const DistributedMesh& part, const DoubleArray& x, double h, const DoubleArray& field, int width,
+                           const py::object& labels) {
         std::span<const double> point(x.data(), static_cast<std::size_t>(x.size())),
             values(field.data(), static_cast<std::size_t>(field.size()));
+        const std::optional<PartLabels> given = labels_of(labels);
         py::gil_scoped_release released;
-        RefinedPart r = refine_part_around(part, point, h, values, width);
+        RefinedPart r = refine_part_around(part, point, h, values, width, given ? &*given : nullptr);
         py::gil_scoped_acquire acquired;
         return refined(std::move(r), width);
       },
-      py::arg("part"), py::arg("x"), py::arg("h"), py::arg("field"), py::arg("width"));
+      py::arg("part"), py::arg("x"), py::arg("h"), py::arg("field"), py::arg("width"), py::arg("labels").none(true));
   m.def(
       "refine_part_near_segment",
-      [refined](const DistributedMesh& part, const DoubleArray& a, const DoubleArray& b, double h, double radius,
-                const DoubleArray& field, int width) {
+      [refined, labels_of](const DistributedMesh& part, const DoubleArray& a, const DoubleArray& b, double h, double radius,
+                           const DoubleArray& field, int width, const py::object& labels) {
         std::span<const double> from(a.data(), static_cast<std::size_t>(a.size())),
             to(b.data(), static_cast<std::size_t>(b.size())), values(field.data(), static_cast<std::size_t>(field.size()));
+        const std::optional<PartLabels> given = labels_of(labels);
         py::gil_scoped_release released;
-        RefinedPart r = refine_part_near_segment(part, from, to, h, radius, values, width);
+        RefinedPart r = refine_part_near_segment(part, from, to, h, radius, values, width, given ? &*given : nullptr);
         py::gil_scoped_acquire acquired;
         return refined(std::move(r), width);
       },
-      py::arg("part"), py::arg("a"), py::arg("b"), py::arg("h"), py::arg("radius"), py::arg("field"), py::arg("width"));
+      py::arg("part"), py::arg("a"), py::arg("b"), py::arg("h"), py::arg("radius"), py::arg("field"), py::arg("width"),
+      py::arg("labels").none(true));
   // RankAgreement for Python's collective calls: `inputs` are (name, the input's bytes) pairs,
   // the same names in the same order on every rank.
   m.def(

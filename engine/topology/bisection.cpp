@@ -2,12 +2,14 @@
 
 #include <algorithm>
 #include <stdexcept>
+#include <utility>
 
 #include "mesh/traversal.hpp"
 
 namespace snede {
 
-Bisection::Bisection(Mesh& mesh, std::optional<BisectionRule> rule) : mesh_(mesh), hierarchy_(mesh, rule) {}
+Bisection::Bisection(Mesh& mesh, std::optional<BisectionRule> rule, std::vector<TaggedSimplex> root_labels)
+    : mesh_(mesh), hierarchy_(mesh, rule, std::move(root_labels)) {}
 
 std::vector<ElementId> Bisection::around_edge(VertexId a, VertexId b, ElementId start) const {
   if (rings_) {

@@ -28,9 +28,11 @@ class EdgeRings {
 
 class Bisection {
  public:
-  // Labels the mesh (initial_labelling; the 3D rule chosen from the mesh unless given) and
-  // watches it for as long as this object lives.
-  explicit Bisection(Mesh& mesh, std::optional<BisectionRule> rule = std::nullopt);
+  // Labels the mesh (initial_labelling; the 3D rule chosen from the mesh unless given; the
+  // roots' labels given, one per element id, or found) and watches it for as long as this
+  // object lives.
+  explicit Bisection(Mesh& mesh, std::optional<BisectionRule> rule = std::nullopt,
+                     std::vector<TaggedSimplex> root_labels = {});
   Bisection(const Bisection&) = delete;
   Bisection& operator=(const Bisection&) = delete;
 

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <initializer_list>
+#include <map>
 #include <numeric>
 #include <optional>
 #include <stdexcept>
@@ -28,6 +29,39 @@ std::int64_t sum_over_ranks(MPI_Comm comm, std::int64_t value) {
 void append(std::vector<std::vector<std::int64_t>>& messages, std::int64_t r, std::initializer_list<std::int64_t> items) {
   auto& message = messages[static_cast<std::size_t>(r)];
   message.insert(message.end(), items);
+}
+
+// Item i's question (`width` numbers, written by question(i, out)) asked of rank whom[i], and
+// the reply answer(question, out) appends there (`reply_width` values of `type`), back in item
+// order (collective).
+template <class T, class Question, class Answer>
+std::vector<T> ask_ranks(MPI_Comm comm, const std::vector<int>& whom, std::size_t width, Question question,
+                         std::size_t reply_width, MPI_Datatype type, Answer answer) {
+  int rank = 0, size = 1;
+  MPI_Comm_rank(comm, &rank);
+  MPI_Comm_size(comm, &size);
+  std::vector<std::vector<std::int64_t>> asked(static_cast<std::size_t>(size));
+  for (std::size_t i = 0; i < whom.size(); ++i) {
+    auto& message = asked[static_cast<std::size_t>(whom[i])];
+    question(i, message);
+    message.push_back(rank);  // where the reply goes
+  }
+  const std::vector<std::int64_t> questions = exchange_messages(comm, asked, MPI_INT64_T);
+  std::vector<std::vector<T>> replies(static_cast<std::size_t>(size));
+  for (std::size_t at = 0; at < questions.size(); at += width + 1)
+    answer(std::span<const std::int64_t>(questions.data() + at, width), replies[static_cast<std::size_t>(questions[at + width])]);
+  const std::vector<T> got = exchange_messages(comm, replies, type);
+  // The replies come by the rank that answered, each rank's in the order it was asked.
+  std::vector<std::size_t> next(static_cast<std::size_t>(size) + 1, 0);
+  for (int r : whom) next[static_cast<std::size_t>(r) + 1] += reply_width;
+  for (std::size_t r = 0; r < static_cast<std::size_t>(size); ++r) next[r + 1] += next[r];
+  std::vector<T> out(whom.size() * reply_width);
+  for (std::size_t i = 0; i < whom.size(); ++i) {
+    std::size_t& from = next[static_cast<std::size_t>(whom[i])];
+    std::copy_n(got.begin() + static_cast<std::ptrdiff_t>(from), reply_width, out.begin() + static_cast<std::ptrdiff_t>(i * reply_width));
+    from += reply_width;
+  }
+  return out;
 }
 
 struct EdgeKeyHash {
@@ -185,9 +219,9 @@ BisectionRule agreed_rule(MPI_Comm comm, const Mesh& mesh) {
 // that number the new vertices and close the refinement across the rank boundary.
 class RankRefinement {
  public:
-  RankRefinement(const DistributedMesh& part, std::span<const double> field, int width)
+  RankRefinement(const DistributedMesh& part, std::span<const double> field, int width, const PartLabels* labels)
       : RankRefinement(part.comm, sorted_part(part, field, width), part.local->cell_dim(), part.local->space_dim(),
-                       part.n_global_vertices, width) {}
+                       part.n_global_vertices, width, labels) {}
 
   Bisection& bisection() { return *bisection_; }
 
@@ -266,8 +300,14 @@ class RankRefinement {
       std::copy_n(got_values.begin() + static_cast<std::ptrdiff_t>(i * (d + w)), d, given.coordinates.begin() + static_cast<std::ptrdiff_t>(at * d));
       std::copy_n(got_values.begin() + static_cast<std::ptrdiff_t>(i * (d + w) + d), w, range_field.begin() + static_cast<std::ptrdiff_t>(at * w));
     }
-    RefinedPart out{.part = distribute_cells(comm_, std::move(given)), .field = {}, .new_vertices = std::move(judged_), .n_split = n_split};
+    const std::vector<std::int64_t> labels = labels_of_cells();
+    const BisectionRule rule = bisection_->hierarchy().rule();
+    RefinedPart out{.part = distribute_cells(comm_, std::move(given)), .field = {}, .new_vertices = std::move(judged_),
+                    .n_split = n_split, .labels = {}};
     out.field = field_from_ranges(out.part.global_vertex, range_field, start);
+    std::vector<std::int64_t> cells;
+    for (VertexId v : out.part.local->cells()) cells.push_back(out.part.global_vertex[static_cast<std::size_t>(v)]);
+    out.labels = PartLabels{.rule = rule, .cells = labels_after_rebalancing(labels, cells)};
     return out;
   }
 
@@ -318,6 +358,7 @@ class RankRefinement {
     const std::vector<std::int64_t> ghost_numbers = exchange_messages(comm_, answers, MPI_INT64_T);
     for (std::size_t i = 0; i < ghost_numbers.size(); i += 2)
       number[static_cast<std::size_t>(local_of_.at(ghost_numbers[i]))] = ghost_numbers[i + 1];
+    PartLabels labels{.rule = bisection_->hierarchy().rule(), .cells = labels_of_cells()};
     bisection_.reset();  // they watch the mesh, which moves into the part
     boundary_.reset();
     RefinedPart out{.part = DistributedMesh{.comm = comm_,
@@ -329,11 +370,13 @@ class RankRefinement {
                                             .n_global_cells = n_global_cells},
                     .field = std::move(field_),
                     .new_vertices = std::move(judged_),
-                    .n_split = n_split};
+                    .n_split = n_split,
+                    .labels = std::move(labels)};
     return out;
   }
 
-  RankRefinement(MPI_Comm comm, SortedPart sorted, int cell_dim, int space_dim, std::int64_t n_global, int width)
+  RankRefinement(MPI_Comm comm, SortedPart sorted, int cell_dim, int space_dim, std::int64_t n_global, int width,
+                 const PartLabels* labels)
       : comm_(comm),
         mesh_(cell_dim, space_dim, std::move(sorted.points), sorted.cells),
         gid_(std::move(sorted.gid)),
@@ -342,11 +385,14 @@ class RankRefinement {
         n_global_(n_global),
         owned_(std::move(sorted.owned)),
         n_old_(mesh_.n_points()) {
-    boundary_.emplace(mesh_, shared_vertices(comm, gid_));
-    bisection_.emplace(mesh_, agreed_rule(comm, mesh_));
     MPI_Comm_rank(comm_, &rank_);
     MPI_Comm_size(comm_, &size_);
     for (std::size_t v = 0; v < gid_.size(); ++v) local_of_.emplace(gid_[v], static_cast<VertexId>(v));
+    boundary_.emplace(mesh_, shared_vertices(comm, gid_));
+    std::vector<TaggedSimplex> roots;
+    std::string problem = labels ? root_labels(*labels, roots) : "";
+    if (problem = first_rank_problem(comm_, "refine_part", problem); !problem.empty()) throw std::invalid_argument(problem);
+    bisection_.emplace(mesh_, labels ? labels->rule : agreed_rule(comm, mesh_), std::move(roots));
     n_numbered_ = n_told_ = mesh_.n_points();
     bisection_->set_edge_rings(&*boundary_);
   }
@@ -424,27 +470,91 @@ class RankRefinement {
   std::vector<double> field_from_ranges(const std::vector<std::int64_t>& ids, const std::vector<double>& range_field,
                                         std::int64_t start) const {
     const auto w = static_cast<std::size_t>(width_);
-    std::vector<std::vector<std::int64_t>> asked(static_cast<std::size_t>(size_));
-    for (std::int64_t id : ids) append(asked, range_holder(id), {id, rank_});
-    const std::vector<std::int64_t> questions = exchange_messages(comm_, asked, MPI_INT64_T);
-    std::vector<std::vector<double>> answers(static_cast<std::size_t>(size_));
-    for (std::size_t i = 0; i < questions.size(); i += 2) {
-      auto& answer = answers[static_cast<std::size_t>(questions[i + 1])];
-      const auto at = static_cast<std::size_t>(questions[i] - start) * w;
-      answer.insert(answer.end(), range_field.begin() + static_cast<std::ptrdiff_t>(at),
-                    range_field.begin() + static_cast<std::ptrdiff_t>(at + w));
+    std::vector<int> whom;
+    for (std::int64_t id : ids) whom.push_back(range_holder(id));
+    return ask_ranks<double>(
+        comm_, whom, 1, [&](std::size_t i, std::vector<std::int64_t>& out) { out.push_back(ids[i]); }, w, MPI_DOUBLE,
+        [&](std::span<const std::int64_t> id, std::vector<double>& out) {
+          const auto at = static_cast<std::ptrdiff_t>(static_cast<std::size_t>(id[0] - start) * w);
+          out.insert(out.end(), range_field.begin() + at, range_field.begin() + at + static_cast<std::ptrdiff_t>(w));
+        });
+  }
+
+  // The labels of the cells a rebalancing gave this rank (`cells`: its new part's, by global
+  // ids), from the ranks that had them: each cell is filed at rank (smallest id mod size) under
+  // its sorted ids (collective).
+  std::vector<std::int64_t> labels_after_rebalancing(const std::vector<std::int64_t>& labels,
+                                                     const std::vector<std::int64_t>& cells) const {
+    const auto corners = static_cast<std::size_t>(mesh_.cell_dim() + 1), width = corners + 1;
+    const auto key_of = [&](const std::int64_t* ids) {
+      std::vector<std::int64_t> key(ids, ids + corners);
+      std::sort(key.begin(), key.end());
+      return key;
+    };
+    std::vector<std::vector<std::int64_t>> filed(static_cast<std::size_t>(size_));
+    for (std::size_t at = 0; at < labels.size(); at += width) {
+      const std::vector<std::int64_t> key = key_of(labels.data() + at);
+      auto& message = filed[static_cast<std::size_t>(key[0] % size_)];
+      message.insert(message.end(), key.begin(), key.end());
+      message.insert(message.end(), labels.begin() + static_cast<std::ptrdiff_t>(at),
+                     labels.begin() + static_cast<std::ptrdiff_t>(at + width));
     }
-    const std::vector<double> got = exchange_messages(comm_, answers, MPI_DOUBLE);
-    // Answers come by holder rank, each in the order this rank asked it.
-    std::vector<std::size_t> next(static_cast<std::size_t>(size_ + 1), 0);
-    for (int r = 0; r < size_; ++r) next[static_cast<std::size_t>(r + 1)] = next[static_cast<std::size_t>(r)] + asked[static_cast<std::size_t>(r)].size() / 2 * w;
-    std::vector<double> field(ids.size() * w);
-    for (std::size_t i = 0; i < ids.size(); ++i) {
-      auto& from = next[static_cast<std::size_t>(range_holder(ids[i]))];
-      std::copy_n(got.begin() + static_cast<std::ptrdiff_t>(from), w, field.begin() + static_cast<std::ptrdiff_t>(i * w));
-      from += w;
+    const std::vector<std::int64_t> kept = exchange_messages(comm_, filed, MPI_INT64_T);
+    std::map<std::vector<std::int64_t>, std::size_t> at_key;  // where each filed label starts in `kept`
+    for (std::size_t at = 0; at < kept.size(); at += corners + width)
+      at_key.emplace(std::vector<std::int64_t>(kept.begin() + static_cast<std::ptrdiff_t>(at),
+                                               kept.begin() + static_cast<std::ptrdiff_t>(at + corners)),
+                     at + corners);
+    std::vector<int> whom;
+    std::vector<std::vector<std::int64_t>> keys;
+    for (std::size_t at = 0; at < cells.size(); at += corners) {
+      keys.push_back(key_of(cells.data() + at));
+      whom.push_back(static_cast<int>(keys.back()[0] % size_));
     }
-    return field;
+    return ask_ranks<std::int64_t>(
+        comm_, whom, corners,
+        [&](std::size_t i, std::vector<std::int64_t>& out) { out.insert(out.end(), keys[i].begin(), keys[i].end()); },
+        width, MPI_INT64_T, [&](std::span<const std::int64_t> key, std::vector<std::int64_t>& out) {
+          const std::size_t at = at_key.at(std::vector<std::int64_t>(key.begin(), key.end()));
+          out.insert(out.end(), kept.begin() + static_cast<std::ptrdiff_t>(at),
+                     kept.begin() + static_cast<std::ptrdiff_t>(at + width));
+        });
+  }
+
+  // The given labels as the sorted copy's roots, one per element (its row); what is wrong
+  // with them, or empty.
+  std::string root_labels(const PartLabels& labels, std::vector<TaggedSimplex>& roots) const {
+    const int d = mesh_.cell_dim();
+    const auto width = static_cast<std::size_t>(d + 2);
+    if (labels.cells.size() != mesh_.n_cells() * width)
+      return "the labels hold " + std::to_string(labels.cells.size()) + " numbers for " +
+             std::to_string(mesh_.n_cells()) + " cells (" + std::to_string(width) + " each): not this part's";
+    for (std::size_t e = 0; e < mesh_.n_cells(); ++e) {
+      TaggedSimplex label;
+      label.dim = static_cast<std::int8_t>(d);
+      label.tag = static_cast<std::int8_t>(labels.cells[e * width + static_cast<std::size_t>(d) + 1]);
+      for (int i = 0; i <= d; ++i) {
+        const auto at = local_of_.find(labels.cells[e * width + static_cast<std::size_t>(i)]);
+        if (at == local_of_.end() || !mesh_.connectivity().element(static_cast<ElementId>(e)).simplex.contains(at->second))
+          return "the label of cell " + std::to_string(e) + " names other vertices than the cell's: not this part's";
+        label.vertex[static_cast<std::size_t>(i)] = at->second;
+      }
+      if (label.tag < 1 || label.tag > d) return "the label of cell " + std::to_string(e) + " has tag " + std::to_string(label.tag);
+      roots.push_back(label);
+    }
+    return "";
+  }
+
+  // The live cells' labels by global ids, in the mesh's cell order (Mesh::cells).
+  std::vector<std::int64_t> labels_of_cells() const {
+    std::vector<std::int64_t> out;
+    const int d = mesh_.cell_dim();
+    for (ElementId e : mesh_.connectivity().element_ids()) {
+      const TaggedSimplex& label = bisection_->hierarchy().label(e);
+      for (int i = 0; i <= d; ++i) out.push_back(gid_[static_cast<std::size_t>(label.vertex[static_cast<std::size_t>(i)])]);
+      out.push_back(label.tag);
+    }
+    return out;
   }
 
   MPI_Comm comm_;
@@ -469,9 +579,10 @@ class RankRefinement {
 
 }  // namespace
 
-RefinedPart refine_part_uniform(const DistributedMesh& part, int levels, std::span<const double> field, int width) {
+RefinedPart refine_part_uniform(const DistributedMesh& part, int levels, std::span<const double> field, int width,
+                                const PartLabels* labels) {
   if (levels < 0) throw std::invalid_argument("refine_part_uniform: levels must be ≥ 0, got " + std::to_string(levels));
-  RankRefinement refinement(part, field, width);
+  RankRefinement refinement(part, field, width, labels);
   std::int64_t split = 0;
   for (int level = 0; level < levels; ++level) {
     {
@@ -490,8 +601,8 @@ namespace {
 // refine_near_segment), each mark being one the serial loop makes.
 template <class Mark>
 RefinedPart refine_until_unmarked(const DistributedMesh& part, std::span<const double> field, int width,
-                                  const std::string& caller, Mark mark) {
-  RankRefinement refinement(part, field, width);
+                                  const PartLabels* labels, const std::string& caller, Mark mark) {
+  RankRefinement refinement(part, field, width, labels);
   std::int64_t split = 0;
   for (bool first = true;; first = false) {
     std::int64_t marked = 0;
@@ -518,12 +629,12 @@ std::string point_text(std::span<const double> x) {
 }  // namespace
 
 RefinedPart refine_part_around(const DistributedMesh& part, std::span<const double> x, double h,
-                               std::span<const double> field, int width) {
+                               std::span<const double> field, int width, const PartLabels* labels) {
   if (x.size() != static_cast<std::size_t>(part.local->space_dim()))
     throw std::invalid_argument("refine_around: the point has " + std::to_string(x.size()) + " coordinates, the mesh is " +
                                 std::to_string(part.local->space_dim()) + "-D");
   bool holds_x = false;
-  return refine_until_unmarked(part, field, width, "refine_part_around", [&](Bisection& bisection, bool first) {
+  return refine_until_unmarked(part, field, width, labels, "refine_part_around", [&](Bisection& bisection, bool first) {
     if (first) {
       holds_x = !bisection.hierarchy().roots_containing(x).empty();
       if (sum_over_ranks(part.comm, holds_x ? 1 : 0) == 0)
@@ -534,8 +645,9 @@ RefinedPart refine_part_around(const DistributedMesh& part, std::span<const doub
 }
 
 RefinedPart refine_part_near_segment(const DistributedMesh& part, std::span<const double> a, std::span<const double> b,
-                                     double h, double radius, std::span<const double> field, int width) {
-  return refine_until_unmarked(part, field, width, "refine_part_near_segment", [&](Bisection& bisection, bool first) {
+                                     double h, double radius, std::span<const double> field, int width,
+                                     const PartLabels* labels) {
+  return refine_until_unmarked(part, field, width, labels, "refine_part_near_segment", [&](Bisection& bisection, bool first) {
     bool near_here = false;
     std::size_t split = 0;
     std::string problem;

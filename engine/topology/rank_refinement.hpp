@@ -13,8 +13,19 @@
 #include <vector>
 
 #include "mesh/distributed_mesh.hpp"
+#include "topology/initial_labelling.hpp"
 
 namespace snede {
+
+// The bisection labels of a part's cells (§6.5), kept from one refinement to the next so that
+// it goes on as the serial hierarchy does: relabelling a refined Kuhn box afresh would lose
+// Maubach's tags and bisect it otherwise (more cells from the third level on).
+struct PartLabels {
+  BisectionRule rule = BisectionRule::newest_vertex;
+  // Per cell of part.local, in its row order: the cell's global vertex ids in label order
+  // (x0..xd), then the tag.
+  std::vector<std::int64_t> cells;
+};
 
 struct RefinedPart {
   DistributedMesh part;
@@ -25,22 +36,27 @@ struct RefinedPart {
   // every new vertex is listed on exactly one rank.
   std::vector<std::int64_t> new_vertices;
   std::int64_t n_split = 0;  // cells split, over all ranks (as serially)
+  PartLabels labels;         // of the new part's cells, for the next refinement
 };
 
 // Collective. Every cell bisected `levels` times (Bisection::refine_uniform). `field` holds
-// `width` values per vertex of part.local.
-RefinedPart refine_part_uniform(const DistributedMesh& part, int levels, std::span<const double> field, int width);
+// `width` values per vertex of part.local; `labels` are those the part's previous refinement
+// gave (nullptr: a part never refined, labelled as serially). Labels that do not fit the part's
+// cells throw the same std::invalid_argument on every rank.
+RefinedPart refine_part_uniform(const DistributedMesh& part, int levels, std::span<const double> field, int width,
+                                const PartLabels* labels);
 
 // Collective. Bisected until every cell whose closure contains x has edges no longer than h
 // (refine_around). Throws the same std::invalid_argument on every rank when no rank's cells
 // contain x or h is below round-off there.
 RefinedPart refine_part_around(const DistributedMesh& part, std::span<const double> x, double h,
-                               std::span<const double> field, int width);
+                               std::span<const double> field, int width, const PartLabels* labels);
 
 // Collective. Bisected until every cell near the segment a–b has edges no longer than h
 // (refine_near_segment); the same std::invalid_argument on every rank when no rank's cells come
 // within `radius` of it or h is below round-off there.
 RefinedPart refine_part_near_segment(const DistributedMesh& part, std::span<const double> a, std::span<const double> b,
-                                     double h, double radius, std::span<const double> field, int width);
+                                     double h, double radius, std::span<const double> field, int width,
+                                     const PartLabels* labels);
 
 }  // namespace snede

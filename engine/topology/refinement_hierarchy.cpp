@@ -3,6 +3,7 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <stdexcept>
+#include <utility>
 
 #include "topology/initial_labelling.hpp"
 
@@ -14,8 +15,9 @@ constexpr double on_face_tolerance = 1e-10;
 
 }  // namespace
 
-RefinementHierarchy::RefinementHierarchy(Mesh& mesh, std::optional<BisectionRule> rule)
-    : mesh_(mesh), given_rule_(rule) {
+RefinementHierarchy::RefinementHierarchy(Mesh& mesh, std::optional<BisectionRule> rule,
+                                         std::vector<TaggedSimplex> root_labels)
+    : mesh_(mesh), given_rule_(rule), given_labels_(std::move(root_labels)) {
   mesh_.connectivity().add_watcher(this, WatchMode::each_operation);  // follows every split
 }
 
@@ -28,7 +30,10 @@ void RefinementHierarchy::init(const Connectivity& connectivity) {
   node_of_element_.assign(connectivity.element_capacity(), no_id);
   rule_ = given_rule_ ? *given_rule_ : bisection_rule_for(mesh_);
   for (ElementId e : connectivity.element_ids())
-    add_root(initial_labelling(mesh_, connectivity.element(e).simplex, rule_), e);
+    add_root(given_labels_.empty() ? initial_labelling(mesh_, connectivity.element(e).simplex, rule_)
+                                   : given_labels_.at(static_cast<std::size_t>(e)),
+             e);
+  std::vector<TaggedSimplex>().swap(given_labels_);
   n_points_seen_ = mesh_.n_points();
 }
 

@@ -34,8 +34,11 @@ class RefinementHierarchy : public ConnectivityWatcher {
  public:
   // Labels every element of `mesh` as a root (initial_labelling) and starts watching it. The
   // 3D rule is chosen from the mesh unless given (a rank's part of a distributed mesh takes the
-  // rule every rank agreed on, which the whole mesh would choose).
-  explicit RefinementHierarchy(Mesh& mesh, std::optional<BisectionRule> rule = std::nullopt);
+  // rule every rank agreed on, which the whole mesh would choose); `root_labels`, one per
+  // element id, replace initial_labelling (a part refined before goes on with the labels its
+  // cells had, as a serial hierarchy would).
+  explicit RefinementHierarchy(Mesh& mesh, std::optional<BisectionRule> rule = std::nullopt,
+                               std::vector<TaggedSimplex> root_labels = {});
   ~RefinementHierarchy() override;
   RefinementHierarchy(const RefinementHierarchy&) = delete;
   RefinementHierarchy& operator=(const RefinementHierarchy&) = delete;
@@ -101,6 +104,7 @@ class RefinementHierarchy : public ConnectivityWatcher {
   mutable RootGrid root_grid_;
   VertexId n_points_seen_ = 0;
   std::optional<BisectionRule> given_rule_;
+  std::vector<TaggedSimplex> given_labels_;  // until init() takes them
   BisectionRule rule_ = BisectionRule::newest_vertex;  // ids below this may be in roots' labels: reusing one moves a root
 };
 

@@ -50,6 +50,7 @@ class PartBody:
         self._local_order = np.argsort(part.global_vertex, kind="stable")
         self._problem, self._problem_conditions = None, None
         self._edits, self._edits_seen = 0, 0  # conditions or displacement set, and as of the latest solve
+        self._labels = None  # the cells' bisection labels (rank_refinement.hpp) once the part was refined
 
     @property
     def dim(self) -> int:
@@ -261,7 +262,8 @@ class PartBody:
             return counted
 
         counted = agreed(self.comm, checked)
-        return self._refined(lambda field: _snede.refine_part_uniform(self.part._impl, counted, field, self.dim))
+        return self._refined(lambda field: _snede.refine_part_uniform(self.part._impl, counted, field, self.dim,
+                                                                                     self._labels))
 
     def refine_around(self, point, h: float) -> int:
         """Bisect until every cell containing ``point`` (shape (dim,)) has edges no longer than
@@ -280,7 +282,8 @@ class PartBody:
             return x, size
 
         x, size = agreed(self.comm, checked)
-        return self._refined(lambda field: _snede.refine_part_around(self.part._impl, x, size, field, self.dim))
+        return self._refined(lambda field: _snede.refine_part_around(self.part._impl, x, size, field, self.dim,
+                                                                                    self._labels))
 
     def refine_near_segment(self, a, b, h: float, radius: float = 0.0) -> int:
         """Bisect until every cell that comes within ``radius`` of the segment ``a``–``b`` (a
@@ -295,7 +298,7 @@ class PartBody:
 
         (start, end), size, reach = agreed(self.comm, checked)
         return self._refined(lambda field: _snede.refine_part_near_segment(self.part._impl, start, end, size, reach,
-                                                                           field, self.dim))
+                                                                           field, self.dim, self._labels))
 
     def _require_same(self, caller: str, **inputs) -> None:
         _snede.require_same_on_every_rank(self.comm.py2f(), caller, list(inputs.items()))
@@ -303,7 +306,8 @@ class PartBody:
     def _refined(self, refine) -> int:
         """The body on the part ``refine(displacement)`` makes (collective)."""
         groups = part_groups.group_shapes(self.mesh, self.comm)
-        new_part, field, new_vertices, split = refine(np.ascontiguousarray(self._displacement).ravel())
+        new_part, field, new_vertices, split, rule, labels = refine(np.ascontiguousarray(self._displacement).ravel())
+        self._labels = (rule, labels)  # the bisection labels go on with the next refinement
         self._inherit_fixed(new_vertices)
         self.part = _part(self.comm, new_part)
         self.mesh = self.part.local

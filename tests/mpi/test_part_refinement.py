@@ -76,6 +76,28 @@ def test_uniform_refinement_on_ranks_is_the_serial_one(make, partition):
     assert_same_cells(body, serial)
 
 
+@pytest.mark.parametrize("partition", ["dmplex", "chunks"])
+def test_successive_refinements_go_on_as_the_serial_hierarchy(partition):
+    """Maubach's tags carried from one refinement to the next (also through a rebalancing):
+    relabelling the refined Kuhn box afresh splits 8 400 cells at the third level, not 5 040."""
+    serial = snede.meshing.box((1.0, 1.0, 1.0), (7, 6, 5))
+    body = snede.Body(part_of(serial, partition), MATERIAL)
+    corner = COMM.bcast(body.mesh.points[body.mesh.cells[0]].mean(axis=0), root=0)  # in a cell of rank 0
+    crowd = (corner, corner + 0.03, 0.03, 0.05)  # a short shaft in rank 0's cells: DMPlex rebalances
+    for edit in (lambda target: target.refine_uniform(1), lambda target: target.refine_near_segment(*crowd),
+                 lambda target: target.refine_uniform(1), lambda target: target.refine_uniform(1)):
+        assert edit(body) == edit(serial)
+        assert_same_cells(body, serial)
+
+
+def test_labels_of_another_part_are_refused_on_every_rank():
+    body = snede.Body(part_of(box(), "chunks"), MATERIAL)
+    other = snede.Body(part_of(snede.meshing.box((1.0, 1.0, 1.0), (3, 3, 3)), "chunks"), MATERIAL)
+    other.refine_uniform(1)
+    with pytest.raises(ValueError, match="not this part's"):
+        snede._snede.refine_part_uniform(body.part._impl, 1, body.displacement.ravel(), 3, other._labels)
+
+
 @pytest.mark.parametrize("make", [box, cylinder])
 @pytest.mark.parametrize("partition", ["dmplex", "chunks"])
 def test_refinement_around_a_point_on_ranks_is_the_serial_one(make, partition):
@@ -201,7 +223,7 @@ def test_parts_are_rebalanced_when_refinement_crowds_one_rank():
     serial = snede.meshing.box((1.0, 1.0, 1.0), (6, 6, 6))
     body = snede.Body(part_of(serial, "chunks"), MATERIAL)
     corner = COMM.bcast(body.mesh.points[body.mesh.cells[0]].mean(axis=0), root=0)  # inside a cell of rank 0
-    body.refine_around(corner, 0.01)
+    body.refine_near_segment(corner, corner + 0.03, 0.03, 0.05)  # three times the cells, all near rank 0's
     counts = COMM.allgather(body.mesh.n_cells)
     assert sum(counts) == body.part.n_global_cells
     if COMM.size > 1:
