@@ -57,58 +57,58 @@ void bind_distributed(py::module_& m) {
         return distribute_cells(MPI_Comm_f2c(static_cast<MPI_Fint>(comm)), std::move(part));
       },
       py::arg("comm"), py::arg("cell_dim"), py::arg("cells"), py::arg("coordinates"));
-  // Conforming bisection on ranks (collective): (new part, `field` carried to it as (n, width),
-  // (n_new, 3) new vertices this rank numbered with their parents, cells split over all ranks,
-  // the labels for the next refinement as (rule, (n_cells, cell_dim + 2))). `labels`: those a
-  // previous refinement gave, or None.
-  const auto refined = [](RefinedPart r, int width) {
-    const auto corners = static_cast<py::ssize_t>(r.part.local->cell_dim() + 2);
-    return py::make_tuple(std::move(r.part), to_array(r.field, width), to_array(r.new_vertices, 3), r.n_split,
+  // Conforming bisection on ranks (collective). Each edit returns (field as (n, width), (n_new, 3)
+  // new vertices this rank numbered with their parents, cells split over all ranks, the
+  // rebalanced part or None, and its labels as (rule, (n_cells, cell_dim + 2))).
+  const auto report = [](RankRefinementReport r, int width) {
+    const auto corners = static_cast<py::ssize_t>(r.rebalanced ? r.rebalanced->local->cell_dim() + 2 : 1);
+    py::object rebalanced = py::none();
+    if (r.rebalanced) rebalanced = py::cast(std::move(*r.rebalanced));
+    return py::make_tuple(to_array(r.field, width), to_array(r.new_vertices, 3), r.n_split, rebalanced,
                           static_cast<int>(r.labels.rule), to_array(r.labels.cells, corners));
   };
-  const auto labels_of = [](const py::object& given) -> std::optional<PartLabels> {
-    if (given.is_none()) return std::nullopt;
-    const auto [rule, cells] = given.cast<std::pair<int, IndexArray>>();
-    return PartLabels{.rule = static_cast<BisectionRule>(rule), .cells = std::vector<std::int64_t>(cells.data(), cells.data() + cells.size())};
-  };
-  m.def(
-      "refine_part_uniform",
-      [refined, labels_of](const DistributedMesh& part, int levels, const DoubleArray& field, int width, const py::object& labels) {
-        std::span<const double> values(field.data(), static_cast<std::size_t>(field.size()));
-        const std::optional<PartLabels> given = labels_of(labels);
-        py::gil_scoped_release released;
-        RefinedPart r = refine_part_uniform(part, levels, values, width, given ? &*given : nullptr);
-        py::gil_scoped_acquire acquired;
-        return refined(std::move(r), width);
-      },
-      py::arg("part"), py::arg("levels"), py::arg("field"), py::arg("width"), py::arg("labels").none(true));
-  m.def(
-      "refine_part_around",
-      [refined, labels_of](const DistributedMesh& part, const DoubleArray& x, double h, const DoubleArray& field, int width,
-                           const py::object& labels) {
-        std::span<const double> point(x.data(), static_cast<std::size_t>(x.size())),
-            values(field.data(), static_cast<std::size_t>(field.size()));
-        const std::optional<PartLabels> given = labels_of(labels);
-        py::gil_scoped_release released;
-        RefinedPart r = refine_part_around(part, point, h, values, width, given ? &*given : nullptr);
-        py::gil_scoped_acquire acquired;
-        return refined(std::move(r), width);
-      },
-      py::arg("part"), py::arg("x"), py::arg("h"), py::arg("field"), py::arg("width"), py::arg("labels").none(true));
-  m.def(
-      "refine_part_near_segment",
-      [refined, labels_of](const DistributedMesh& part, const DoubleArray& a, const DoubleArray& b, double h, double radius,
-                           const DoubleArray& field, int width, const py::object& labels) {
-        std::span<const double> from(a.data(), static_cast<std::size_t>(a.size())),
-            to(b.data(), static_cast<std::size_t>(b.size())), values(field.data(), static_cast<std::size_t>(field.size()));
-        const std::optional<PartLabels> given = labels_of(labels);
-        py::gil_scoped_release released;
-        RefinedPart r = refine_part_near_segment(part, from, to, h, radius, values, width, given ? &*given : nullptr);
-        py::gil_scoped_acquire acquired;
-        return refined(std::move(r), width);
-      },
-      py::arg("part"), py::arg("a"), py::arg("b"), py::arg("h"), py::arg("radius"), py::arg("field"), py::arg("width"),
-      py::arg("labels").none(true));
+  const auto view = [](const DoubleArray& a) { return std::span<const double>(a.data(), static_cast<std::size_t>(a.size())); };
+  py::class_<PartRefinement>(m, "PartRefinement")
+      .def(py::init([](const DistributedMesh& part, const py::object& labels) {
+             if (labels.is_none()) return std::make_unique<PartRefinement>(part, nullptr);
+             const auto [rule, cells] = labels.cast<std::pair<int, IndexArray>>();
+             const PartLabels given{.rule = static_cast<BisectionRule>(rule),
+                                    .cells = std::vector<std::int64_t>(cells.data(), cells.data() + cells.size())};
+             return std::make_unique<PartRefinement>(part, &given);
+           }),
+           py::arg("part"), py::arg("labels").none(true))
+      .def_property_readonly(
+          "part", [](PartRefinement& r) -> DistributedMesh& { return r.part(); }, py::return_value_policy::reference_internal)
+      .def_property_readonly("original_vertex", [](const PartRefinement& r) { return to_array(r.original_vertex(), 1); })
+      .def_property_readonly("spent", &PartRefinement::spent)
+      .def(
+          "refine_uniform",
+          [report, view](PartRefinement& r, int levels, const DoubleArray& field, int width) {
+            py::gil_scoped_release released;
+            RankRefinementReport done = r.refine_uniform(levels, view(field), width);
+            py::gil_scoped_acquire acquired;
+            return report(std::move(done), width);
+          },
+          py::arg("levels"), py::arg("field"), py::arg("width"))
+      .def(
+          "refine_around",
+          [report, view](PartRefinement& r, const DoubleArray& x, double h, const DoubleArray& field, int width) {
+            py::gil_scoped_release released;
+            RankRefinementReport done = r.refine_around(view(x), h, view(field), width);
+            py::gil_scoped_acquire acquired;
+            return report(std::move(done), width);
+          },
+          py::arg("x"), py::arg("h"), py::arg("field"), py::arg("width"))
+      .def(
+          "refine_near_segment",
+          [report, view](PartRefinement& r, const DoubleArray& a, const DoubleArray& b, double h, double radius,
+                         const DoubleArray& field, int width) {
+            py::gil_scoped_release released;
+            RankRefinementReport done = r.refine_near_segment(view(a), view(b), h, radius, view(field), width);
+            py::gil_scoped_acquire acquired;
+            return report(std::move(done), width);
+          },
+          py::arg("a"), py::arg("b"), py::arg("h"), py::arg("radius"), py::arg("field"), py::arg("width"));
   // RankAgreement for Python's collective calls: `inputs` are (name, the input's bytes) pairs,
   // the same names in the same order on every rank.
   m.def(

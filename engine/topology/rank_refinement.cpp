@@ -173,37 +173,32 @@ std::unordered_map<VertexId, std::vector<int>> shared_vertices(MPI_Comm comm, co
   return holders;
 }
 
-// The part's vertices in the order of their global ids, so that the labelling's ties between
-// equal edges (vertex ids: initial_labelling.hpp) break as in the serial mesh.
-struct SortedPart {
-  std::vector<std::int64_t> gid;
-  std::vector<std::uint8_t> owned;
-  std::vector<double> points, field;
-  std::vector<std::int64_t> cells;
-};
-
-SortedPart sorted_part(const DistributedMesh& part, std::span<const double> field, int width) {
+// The part copied with its vertices in the order of their global ids, so that the labelling's
+// ties between equal edges (vertex ids: initial_labelling.hpp) break as in the serial mesh;
+// `original` gives each vertex's index in the part given.
+DistributedMesh sorted_part(const DistributedMesh& part, std::vector<std::int64_t>& original) {
   const Mesh& local = *part.local;
   const auto n = static_cast<std::size_t>(local.n_points());
-  if (field.size() != n * static_cast<std::size_t>(width))
-    throw std::invalid_argument("refine_part: the field holds " + std::to_string(field.size()) + " values, not " +
-                                std::to_string(width) + " per each of the part's " + std::to_string(n) + " vertices");
-  std::vector<std::size_t> order(n);
-  std::iota(order.begin(), order.end(), std::size_t{0});
-  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return part.global_vertex[a] < part.global_vertex[b]; });
-  std::vector<std::int64_t> sorted_of(n);
-  SortedPart out;
-  const auto d = static_cast<std::size_t>(local.space_dim()), w = static_cast<std::size_t>(width);
+  original.resize(n);
+  std::iota(original.begin(), original.end(), std::int64_t{0});
+  std::sort(original.begin(), original.end(),
+            [&](std::int64_t a, std::int64_t b) { return part.global_vertex[static_cast<std::size_t>(a)] < part.global_vertex[static_cast<std::size_t>(b)]; });
+  std::vector<std::int64_t> sorted_of(n), cells;
+  DistributedMesh out{.comm = part.comm, .local = nullptr, .global_vertex = {}, .owned = {}, .global_number = {},
+                      .n_global_vertices = part.n_global_vertices, .n_global_cells = part.n_global_cells};
+  std::vector<double> points;
+  const auto d = static_cast<std::size_t>(local.space_dim());
   for (std::size_t i = 0; i < n; ++i) {
-    sorted_of[order[i]] = static_cast<std::int64_t>(i);
-    out.gid.push_back(part.global_vertex[order[i]]);
-    out.owned.push_back(part.owned[order[i]]);
-    out.points.insert(out.points.end(), local.points().begin() + static_cast<std::ptrdiff_t>(order[i] * d),
-                      local.points().begin() + static_cast<std::ptrdiff_t>((order[i] + 1) * d));
-    out.field.insert(out.field.end(), field.begin() + static_cast<std::ptrdiff_t>(order[i] * w),
-                     field.begin() + static_cast<std::ptrdiff_t>((order[i] + 1) * w));
+    const auto from = static_cast<std::size_t>(original[i]);
+    sorted_of[from] = static_cast<std::int64_t>(i);
+    out.global_vertex.push_back(part.global_vertex[from]);
+    out.owned.push_back(part.owned[from]);
+    out.global_number.push_back(part.global_number[from]);
+    points.insert(points.end(), local.points().begin() + static_cast<std::ptrdiff_t>(from * d),
+                  local.points().begin() + static_cast<std::ptrdiff_t>((from + 1) * d));
   }
-  for (VertexId v : local.cells()) out.cells.push_back(sorted_of[static_cast<std::size_t>(v)]);
+  for (VertexId v : local.cells()) cells.push_back(sorted_of[static_cast<std::size_t>(v)]);
+  out.local = std::make_unique<Mesh>(local.cell_dim(), local.space_dim(), std::move(points), cells);
   return out;
 }
 
@@ -215,15 +210,50 @@ BisectionRule agreed_rule(MPI_Comm comm, const Mesh& mesh) {
   return longest ? BisectionRule::longest_edge : BisectionRule::newest_vertex;
 }
 
-// One rank's share of a distributed refinement: its cells, bisected locally, and the exchanges
-// that number the new vertices and close the refinement across the rank boundary.
-class RankRefinement {
- public:
-  RankRefinement(const DistributedMesh& part, std::span<const double> field, int width, const PartLabels* labels)
-      : RankRefinement(part.comm, sorted_part(part, field, width), part.local->cell_dim(), part.local->space_dim(),
-                       part.n_global_vertices, width, labels) {}
+}  // namespace
 
+// One rank's share of a distributed refinement, kept between edits: its part (cells, vertices,
+// owners, numbering) refined in place, the bisection hierarchy and the rank boundary, and the
+// exchanges that number the new vertices and close each refinement across the rank boundary.
+class PartRefinement::State {
+ public:
+  State(const DistributedMesh& part, const PartLabels* labels)
+      : comm_(part.comm), part_(sorted_part(part, original_)), mesh_(*part_.local) {
+    MPI_Comm_rank(comm_, &rank_);
+    MPI_Comm_size(comm_, &size_);
+    for (std::size_t v = 0; v < gid().size(); ++v) local_of_.emplace(gid()[v], static_cast<VertexId>(v));
+    boundary_.emplace(mesh_, shared_vertices(comm_, gid()));
+    std::vector<TaggedSimplex> roots;
+    std::string problem = labels ? root_labels(*labels, roots) : "";
+    if (problem = first_rank_problem(comm_, "PartRefinement", problem); !problem.empty()) throw std::invalid_argument(problem);
+    bisection_.emplace(mesh_, labels ? labels->rule : agreed_rule(comm_, mesh_), std::move(roots));
+    bisection_->set_edge_rings(&*boundary_);
+  }
+  ~State() {
+    bisection_.reset();  // they watch the mesh
+    boundary_.reset();
+  }
+
+  DistributedMesh& part() { return part_; }
+  const std::vector<std::int64_t>& original() const { return original_; }
+  bool spent() const { return spent_; }
   Bisection& bisection() { return *bisection_; }
+
+  // Starts an edit: `field` (width per vertex of the part) is carried to the new vertices.
+  void begin(std::span<const double> field, int width) {
+    if (spent_) throw std::logic_error("PartRefinement: its part was rebalanced; refine the rebalanced part");
+    const auto n = static_cast<std::size_t>(mesh_.n_points());
+    if (width < 1 || field.size() != n * static_cast<std::size_t>(width))
+      throw std::invalid_argument("PartRefinement: the field holds " + std::to_string(field.size()) + " values, not " +
+                                  std::to_string(width) + " per each of the part's " + std::to_string(n) + " vertices");
+    field_.assign(field.begin(), field.end());
+    width_ = width;
+    n_before_ = n_numbered_ = n_told_ = mesh_.n_points();
+    n_global_ = part_.n_global_vertices;
+    numbered_.clear();
+    judged_.clear();
+    waiting_.clear();
+  }
 
   // After this rank's own splits: numbers the new vertices and splits the edges other ranks
   // split, until no rank splits any more (collective). Returns the cells split here.
@@ -237,7 +267,7 @@ class RankRefinement {
         if (const std::vector<int>* others = boundary_->other_holders(v)) {
           const VertexParents parents = mesh_.parents(v);
           for (int r : *others)
-            append(told, r, {gid_[static_cast<std::size_t>(parents.vertex[0])], gid_[static_cast<std::size_t>(parents.vertex[1])]});
+            append(told, r, {gid()[static_cast<std::size_t>(parents.vertex[0])], gid()[static_cast<std::size_t>(parents.vertex[1])]});
         }
       n_told_ = mesh_.n_points();
       // An edge told of may end at a midpoint this rank made in the same round and has not
@@ -263,29 +293,34 @@ class RankRefinement {
   }
 
   // The refined cells as a new part, the field carried to it (collective).
-  RefinedPart finish(std::int64_t n_split) {
+  // Ends the edit (collective): balanced parts (as distribute_cells judges them) stay refined in
+  // place, renumbered; others go to DMPlex to be balanced, and this refinement is spent.
+  RankRefinementReport finish(std::int64_t n_split) {
     const ScopedEvent timed(log_event("SnedeRankNewPart"));
     interpolate_field();
-    // Balanced parts (as distribute_cells judges them) stay as they are: the refined mesh
-    // becomes the part, with no copy; others go to DMPlex to be balanced.
     std::int64_t n_cells = static_cast<std::int64_t>(mesh_.n_cells()), largest = n_cells;
     MPI_Allreduce(MPI_IN_PLACE, &largest, 1, MPI_INT64_T, MPI_MAX, comm_);
     const std::int64_t total = sum_over_ranks(comm_, n_cells);
-    if (static_cast<double>(largest) * size_ <= 1.2 * static_cast<double>(total)) return part_in_place(n_split, total);
+    if (static_cast<double>(largest) * size_ <= 1.2 * static_cast<double>(total)) {
+      renumber_in_place(total);
+      return RankRefinementReport{.field = std::move(field_), .new_vertices = std::move(judged_), .n_split = n_split,
+                                  .rebalanced = std::nullopt, .labels = {}};
+    }
+    spent_ = true;
     return rebalanced_part(n_split);
   }
 
  private:
-  RefinedPart rebalanced_part(std::int64_t n_split) {
+  RankRefinementReport rebalanced_part(std::int64_t n_split) {
     RankCells given{.cell_dim = mesh_.cell_dim(), .space_dim = mesh_.space_dim(), .cells = {}, .coordinates = {}};
-    for (VertexId v : mesh_.cells()) given.cells.push_back(gid_[static_cast<std::size_t>(v)]);
+    for (VertexId v : mesh_.cells()) given.cells.push_back(gid()[static_cast<std::size_t>(v)]);
     // Each rank takes the coordinates and field of one range of global ids.
     const auto d = static_cast<std::size_t>(mesh_.space_dim()), w = static_cast<std::size_t>(width_);
     std::vector<std::vector<std::int64_t>> ids(static_cast<std::size_t>(size_));
     std::vector<std::vector<double>> values(static_cast<std::size_t>(size_));
     for (VertexId v = 0; v < mesh_.n_points(); ++v) {
-      const auto r = static_cast<std::size_t>(range_holder(gid_[v]));
-      ids[r].push_back(gid_[v]);
+      const auto r = static_cast<std::size_t>(range_holder(gid()[v]));
+      ids[r].push_back(gid()[v]);
       values[r].insert(values[r].end(), mesh_.point(v).begin(), mesh_.point(v).end());
       values[r].insert(values[r].end(), field_.begin() + static_cast<std::ptrdiff_t>(v * w),
                        field_.begin() + static_cast<std::ptrdiff_t>((v + 1) * w));
@@ -302,28 +337,29 @@ class RankRefinement {
     }
     const std::vector<std::int64_t> labels = labels_of_cells();
     const BisectionRule rule = bisection_->hierarchy().rule();
-    RefinedPart out{.part = distribute_cells(comm_, std::move(given)), .field = {}, .new_vertices = std::move(judged_),
-                    .n_split = n_split, .labels = {}};
-    out.field = field_from_ranges(out.part.global_vertex, range_field, start);
+    RankRefinementReport out{.field = {}, .new_vertices = std::move(judged_), .n_split = n_split,
+                             .rebalanced = distribute_cells(comm_, std::move(given)), .labels = {}};
+    const DistributedMesh& balanced = *out.rebalanced;
+    out.field = field_from_ranges(balanced.global_vertex, range_field, start);
     std::vector<std::int64_t> cells;
-    for (VertexId v : out.part.local->cells()) cells.push_back(out.part.global_vertex[static_cast<std::size_t>(v)]);
+    for (VertexId v : balanced.local->cells()) cells.push_back(balanced.global_vertex[static_cast<std::size_t>(v)]);
     out.labels = PartLabels{.rule = rule, .cells = labels_after_rebalancing(labels, cells)};
     return out;
   }
 
-  // The refined mesh as this rank's part: owners for the new vertices that other ranks hold
-  // too (the lowest rank holding one), and PETSc's vertex numbering anew (owned vertices
-  // contiguous in rank order), both agreed by global id at rank (id mod size).
-  RefinedPart part_in_place(std::int64_t n_split, std::int64_t n_global_cells) {
+  // The part refined in place: owners for the new vertices that other ranks hold too (the
+  // lowest rank holding one), and PETSc's vertex numbering anew (owned vertices contiguous in
+  // rank order), both agreed by global id at rank (id mod size).
+  void renumber_in_place(std::int64_t n_global_cells) {
     const VertexId n = mesh_.n_points();
-    owned_.resize(static_cast<std::size_t>(n), 1);
+    part_.owned.resize(static_cast<std::size_t>(n), 1);
     std::vector<VertexId> shared;  // vertices other ranks may hold
     for (VertexId v = 0; v < n; ++v)
       if (boundary_->other_holders(v)) shared.push_back(v);
     // The owner of each shared new vertex.
     std::vector<std::vector<std::int64_t>> asked(static_cast<std::size_t>(size_));
     for (VertexId v : shared)
-      if (v >= n_old_) append(asked, gid_[static_cast<std::size_t>(v)] % size_, {gid_[static_cast<std::size_t>(v)], rank_});
+      if (v >= n_before_) append(asked, gid()[static_cast<std::size_t>(v)] % size_, {gid()[static_cast<std::size_t>(v)], rank_});
     const std::vector<std::int64_t> holders = exchange_messages(comm_, asked, MPI_INT64_T);
     std::unordered_map<std::int64_t, std::int64_t> owner;
     for (std::size_t i = 0; i < holders.size(); i += 2) {
@@ -334,18 +370,18 @@ class RankRefinement {
     for (std::size_t i = 0; i < holders.size(); i += 2) append(told, holders[i + 1], {holders[i], owner.at(holders[i])});
     const std::vector<std::int64_t> owners = exchange_messages(comm_, told, MPI_INT64_T);
     for (std::size_t i = 0; i < owners.size(); i += 2)
-      owned_[static_cast<std::size_t>(local_of_.at(owners[i]))] = owners[i + 1] == rank_;
+      part_.owned[static_cast<std::size_t>(local_of_.at(owners[i]))] = owners[i + 1] == rank_;
     // PETSc's numbering: this rank's owned vertices after the lower ranks'.
-    std::int64_t first = 0, n_owned = std::count(owned_.begin(), owned_.end(), std::uint8_t{1});
+    std::int64_t first = 0, n_owned = std::count(part_.owned.begin(), part_.owned.end(), std::uint8_t{1});
     MPI_Exscan(&n_owned, &first, 1, MPI_INT64_T, MPI_SUM, comm_);
     if (rank_ == 0) first = 0;
     std::vector<std::int64_t> number(static_cast<std::size_t>(n), -1);
     for (std::size_t v = 0; v < number.size(); ++v)
-      if (owned_[v]) number[v] = first++;
+      if (part_.owned[v]) number[v] = first++;
     // A ghost learns its owner's number.
     std::vector<std::vector<std::int64_t>> given(static_cast<std::size_t>(size_));
     for (VertexId v : shared) {
-      const std::int64_t id = gid_[static_cast<std::size_t>(v)];
+      const std::int64_t id = gid()[static_cast<std::size_t>(v)];
       append(given, id % size_, {id, rank_, number[static_cast<std::size_t>(v)]});
     }
     const std::vector<std::int64_t> numbers = exchange_messages(comm_, given, MPI_INT64_T);
@@ -358,57 +394,24 @@ class RankRefinement {
     const std::vector<std::int64_t> ghost_numbers = exchange_messages(comm_, answers, MPI_INT64_T);
     for (std::size_t i = 0; i < ghost_numbers.size(); i += 2)
       number[static_cast<std::size_t>(local_of_.at(ghost_numbers[i]))] = ghost_numbers[i + 1];
-    PartLabels labels{.rule = bisection_->hierarchy().rule(), .cells = labels_of_cells()};
-    bisection_.reset();  // they watch the mesh, which moves into the part
-    boundary_.reset();
-    RefinedPart out{.part = DistributedMesh{.comm = comm_,
-                                            .local = std::make_unique<Mesh>(std::move(mesh_)),
-                                            .global_vertex = std::move(gid_),
-                                            .owned = std::move(owned_),
-                                            .global_number = std::move(number),
-                                            .n_global_vertices = n_global_,
-                                            .n_global_cells = n_global_cells},
-                    .field = std::move(field_),
-                    .new_vertices = std::move(judged_),
-                    .n_split = n_split,
-                    .labels = std::move(labels)};
-    return out;
+    part_.global_number = std::move(number);
+    part_.n_global_vertices = n_global_;
+    part_.n_global_cells = n_global_cells;
   }
 
-  RankRefinement(MPI_Comm comm, SortedPart sorted, int cell_dim, int space_dim, std::int64_t n_global, int width,
-                 const PartLabels* labels)
-      : comm_(comm),
-        mesh_(cell_dim, space_dim, std::move(sorted.points), sorted.cells),
-        gid_(std::move(sorted.gid)),
-        field_(std::move(sorted.field)),
-        width_(width),
-        n_global_(n_global),
-        owned_(std::move(sorted.owned)),
-        n_old_(mesh_.n_points()) {
-    MPI_Comm_rank(comm_, &rank_);
-    MPI_Comm_size(comm_, &size_);
-    for (std::size_t v = 0; v < gid_.size(); ++v) local_of_.emplace(gid_[v], static_cast<VertexId>(v));
-    boundary_.emplace(mesh_, shared_vertices(comm, gid_));
-    std::vector<TaggedSimplex> roots;
-    std::string problem = labels ? root_labels(*labels, roots) : "";
-    if (problem = first_rank_problem(comm_, "refine_part", problem); !problem.empty()) throw std::invalid_argument(problem);
-    bisection_.emplace(mesh_, labels ? labels->rule : agreed_rule(comm, mesh_), std::move(roots));
-    n_numbered_ = n_told_ = mesh_.n_points();
-    bisection_->set_edge_rings(&*boundary_);
-  }
 
   // Global ids for the new vertices: a midpoint is named by its parents' ids and numbered by
   // rank (smaller parent id mod size), so every rank that splits an edge gives its midpoint the
   // same id. Midpoints of midpoints wait for their parents' ids (collective rounds).
   void number_new_vertices() {
-    gid_.resize(static_cast<std::size_t>(mesh_.n_points()), -1);
+    gid().resize(static_cast<std::size_t>(mesh_.n_points()), -1);
     for (;;) {
       std::vector<std::vector<std::int64_t>> asked(static_cast<std::size_t>(size_));
       std::int64_t waiting = 0;
       for (VertexId v = n_numbered_; v < mesh_.n_points(); ++v) {
-        if (gid_[v] >= 0) continue;
+        if (gid()[v] >= 0) continue;
         const VertexParents parents = mesh_.parents(v);
-        const std::int64_t a = gid_[parents.vertex[0]], b = gid_[parents.vertex[1]];
+        const std::int64_t a = gid()[parents.vertex[0]], b = gid()[parents.vertex[1]];
         if (a < 0 || b < 0) {
           ++waiting;
           continue;
@@ -438,10 +441,10 @@ class RankRefinement {
         append(answers, questions[i + 3], {questions[i + 2], numbered_.at({questions[i], questions[i + 1]})});
       const std::vector<std::int64_t> ids = exchange_messages(comm_, answers, MPI_INT64_T);
       for (std::size_t i = 0; i < ids.size(); i += 2) {
-        gid_[static_cast<std::size_t>(ids[i])] = ids[i + 1];
+        gid()[static_cast<std::size_t>(ids[i])] = ids[i + 1];
         local_of_.emplace(ids[i + 1], static_cast<VertexId>(ids[i]));
       }
-      while (n_numbered_ < mesh_.n_points() && gid_[n_numbered_] >= 0) ++n_numbered_;
+      while (n_numbered_ < mesh_.n_points() && gid()[n_numbered_] >= 0) ++n_numbered_;
     }
   }
 
@@ -551,74 +554,35 @@ class RankRefinement {
     const int d = mesh_.cell_dim();
     for (ElementId e : mesh_.connectivity().element_ids()) {
       const TaggedSimplex& label = bisection_->hierarchy().label(e);
-      for (int i = 0; i <= d; ++i) out.push_back(gid_[static_cast<std::size_t>(label.vertex[static_cast<std::size_t>(i)])]);
+      for (int i = 0; i <= d; ++i) out.push_back(gid()[static_cast<std::size_t>(label.vertex[static_cast<std::size_t>(i)])]);
       out.push_back(label.tag);
     }
     return out;
   }
 
+  std::vector<std::int64_t>& gid() { return part_.global_vertex; }
+  const std::vector<std::int64_t>& gid() const { return part_.global_vertex; }
+
   MPI_Comm comm_;
   int rank_ = 0, size_ = 1;
-  Mesh mesh_;
-  std::vector<std::int64_t> gid_;
+  std::vector<std::int64_t> original_;  // the index in the given part of each vertex it had
+  DistributedMesh part_;
+  Mesh& mesh_;
   std::vector<double> field_;
-  int width_;
-  std::int64_t n_global_;
+  int width_ = 1;
+  std::int64_t n_global_ = 0;  // vertices numbered so far in this edit
   std::unordered_map<std::int64_t, VertexId> local_of_;
   // As the numbering rank: the edges whose midpoints this rank numbered, and the triples.
   std::unordered_map<std::pair<std::int64_t, std::int64_t>, std::int64_t, EdgeKeyHash> numbered_;
   std::vector<std::int64_t> judged_;
   std::vector<std::int64_t> waiting_;  // edges told of, by global ids, with an end not (yet) here
-  VertexId n_numbered_ = 0, n_told_ = 0;
-  std::vector<std::uint8_t> owned_;  // of the part's vertices
-  VertexId n_old_;                    // the part's vertices, before the new ones
-  // Made in place and dropped before the mesh becomes the new part (they watch it).
+  VertexId n_numbered_ = 0, n_told_ = 0, n_before_ = 0;
+  bool spent_ = false;
   std::optional<RankBoundary> boundary_;
   std::optional<Bisection> bisection_;
 };
 
-}  // namespace
-
-RefinedPart refine_part_uniform(const DistributedMesh& part, int levels, std::span<const double> field, int width,
-                                const PartLabels* labels) {
-  if (levels < 0) throw std::invalid_argument("refine_part_uniform: levels must be ≥ 0, got " + std::to_string(levels));
-  RankRefinement refinement(part, field, width, labels);
-  std::int64_t split = 0;
-  for (int level = 0; level < levels; ++level) {
-    {
-      const ScopedEvent timed(log_event("SnedeRankBisect"));
-      split += static_cast<std::int64_t>(refinement.bisection().refine_uniform(1));
-    }
-    split += refinement.close_across_ranks();
-  }
-  return refinement.finish(sum_over_ranks(part.comm, split));
-}
-
 namespace {
-
-// Marks and splits on each rank (`mark`: the cells split, or std::invalid_argument), then closes
-// across the ranks, until no rank marks any more: the serial loops' fixed point (refine_around,
-// refine_near_segment), each mark being one the serial loop makes.
-template <class Mark>
-RefinedPart refine_until_unmarked(const DistributedMesh& part, std::span<const double> field, int width,
-                                  const PartLabels* labels, const std::string& caller, Mark mark) {
-  RankRefinement refinement(part, field, width, labels);
-  std::int64_t split = 0;
-  for (bool first = true;; first = false) {
-    std::int64_t marked = 0;
-    std::string problem;
-    try {
-      const ScopedEvent timed(log_event("SnedeRankBisect"));
-      marked = static_cast<std::int64_t>(mark(refinement.bisection(), first));
-    } catch (const std::invalid_argument& error) {
-      problem = error.what();
-    }
-    if (problem = first_rank_problem(part.comm, caller, problem); !problem.empty()) throw std::invalid_argument(problem);
-    split += marked + refinement.close_across_ranks();
-    if (sum_over_ranks(part.comm, marked) == 0) break;
-  }
-  return refinement.finish(sum_over_ranks(part.comm, split));
-}
 
 std::string point_text(std::span<const double> x) {
   std::string text;
@@ -628,35 +592,82 @@ std::string point_text(std::span<const double> x) {
 
 }  // namespace
 
-RefinedPart refine_part_around(const DistributedMesh& part, std::span<const double> x, double h,
-                               std::span<const double> field, int width, const PartLabels* labels) {
+PartRefinement::PartRefinement(const DistributedMesh& part, const PartLabels* labels)
+    : state_(std::make_unique<State>(part, labels)) {}
+
+PartRefinement::~PartRefinement() = default;
+
+const DistributedMesh& PartRefinement::part() const { return state_->part(); }
+DistributedMesh& PartRefinement::part() { return state_->part(); }
+const std::vector<std::int64_t>& PartRefinement::original_vertex() const { return state_->original(); }
+bool PartRefinement::spent() const { return state_->spent(); }
+
+RankRefinementReport PartRefinement::refine_uniform(int levels, std::span<const double> field, int width) {
+  if (levels < 0) throw std::invalid_argument("refine_uniform: levels must be ≥ 0, got " + std::to_string(levels));
+  state_->begin(field, width);
+  std::int64_t split = 0;
+  for (int level = 0; level < levels; ++level) {
+    {
+      const ScopedEvent timed(log_event("SnedeRankBisect"));
+      split += static_cast<std::int64_t>(state_->bisection().refine_uniform(1));
+    }
+    split += state_->close_across_ranks();
+  }
+  return state_->finish(sum_over_ranks(state_->part().comm, split));
+}
+
+template <class Mark>
+RankRefinementReport PartRefinement::refine_until_unmarked(std::span<const double> field, int width,
+                                                           const std::string& caller, Mark mark) {
+  state_->begin(field, width);
+  const MPI_Comm comm = state_->part().comm;
+  std::int64_t split = 0;
+  for (bool first = true;; first = false) {
+    std::int64_t marked = 0;
+    std::string problem;
+    try {
+      const ScopedEvent timed(log_event("SnedeRankBisect"));
+      marked = static_cast<std::int64_t>(mark(state_->bisection(), first));
+    } catch (const std::invalid_argument& error) {
+      problem = error.what();
+    }
+    if (problem = first_rank_problem(comm, caller, problem); !problem.empty()) throw std::invalid_argument(problem);
+    split += marked + state_->close_across_ranks();
+    if (sum_over_ranks(comm, marked) == 0) break;
+  }
+  return state_->finish(sum_over_ranks(comm, split));
+}
+
+RankRefinementReport PartRefinement::refine_around(std::span<const double> x, double h, std::span<const double> field,
+                                                   int width) {
+  const DistributedMesh& part = state_->part();
   if (x.size() != static_cast<std::size_t>(part.local->space_dim()))
     throw std::invalid_argument("refine_around: the point has " + std::to_string(x.size()) + " coordinates, the mesh is " +
                                 std::to_string(part.local->space_dim()) + "-D");
   bool holds_x = false;
-  return refine_until_unmarked(part, field, width, labels, "refine_part_around", [&](Bisection& bisection, bool first) {
+  return refine_until_unmarked(field, width, "refine_around", [&](Bisection& bisection, bool first) {
     if (first) {
       holds_x = !bisection.hierarchy().roots_containing(x).empty();
       if (sum_over_ranks(part.comm, holds_x ? 1 : 0) == 0)
         throw std::invalid_argument("point " + point_text(x) + " is outside the mesh (no rank's cells hold it)");
     }
-    return holds_x ? refine_around(bisection, x, h) : std::size_t{0};
+    return holds_x ? snede::refine_around(bisection, x, h) : std::size_t{0};
   });
 }
 
-RefinedPart refine_part_near_segment(const DistributedMesh& part, std::span<const double> a, std::span<const double> b,
-                                     double h, double radius, std::span<const double> field, int width,
-                                     const PartLabels* labels) {
-  return refine_until_unmarked(part, field, width, labels, "refine_part_near_segment", [&](Bisection& bisection, bool first) {
+RankRefinementReport PartRefinement::refine_near_segment(std::span<const double> a, std::span<const double> b, double h,
+                                                         double radius, std::span<const double> field, int width) {
+  const MPI_Comm comm = state_->part().comm;
+  return refine_until_unmarked(field, width, "refine_near_segment", [&](Bisection& bisection, bool first) {
     bool near_here = false;
     std::size_t split = 0;
     std::string problem;
     try {
-      split = refine_near_segment(bisection, a, b, h, radius, &near_here);
+      split = snede::refine_near_segment(bisection, a, b, h, radius, &near_here);
     } catch (const std::invalid_argument& error) {
       problem = error.what();  // thrown after the reduction below, which every rank enters
     }
-    const bool near_anywhere = !first || sum_over_ranks(part.comm, near_here ? 1 : 0) > 0;
+    const bool near_anywhere = !first || sum_over_ranks(comm, near_here ? 1 : 0) > 0;
     if (!problem.empty()) throw std::invalid_argument(problem);
     if (!near_anywhere)
       throw std::invalid_argument("the segment does not come within radius " + std::to_string(radius) +

@@ -140,6 +140,16 @@ def distribute_cells(cells, coordinates, comm=None) -> DistributedMesh:
                                                coordinates.reshape(-1, max(space, 1))))
 
 
+def refresh_part(part: DistributedMesh) -> None:
+    """Re-reads the arrays of a part whose engine object was refined in place (rank_refinement):
+    its ids, owners and numbering; ``part.local`` is the same mesh, refined."""
+    impl = part._impl
+    part.global_vertex = impl.global_vertex.ravel().copy()
+    part.owned = impl.owned.ravel().astype(bool)
+    part.global_number = impl.global_number.ravel().copy()
+    part.n_global_vertices, part.n_global_cells = int(impl.n_global_vertices), int(impl.n_global_cells)
+
+
 def _part(comm, part) -> DistributedMesh:
     local = Mesh._wrap(part.local)
     local._distributed_part = f"rank {comm.rank}'s part of a mesh distributed over {comm.size} MPI ranks"

@@ -19,7 +19,7 @@ import numpy as np
 
 from snede import _checks, _snede, part_groups
 from snede._body_arguments import check_body, displacement_field, face_forces, traction_faces, vertex_selection
-from snede.distributed import DistributedMesh, DistributedStatic, _part, _world, agreed
+from snede.distributed import DistributedMesh, DistributedStatic, _part, _world, agreed, refresh_part
 
 
 class PartBody:
@@ -50,7 +50,8 @@ class PartBody:
         self._local_order = np.argsort(part.global_vertex, kind="stable")
         self._problem, self._problem_conditions = None, None
         self._edits, self._edits_seen = 0, 0  # conditions or displacement set, and as of the latest solve
-        self._labels = None  # the cells' bisection labels (rank_refinement.hpp) once the part was refined
+        self._refiner = None  # the part's refinement (rank_refinement.hpp), kept from edit to edit
+        self._labels = None  # the cells' bisection labels after a refinement rebalanced the part
 
     @property
     def dim(self) -> int:
@@ -262,16 +263,17 @@ class PartBody:
             return counted
 
         counted = agreed(self.comm, checked)
-        return self._refined(lambda field: _snede.refine_part_uniform(self.part._impl, counted, field, self.dim,
-                                                                                     self._labels))
+        return self._refined(lambda refiner, field: refiner.refine_uniform(counted, field, self.dim))
 
     def refine_around(self, point, h: float) -> int:
         """Bisect until every cell containing ``point`` (shape (dim,)) has edges no longer than
         ``h``, as ``Mesh.refine_around`` does serially, on whichever ranks hold the point; the
         refinement spreads across the rank boundary as far as conformity needs. Collective.
 
-        The body's part is replaced by the refined one (``body.part``, ``body.mesh``; DMPlex
-        rebalances it when the largest rank holds more than 1.2 times the mean cells); the
+        The first refinement copies the part once, its vertices in the order of their global ids;
+        this and later ones then refine it in place, at the cost of the cells they split (``body.part``
+        and ``body.mesh`` are the refined ones), until a rank holds more than 1.2 times the mean
+        cells: DMPlex then rebalances them into a new part. The
         displacement is carried (a new vertex takes its parents' mean), a new vertex between two
         fixed ones is fixed (as serially), loads stay on their vertices and new vertices carry
         none, and the named groups follow (a cell in its parent's groups, a boundary face in its
@@ -282,8 +284,7 @@ class PartBody:
             return x, size
 
         x, size = agreed(self.comm, checked)
-        return self._refined(lambda field: _snede.refine_part_around(self.part._impl, x, size, field, self.dim,
-                                                                                    self._labels))
+        return self._refined(lambda refiner, field: refiner.refine_around(x, size, field, self.dim))
 
     def refine_near_segment(self, a, b, h: float, radius: float = 0.0) -> int:
         """Bisect until every cell that comes within ``radius`` of the segment ``a``–``b`` (a
@@ -297,26 +298,50 @@ class PartBody:
             return ends, size, reach
 
         (start, end), size, reach = agreed(self.comm, checked)
-        return self._refined(lambda field: _snede.refine_part_near_segment(self.part._impl, start, end, size, reach,
-                                                                           field, self.dim, self._labels))
+        return self._refined(lambda refiner, field: refiner.refine_near_segment(start, end, size, reach, field, self.dim))
 
     def _require_same(self, caller: str, **inputs) -> None:
         _snede.require_same_on_every_rank(self.comm.py2f(), caller, list(inputs.items()))
 
-    def _refined(self, refine) -> int:
-        """The body on the part ``refine(displacement)`` makes (collective)."""
-        groups = part_groups.group_shapes(self.mesh, self.comm)
-        new_part, field, new_vertices, split, rule, labels = refine(np.ascontiguousarray(self._displacement).ravel())
-        self._labels = (rule, labels)  # the bisection labels go on with the next refinement
+    def _refined(self, edit) -> int:
+        """``edit(refiner, displacement)`` on this body's part (collective)."""
+        if self._refiner is None:
+            self._start_refining()
+        self._problem, self._problem_conditions = None, None  # its body watches the mesh the edit changes
+        field, new_vertices, split, rebalanced, rule, labels = edit(
+            self._refiner, np.ascontiguousarray(self._displacement).ravel())
         self._inherit_fixed(new_vertices)
-        self.part = _part(self.comm, new_part)
-        self.mesh = self.part.local
-        part_groups.give_group_shapes(self.mesh, self.boundary_faces(), *groups)
+        if rebalanced is None:  # refined in place: the same mesh, whose groups follow it as serially
+            refresh_part(self.part)
+        else:
+            groups = part_groups.group_shapes(self.mesh, self.comm)
+            self.part = _part(self.comm, rebalanced)
+            self.mesh = self.part.local
+            part_groups.give_group_shapes(self.mesh, self.boundary_faces(), *groups)
+            self._refiner, self._labels = None, (rule, labels)  # labels for the next refiner
         self._displacement = np.ascontiguousarray(field).reshape(self.mesh.n_points, self.dim)
         self._local_order = np.argsort(self.part.global_vertex, kind="stable")
-        self._problem, self._problem_conditions = None, None
         self._edits += 1
         return int(split)
+
+    def _start_refining(self) -> None:
+        """The part copied in global-id order into a refinement kept from edit to edit (collective);
+        the displacement and the named groups go to the copy's vertex order."""
+        refiner = _snede.PartRefinement(self.part._impl, self._labels)
+        old_of_new = refiner.original_vertex.ravel()
+        new_of_old = np.empty_like(old_of_new)
+        new_of_old[old_of_new] = np.arange(len(old_of_new))
+        cell_groups = self.mesh.cell_groups
+        face_groups = {name: faces for name, faces in self.mesh.boundary_groups.items() if name != part_groups.INCISION}
+        self.part = _part(self.comm, refiner.part)
+        self.mesh = self.part.local
+        for name, rows in cell_groups.items():  # the copy keeps the cells' order
+            self.mesh.add_cell_group(name, rows)
+        for name, faces in face_groups.items():
+            self.mesh.add_boundary_group(name, new_of_old[faces])
+        self._displacement = self._displacement[old_of_new]
+        self._local_order = np.argsort(self.part.global_vertex, kind="stable")
+        self._refiner = refiner
 
     def _inherit_fixed(self, new_vertices: np.ndarray) -> None:
         """A new vertex both of whose parents are fixed is fixed at their mean (as the serial

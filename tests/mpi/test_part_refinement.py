@@ -92,10 +92,14 @@ def test_successive_refinements_go_on_as_the_serial_hierarchy(partition):
 
 def test_labels_of_another_part_are_refused_on_every_rank():
     body = snede.Body(part_of(box(), "chunks"), MATERIAL)
-    other = snede.Body(part_of(snede.meshing.box((1.0, 1.0, 1.0), (3, 3, 3)), "chunks"), MATERIAL)
-    other.refine_uniform(1)
+    n_cells = body.mesh.n_cells
+    too_few = (0, np.zeros((max(n_cells - 1, 0), 5), dtype=np.int64))
     with pytest.raises(ValueError, match="not this part's"):
-        snede._snede.refine_part_uniform(body.part._impl, 1, body.displacement.ravel(), 3, other._labels)
+        snede._snede.PartRefinement(body.part._impl, too_few)
+    elsewhere = np.full((n_cells, 5), body.part.n_global_vertices + 7, dtype=np.int64)  # vertices no rank has
+    elsewhere[:, 4] = 3
+    with pytest.raises(ValueError, match="not this part's"):
+        snede._snede.PartRefinement(body.part._impl, (0, elsewhere))
 
 
 @pytest.mark.parametrize("make", [box, cylinder])
