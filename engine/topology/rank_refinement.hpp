@@ -4,8 +4,9 @@
 // makes too (an element is split only at its refinement edge, and only when a mark or a split
 // edge of a neighbour requires it), so the result is the least conforming refinement of the
 // marks, which is the serial one: the same cells as serially, however the body is partitioned.
-// The refined cells go to a new part through distribute_cells, which keeps balanced parts and
-// has DMPlex rebalance them when the largest rank holds more than 1.2 times the mean.
+// The part is refined in place while the ranks stay balanced (the largest at most 1.2 times the
+// mean cells, as distribute_cells judges); beyond, DMPlex rebalances the refined cells into a
+// new part (distribute_cells).
 #pragma once
 
 #include <cstdint>
