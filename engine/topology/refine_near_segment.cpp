@@ -58,12 +58,20 @@ std::size_t refine_near_segment(Bisection& bisection, std::span<const double> a,
   ChangeBatch batch(bisection.mesh().connectivity());  // one change for the watchers (§7.4)
   std::size_t n_split = 0;
   bool any_near = false;
+  // Only roots whose boxes meet the segment's box grown by the radius can come within the
+  // radius; they are searched in the order of all roots, so the splits come in the same order.
+  BoundingBox reach_box;
+  for (int k = 0; k < d; ++k) {
+    reach_box.lo[k] = std::min(from[k], to[k]) - radius;
+    reach_box.hi[k] = std::max(from[k], to[k]) + radius;
+  }
+  const std::vector<NodeId> near_roots = tree.roots_meeting(reach_box);
   std::vector<NodeId> stack;
   for (;;) {
     // The live elements near the segment with an edge longer than h, found by descending the
     // tree into the halves whose bounding balls come near it.
     std::vector<ElementId> too_long;
-    stack.assign(tree.roots().begin(), tree.roots().end());
+    stack = near_roots;
     while (!stack.empty()) {
       const RefinementNode& node = tree.node(stack.back());
       stack.pop_back();

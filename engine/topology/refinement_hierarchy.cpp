@@ -200,6 +200,13 @@ std::vector<NodeId> RefinementHierarchy::roots_containing(std::span<const double
   return found;
 }
 
+std::vector<NodeId> RefinementHierarchy::roots_meeting(const BoundingBox& box) const {
+  if (mesh_.is_surface()) return roots_;  // the grid's boxes span the cells' own dimensions
+  if (!root_grid_.built() || root_grid_.n_added() > root_grid_.n_built() / 4)
+    root_grid_.build(mesh_.dim(), roots_, [this](NodeId r) { return padded_box(r); });
+  return root_grid_.candidates(box);
+}
+
 std::vector<ElementId> RefinementHierarchy::locate_all(std::span<const double> x, std::span<const NodeId> roots) const {
   std::vector<ElementId> found;
   std::vector<NodeId> stack(roots.begin(), roots.end());

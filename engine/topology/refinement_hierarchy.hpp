@@ -71,6 +71,9 @@ class RefinementHierarchy : public ConnectivityWatcher {
   // the roots containing x (those near x, found through a grid over the roots' boxes, built
   // on first use and after a change that moved a vertex), then the descent from them.
   std::vector<NodeId> roots_containing(std::span<const double> x) const;
+  // The roots whose boxes meet `box`, in the order of roots() (a surface's: every root), so
+  // that a search near a segment descends from those alone (refine_near_segment).
+  std::vector<NodeId> roots_meeting(const BoundingBox& box) const;
   std::vector<ElementId> locate_all(std::span<const double> x, std::span<const NodeId> roots) const;
   // One live element containing x, or no_id if x is outside the mesh.
   ElementId locate(std::span<const double> x) const;

@@ -18,6 +18,24 @@ int RootGrid::cell_along(int k, double c) const {
   return static_cast<int>(std::clamp(cell, 0.0, static_cast<double>(n_cells_[k] - 1)));
 }
 
+template <class Visit>
+void RootGrid::for_each_cell(const BoundingBox& box, Visit visit) const {
+  std::array<int, max_dimension> first{}, last{}, index{};
+  for (int k = 0; k < dim_; ++k) {
+    first[k] = index[k] = cell_along(k, box.lo[k]);
+    last[k] = cell_along(k, box.hi[k]);
+  }
+  for (;;) {
+    std::size_t cell = 0;
+    for (int k = 0; k < dim_; ++k) cell = cell * static_cast<std::size_t>(n_cells_[k]) + static_cast<std::size_t>(index[k]);
+    visit(cell);
+    int k = dim_ - 1;
+    while (k >= 0 && index[k] == last[k]) index[k] = first[k], --k;
+    if (k < 0) return;
+    ++index[k];
+  }
+}
+
 void RootGrid::build(int dim, std::span<const NodeId> roots, const std::function<BoundingBox(NodeId)>& box_of) {
   clear();
   dim_ = dim;
@@ -53,22 +71,6 @@ void RootGrid::build(int dim, std::span<const NodeId> roots, const std::function
   }
   // Counting sort of (cell, root) pairs into the CSR arrays: count, then place.
   cell_start_.assign(n_total + 1, 0);
-  auto for_each_cell = [&](const BoundingBox& box, auto&& visit) {
-    std::array<int, max_dimension> first{}, last{}, index{};
-    for (int k = 0; k < dim; ++k) {
-      first[k] = index[k] = cell_along(k, box.lo[k]);
-      last[k] = cell_along(k, box.hi[k]);
-    }
-    for (;;) {
-      std::size_t cell = 0;
-      for (int k = 0; k < dim; ++k) cell = cell * static_cast<std::size_t>(n_cells_[k]) + static_cast<std::size_t>(index[k]);
-      visit(cell);
-      int k = dim - 1;
-      while (k >= 0 && index[k] == last[k]) index[k] = first[k], --k;
-      if (k < 0) return;
-      ++index[k];
-    }
-  };
   for (const BoundingBox& box : boxes) for_each_cell(box, [&](std::size_t cell) { ++cell_start_[cell + 1]; });
   for (std::size_t c = 0; c < n_total; ++c) cell_start_[c + 1] += cell_start_[c];
   roots_.resize(cell_start_[n_total]);
@@ -85,6 +87,18 @@ std::vector<NodeId> RootGrid::candidates(std::span<const double> x) const {
   std::vector<NodeId> found(roots_.begin() + static_cast<std::ptrdiff_t>(cell_start_[cell]),
                             roots_.begin() + static_cast<std::ptrdiff_t>(cell_start_[cell + 1]));
   found.insert(found.end(), added_.begin(), added_.end());
+  return found;
+}
+
+std::vector<NodeId> RootGrid::candidates(const BoundingBox& box) const {
+  std::vector<NodeId> found;
+  for_each_cell(box, [&](std::size_t cell) {
+    found.insert(found.end(), roots_.begin() + static_cast<std::ptrdiff_t>(cell_start_[cell]),
+                 roots_.begin() + static_cast<std::ptrdiff_t>(cell_start_[cell + 1]));
+  });
+  found.insert(found.end(), added_.begin(), added_.end());
+  std::sort(found.begin(), found.end());
+  found.erase(std::unique(found.begin(), found.end()), found.end());
   return found;
 }
 

@@ -1,6 +1,7 @@
 // A uniform grid over the bounding boxes of the bisection hierarchy's roots (§6.5), so that
 // point location — refine_around's first step — tests the few roots near the point instead of
-// every root of the mesh (a scan cost 6 ms at 10⁵ tetrahedra, 60 ms at 10⁶, per call). Built in
+// every root of the mesh (a scan cost 6 ms at 10⁵ tetrahedra, 60 ms at 10⁶, per call), and
+// refinement along a needle's shaft the roots near the shaft. Built in
 // O(roots); roots added afterwards are listed apart and tested at every query, until there are
 // a quarter as many of them as of the grid's roots and the owner rebuilds it.
 #pragma once
@@ -35,10 +36,16 @@ class RootGrid {
   // Every root whose box contains x is among these (each once): those whose box meets x's cell,
   // then the roots added since build(). x: (dim,).
   std::vector<NodeId> candidates(std::span<const double> x) const;
+  // Every root whose box meets `box` is among these, each once, in increasing order (the grid's
+  // roots in the cells the box meets, and the roots added since build()).
+  std::vector<NodeId> candidates(const BoundingBox& box) const;
 
  private:
   // The cell index along axis k of coordinate c, clamped to the grid.
   int cell_along(int k, double c) const;
+  // visit(cell) for every cell `box` meets.
+  template <class Visit>
+  void for_each_cell(const BoundingBox& box, Visit visit) const;
 
   bool built_ = false;
   int dim_ = 0;
