@@ -91,8 +91,9 @@ class RankBoundary final : public ConnectivityWatcher, public EdgeRings {
 
   std::vector<ElementId> around(VertexId a, VertexId b) const override {
     std::vector<ElementId> found;
-    if (!holders_.count(a) || !holders_.count(b)) return found;
-    for (ElementId e : stars_.at(a))
+    const auto star = stars_.find(a);
+    if (!holders_.count(a) || !holders_.count(b) || star == stars_.end()) return found;
+    for (ElementId e : star->second)
       if (mesh_.connectivity().element(e).simplex.contains(b)) found.push_back(e);
     return found;
   }
@@ -292,7 +293,6 @@ class PartRefinement::State {
     }
   }
 
-  // The refined cells as a new part, the field carried to it (collective).
   // Ends the edit (collective): balanced parts (as distribute_cells judges them) stay refined in
   // place, renumbered; others go to DMPlex to be balanced, and this refinement is spent.
   RankRefinementReport finish(std::int64_t n_split) {
