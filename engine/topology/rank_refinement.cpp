@@ -13,6 +13,7 @@
 #include "core/log_event.hpp"
 #include "core/rank_agreement.hpp"
 #include "core/rank_messages.hpp"
+#include "mesh/vertex_parents.hpp"
 #include "topology/bisection.hpp"
 #include "topology/refine_around.hpp"
 #include "topology/refine_near_segment.hpp"
@@ -450,15 +451,10 @@ class PartRefinement::State {
 
   // New vertices' values from their parents', in the order they were made (parents first).
   void interpolate_field() {
-    const auto w = static_cast<std::size_t>(width_);
-    const auto n_before = field_.size() / std::max<std::size_t>(w, 1);
-    field_.resize(static_cast<std::size_t>(mesh_.n_points()) * w, 0.0);
-    for (auto v = static_cast<VertexId>(n_before); w > 0 && v < mesh_.n_points(); ++v) {
-      const VertexParents parents = mesh_.parents(v);
-      for (std::size_t i = 0; i < parents.count(); ++i)
-        for (std::size_t k = 0; k < w; ++k)
-          field_[static_cast<std::size_t>(v) * w + k] += parents.weight[i] * field_[static_cast<std::size_t>(parents.vertex[i]) * w + k];
-    }
+    std::vector<VertexEvent> added;
+    for (VertexId v = n_before_; v < mesh_.n_points(); ++v) added.push_back({VertexEventKind::added, v, mesh_.parents(v)});
+    field_.resize(static_cast<std::size_t>(mesh_.n_points()) * static_cast<std::size_t>(width_), 0.0);
+    replay_vertex_events(field_, width_, added);  // as a serial Body's fields follow (§7.4)
   }
 
   std::int64_t range_start(int r) const { return n_global_ * r / size_; }

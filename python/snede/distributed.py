@@ -141,8 +141,9 @@ def distribute_cells(cells, coordinates, comm=None) -> DistributedMesh:
 
 
 def refresh_part(part: DistributedMesh) -> None:
-    """Re-reads the arrays of a part whose engine object was refined in place (rank_refinement):
-    its ids, owners and numbering; ``part.local`` is the same mesh, refined."""
+    """Reads the arrays of a part from its engine object, which a refinement on the ranks
+    changes in place (rank_refinement): its ids, owners and numbering; ``part.local`` is the same
+    mesh, refined."""
     impl = part._impl
     part.global_vertex = impl.global_vertex.ravel().copy()
     part.owned = impl.owned.ravel().astype(bool)
@@ -153,10 +154,10 @@ def refresh_part(part: DistributedMesh) -> None:
 def _part(comm, part) -> DistributedMesh:
     local = Mesh._wrap(part.local)
     local._distributed_part = f"rank {comm.rank}'s part of a mesh distributed over {comm.size} MPI ranks"
-    return DistributedMesh(comm=comm, local=local, global_vertex=part.global_vertex.ravel().copy(),
-                           owned=part.owned.ravel().astype(bool), global_number=part.global_number.ravel().copy(),
-                           n_global_vertices=int(part.n_global_vertices),
-                           n_global_cells=int(part.n_global_cells), _impl=part)
+    made = DistributedMesh(comm=comm, local=local, global_vertex=None, owned=None, global_number=None,
+                           n_global_vertices=0, n_global_cells=0, _impl=part)
+    refresh_part(made)
+    return made
 
 
 class DistributedStatic:
