@@ -31,7 +31,7 @@ class AggregationMultigrid final : public GalerkinMultigrid {
   // until the coarsest level has few enough unknowns for a direct solve, or to `max_levels`
   // counting the fine one (0: no limit). Throws std::invalid_argument for max_levels 1 or
   // negative, or more levels than the mesh can give, and for a surface mesh.
-  // smooth_first_level: the first level's interpolation is smoothed (smoothed_interpolation).
+  // smooth_first_level: every level's interpolation is smoothed (smoothed_aggregation.hpp).
   // aggregate_width: the first level's grid cells, in mean edge lengths.
   explicit AggregationMultigrid(Model& fine, int max_levels = 0, bool smooth_first_level = false,
                                 double aggregate_width = default_aggregate_width);

@@ -8,7 +8,7 @@
 #include "core/error.hpp"
 #include "core/rank_agreement.hpp"
 #include "multigrid/coarse_basis.hpp"
-#include "multigrid/rank_smoothed_interpolation.hpp"
+#include "multigrid/smoothed_aggregation.hpp"
 
 namespace snede {
 namespace {
@@ -69,9 +69,16 @@ RankAggregationLevels levels_over(const DistributedMesh& part, const VertexProje
   const NodeLevel vertices = owned_vertex_level(part, projection);
   std::vector<AggregateLevel> finest_first = aggregate_levels(
       vertices, aggregate_width * global_mean_edge_length(part), max_levels, direct_unknowns, part.comm);
-  if (smooth_first_level && !finest_first.empty())
-    finest_first.front().interpolation =
-        rank_smoothed_interpolation(part, projection, finest_first.front().interpolation);
+  if (smooth_first_level) {
+    std::vector<VertexId> owned_local;  // the owned vertices' local ids, in their rows' order
+    for (std::size_t v = 0; v < part.owned.size(); ++v)
+      if (part.owned[v]) owned_local.push_back(static_cast<VertexId>(v));
+    std::sort(owned_local.begin(), owned_local.end(),
+              [&](VertexId a, VertexId b) { return part.global_number[a] < part.global_number[b]; });
+    const MatHandle adjacency =
+        cell_edge_adjacency(part.comm, mesh, part.global_number, static_cast<PetscInt>(owned_local.size()));
+    smooth_interpolations(adjacency, mesh.dim(), owned_local, projection, finest_first, true);
+  }
   RankAggregationLevels levels;
   for (auto level = finest_first.rbegin(); level != finest_first.rend(); ++level) {
     PetscInt rows = 0, columns = 0;

@@ -34,8 +34,8 @@ struct RankAggregationLevels {
 // coarse unknowns. Throws std::invalid_argument (the same on every rank) for a surface mesh
 // (preconditioner "mg" is for volume meshes), a width that is not positive, max_levels 1 or
 // negative, or constraints of another size than the rank's vertices on some rank.
-// smooth_first_level: the first level's interpolation is smoothed (rank_smoothed_interpolation.hpp;
-// its coarse functions then reach into the neighbouring ranks' vertices).
+// smooth_first_level: every level's interpolation is smoothed (smoothed_aggregation.hpp; the
+// coarse functions then reach into the neighbouring ranks' vertices).
 RankAggregationLevels rank_aggregation_levels(const DistributedMesh& part, const Constraints& constraints,
                                               double aggregate_width, int max_levels = 0,
                                               PetscInt direct_unknowns = default_direct_unknowns,
