@@ -29,6 +29,7 @@
 
 #include <deque>
 #include <unordered_map>
+#include <utility>
 #include <vector>
 
 #include "cutting/sweep_triangle.hpp"
@@ -56,6 +57,15 @@ class FaceSelector {
   void forget() {
     sweeps_.clear();
     previous_touched_.clear();
+  }
+  // What the next selection depends on besides the mesh: the remembered sweeps (oldest first)
+  // and the tetrahedra the latest one met; restore() takes them back (a cutter going on in a
+  // renumbered copy of its mesh).
+  const std::deque<SweepTriangle>& remembered() const { return sweeps_; }
+  const std::vector<ElementId>& previous_touched() const { return previous_touched_; }
+  void restore(std::deque<SweepTriangle> sweeps, std::vector<ElementId> previous_touched) {
+    sweeps_ = std::move(sweeps);
+    previous_touched_ = std::move(previous_touched);
   }
 
  private:

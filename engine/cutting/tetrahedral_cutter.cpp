@@ -12,8 +12,27 @@
 #include "core/predicates.hpp"
 #include "cutting/node_snapping.hpp"
 #include "topology/dissect.hpp"
+#include "topology/local_star.hpp"
 
 namespace snede {
+namespace {
+
+// The face of c oriented as σ (interior or boundary), or no_id.
+FaceId face_of(const Connectivity& c, const Simplex& sigma) {
+  for (ElementId e : local_star(c, sigma.vertex(0)).elements)
+    for (FaceId f : c.element(e).faces)
+      if (f != no_id && c.face(f).simplex == sigma) return f;
+  return no_id;
+}
+
+// The tetrahedron of c whose simplex is σ, or no_id.
+ElementId element_of(const Connectivity& c, const Simplex& sigma) {
+  for (ElementId e : local_star(c, sigma.vertex(0)).elements)
+    if (c.element(e).simplex == sigma) return e;
+  return no_id;
+}
+
+}  // namespace
 
 TetrahedralCutter::TetrahedralCutter(Mesh& mesh, CutBody body, CutterOptions options)
     : mesh_(mesh), body_(std::move(body)), options_(options), pieces_(mesh.connectivity()) {
@@ -316,6 +335,67 @@ void TetrahedralCutter::on_change(const Connectivity& c, const ConnectivityChang
     });
     if (inside) incision_[f] = c.face(f).simplex;
   }
+}
+
+CutterMemory TetrahedralCutter::memory() const {
+  const Connectivity& c = mesh_.connectivity();
+  CutterMemory memory{.scalpel = scalpel_, .cut_configuration = cut_configuration_,
+                      .placed = {placed_.begin(), placed_.end()}, .joined = {}, .incision = {}, .sweeps = {},
+                      .previous_touched = {}};
+  std::sort(memory.placed.begin(), memory.placed.end());
+  for (const auto& [f, simplex] : joined_) memory.joined.push_back(simplex);
+  for (const auto& [f, simplex] : incision_) memory.incision.push_back(simplex);
+  std::sort(memory.incision.begin(), memory.incision.end());
+  for (const SweepTriangle& sweep : selector_.remembered()) {
+    std::array<double, 9> corners{};
+    for (int i = 0; i < 3; ++i)
+      for (int k = 0; k < 3; ++k) corners[static_cast<std::size_t>(3 * i + k)] = sweep.corner(i)[k];
+    memory.sweeps.push_back(corners);
+  }
+  for (ElementId e : selector_.previous_touched())
+    if (c.is_element(e)) memory.previous_touched.push_back(c.element(e).simplex);
+  return memory;
+}
+
+void TetrahedralCutter::restore(const CutterMemory& memory) {
+  const Connectivity& c = mesh_.connectivity();
+  const auto fail = [](const std::string& what) {
+    throw std::invalid_argument("TetrahedralCutter.restore: " + what);
+  };
+  const auto check_vertices = [&](const Simplex& sigma, const char* what) {
+    for (VertexId v : sigma.vertices())
+      if (!mesh_.is_vertex(v)) fail(std::string(what) + " " + sigma.to_string() + " has no live vertex " + std::to_string(v));
+  };
+  if (!memory.cut_configuration.empty() && memory.cut_configuration.size() != 3 * static_cast<std::size_t>(mesh_.n_points()))
+    fail("the cut configuration has " + std::to_string(memory.cut_configuration.size()) + " values, the mesh " +
+         std::to_string(mesh_.n_points()) + " rows of 3");
+  for (VertexId v : memory.placed)
+    if (!mesh_.is_vertex(v)) fail("placed vertex " + std::to_string(v) + " is not a live vertex");
+  std::vector<std::pair<FaceId, Simplex>> joined;
+  std::unordered_map<FaceId, Simplex> incision;
+  for (const auto& [simplexes, what] : {std::pair{&memory.joined, "joined face"}, std::pair{&memory.incision, "incision face"}})
+    for (const Simplex& sigma : *simplexes) {
+      check_vertices(sigma, what);
+      const FaceId f = face_of(c, sigma);
+      if (f == no_id) fail(std::string("the mesh has no ") + what + " " + sigma.to_string());
+      if (simplexes == &memory.joined) joined.emplace_back(f, sigma);
+      else incision.emplace(f, sigma);
+    }
+  std::vector<ElementId> touched;
+  for (const Simplex& sigma : memory.previous_touched) {
+    check_vertices(sigma, "tetrahedron");
+    const ElementId e = element_of(c, sigma);
+    if (e == no_id) fail("the mesh has no tetrahedron " + sigma.to_string());
+    touched.push_back(e);
+  }
+  std::deque<SweepTriangle> sweeps;
+  for (const auto& corners : memory.sweeps) sweeps.emplace_back(corners);
+  scalpel_ = memory.scalpel;
+  cut_configuration_ = memory.cut_configuration;
+  placed_ = {memory.placed.begin(), memory.placed.end()};
+  joined_ = std::move(joined);
+  incision_ = std::move(incision);
+  selector_.restore(std::move(sweeps), std::move(touched));
 }
 
 }  // namespace snede

@@ -44,6 +44,19 @@ struct CutterOptions {
   int max_fragment_elements = 10;
 };
 
+// What a cutter remembers between sweeps, by vertices of its mesh, so that it can go on in a
+// copy of the mesh numbered otherwise (a distributed body's cutting rank, issue 52): faces and
+// tetrahedra as oriented simplices, found again by their vertices.
+struct CutterMemory {
+  std::optional<std::array<double, 6>> scalpel;  // where the scalpel is, if placed
+  std::vector<double> cut_configuration;         // 3 per mesh row while an incision is open, else empty
+  std::vector<VertexId> placed;                  // vertices snapped or on the incision
+  std::vector<Simplex> joined;                   // selected faces the dissection left joined
+  std::vector<Simplex> incision;                 // the incision's boundary faces
+  std::vector<std::array<double, 9>> sweeps;     // the remembered sweep triangles, oldest first
+  std::vector<Simplex> previous_touched;         // the tetrahedra the latest sweep met
+};
+
 class TetrahedralCutter : public ConnectivityWatcher {
  public:
   // Cuts `mesh` (tetrahedral). With a simulated body on this mesh the scalpel acts on the
@@ -74,6 +87,13 @@ class TetrahedralCutter : public ConnectivityWatcher {
   // split or bisection of an incision face made inside it.
   std::vector<VertexId> incision_faces() const;
   const CutterOptions& options() const { return options_; }
+
+  // The memory above, in this mesh's vertex ids.
+  CutterMemory memory() const;
+  // Goes on from `memory` (in this mesh's vertex ids; a new cutter, before its first cut).
+  // Throws std::invalid_argument, before changing anything, for a face or tetrahedron the mesh
+  // does not have, a vertex out of range, or a cut configuration of another size.
+  void restore(const CutterMemory& memory);
 
   void init(const Connectivity&) override {}
   void on_change(const Connectivity& connectivity, const ConnectivityChange& change) override;

@@ -207,5 +207,87 @@ TEST(TetrahedralCutter, FreePiecesAreOnlyCountedWhenHoldingThemIsOff) {
   EXPECT_TRUE(left.held_faces.empty());
 }
 
+// The mesh without its removed vertices, live vertices and cells kept in order (as a distributed
+// body's cutting rank rebuilds its part); new_of_old maps the vertex ids (−1: removed).
+Mesh compacted(const Mesh& mesh, std::vector<VertexId>& new_of_old) {
+  new_of_old.assign(static_cast<std::size_t>(mesh.n_points()), -1);
+  std::vector<double> points;
+  for (VertexId v = 0, next = 0; v < mesh.n_points(); ++v)
+    if (mesh.is_vertex(v)) {
+      new_of_old[static_cast<std::size_t>(v)] = next++;
+      points.insert(points.end(), mesh.point(v).begin(), mesh.point(v).end());
+    }
+  std::vector<std::int64_t> cells;
+  for (VertexId v : mesh.cells()) cells.push_back(new_of_old[static_cast<std::size_t>(v)]);
+  return Mesh(3, 3, std::move(points), cells);
+}
+
+// Each cell as its corners' coordinates, sorted; the list sorted: a mesh's cells whatever the
+// numbering.
+std::vector<std::vector<double>> cell_coordinates(const Mesh& mesh) {
+  std::vector<std::vector<double>> all;
+  for (const std::vector<VertexId>& row : cell_rows(mesh)) {
+    std::vector<std::array<double, 3>> corners;
+    for (VertexId v : row) corners.push_back({mesh.point(v)[0], mesh.point(v)[1], mesh.point(v)[2]});
+    std::sort(corners.begin(), corners.end());
+    std::vector<double> flat;
+    for (const auto& x : corners) flat.insert(flat.end(), x.begin(), x.end());
+    all.push_back(flat);
+  }
+  std::sort(all.begin(), all.end());
+  return all;
+}
+
+TEST(TetrahedralCutter, ACutterGoesOnFromItsMemoryInACompactedCopyOfItsMesh) {
+  // Half a path cut, then the rest twice: by the same cutter, and by a new one on a copy of the
+  // mesh without its removed vertices (its faces and elements numbered anew), restored from the
+  // first one's memory mapped to the copy.
+  // The memory matters: the first half leaves tetrahedra incomplete (the blade stops inside)
+  // and an incision whose faces the second half extends.
+  const std::vector<Scalpel> path = planar_path({1, 0.35, 0.15}, 0.47, 33);
+  Mesh mesh = kuhn_cube(6);
+  TetrahedralCutter cutter(mesh, CutBody{}, CutterOptions{});
+  cut_along(cutter, {path.begin(), path.begin() + 16});
+  const CutterMemory memory = cutter.memory();
+  ASSERT_TRUE(memory.scalpel.has_value());
+  ASSERT_FALSE(memory.incision.empty());
+  ASSERT_FALSE(memory.previous_touched.empty());
+
+  std::vector<VertexId> new_of_old;
+  Mesh copy = compacted(mesh, new_of_old);
+  const auto map = [&](VertexId v) { return new_of_old[static_cast<std::size_t>(v)]; };
+  CutterMemory mapped = memory;
+  for (VertexId& v : mapped.placed) v = map(v);
+  for (auto* simplexes : {&mapped.joined, &mapped.incision, &mapped.previous_touched})
+    for (Simplex& sigma : *simplexes) sigma = sigma.mapped(map);
+  TetrahedralCutter going_on(copy, CutBody{}, CutterOptions{});
+  going_on.restore(mapped);
+
+  const CutResult straight = cut_along(cutter, {path.begin() + 16, path.end()});
+  const CutResult restored = cut_along(going_on, {path.begin() + 16, path.end()});
+  EXPECT_GT(straight.faces_dissected, 0);
+  EXPECT_EQ(restored.faces_dissected, straight.faces_dissected);
+  EXPECT_EQ(restored.vertices_snapped, straight.vertices_snapped);
+  EXPECT_EQ(count_pieces(copy), count_pieces(mesh));
+  EXPECT_EQ(count_pieces(mesh), 2);
+  EXPECT_EQ(cell_coordinates(copy), cell_coordinates(mesh));
+  EXPECT_EQ(going_on.incision_faces().size(), cutter.incision_faces().size());
+  expect_sound(copy);
+}
+
+TEST(TetrahedralCutter, RestoreRefusesAFaceTheMeshDoesNotHave) {
+  Mesh mesh = kuhn_cube(2);
+  TetrahedralCutter cutter(mesh, CutBody{}, CutterOptions{});
+  CutterMemory memory;
+  memory.incision.push_back(Simplex(1, {0, 1, 26}));
+  EXPECT_THROW(cutter.restore(memory), std::invalid_argument);
+  memory.incision.clear();
+  memory.placed.push_back(mesh.n_points());
+  EXPECT_THROW(cutter.restore(memory), std::invalid_argument);
+  memory.placed.clear();
+  memory.cut_configuration.assign(5, 0.0);
+  EXPECT_THROW(cutter.restore(memory), std::invalid_argument);
+}
+
 }  // namespace
 }  // namespace snede::testing
