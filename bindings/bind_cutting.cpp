@@ -59,7 +59,66 @@ void bind_cutting(py::module_& m) {
            py::arg("scalpel"), py::call_guard<py::gil_scoped_release>())
       .def("lift", &TetrahedralCutter::lift)
       .def_property_readonly("placed", &TetrahedralCutter::placed)
-      .def("incision_faces", [](const TetrahedralCutter& c) { return to_array(c.incision_faces(), 3); });
+      .def("incision_faces", [](const TetrahedralCutter& c) { return to_array(c.incision_faces(), 3); })
+      // The cutter's memory (tetrahedral_cutter.hpp) as a dict of arrays, faces and tetrahedra as
+      // positively ordered vertex rows; restore() takes the same dict in another numbering.
+      .def("memory", [](const TetrahedralCutter& c) {
+             const CutterMemory memory = c.memory();
+             const auto rows = [](const std::vector<Simplex>& simplexes, int corners) {
+               std::vector<std::int64_t> flat;
+               for (const Simplex& sigma : simplexes) {
+                 const auto v = sigma.oriented_vertices();
+                 flat.insert(flat.end(), v.begin(), v.begin() + corners);
+               }
+               return to_array(flat, corners);
+             };
+             std::vector<double> sweeps;
+             for (const auto& corners : memory.sweeps) sweeps.insert(sweeps.end(), corners.begin(), corners.end());
+             py::dict out;
+             out["scalpel"] = memory.scalpel ? py::object(to_array(std::vector<double>(memory.scalpel->begin(), memory.scalpel->end()), 3))
+                                             : py::object(py::none());
+             out["cut_configuration"] = to_array(memory.cut_configuration, 3);
+             out["placed"] = to_array(std::vector<std::int64_t>(memory.placed.begin(), memory.placed.end()), 1);
+             out["joined"] = rows(memory.joined, 3);
+             out["incision"] = rows(memory.incision, 3);
+             out["sweeps"] = to_array(sweeps, 9);
+             out["previous_touched"] = rows(memory.previous_touched, 4);
+             return out;
+           })
+      .def("restore", [](TetrahedralCutter& c, const py::dict& given) {
+             CutterMemory memory;
+             const auto simplexes = [&](const char* key) {
+               const auto rows = given[key].cast<IndexArray>();
+               std::vector<Simplex> out;
+               const auto corners = rows.ndim() == 2 ? rows.shape(1) : 0;
+               for (py::ssize_t i = 0; corners > 0 && i < rows.shape(0); ++i) {
+                 std::vector<VertexId> v;
+                 for (py::ssize_t k = 0; k < corners; ++k) v.push_back(static_cast<VertexId>(rows.at(i, k)));
+                 out.emplace_back(1, v);
+               }
+               return out;
+             };
+             if (!given["scalpel"].is_none()) {
+               const auto scalpel = given["scalpel"].cast<DoubleArray>();
+               if (scalpel.size() != 6) throw std::invalid_argument("restore: the scalpel is 6 numbers");
+               memory.scalpel.emplace();
+               std::copy_n(scalpel.data(), 6, memory.scalpel->begin());
+             }
+             const auto configuration = given["cut_configuration"].cast<DoubleArray>();
+             memory.cut_configuration.assign(configuration.data(), configuration.data() + configuration.size());
+             const auto placed = given["placed"].cast<IndexArray>();
+             for (py::ssize_t i = 0; i < placed.size(); ++i) memory.placed.push_back(static_cast<VertexId>(placed.data()[i]));
+             memory.joined = simplexes("joined");
+             memory.incision = simplexes("incision");
+             memory.previous_touched = simplexes("previous_touched");
+             const auto sweeps = given["sweeps"].cast<DoubleArray>();
+             for (py::ssize_t i = 0; i + 9 <= sweeps.size(); i += 9) {
+               std::array<double, 9> corners{};
+               std::copy_n(sweeps.data() + i, 9, corners.begin());
+               memory.sweeps.push_back(corners);
+             }
+             c.restore(memory);
+           }, py::arg("memory"));
 }
 
 }  // namespace snede::bindings

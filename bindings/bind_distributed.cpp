@@ -47,16 +47,16 @@ void bind_distributed(py::module_& m) {
   // coordinates of this rank's range of vertices ((n, space_dim)).
   m.def(
       "distribute_cells",
-      [](std::int64_t comm, int cell_dim, const IndexArray& cells, const DoubleArray& coordinates) {
+      [](std::int64_t comm, int cell_dim, const IndexArray& cells, const DoubleArray& coordinates, bool keep_as_given) {
         RankCells part;
         part.cell_dim = cell_dim;
         part.space_dim = coordinates.ndim() == 2 ? static_cast<int>(coordinates.shape(1)) : 0;
         part.cells.assign(cells.data(), cells.data() + cells.size());
         part.coordinates.assign(coordinates.data(), coordinates.data() + coordinates.size());
         py::gil_scoped_release released;
-        return distribute_cells(MPI_Comm_f2c(static_cast<MPI_Fint>(comm)), std::move(part));
+        return distribute_cells(MPI_Comm_f2c(static_cast<MPI_Fint>(comm)), std::move(part), keep_as_given);
       },
-      py::arg("comm"), py::arg("cell_dim"), py::arg("cells"), py::arg("coordinates"));
+      py::arg("comm"), py::arg("cell_dim"), py::arg("cells"), py::arg("coordinates"), py::arg("keep_as_given") = false);
   // Conforming bisection on ranks (collective). Each edit returns (field as (n, width), (n_new, 3)
   // new vertices this rank numbered with their parents, cells split over all ranks, the
   // rebalanced part or None, and its labels as (rule, (n_cells, cell_dim + 2))).
@@ -178,6 +178,13 @@ void bind_distributed(py::module_& m) {
       .def("require_held", &DistributedStatic::require_held,
            "Collective: ValueError on every rank when some piece of the body (on any ranks) is not held "
            "(the serial Body's check, problem/rank_piece_holding.hpp).")
+      // (each local cell's piece over all ranks, in cell_ids order; how many pieces; the loose ones).
+      .def("pieces", [](const DistributedStatic& s) {
+             const RankPieces pieces = s.pieces();
+             std::vector<std::int64_t> labels(pieces.cell_piece.begin(), pieces.cell_piece.end()), loose;
+             for (const LoosePiece& piece : pieces.loose) loose.push_back(piece.piece);
+             return py::make_tuple(to_array(labels, 1), pieces.n_pieces, to_array(loose, 1));
+           })
       .def("energy", [](DistributedStatic& s) { return s.energy(); })
       .def("local_displacement", [](DistributedStatic& s) { return to_array(s.local_displacement(), 1); });
 }

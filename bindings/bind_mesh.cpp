@@ -112,6 +112,13 @@ void bind_mesh(py::module_& m) {
       .def("connected_components", &components_of)
       .def("add_vertex", [](Mesh& mesh, const IndexArray& v, const DoubleArray& w) { return mesh.add_vertex(parents_of(v, w)); },
            py::arg("parents"), py::arg("weights"))
+      // The live vertices added by an edit (those with recorded parents), ascending.
+      .def("rows_with_parents", [](const Mesh& mesh) {
+             std::vector<std::int64_t> rows;
+             for (VertexId v = 0; v < mesh.n_points(); ++v)
+               if (mesh.is_vertex(v) && mesh.parents(v).count() > 0) rows.push_back(v);
+             return to_array(rows, 1);
+           })
       .def("move_vertex", [](Mesh& mesh, VertexId v, const IndexArray& p, const DoubleArray& w) {
              mesh.move_vertex(v, parents_of(p, w));
            }, py::arg("vertex"), py::arg("parents"), py::arg("weights"))

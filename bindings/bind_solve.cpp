@@ -93,6 +93,19 @@ void bind_solve(py::module_& m) {
              }
              return py::make_tuple(to_array(fixed, 1), to_array(anchors, s.dim()), to_array(sliding, 1));
            })
+      // (sliding vertices, their lines' directions (n, dim), their anchors (n, dim)).
+      .def("sliding_table", [](const Model& s) {
+             const Constraints& c = s.constraints();
+             std::vector<std::int64_t> sliding;
+             std::vector<double> directions, anchors;
+             for (VertexId v = 0; v < c.n_points(); ++v) {
+               if (c[v].kind != ConstraintKind::slide) continue;
+               sliding.push_back(v);
+               directions.insert(directions.end(), c[v].direction.begin(), c[v].direction.begin() + s.dim());
+               anchors.insert(anchors.end(), c[v].anchor.begin(), c[v].anchor.begin() + s.dim());
+             }
+             return py::make_tuple(to_array(sliding, 1), to_array(directions, s.dim()), to_array(anchors, s.dim()));
+           })
       // The corners of one cell of each piece the constraints do not hold, (n_pieces, cell_dim + 1).
       .def("loose_piece_cells", [](Model& s) {
              const Mesh& mesh = s.body().mesh();

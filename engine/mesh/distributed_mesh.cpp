@@ -222,7 +222,7 @@ DistributedMesh distribute_mesh(MPI_Comm comm, const Mesh* serial) {
   return take_part(comm, std::move(dm), std::move(serial_id), cell_dim, space_dim, shape[2], shape[3]);
 }
 
-DistributedMesh distribute_cells(MPI_Comm comm, RankCells given) {
+DistributedMesh distribute_cells(MPI_Comm comm, RankCells given, bool keep_as_given) {
   keep_petsc_communicator(comm);
   const std::string problem = agreed_rank_cells(comm, given);
   if (!problem.empty()) throw std::invalid_argument(problem);
@@ -239,7 +239,7 @@ DistributedMesh distribute_cells(MPI_Comm comm, RankCells given) {
   MPI_Allreduce(MPI_IN_PLACE, &largest, 1, MPI_INT64_T, MPI_MAX, comm);
   int ranks = 1;
   MPI_Comm_size(comm, &ranks);
-  if (static_cast<double>(largest) * ranks <= 1.2 * static_cast<double>(totals[1]))
+  if (keep_as_given || static_cast<double>(largest) * ranks <= 1.2 * static_cast<double>(totals[1]))
     return part_as_given(comm, std::move(given), totals[0], totals[1]);
 
   std::vector<PetscInt> cells(given.cells.begin(), given.cells.end());

@@ -51,6 +51,8 @@ struct RankCells {
 // DMPlexDistribute (a rank's cells need not stay on it). global_vertex holds the global ids. Throws the same
 // std::invalid_argument on every rank when a rank's part is malformed (sizes, dimensions that
 // differ between ranks, an id outside 0..n_vertices−1) or a vertex is in no cell.
-DistributedMesh distribute_cells(MPI_Comm comm, RankCells part);
+// keep_as_given: every rank keeps the cells it gives, balanced or not (a cut gathering the
+// cells near the scalpel on one rank).
+DistributedMesh distribute_cells(MPI_Comm comm, RankCells part, bool keep_as_given = false);
 
 }  // namespace snede

@@ -418,6 +418,8 @@ class AssembledDistributedTangent final : public AssembledProblemTangent {
 
 void DistributedStatic::require_held() const { require_held_on_ranks(part_, constraints_); }
 
+RankPieces DistributedStatic::pieces() const { return pieces_on_ranks(part_, constraints_); }
+
 std::unique_ptr<AssembledProblemTangent> DistributedStatic::make_assembled_tangent(MatrixFormat) {
   return std::make_unique<AssembledDistributedTangent>(*this);
 }

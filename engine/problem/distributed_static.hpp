@@ -30,6 +30,7 @@
 #include "problem/constraints.hpp"
 #include "problem/distributed_assembly.hpp"
 #include "problem/problem.hpp"
+#include "problem/rank_piece_holding.hpp"
 
 namespace snede {
 
@@ -81,6 +82,8 @@ class DistributedStatic final : public Problem {
   // Collective: throws the same std::invalid_argument on every rank when a piece of the body,
   // wherever its cells lie, is not held by the constraints (rank_piece_holding.hpp).
   void require_held() const;
+  // Collective: the body's pieces and those the constraints leave loose (rank_piece_holding.hpp).
+  RankPieces pieces() const;
 
   // What the solvers (SNES callbacks, DynamicRelaxation) use. All collective.
   // F = P(−f_int(u) − f_ext) + c (I − P)(u − ū). Not admissible when an element on some rank is

@@ -98,7 +98,7 @@ std::pair<std::vector<int>, int> global_pieces(const DistributedMesh& part, cons
 
 }  // namespace
 
-void require_held_on_ranks(const DistributedMesh& part, const Constraints& constraints) {
+RankPieces pieces_on_ranks(const DistributedMesh& part, const Constraints& constraints) {
   const MPI_Comm comm = part.comm;
   const Mesh& mesh = *part.local;
   const Connectivity& c = mesh.connectivity();
@@ -157,7 +157,8 @@ void require_held_on_ranks(const DistributedMesh& part, const Constraints& const
   for (int piece = 0; piece < n_pieces; ++piece) spans[piece] = grams[piece].span;
   MPI_Allreduce(MPI_IN_PLACE, spans.data(), n_pieces, MPI_DOUBLE, MPI_MAX, comm);
   MPI_Allreduce(MPI_IN_PLACE, owned_components.data(), n_pieces, MPI_INT64_T, MPI_SUM, comm);
-  std::vector<LoosePiece> loose;
+  RankPieces pieces{.cell_piece = {}, .n_pieces = n_pieces, .loose = {}, .lowest_vertex = some_vertex};
+  for (ElementId e : c.element_ids()) pieces.cell_piece.push_back(global_of_local[element_piece[e]]);
   for (int piece = 0; piece < n_pieces; ++piece) {
     RigidMotionGram whole(dim);
     std::copy_n(sums.data() + piece * entries, entries, whole.gram.data());
@@ -165,10 +166,16 @@ void require_held_on_ranks(const DistributedMesh& part, const Constraints& const
     whole.components = static_cast<std::size_t>(owned_components[piece]);
     const std::size_t stopped = whole.rank();
     if ((mesh.is_surface() ? whole.components : stopped) < static_cast<std::size_t>(n_motions))
-      loose.push_back({piece, n_pieces, static_cast<std::size_t>(cells[piece]), no_id, whole.components, stopped,
-                       static_cast<std::size_t>(n_motions)});
+      pieces.loose.push_back({piece, n_pieces, static_cast<std::size_t>(cells[piece]), no_id, whole.components, stopped,
+                              static_cast<std::size_t>(n_motions)});
   }
-  if (!loose.empty()) throw std::invalid_argument(not_held_message(loose, some_vertex[loose.front().piece]));
+  return pieces;
+}
+
+void require_held_on_ranks(const DistributedMesh& part, const Constraints& constraints) {
+  const RankPieces pieces = pieces_on_ranks(part, constraints);
+  if (!pieces.loose.empty())
+    throw std::invalid_argument(not_held_message(pieces.loose, pieces.lowest_vertex[pieces.loose.front().piece]));
 }
 
 }  // namespace snede

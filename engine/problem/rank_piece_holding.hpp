@@ -6,14 +6,29 @@
 // summed over the ranks about one origin. Only the pieces' labels and 6 × 6 matrices travel.
 #pragma once
 
+#include <cstdint>
+#include <vector>
+
 #include "mesh/distributed_mesh.hpp"
+#include "problem/piece_holding.hpp"
 #include "problem/constraints.hpp"
 
 namespace snede {
 
+// The whole body's pieces as this rank sees them, and those the constraints do not hold.
+struct RankPieces {
+  std::vector<int> cell_piece;     // per live cell of the part, in mesh.cell_ids() order
+  int n_pieces = 0;                // over all ranks, numbered 0..n_pieces−1 alike on every rank
+  std::vector<LoosePiece> loose;   // the same on every rank (first_cell: no_id)
+  std::vector<std::int64_t> lowest_vertex;  // per piece: its lowest serial vertex id
+};
+
+// Collective: the pieces, and which of them some rigid motion leaves free (a membrane: fewer
+// than 6 constrained components). `constraints` are the part's local vertices' (owned and ghosts).
+RankPieces pieces_on_ranks(const DistributedMesh& part, const Constraints& constraints);
+
 // Collective: throws the same std::invalid_argument on every rank (the serial message) when
-// some piece's constraints leave it a rigid motion (a membrane: fewer than 6 constrained
-// components). `constraints` are the part's local vertices' (owned and ghosts).
+// some piece is loose.
 void require_held_on_ranks(const DistributedMesh& part, const Constraints& constraints);
 
 }  // namespace snede

@@ -15,6 +15,8 @@ from snede import _checks, _records, _renamed, _snede
 from snede._engine import engine_property
 from snede._snede import CutResult, TetrahedralCutterOptions
 from snede.mesh import Mesh
+from snede.part_body import PartBody
+from snede.part_cutting import PartCutter
 
 
 def body_and_mesh(body_or_mesh, cutter: str):
@@ -78,17 +80,21 @@ class TetrahedralCutter:
                  remove_degeneracies: bool | None = None, min_aspect_ratio: float | None = None,
                  large_angle: float | None = None, fix_free_pieces: bool | None = None,
                  max_fragment_elements: int | None = None):
-        self.body, self.mesh, model = body_and_mesh(body_or_mesh, type(self).__name__)
-        if self.mesh.cell_dim != 3:
-            raise ValueError(f"TetrahedralCutter needs a tetrahedral mesh; this mesh has {self.mesh.cell_dim}-D cells")
         if max_fragment_elements is not None:
             max_fragment_elements = _checks.count(max_fragment_elements, "max_fragment_elements", 0)
         settings = _records.settings(TetrahedralCutterOptions, options, snap=snap,
                                      remove_degeneracies=remove_degeneracies, min_aspect_ratio=min_aspect_ratio,
                                      large_angle=large_angle, fix_free_pieces=fix_free_pieces,
                                      max_fragment_elements=max_fragment_elements)
-        self._impl = _snede.TetrahedralCutter(self.mesh._impl, model, settings)
         self._settings = settings
+        if isinstance(body_or_mesh, PartBody):  # a body on MPI ranks: the cut runs on one of them
+            self.body, self.mesh = body_or_mesh, None
+            self._impl = PartCutter(body_or_mesh, settings)
+            return
+        self.body, self.mesh, model = body_and_mesh(body_or_mesh, type(self).__name__)
+        if self.mesh.cell_dim != 3:
+            raise ValueError(f"TetrahedralCutter needs a tetrahedral mesh; this mesh has {self.mesh.cell_dim}-D cells")
+        self._impl = _snede.TetrahedralCutter(self.mesh._impl, model, settings)
 
     @property
     def options(self) -> TetrahedralCutterOptions:
@@ -96,9 +102,13 @@ class TetrahedralCutter:
         return TetrahedralCutterOptions(**_records.fields(self._settings))
 
     def cut_triangle(self, corners) -> CutResult:
+        if isinstance(self._impl, PartCutter):
+            raise NotImplementedError("cut_triangle on a body on MPI ranks: move the scalpel with move() or cut()")
         return self._impl.cut_triangle(_checks.coordinates(corners, (3, 3), "corners"))
 
     def move(self, scalpel) -> CutResult:
+        if isinstance(self._impl, PartCutter):
+            return self._impl.move(scalpel)  # checked on every rank together
         return self._impl.move(_checks.coordinates(scalpel, (2, 3), "scalpel"))
 
     def cut(self, path, progress=None) -> CutResult:

@@ -52,6 +52,8 @@ class PartBody:
         self._edits, self._edits_seen = 0, 0  # conditions or displacement set, and as of the latest solve
         self._refiner = None  # the part's refinement (rank_refinement.hpp), kept from edit to edit
         self._labels = None  # the cells' bisection labels after a refinement rebalanced the part
+        self._cut_configuration = None  # the displacement an open incision began in (part_cutting.py)
+        self._cut_ids = None  # on the cutting rank after a cut: each row's global id
 
     @property
     def dim(self) -> int:
@@ -358,6 +360,43 @@ class PartBody:
             if not every:
                 return
             self._fixed.update(every)
+
+    # -- a part made anew (part_cutting.py) ------------------------------------------------------
+    def _take_part(self, part: DistributedMesh, displacement: np.ndarray, new_ids) -> None:
+        """This body on ``part`` (collective): the displacement given on its vertices, the
+        conditions' global ids mapped by ``new_ids`` (ids no longer used dropped)."""
+        self.part, self.mesh = part, part.local
+        self._displacement = np.ascontiguousarray(displacement, dtype=np.float64).reshape(self.mesh.n_points, self.dim)
+        self._local_order = np.argsort(part.global_vertex, kind="stable")
+        self._problem, self._problem_conditions = None, None
+        self._refiner, self._labels = None, None  # a cut part is labelled afresh by its next refinement
+        tables = [self._fixed, self._sliding] + list(self._channels.values())
+        keys = np.fromiter((v for table in tables for v in table), dtype=np.int64)
+        mapped = iter(new_ids(keys).tolist())
+        for table in tables:
+            entries = [(new, value) for new, value in zip(mapped, list(table.values()))]
+            table.clear()
+            table.update((new, value) for new, value in entries if new >= 0)
+        self._edits += 1
+
+    def _apply_conditions(self, replaced, fixed, sliding, channels) -> None:
+        """The conditions of the vertices ``replaced`` (global ids) replaced by those given:
+        ``fixed`` (ids, values), ``sliding`` (ids, directions, anchors), ``channels`` (name → ids,
+        forces). The same on every rank."""
+        for v in np.asarray(replaced).tolist():
+            self._fixed.pop(v, None)
+            self._sliding.pop(v, None)
+            for forces in self._channels.values():
+                forces.pop(v, None)
+        for v, value in zip(*(np.asarray(a) for a in fixed)):
+            self._fixed[int(v)] = tuple(value)
+        for v, direction, anchor in zip(*(np.asarray(a) for a in sliding)):
+            self._sliding[int(v)] = (tuple(direction), tuple(anchor))
+        for name, (ids, forces) in channels.items():
+            table = self._channels.setdefault(name, {})
+            for v, force in zip(np.asarray(ids).tolist(), np.asarray(forces)):
+                table[v] = force
+        self._edits += 1
 
     # -- what a solver takes (StaticSolver) --------------------------------------------------
     def problem(self) -> DistributedStatic:
