@@ -129,6 +129,15 @@ std::vector<VertexId> TetrahedralCutter::snap(const FaceSelection& selection, Cu
     for (VertexId v : mesh_.connectivity().face(f).simplex.vertices()) vertices.push_back(v);
   std::sort(vertices.begin(), vertices.end());
   vertices.erase(std::unique(vertices.begin(), vertices.end()), vertices.end());
+  // Each snap moves its vertex before the next is tried, so the order decides which of two
+  // neighbours is refused: an order by where the vertices are (their reference coordinates, then
+  // their ids for vertices at one place, a cut's copies), not by how the mesh numbers them, so that
+  // a renumbered copy of the mesh (a distributed body's cutting rank, issue 52) snaps alike.
+  std::sort(vertices.begin(), vertices.end(), [&](VertexId a, VertexId b) {
+    const auto x = mesh_.point(a), y = mesh_.point(b);
+    return std::lexicographical_compare(x.begin(), x.end(), y.begin(), y.end()) ||
+           (std::equal(x.begin(), x.end(), y.begin()) && a < b);
+  });
   for (VertexId v : vertices) {
     if (placed_.count(v)) continue;
     if (constrained(v)) {  // a support stays where the user put it

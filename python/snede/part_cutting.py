@@ -125,7 +125,13 @@ class PartCutter:
             every = np.unique(np.concatenate(comm.allgather(marked)))
             near |= np.isin(part.global_vertex[cells], every).any(axis=1)
         moving = int(np.count_nonzero(near)) if comm.rank != self.cutting_rank else 0
-        if comm.allreduce(moving) == 0:
+        # The cutting rank's part made anew unless its vertices are in global id order, as
+        # part_as_given makes them (a part DMPlex rebalanced is not: the serial cutter snaps in
+        # vertex id order, and so must this), and none has recorded parents (a refinement in place
+        # adds such vertices; the cut's new vertices are found by theirs).
+        stale = comm.rank == self.cutting_rank and bool(np.any(np.diff(part.global_vertex) <= 0))
+        stale = stale or body._refiner is not None
+        if comm.allreduce(moving) == 0 and not comm.allreduce(int(stale)):
             return
         destination = np.where(near, self.cutting_rank, comm.rank)
         self._move(destination, keep_as_given=True, ids=part.global_vertex.astype(np.int64))
@@ -266,6 +272,7 @@ class PartCutter:
         channel's (ids, forces)."""
         fixed, anchors, _ = serial._model.constraint_table()
         sliding, directions, slide_anchors = serial._model.sliding_table()
+        fixed, sliding = fixed.ravel(), sliding.ravel()
         channels = {}
         for name in serial._model.load_channels:
             forces = serial._model.channel_forces(name)
@@ -304,12 +311,13 @@ class PartCutter:
             labels, n_pieces, _ = body.problem()._impl.pieces()
             piece_cells = comm.allreduce(np.bincount(labels.ravel(), minlength=n_pieces))
         report.components = int(n_pieces)
+        report.free_pieces, report.pieces_fixed = 0, 0  # the cutting rank's part alone counted them
         report.piece_elements = sorted(piece_cells.tolist(), reverse=True) if n_pieces > 1 else []
         _, _, loose = body.problem()._impl.pieces()
-        report.free_pieces += len(loose)
+        report.free_pieces = len(loose)
         if len(loose) and self.settings.fix_free_pieces:
             self._hold(labels.ravel(), loose.ravel())
-            report.pieces_fixed += len(loose)
+            report.pieces_fixed = len(loose)
         return report
 
     def _hold(self, labels: np.ndarray, loose: np.ndarray) -> None:

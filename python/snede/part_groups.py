@@ -49,12 +49,17 @@ def group_shapes(mesh, comm) -> tuple[dict, dict]:
     (name → (n, corners, dim)), gathered on every rank (collective)."""
     cells = {name: mesh.points[mesh.cells[rows]] for name, rows in mesh.cell_groups.items()}
     faces = {name: mesh.points[members] for name, members in mesh.boundary_groups.items() if name != INCISION}
-    every = comm.allgather((cells, faces))
+    return gathered(comm, (cells, faces))
+
+
+def gathered(comm, groups: tuple[dict, dict]) -> tuple[dict, dict]:
+    """Each rank's (cell groups, boundary groups), name → member rows, joined over the ranks of
+    ``comm``: every name on every rank, with every rank's members (collective)."""
+    every = comm.allgather(groups)
 
     def joined(kind: int) -> dict:
-        names = sorted({name for groups in every for name in groups[kind]})
-        return {name: np.concatenate([groups[kind][name] for groups in every if name in groups[kind]])
-                for name in names}
+        names = sorted({name for rank_groups in every for name in rank_groups[kind]})
+        return {name: np.concatenate([g[kind][name] for g in every if name in g[kind]]) for name in names}
 
     return joined(0), joined(1)
 

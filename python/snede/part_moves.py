@@ -138,10 +138,4 @@ def _group_members(mesh, cells_by_new_id: np.ndarray, kept: np.ndarray, dense: D
 def _give_group_members(part: DistributedMesh, comm, groups: tuple[dict, dict]) -> None:
     from snede import part_groups
 
-    every = comm.allgather(groups)
-
-    def joined(kind: int) -> dict:
-        names = sorted({name for g in every for name in g[kind]})
-        return {name: np.concatenate([g[kind][name] for g in every if name in g[kind]]) for name in names}
-
-    part_groups.give_groups(part, joined(0), joined(1))
+    part_groups.give_groups(part, *part_groups.gathered(comm, groups))
