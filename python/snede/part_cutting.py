@@ -111,12 +111,11 @@ class PartCutter:
 
     # -- the cells near the sweep, to the cutting rank -------------------------------------
     def _gather_near(self, corners: np.ndarray) -> None:
+        """``corners``: the scalpel's ends before and after the move, (4, 3)."""
         body, comm = self.body, self.comm
         part, mesh = body.part, body.mesh
         cells = mesh.cells
-        x = mesh.points + body._cut_configuration
-        lo, hi = corners.min(axis=0), corners.max(axis=0)
-        near = np.all((x[cells].min(axis=1) <= hi) & (x[cells].max(axis=1) >= lo), axis=1)
+        near = _meeting_the_sweep((mesh.points + body._cut_configuration)[cells], corners)
         remembered = comm.bcast(self._remembered_vertices() if comm.rank == self.cutting_rank else None,
                                 root=self.cutting_rank)
         near |= np.isin(part.global_vertex[cells], remembered).any(axis=1)
@@ -345,3 +344,27 @@ def _row_keys(rows: np.ndarray) -> np.ndarray:
     from snede.part_groups import _keys
 
     return _keys(np.sort(np.asarray(rows, dtype=np.int64), axis=1))
+
+
+def _meeting_the_sweep(tetrahedra: np.ndarray, scalpels: np.ndarray) -> np.ndarray:
+    """Which of ``tetrahedra`` ((n, 4, 3) corners) may meet the sweep of the scalpel from
+    ``scalpels[:2]`` to ``scalpels[2:]``: the two sweep triangles TetrahedralCutter.move makes. A
+    tetrahedron meets a triangle only if their boxes overlap and its corners are not all strictly
+    on one side of the triangle's plane (rounding: a margin of 1e-9 of the sizes involved), so the
+    cells kept are a thin layer along the sweep, not its whole box."""
+    p0, p1, q0, q1 = scalpels
+    lo, hi = tetrahedra.min(axis=1), tetrahedra.max(axis=1)
+    kept = np.zeros(len(tetrahedra), dtype=bool)
+    for triangle in ((p0, p1, q1), (p0, q1, q0)):
+        a, b, c = (np.asarray(v, dtype=np.float64) for v in triangle)
+        normal = np.cross(b - a, c - a)
+        length = np.linalg.norm(normal)
+        if length == 0:
+            continue  # a half that sweeps no area
+        normal /= length
+        side = (tetrahedra - a) @ normal
+        margin = 1e-9 * (np.abs(tetrahedra).max() + np.abs(a).max() + np.linalg.norm(b - a) + np.linalg.norm(c - a))
+        straddles = (side.min(axis=1) <= margin) & (side.max(axis=1) >= -margin)
+        box = np.all((lo <= np.maximum.reduce([a, b, c])) & (hi >= np.minimum.reduce([a, b, c])), axis=1)
+        kept |= straddles & box
+    return kept

@@ -5,7 +5,8 @@ cell group that the rank was given, and the faces of a boundary group that are b
 the rank's cells. So ``body.fix("held")`` and ``body.add_traction("pressed", ...)`` name the same
 groups on a part as on the serial mesh. Members are matched by their corners' serial vertex ids;
 a boundary face of the serial mesh belongs to one cell, hence to one rank, so a traction on it is
-counted once. The faces cuts opened (``"incision"``) are not carried: a part cannot be cut.
+counted once. The faces cuts opened (``"incision"``) are not carried: a part's cut faces are its
+scalpel's ``incision_faces()`` (part_cutting.py).
 
 A part refined on the ranks (``PartBody.refine_uniform`` ...) finds its groups by where things
 lie, as a serial mesh's groups follow bisection (mesh_groups.py): a cell is in the groups of the
