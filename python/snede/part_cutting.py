@@ -37,9 +37,10 @@ RINGS = 3
 
 
 class PartCutter:
-    """The scalpel of ``snede.TetrahedralCutter(part_body, ...)``: the same calls as the serial
-    cutter (``move``, ``cut``, ``cut_triangle`` is serial only, ``lift``, ``placed``,
-    ``incision_faces``), collective on the body's ranks, every rank giving the same scalpel."""
+    """The scalpel of ``snede.TetrahedralCutter(part_body, ...)``: the serial cutter's ``move``,
+    ``lift``, ``placed`` and ``incision_faces`` (``TetrahedralCutter.cut`` moves it along a path;
+    ``cut_triangle`` is serial only), collective on the body's ranks, every rank giving the same
+    scalpel."""
 
     def __init__(self, body, settings: TetrahedralCutterOptions):
         from snede import _records
@@ -125,9 +126,10 @@ class PartCutter:
             near |= np.isin(part.global_vertex[cells], every).any(axis=1)
         moving = int(np.count_nonzero(near)) if comm.rank != self.cutting_rank else 0
         # The cutting rank's part made anew unless its vertices are in global id order, as
-        # part_as_given makes them (a part DMPlex rebalanced is not: the serial cutter snaps in
-        # vertex id order, and so must this), and none has recorded parents (a refinement in place
-        # adds such vertices; the cut's new vertices are found by theirs).
+        # part_as_given makes them (a part DMPlex rebalanced is not; the serial cutter breaks
+        # exact ties by vertex id: an edge crossed at its middle marks its lower id), and none has
+        # recorded parents (a refinement in place adds such vertices; the cut's new vertices are
+        # found by theirs).
         stale = comm.rank == self.cutting_rank and bool(np.any(np.diff(part.global_vertex) <= 0))
         stale = stale or body._refiner is not None
         if comm.allreduce(moving) == 0 and not comm.allreduce(int(stale)):
