@@ -86,7 +86,7 @@ def moved_part(part: DistributedMesh, ids: np.ndarray, destination: np.ndarray, 
     comm, mesh = part.comm, part.local
     kept = destination >= 0
     cells = ids[mesh.cells]
-    n_ids = comm.allreduce(int(ids.max()) + 1 if len(ids) else 0)
+    n_ids = max(comm.allgather(int(ids.max()) + 1 if len(ids) else 0))
     dense = DenseIds(comm, cells[kept].ravel(), n_ids)
     cells = dense.new(cells.ravel()).reshape(cells.shape)
     # The values of each vertex once, from one holder (the lowest rank holding it), to the rank
