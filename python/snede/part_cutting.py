@@ -294,7 +294,7 @@ class PartCutter:
     def _with_pieces(self, report: CutResult) -> CutResult:
         """The pieces after the move: tiny fragments removed, loose pieces held (§3.3)."""
         body, comm = self.body, self.comm
-        labels, n_pieces, _ = body.problem()._impl.pieces()
+        labels, n_pieces, loose = body.problem()._impl.pieces()
         volume = _cell_volumes(body.mesh)
         piece_volume = np.zeros(n_pieces)
         np.add.at(piece_volume, labels.ravel(), volume)
@@ -309,13 +309,12 @@ class PartCutter:
             dropped = np.isin(labels.ravel(), fragments)
             self._move(np.where(dropped, -1, comm.rank), keep_as_given=True,
                        ids=body.part.global_vertex.astype(np.int64))
-            labels, n_pieces, _ = body.problem()._impl.pieces()
+            labels, n_pieces, loose = body.problem()._impl.pieces()
             piece_cells = comm.allreduce(np.bincount(labels.ravel(), minlength=n_pieces))
         report.components = int(n_pieces)
-        report.free_pieces, report.pieces_fixed = 0, 0  # the cutting rank's part alone counted them
         report.piece_elements = sorted(piece_cells.tolist(), reverse=True) if n_pieces > 1 else []
-        _, _, loose = body.problem()._impl.pieces()
-        report.free_pieces = len(loose)
+        # The cutting rank's serial cutter counted its part's pieces alone: the counts are these.
+        report.free_pieces, report.pieces_fixed = len(loose), 0
         if len(loose) and self.settings.fix_free_pieces:
             self._hold(labels.ravel(), loose.ravel())
             report.pieces_fixed = len(loose)
